@@ -1,0 +1,7 @@
+//! GPU side: device, GPU struct layouts, readback, timestamp queries.
+
+mod context;
+pub mod readback;
+pub mod structs;
+
+pub use context::{GpuContext, GpuError};

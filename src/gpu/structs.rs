@@ -1,0 +1,1 @@
+//! GPU struct layouts shared with WGSL (`shaders/common/types.wgsl`).

@@ -1,0 +1,1 @@
+//! Layered BRDF materials (RON model, WGSL generation, f64 reference).

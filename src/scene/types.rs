@@ -1,0 +1,208 @@
+use glam::{Mat4, Vec2, Vec3, Vec4};
+use serde::{Deserialize, Serialize};
+
+/// A triangle mesh already transformed to world space.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    pub name: String,
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    pub uvs: Vec<Vec2>,
+    /// xyz tangent, w handedness (glTF convention).
+    pub tangents: Vec<Vec4>,
+    /// Triangle list; always present (non-indexed input gets 0..n).
+    pub indices: Vec<u32>,
+    /// Index into [`Scene::materials`].
+    pub material: usize,
+}
+
+/// How a surface lets light through (glTF `alphaMode`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub enum AlphaMode {
+    #[default]
+    Opaque,
+    Mask(f32),
+    Blend,
+}
+
+/// A glTF metallic-roughness material as imported; the material module maps it onto
+/// its layered model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SurfaceMaterial {
+    pub name: String,
+    pub base_color: Vec4,
+    pub metallic: f32,
+    pub roughness: f32,
+    pub emissive: Vec3,
+    pub alpha_mode: AlphaMode,
+    pub double_sided: bool,
+    /// Bit identifying the material type for light material masks (Leo demo).
+    pub type_bit: u32,
+}
+
+impl Default for SurfaceMaterial {
+    fn default() -> Self {
+        Self {
+            name: "default".into(),
+            base_color: Vec4::ONE,
+            metallic: 0.0,
+            roughness: 1.0,
+            emissive: Vec3::ZERO,
+            alpha_mode: AlphaMode::Opaque,
+            double_sided: false,
+            type_bit: 1,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum LightShape {
+    Point,
+    /// Cone angles in radians from the axis; `inner <= outer <= pi/2`.
+    Spot {
+        direction: Vec3,
+        inner_angle: f32,
+        outer_angle: f32,
+    },
+}
+
+/// Light flags (bit set).
+pub mod light_flags {
+    pub const CASTS_SHADOW: u32 = 1;
+    pub const INDIRECT: u32 = 2;
+}
+
+/// A punctual light with a finite range (KHR_lights_punctual semantics: intensity in
+/// candela, falloff window reaching exactly zero at `range`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Light {
+    pub position: Vec3,
+    pub range: f32,
+    pub color: Vec3,
+    pub intensity: f32,
+    pub shape: LightShape,
+    #[serde(default)]
+    pub flags: u32,
+    /// Which material type bits this light lights.
+    #[serde(default = "all_materials")]
+    pub material_mask: u32,
+}
+
+fn all_materials() -> u32 {
+    u32::MAX
+}
+
+impl Light {
+    pub fn point(position: Vec3, range: f32, color: Vec3, intensity: f32) -> Self {
+        Self {
+            position,
+            range,
+            color,
+            intensity,
+            shape: LightShape::Point,
+            flags: 0,
+            material_mask: u32::MAX,
+        }
+    }
+}
+
+/// A perspective camera.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Camera {
+    pub eye: Vec3,
+    pub target: Vec3,
+    #[serde(default = "default_up")]
+    pub up: Vec3,
+    /// Vertical field of view in radians.
+    pub fov_y: f32,
+    pub near: f32,
+    pub far: f32,
+}
+
+fn default_up() -> Vec3 {
+    Vec3::Y
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Self {
+            eye: Vec3::new(0.0, 1.0, 5.0),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            fov_y: 60f32.to_radians(),
+            near: 0.1,
+            far: 100.0,
+        }
+    }
+}
+
+impl Camera {
+    pub fn view(&self) -> Mat4 {
+        Mat4::look_at_rh(self.eye, self.target, self.up)
+    }
+    /// Right-handed projection to wgpu's depth range 0 (near) .. 1 (far).
+    pub fn projection(&self, aspect: f32) -> Mat4 {
+        Mat4::perspective_rh(self.fov_y, aspect, self.near, self.far)
+    }
+}
+
+/// What a scene contains, for the graph's `when:` conditions.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SceneFeatures {
+    pub has_transparent: bool,
+    pub has_alpha_mask: bool,
+    pub has_shadow_casters: bool,
+    pub has_indirect_lights: bool,
+    pub has_spot_lights: bool,
+    pub has_lights: bool,
+    pub msaa: bool,
+}
+
+/// Everything needed to render a frame.
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    pub name: String,
+    pub meshes: Vec<Mesh>,
+    pub materials: Vec<SurfaceMaterial>,
+    pub lights: Vec<Light>,
+    pub camera: Camera,
+    /// Preferred output size, if the scene names one.
+    pub output_size: Option<(u32, u32)>,
+    /// Constant ambient radiance added to every surface (0 for reference scenes).
+    pub ambient: Vec3,
+}
+
+impl Scene {
+    pub fn features(&self) -> SceneFeatures {
+        let uses = |f: &dyn Fn(&SurfaceMaterial) -> bool| {
+            self.meshes
+                .iter()
+                .any(|m| self.materials.get(m.material).is_some_and(f))
+        };
+        SceneFeatures {
+            has_transparent: uses(&|m| m.alpha_mode == AlphaMode::Blend),
+            has_alpha_mask: uses(&|m| matches!(m.alpha_mode, AlphaMode::Mask(_))),
+            has_shadow_casters: self
+                .lights
+                .iter()
+                .any(|l| l.flags & light_flags::CASTS_SHADOW != 0),
+            has_indirect_lights: self
+                .lights
+                .iter()
+                .any(|l| l.flags & light_flags::INDIRECT != 0),
+            has_spot_lights: self
+                .lights
+                .iter()
+                .any(|l| matches!(l.shape, LightShape::Spot { .. })),
+            has_lights: !self.lights.is_empty(),
+            msaa: false,
+        }
+    }
+
+    /// Axis-aligned bounds of all geometry, or `None` for an empty scene.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut it = self.meshes.iter().flat_map(|m| m.positions.iter().copied());
+        let first = it.next()?;
+        Some(it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+    }
+}
