@@ -25,6 +25,18 @@ pub enum AlphaMode {
     Blend,
 }
 
+/// Decoded texture pixels (RGBA8). `srgb` says whether the bytes are sRGB-encoded
+/// (base colour, emissive) or linear data (metallic-roughness, normal, occlusion).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TextureImage {
+    /// File name or glTF image name, for messages.
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    pub rgba8: Vec<u8>,
+    pub srgb: bool,
+}
+
 /// A glTF metallic-roughness material as imported; the material module maps it onto
 /// its layered model.
 #[derive(Clone, Debug, PartialEq)]
@@ -38,6 +50,14 @@ pub struct SurfaceMaterial {
     pub double_sided: bool,
     /// Bit identifying the material type for light material masks (Leo demo).
     pub type_bit: u32,
+    pub base_color_texture: Option<std::sync::Arc<TextureImage>>,
+    /// glTF layout: roughness in G, metallic in B.
+    pub metallic_roughness_texture: Option<std::sync::Arc<TextureImage>>,
+    pub normal_texture: Option<std::sync::Arc<TextureImage>>,
+    pub normal_scale: f32,
+    pub emissive_texture: Option<std::sync::Arc<TextureImage>>,
+    pub occlusion_texture: Option<std::sync::Arc<TextureImage>>,
+    pub occlusion_strength: f32,
 }
 
 impl Default for SurfaceMaterial {
@@ -51,6 +71,13 @@ impl Default for SurfaceMaterial {
             alpha_mode: AlphaMode::Opaque,
             double_sided: false,
             type_bit: 1,
+            base_color_texture: None,
+            metallic_roughness_texture: None,
+            normal_texture: None,
+            normal_scale: 1.0,
+            emissive_texture: None,
+            occlusion_texture: None,
+            occlusion_strength: 1.0,
         }
     }
 }
