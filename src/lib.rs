@@ -7,3 +7,4 @@ pub mod gpu;
 pub mod graph;
 pub mod material;
 pub mod scene;
+pub mod shader;

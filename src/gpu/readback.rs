@@ -37,7 +37,10 @@ fn map_and_copy(
     rx.recv()
         .map_err(|e| GpuError::Readback(e.to_string()))?
         .map_err(|e| GpuError::Readback(e.to_string()))?;
-    let data = slice.get_mapped_range()[..len].to_vec();
+    let data = slice
+        .get_mapped_range()
+        .map_err(|e| GpuError::Readback(e.to_string()))?[..len]
+        .to_vec();
     staging.unmap();
     Ok(data)
 }

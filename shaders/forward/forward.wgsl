@@ -1,0 +1,100 @@
+// Depth prepass and forward shading of one material. The material's generated code is
+// included as <material>; defines: LIGHT_LISTS (read culled lists), DEPTH_ONLY
+// (prepass), ALPHA_MASK (prepass discards below the cutoff).
+
+#include "common/types.wgsl"
+#include "common/lighting.wgsl"
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
+@group(0) @binding(2) var<storage, read> light_properties: array<LightProperties>;
+#if LIGHT_LISTS
+@group(0) @binding(3) var<storage, read> light_lists: array<u32>;
+@group(0) @binding(4) var<uniform> list_params: ListParams;
+#endif
+
+#include "common/light_lists.wgsl"
+
+struct ShadingPoint {
+    position: vec3<f32>,
+    normal: vec3<f32>,
+    tangent: vec4<f32>,
+    uv: vec2<f32>,
+    view: vec3<f32>,
+};
+
+#include <material>
+
+struct VertexIn {
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+    @location(3) tangent: vec4<f32>,
+};
+
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+    @location(3) tangent: vec4<f32>,
+};
+
+@vertex
+fn vs_main(v: VertexIn) -> VertexOut {
+    var out: VertexOut;
+    // The prepass and the shading pass run this same code, so depths match exactly.
+    out.clip = frame.view_proj * vec4<f32>(v.position, 1.0);
+    out.world = v.position;
+    out.normal = v.normal;
+    out.uv = v.uv;
+    out.tangent = v.tangent;
+    return out;
+}
+
+fn shading_point(in: VertexOut, front: bool) -> ShadingPoint {
+    var p: ShadingPoint;
+    p.position = in.world;
+    p.view = normalize(frame.camera_pos.xyz - in.world);
+    var n = normalize(in.normal);
+    if (!front) {
+        n = -n;
+    }
+    p.normal = n;
+    p.tangent = in.tangent;
+    p.uv = in.uv;
+    return p;
+}
+
+#if DEPTH_ONLY
+@fragment
+fn fs_depth(in: VertexOut, @builtin(front_facing) front: bool) {
+#if ALPHA_MASK
+    let m = material_setup(shading_point(in, front));
+    if (material_alpha(m) < ALPHA_CUTOFF) {
+        discard;
+    }
+#endif
+}
+#else
+@fragment
+fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    let p = shading_point(in, front);
+    let m = material_setup(p);
+    let view_z = -(frame.view * vec4<f32>(in.world, 1.0)).z;
+    var color = material_emission(m) + frame.ambient.rgb * material_eval(m, p.normal);
+    let range = light_range(in.clip.xy, view_z);
+    for (var k = 0u; k < range.count; k++) {
+        let i = light_at(range, k);
+        let props = light_properties[i];
+        if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
+            continue;
+        }
+        let inc = incident_light(light_geometry[i], props, in.world);
+        if (any(inc.radiance > vec3<f32>(0.0))) {
+            color += inc.radiance * material_eval(m, inc.dir);
+        }
+    }
+    return vec4<f32>(color, material_alpha(m));
+}
+#endif

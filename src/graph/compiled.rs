@@ -1,0 +1,130 @@
+//! A compiled graph: plain data you can print and assert on.
+
+use super::model::PassKind;
+use super::plan::ResourcePlan;
+use super::roles::PassRoles;
+use super::specialise::CullReason;
+use super::validate::CheckedGraph;
+use std::fmt::Write;
+
+#[derive(Clone, Debug)]
+pub struct ScheduledPass {
+    pub name: String,
+    /// Index into the graph file's passes.
+    pub index: usize,
+    pub kind: PassKind,
+    pub roles: PassRoles,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct CulledPass {
+    pub name: String,
+    pub reason: CullReason,
+}
+
+#[derive(Clone, Debug)]
+pub struct CompiledGraph {
+    pub checked: CheckedGraph,
+    /// Passes that run, in order.
+    pub passes: Vec<ScheduledPass>,
+    pub culled: Vec<CulledPass>,
+    pub plan: ResourcePlan,
+}
+
+impl CompiledGraph {
+    pub fn name(&self) -> &str {
+        &self.checked.desc.name
+    }
+    pub fn pass_names(&self) -> Vec<&str> {
+        self.passes.iter().map(|p| p.name.as_str()).collect()
+    }
+    pub fn culled_reason(&self, pass: &str) -> Option<&CullReason> {
+        self.culled
+            .iter()
+            .find(|c| c.name == pass)
+            .map(|c| &c.reason)
+    }
+    pub fn output(&self) -> &str {
+        &self.checked.desc.output
+    }
+
+    /// The schedule after culling as Graphviz: passes in order, resources as boxes,
+    /// culled passes grey and dashed with the reason.
+    pub fn to_dot(&self) -> String {
+        let desc = &self.checked.desc;
+        let mut s = format!("digraph \"{}\" {{\n  rankdir=LR;\n", desc.name);
+        for (pos, p) in self.passes.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "  \"{}\" [shape=ellipse, label=\"{}. {}\\n{}\"];",
+                p.name,
+                pos + 1,
+                p.name,
+                p.kind.label()
+            );
+        }
+        for c in &self.culled {
+            let why = match &c.reason {
+                CullReason::WhenFalse(f) => format!("when {f} is false"),
+                CullReason::Unreachable => "reaches no output".to_string(),
+            };
+            let _ = writeln!(
+                s,
+                "  \"{}\" [shape=ellipse, style=dashed, color=grey, fontcolor=grey, label=\"{}\\nculled: {}\"];",
+                c.name, c.name, why
+            );
+        }
+        for r in &self.plan.resources {
+            let _ = writeln!(
+                s,
+                "  \"res:{0}\" [shape=box, label=\"{0}\\nphysical #{1}\"];",
+                r.name, r.physical
+            );
+        }
+        for p in &self.passes {
+            let pass = &desc.passes[p.index];
+            for r in &pass.reads {
+                let _ = writeln!(s, "  \"res:{r}\" -> \"{}\";", p.name);
+            }
+            for w in &pass.writes {
+                let _ = writeln!(s, "  \"{}\" -> \"res:{w}\";", p.name);
+            }
+        }
+        s.push_str("}\n");
+        s
+    }
+}
+
+/// Assembles the compiled graph from the steps' results.
+pub(crate) fn assemble(
+    checked: CheckedGraph,
+    culled: Vec<Option<CullReason>>,
+    schedule: Vec<usize>,
+    plan: ResourcePlan,
+) -> CompiledGraph {
+    let passes = schedule
+        .iter()
+        .map(|&i| ScheduledPass {
+            name: checked.desc.passes[i].name.clone(),
+            index: i,
+            kind: checked.desc.passes[i].kind.clone(),
+            roles: checked.roles[i].clone(),
+        })
+        .collect();
+    let culled = culled
+        .into_iter()
+        .enumerate()
+        .filter_map(|(i, c)| {
+            c.map(|reason| CulledPass {
+                name: checked.desc.passes[i].name.clone(),
+                reason,
+            })
+        })
+        .collect();
+    CompiledGraph {
+        checked,
+        passes,
+        culled,
+        plan,
+    }
+}

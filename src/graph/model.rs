@@ -1,0 +1,259 @@
+//! The graph file format: plain serde data, exactly what a RON file says.
+
+use serde::{Deserialize, Serialize};
+
+/// A whole graph file (`graphs/*.ron`).
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+pub struct GraphDesc {
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    pub resources: Vec<ResourceDesc>,
+    pub passes: Vec<PassDesc>,
+    /// The resource presented as the frame (a colour texture).
+    pub output: String,
+    /// Passes kept even though nothing reads what they write (statistics, readbacks).
+    #[serde(default)]
+    pub side_effects: Vec<String>,
+}
+
+/// A named resource. Sizes are plain data relative to the output.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+pub enum ResourceDesc {
+    Texture {
+        name: String,
+        format: TextureFormat,
+        #[serde(default)]
+        size: TextureSize,
+        #[serde(default = "one")]
+        samples: u32,
+    },
+    Buffer {
+        name: String,
+        #[serde(default)]
+        size: BufferSize,
+    },
+    /// Data owned by the scene, bound read-only.
+    Import { name: String, from: SceneResource },
+}
+
+fn one() -> u32 {
+    1
+}
+
+impl ResourceDesc {
+    pub fn name(&self) -> &str {
+        match self {
+            ResourceDesc::Texture { name, .. }
+            | ResourceDesc::Buffer { name, .. }
+            | ResourceDesc::Import { name, .. } => name,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum TextureFormat {
+    Rgba8Unorm,
+    Rgba16Float,
+    Rgba32Float,
+    R32Float,
+    Rg32Float,
+    R32Uint,
+    Depth32Float,
+}
+
+impl TextureFormat {
+    pub fn is_depth(self) -> bool {
+        matches!(self, TextureFormat::Depth32Float)
+    }
+    pub fn to_wgpu(self) -> wgpu::TextureFormat {
+        use wgpu::TextureFormat as W;
+        match self {
+            TextureFormat::Rgba8Unorm => W::Rgba8Unorm,
+            TextureFormat::Rgba16Float => W::Rgba16Float,
+            TextureFormat::Rgba32Float => W::Rgba32Float,
+            TextureFormat::R32Float => W::R32Float,
+            TextureFormat::Rg32Float => W::Rg32Float,
+            TextureFormat::R32Uint => W::R32Uint,
+            TextureFormat::Depth32Float => W::Depth32Float,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq)]
+pub enum TextureSize {
+    /// The output's size.
+    #[default]
+    Output,
+    /// The output's size times a factor, rounded up, at least 1.
+    Scaled(f32),
+    Fixed(u32, u32),
+}
+
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq)]
+pub enum BufferSize {
+    /// Sized by the built-in pass that writes it (e.g. per-tile light lists from the
+    /// culling pass's tile size and capacity).
+    #[default]
+    Auto,
+    Bytes(u64),
+    /// `bytes` for every `tile`×`tile` tile of the output.
+    PerTile {
+        tile: u32,
+        bytes: u64,
+    },
+    PerPixel(u64),
+    PerLight(u64),
+}
+
+/// What a scene provides to the graph.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum SceneResource {
+    /// Light positions, ranges and cones: all culling needs.
+    LightGeometry,
+    /// Light colours, intensities, flags and material masks.
+    LightProperties,
+    /// Vertex and index buffers of every mesh.
+    Geometry,
+}
+
+/// A scene feature a pass can be conditional on (`when:`).
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
+pub enum SceneFeature {
+    Transparent,
+    AlphaMask,
+    ShadowCasters,
+    IndirectLights,
+    SpotLights,
+    Lights,
+    Msaa,
+}
+
+impl SceneFeature {
+    pub fn holds(self, f: &crate::scene::SceneFeatures) -> bool {
+        match self {
+            SceneFeature::Transparent => f.has_transparent,
+            SceneFeature::AlphaMask => f.has_alpha_mask,
+            SceneFeature::ShadowCasters => f.has_shadow_casters,
+            SceneFeature::IndirectLights => f.has_indirect_lights,
+            SceneFeature::SpotLights => f.has_spot_lights,
+            SceneFeature::Lights => f.has_lights,
+            SceneFeature::Msaa => f.msaa,
+        }
+    }
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+pub struct PassDesc {
+    pub name: String,
+    pub kind: PassKind,
+    #[serde(default)]
+    pub reads: Vec<String>,
+    #[serde(default)]
+    pub writes: Vec<String>,
+    #[serde(default)]
+    pub when: Option<SceneFeature>,
+}
+
+/// How a culling pass bounds a tile in depth.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash, Default)]
+pub enum CullVariant {
+    /// One list per tile between the tile's min and max depth.
+    #[default]
+    Frustum,
+    /// Two lists per tile, split at the middle of the depth range.
+    HalfZ,
+    /// 2.5D: 32 depth cells, a light survives if its cells meet the tile's occupied cells.
+    DepthMask,
+    /// A 3D grid: `slices` exponential depth slices per tile, one list per cell.
+    Clustered { slices: u32 },
+}
+
+/// Where light lists come from for forward shading.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash, Default)]
+pub enum LightSource {
+    /// Every light at every pixel: the reference.
+    #[default]
+    AllLights,
+    /// The lists written by a `LightCulling` pass (read as a buffer).
+    Culled,
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
+pub enum Dispatch {
+    /// One invocation per output pixel, in workgroups of the given size.
+    PerPixel {
+        workgroup: (u32, u32),
+    },
+    /// One workgroup per `tile`×`tile` tile.
+    PerTile {
+        tile: u32,
+    },
+    /// One invocation per light, in workgroups of `workgroup`.
+    PerLight {
+        workgroup: u32,
+    },
+    Fixed(u32, u32, u32),
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+pub enum PassKind {
+    /// Depth only, no colour target; alpha-masked geometry discards.
+    DepthPrepass,
+    /// Tiled light culling against the prepass depth.
+    LightCulling {
+        tile: u32,
+        #[serde(default)]
+        variant: CullVariant,
+        /// Most lights a tile (or a half, or a cluster) can list.
+        #[serde(default = "default_capacity")]
+        capacity: u32,
+    },
+    /// Forward shading of the scene's materials through the light loop.
+    ForwardShading {
+        #[serde(default)]
+        lights: LightSource,
+    },
+    /// A compute shader the graph file names; bindings are matched by name.
+    Compute {
+        shader: String,
+        #[serde(default = "default_entry")]
+        entry: String,
+        dispatch: Dispatch,
+    },
+    /// A full-screen triangle with a fragment shader; bindings matched by name.
+    Fullscreen {
+        shader: String,
+        #[serde(default = "default_fragment_entry")]
+        entry: String,
+    },
+}
+
+fn default_capacity() -> u32 {
+    256
+}
+fn default_entry() -> String {
+    "main".into()
+}
+fn default_fragment_entry() -> String {
+    "fs_main".into()
+}
+
+impl PassKind {
+    pub fn label(&self) -> &'static str {
+        match self {
+            PassKind::DepthPrepass => "DepthPrepass",
+            PassKind::LightCulling { .. } => "LightCulling",
+            PassKind::ForwardShading { .. } => "ForwardShading",
+            PassKind::Compute { .. } => "Compute",
+            PassKind::Fullscreen { .. } => "Fullscreen",
+        }
+    }
+    /// The WGSL file a generic pass runs, relative to the shader root.
+    pub fn shader_file(&self) -> Option<&str> {
+        match self {
+            PassKind::Compute { shader, .. } | PassKind::Fullscreen { shader, .. } => Some(shader),
+            _ => None,
+        }
+    }
+}

@@ -1,0 +1,43 @@
+//! Step 1: text to [`GraphDesc`], with file:line:col on every syntax error.
+
+use super::error::GraphError;
+use super::location::SourceText;
+use super::model::GraphDesc;
+use std::path::Path;
+
+/// Reads and parses a graph file.
+pub fn load(path: &Path) -> Result<(GraphDesc, SourceText), GraphError> {
+    let text = std::fs::read_to_string(path).map_err(|e| GraphError::Io {
+        at: SourceText::new(path, "").at(1, 1),
+        message: e.to_string(),
+    })?;
+    let source = SourceText::new(path, text);
+    let desc = parse(&source)?;
+    Ok((desc, source))
+}
+
+/// Parses graph text; `source.file` is only used in messages.
+pub fn parse(source: &SourceText) -> Result<GraphDesc, GraphError> {
+    ron::from_str::<GraphDesc>(&source.text).map_err(|e| {
+        let (line, col) = (e.span.start.line, e.span.start.col);
+        let at = source.at(line, col);
+        let pass = source.pass_around(source.offset_of(line, col));
+        if let ron::Error::NoSuchEnumVariant {
+            expected, found, ..
+        } = &e.code
+        {
+            if expected.contains(&"DepthPrepass") {
+                return GraphError::UnknownPassKind {
+                    at,
+                    pass: pass.unwrap_or_else(|| "?".into()),
+                    kind: found.clone(),
+                };
+            }
+        }
+        GraphError::Parse {
+            at,
+            context: pass.map(|p| format!("pass '{p}': ")).unwrap_or_default(),
+            message: e.code.to_string(),
+        }
+    })
+}

@@ -1,0 +1,293 @@
+//! Step 5: resource lifetimes and reuse. wgpu has no placed resources, so aliasing means
+//! one physical texture or buffer serving several graph resources with the same
+//! descriptor whose lifetimes (first to last use in the schedule) do not overlap.
+
+use super::model::{
+    BufferSize, CullVariant, GraphDesc, PassKind, ResourceDesc, TextureFormat, TextureSize,
+};
+use super::roles::PassRoles;
+use crate::shader::BindingKind;
+
+/// What a physical resource is; two graph resources may share one only if these are equal.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub enum PhysicalDesc {
+    Texture {
+        format: TextureFormat,
+        width: u32,
+        height: u32,
+        samples: u32,
+    },
+    Buffer {
+        bytes: u64,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct PhysicalResource {
+    pub desc: PhysicalDesc,
+    pub texture_usage: wgpu::TextureUsages,
+    pub buffer_usage: wgpu::BufferUsages,
+    /// Graph resources this one serves, in order of use.
+    pub serves: Vec<String>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlannedResource {
+    pub name: String,
+    /// Index into [`ResourcePlan::physical`].
+    pub physical: usize,
+    /// First and last schedule position that uses it (inclusive).
+    pub first: usize,
+    pub last: usize,
+    /// No running pass writes it (its writers were culled): cleared to zero each frame.
+    pub absent: bool,
+}
+
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ResourcePlan {
+    pub resources: Vec<PlannedResource>,
+    pub physical: Vec<PhysicalResource>,
+}
+
+impl ResourcePlan {
+    pub fn get(&self, name: &str) -> Option<&PlannedResource> {
+        self.resources.iter().find(|r| r.name == name)
+    }
+}
+
+/// Sizes the plan needs from outside the graph.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameSize {
+    pub width: u32,
+    pub height: u32,
+    pub lights: u32,
+}
+
+/// Layout of a culling pass's light-list buffer, shared with `shaders/cull/*.wgsl`:
+/// a header of 4 u32 (pool cursor, lists that overflowed, longest list wanted, pool
+/// overflows), then (offset, count, z_min, z_max) per list, then the index pool.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ListLayout {
+    pub tiles_x: u32,
+    pub tiles_y: u32,
+    pub lists_per_tile: u32,
+    pub capacity: u32,
+}
+
+impl ListLayout {
+    pub const HEADER_WORDS: u32 = 4;
+    /// Words per list entry: offset, count, and the view-depth range it covers (f32 bits).
+    pub const ENTRY_WORDS: u32 = 4;
+    pub fn new(tile: u32, variant: CullVariant, capacity: u32, width: u32, height: u32) -> Self {
+        Self {
+            tiles_x: width.div_ceil(tile),
+            tiles_y: height.div_ceil(tile),
+            lists_per_tile: match variant {
+                CullVariant::HalfZ => 2,
+                CullVariant::Clustered { slices } => slices,
+                CullVariant::Frustum | CullVariant::DepthMask => 1,
+            },
+            capacity,
+        }
+    }
+    pub fn lists(&self) -> u32 {
+        self.tiles_x * self.tiles_y * self.lists_per_tile
+    }
+    pub fn pool_offset_words(&self) -> u32 {
+        Self::HEADER_WORDS + Self::ENTRY_WORDS * self.lists()
+    }
+    /// The pool holds every list at full capacity, so only a list longer than the
+    /// capacity can overflow (counted, never silent).
+    pub fn bytes(&self) -> u64 {
+        4 * (self.pool_offset_words() as u64 + self.lists() as u64 * self.capacity as u64)
+    }
+}
+
+fn texture_extent(size: TextureSize, frame: FrameSize) -> (u32, u32) {
+    match size {
+        TextureSize::Output => (frame.width, frame.height),
+        TextureSize::Scaled(s) => (
+            ((frame.width as f32 * s).ceil() as u32).max(1),
+            ((frame.height as f32 * s).ceil() as u32).max(1),
+        ),
+        TextureSize::Fixed(w, h) => (w.max(1), h.max(1)),
+    }
+}
+
+fn buffer_bytes(name: &str, size: BufferSize, desc: &GraphDesc, frame: FrameSize) -> u64 {
+    let bytes = match size {
+        BufferSize::Bytes(b) => b,
+        BufferSize::PerTile { tile, bytes } => {
+            let t = tile.max(1);
+            frame.width.div_ceil(t) as u64 * frame.height.div_ceil(t) as u64 * bytes
+        }
+        BufferSize::PerPixel(b) => frame.width as u64 * frame.height as u64 * b,
+        BufferSize::PerLight(b) => frame.lights.max(1) as u64 * b,
+        BufferSize::Auto => desc
+            .passes
+            .iter()
+            .find_map(|p| match p.kind {
+                PassKind::LightCulling {
+                    tile,
+                    variant,
+                    capacity,
+                } if p.writes.iter().any(|w| w == name) => Some(
+                    ListLayout::new(tile, variant, capacity, frame.width, frame.height).bytes(),
+                ),
+                _ => None,
+            })
+            .unwrap_or(16),
+    };
+    // Storage bindings need a multiple of 4 and at least one element.
+    bytes.max(16).next_multiple_of(4)
+}
+
+/// Plans physical resources for the passes in `schedule` (pass indices, in order).
+pub fn plan(
+    desc: &GraphDesc,
+    roles: &[PassRoles],
+    schedule: &[usize],
+    frame: FrameSize,
+) -> ResourcePlan {
+    let mut plan = ResourcePlan::default();
+    // Transients in order of first use.
+    let mut uses: Vec<(usize, usize, &ResourceDesc)> = Vec::new();
+    for r in &desc.resources {
+        if matches!(r, ResourceDesc::Import { .. }) {
+            continue;
+        }
+        let positions: Vec<usize> = schedule
+            .iter()
+            .enumerate()
+            .filter(|(_, &p)| {
+                let pass = &desc.passes[p];
+                pass.reads.iter().chain(&pass.writes).any(|n| n == r.name())
+            })
+            .map(|(pos, _)| pos)
+            .collect();
+        let (Some(&first), Some(&last)) = (positions.first(), positions.last()) else {
+            continue;
+        };
+        // The output lives to the end of the frame (it is read back).
+        let last = if r.name() == desc.output {
+            schedule.len()
+        } else {
+            last
+        };
+        uses.push((first, last, r));
+    }
+    uses.sort_by_key(|u| u.0);
+    for (first, last, r) in uses {
+        let (pdesc, tex_usage, buf_usage) = describe(r, desc, roles, schedule, frame);
+        let absent = !schedule
+            .iter()
+            .any(|&p| desc.passes[p].writes.iter().any(|w| w == r.name()));
+        let reuse = plan.physical.iter().position(|ph| {
+            ph.desc == pdesc
+                && ph
+                    .serves
+                    .iter()
+                    .all(|s| plan.get(s).is_some_and(|pr| pr.last < first))
+        });
+        let physical = match reuse {
+            Some(i) => i,
+            None => {
+                plan.physical.push(PhysicalResource {
+                    desc: pdesc,
+                    texture_usage: wgpu::TextureUsages::empty(),
+                    buffer_usage: wgpu::BufferUsages::empty(),
+                    serves: Vec::new(),
+                });
+                plan.physical.len() - 1
+            }
+        };
+        let ph = &mut plan.physical[physical];
+        ph.texture_usage |= tex_usage;
+        ph.buffer_usage |= buf_usage;
+        ph.serves.push(r.name().to_string());
+        plan.resources.push(PlannedResource {
+            name: r.name().to_string(),
+            physical,
+            first,
+            last,
+            absent,
+        });
+    }
+    plan
+}
+
+fn describe(
+    r: &ResourceDesc,
+    desc: &GraphDesc,
+    roles: &[PassRoles],
+    schedule: &[usize],
+    frame: FrameSize,
+) -> (PhysicalDesc, wgpu::TextureUsages, wgpu::BufferUsages) {
+    use wgpu::{BufferUsages as B, TextureUsages as T};
+    match r {
+        ResourceDesc::Texture {
+            name,
+            format,
+            size,
+            samples,
+        } => {
+            let (width, height) = texture_extent(*size, frame);
+            // Copies: readback of the output and of any texture a test inspects.
+            let mut usage = T::COPY_SRC;
+            for &p in schedule {
+                let role = &roles[p];
+                let is_slot =
+                    role.slots.values().any(|v| v == name) || role.target.as_deref() == Some(name);
+                if is_slot {
+                    usage |= T::RENDER_ATTACHMENT;
+                    if format.is_depth()
+                        && matches!(desc.passes[p].kind, PassKind::LightCulling { .. })
+                    {
+                        usage |= T::TEXTURE_BINDING;
+                    }
+                }
+                for (b, n) in &role.bindings {
+                    if n == name {
+                        usage |= match b.kind {
+                            BindingKind::StorageTexture { .. } => T::STORAGE_BINDING,
+                            _ => T::TEXTURE_BINDING,
+                        };
+                    }
+                }
+            }
+            (
+                PhysicalDesc::Texture {
+                    format: *format,
+                    width,
+                    height,
+                    samples: *samples,
+                },
+                usage,
+                B::empty(),
+            )
+        }
+        ResourceDesc::Buffer { name, size } => (
+            PhysicalDesc::Buffer {
+                bytes: buffer_bytes(name, *size, desc, frame),
+            },
+            T::empty(),
+            B::STORAGE | B::COPY_SRC | B::COPY_DST | B::UNIFORM,
+        ),
+        ResourceDesc::Import { .. } => unreachable!("imports are not planned"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn list_layout_counts_partial_tiles() {
+        let l = ListLayout::new(16, CullVariant::Frustum, 256, 333, 197);
+        assert_eq!((l.tiles_x, l.tiles_y), (21, 13));
+        assert_eq!(l.lists(), 273);
+        let h = ListLayout::new(8, CullVariant::HalfZ, 64, 16, 16);
+        assert_eq!(h.lists(), 8);
+        assert_eq!(h.bytes(), 4 * (4 + 32 + 8 * 64));
+    }
+}

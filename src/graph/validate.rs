@@ -1,0 +1,259 @@
+//! Step 2: everything that can be wrong with a graph, found before anything reaches the GPU.
+
+use super::deps::{self, DepGraph};
+use super::error::{GraphError, GraphErrors};
+use super::location::SourceText;
+use super::model::{GraphDesc, PassKind, ResourceDesc};
+use super::roles::{PassRoles, RoleCtx};
+use crate::shader::{reflect_bindings, Composed, ShaderLibrary};
+use std::collections::{BTreeMap, BTreeSet};
+
+/// A graph that passed validation: its roles resolved and its shaders composed.
+#[derive(Clone, Debug)]
+pub struct CheckedGraph {
+    pub desc: GraphDesc,
+    pub source: SourceText,
+    pub deps: DepGraph,
+    /// Per pass, in declaration order.
+    pub roles: Vec<PassRoles>,
+    /// Per pass: the composed shader of a generic pass.
+    pub shaders: Vec<Option<Composed>>,
+}
+
+pub fn validate(
+    desc: GraphDesc,
+    source: SourceText,
+    shaders: &ShaderLibrary,
+) -> Result<CheckedGraph, GraphErrors> {
+    let mut errors = Vec::new();
+    let resources = names_and_duplicates(&desc, &source, &mut errors);
+    check_references(&desc, &source, &resources, &mut errors);
+    if !errors.is_empty() {
+        // Role and order checks assume every name resolves.
+        return Err(GraphErrors(errors));
+    }
+    check_writes(&desc, &source, &resources, &mut errors);
+
+    let deps = deps::build(&desc);
+    for cycle in deps::cycles(&desc, &deps) {
+        errors.push(GraphError::Cycle {
+            at: source.of_declaration(&cycle[0]),
+            passes: cycle,
+        });
+    }
+    if errors.is_empty() {
+        check_writer_order(&desc, &source, &deps, &mut errors);
+    }
+
+    let ctx = RoleCtx {
+        source: &source,
+        resources: &resources,
+    };
+    let mut roles = Vec::new();
+    let mut composed = Vec::new();
+    for pass in &desc.passes {
+        let (r, c) = match pass.kind.shader_file() {
+            None => (ctx.builtin(pass), None),
+            Some(file) => match generic_shader(pass, file, shaders, &source) {
+                Ok(c) => {
+                    let module = c.1;
+                    (
+                        ctx.generic(pass, file, &reflect_bindings(&module)),
+                        Some(c.0),
+                    )
+                }
+                Err(e) => (Err(vec![e]), None),
+            },
+        };
+        match r {
+            Ok(r) => roles.push(r),
+            Err(mut e) => errors.append(&mut e),
+        }
+        composed.push(c);
+    }
+    if errors.is_empty() {
+        Ok(CheckedGraph {
+            desc,
+            source,
+            deps,
+            roles,
+            shaders: composed,
+        })
+    } else {
+        Err(GraphErrors(errors))
+    }
+}
+
+fn names_and_duplicates<'a>(
+    desc: &'a GraphDesc,
+    source: &SourceText,
+    errors: &mut Vec<GraphError>,
+) -> BTreeMap<&'a str, &'a ResourceDesc> {
+    let mut resources = BTreeMap::new();
+    for r in &desc.resources {
+        if resources.insert(r.name(), r).is_some() {
+            errors.push(GraphError::Duplicate {
+                at: source.of_declaration(r.name()),
+                what: "resource",
+                name: r.name().to_string(),
+            });
+        }
+    }
+    let mut passes = BTreeSet::new();
+    for p in &desc.passes {
+        if !passes.insert(p.name.as_str()) || resources.contains_key(p.name.as_str()) {
+            errors.push(GraphError::Duplicate {
+                at: source.of_declaration(&p.name),
+                what: "pass",
+                name: p.name.clone(),
+            });
+        }
+    }
+    resources
+}
+
+fn check_references(
+    desc: &GraphDesc,
+    source: &SourceText,
+    resources: &BTreeMap<&str, &ResourceDesc>,
+    errors: &mut Vec<GraphError>,
+) {
+    for pass in &desc.passes {
+        for name in pass.reads.iter().chain(&pass.writes) {
+            if !resources.contains_key(name.as_str()) {
+                errors.push(GraphError::UnknownResource {
+                    at: source.in_pass(&pass.name, name),
+                    pass: pass.name.clone(),
+                    resource: name.clone(),
+                });
+            }
+        }
+    }
+    let output_at = || {
+        let i = source.text.find("output").unwrap_or(0);
+        source.at_offset(i)
+    };
+    match resources.get(desc.output.as_str()) {
+        Some(ResourceDesc::Texture { format, .. }) if !format.is_depth() => {}
+        _ => errors.push(GraphError::BadOutput {
+            at: output_at(),
+            resource: desc.output.clone(),
+        }),
+    }
+    for s in &desc.side_effects {
+        if !desc.passes.iter().any(|p| &p.name == s) {
+            let at = source.at_offset(source.text.find(&format!("\"{s}\"")).unwrap_or(0));
+            errors.push(GraphError::UnknownSideEffect {
+                at,
+                pass: s.clone(),
+            });
+        }
+    }
+}
+
+fn check_writes(
+    desc: &GraphDesc,
+    source: &SourceText,
+    resources: &BTreeMap<&str, &ResourceDesc>,
+    errors: &mut Vec<GraphError>,
+) {
+    for pass in &desc.passes {
+        for name in &pass.writes {
+            if let Some(ResourceDesc::Import { from, .. }) = resources.get(name.as_str()) {
+                errors.push(GraphError::Mismatch {
+                    at: source.in_pass(&pass.name, name),
+                    pass: pass.name.clone(),
+                    resource: name.clone(),
+                    problem: format!("scene import {from:?} is read-only and cannot be written"),
+                });
+            }
+        }
+        for name in &pass.reads {
+            let is_import = matches!(
+                resources.get(name.as_str()),
+                Some(ResourceDesc::Import { .. })
+            );
+            let written_elsewhere = desc
+                .passes
+                .iter()
+                .any(|p| p.name != pass.name && p.writes.contains(name));
+            if !is_import && !written_elsewhere {
+                errors.push(GraphError::ReadNeverWritten {
+                    at: source.in_pass(&pass.name, name),
+                    pass: pass.name.clone(),
+                    resource: name.clone(),
+                });
+            }
+        }
+    }
+}
+
+/// Two passes writing one resource must be ordered by a path between them.
+fn check_writer_order(
+    desc: &GraphDesc,
+    source: &SourceText,
+    deps: &DepGraph,
+    errors: &mut Vec<GraphError>,
+) {
+    use petgraph::algo::has_path_connecting;
+    use petgraph::graph::NodeIndex;
+    let mut reported = BTreeSet::new();
+    for r in &desc.resources {
+        let writers: Vec<usize> = (0..desc.passes.len())
+            .filter(|&i| desc.passes[i].writes.iter().any(|w| w == r.name()))
+            .collect();
+        for (k, &a) in writers.iter().enumerate() {
+            for &b in &writers[k + 1..] {
+                let (na, nb) = (NodeIndex::new(a), NodeIndex::new(b));
+                if !has_path_connecting(deps, na, nb, None)
+                    && !has_path_connecting(deps, nb, na, None)
+                    && reported.insert((a, b))
+                {
+                    errors.push(GraphError::UnorderedWriters {
+                        at: source.in_pass(&desc.passes[b].name, r.name()),
+                        resource: r.name().to_string(),
+                        first: desc.passes[a].name.clone(),
+                        second: desc.passes[b].name.clone(),
+                    });
+                }
+            }
+        }
+    }
+}
+
+fn generic_shader(
+    pass: &super::model::PassDesc,
+    file: &str,
+    shaders: &ShaderLibrary,
+    source: &SourceText,
+) -> Result<(Composed, naga::Module), GraphError> {
+    let shader_error = |message: String| GraphError::Shader {
+        at: source.in_pass(&pass.name, file),
+        pass: pass.name.clone(),
+        message,
+    };
+    let composed = shaders
+        .compose(file, &Default::default(), &Default::default())
+        .map_err(|e| shader_error(e.to_string()))?;
+    let module = composed
+        .validate()
+        .map_err(|e| shader_error(e.to_string()))?;
+    let entry = match &pass.kind {
+        PassKind::Compute { entry, .. } | PassKind::Fullscreen { entry, .. } => entry,
+        _ => unreachable!(),
+    };
+    let stage = match pass.kind {
+        PassKind::Compute { .. } => naga::ShaderStage::Compute,
+        _ => naga::ShaderStage::Fragment,
+    };
+    if !module
+        .entry_points
+        .iter()
+        .any(|e| &e.name == entry && e.stage == stage)
+    {
+        return Err(shader_error(format!(
+            "{file} has no {stage:?} entry point named '{entry}'"
+        )));
+    }
+    Ok((composed, module))
+}

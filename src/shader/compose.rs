@@ -1,0 +1,317 @@
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum ShaderError {
+    #[error("{file}: cannot read shader: {message}")]
+    Io { file: PathBuf, message: String },
+    #[error("{file}:{line}: {message}")]
+    Directive {
+        file: PathBuf,
+        line: usize,
+        message: String,
+    },
+    /// naga rejected the WGSL; `line`/`col` are in the original file.
+    #[error("{file}:{line}:{col}: {message}\n    {source_line}")]
+    Invalid {
+        file: PathBuf,
+        line: usize,
+        col: usize,
+        message: String,
+        source_line: String,
+    },
+}
+
+/// Where shader files are found; `#include "x.wgsl"` resolves against `root`.
+/// Virtual files (generated code such as materials) are included as `#include <name>`.
+#[derive(Clone, Debug)]
+pub struct ShaderLibrary {
+    pub root: PathBuf,
+}
+
+/// A shader after includes and defines, with a map from each line back to its origin.
+#[derive(Clone, Debug)]
+pub struct Composed {
+    pub text: String,
+    /// For line i (0-based) of `text`: the file it came from and its 1-based line there.
+    pub origin: Vec<(PathBuf, usize)>,
+    /// Every real file that went into it (for hot reload dependencies).
+    pub files: Vec<PathBuf>,
+}
+
+impl ShaderLibrary {
+    pub fn new(root: impl Into<PathBuf>) -> Self {
+        Self { root: root.into() }
+    }
+
+    /// The project's own shaders/ folder (next to Cargo.toml).
+    pub fn builtin() -> Self {
+        Self::new(Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders"))
+    }
+
+    /// Reads `file` (relative to the root), expands includes and `#if`, and prepends the
+    /// defines as WGSL constants (`const NAME = VALUE;`).
+    pub fn compose(
+        &self,
+        file: &str,
+        defines: &BTreeMap<String, String>,
+        virtual_files: &BTreeMap<String, String>,
+    ) -> Result<Composed, ShaderError> {
+        let mut out = Composed {
+            text: String::new(),
+            origin: Vec::new(),
+            files: Vec::new(),
+        };
+        for (name, value) in defines {
+            out.push_line(
+                &format!("const {name} = {value};"),
+                Path::new("<defines>"),
+                0,
+            );
+        }
+        let path = self.root.join(file);
+        self.include(&path, defines, virtual_files, &mut out)?;
+        Ok(out)
+    }
+
+    fn include(
+        &self,
+        path: &Path,
+        defines: &BTreeMap<String, String>,
+        virtual_files: &BTreeMap<String, String>,
+        out: &mut Composed,
+    ) -> Result<(), ShaderError> {
+        if out.files.iter().any(|f| f == path) {
+            return Ok(()); // include once
+        }
+        let text = std::fs::read_to_string(path).map_err(|e| ShaderError::Io {
+            file: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        out.files.push(path.to_path_buf());
+        self.expand(path, &text, defines, virtual_files, out)
+    }
+
+    fn expand(
+        &self,
+        path: &Path,
+        text: &str,
+        defines: &BTreeMap<String, String>,
+        virtual_files: &BTreeMap<String, String>,
+        out: &mut Composed,
+    ) -> Result<(), ShaderError> {
+        // Stack of (this branch active, some branch taken) for nested #if.
+        let mut conditions: Vec<(bool, bool)> = Vec::new();
+        let directive_error = |line: usize, message: String| ShaderError::Directive {
+            file: path.to_path_buf(),
+            line,
+            message,
+        };
+        for (i, line) in text.lines().enumerate() {
+            let n = i + 1;
+            let active = conditions.iter().all(|c| c.0);
+            let trimmed = line.trim_start();
+            if let Some(rest) = trimmed.strip_prefix("#if ") {
+                let on = active && is_set(defines, rest.trim());
+                conditions.push((on, on));
+                out.push_line("", path, n);
+            } else if trimmed.starts_with("#else") {
+                let parent =
+                    conditions.len() < 2 || conditions[..conditions.len() - 1].iter().all(|c| c.0);
+                let top = conditions
+                    .last_mut()
+                    .ok_or_else(|| directive_error(n, "#else without #if".into()))?;
+                top.0 = parent && !top.1;
+                out.push_line("", path, n);
+            } else if trimmed.starts_with("#endif") {
+                conditions
+                    .pop()
+                    .ok_or_else(|| directive_error(n, "#endif without #if".into()))?;
+                out.push_line("", path, n);
+            } else if let Some(rest) = trimmed.strip_prefix("#include") {
+                out.push_line("", path, n);
+                if !active {
+                    continue;
+                }
+                let rest = rest.trim();
+                if let Some(name) = rest.strip_prefix('<').and_then(|r| r.strip_suffix('>')) {
+                    let code = virtual_files.get(name).ok_or_else(|| {
+                        directive_error(n, format!("no generated code named <{name}>"))
+                    })?;
+                    let vpath = PathBuf::from(format!("<{name}>"));
+                    self.expand(&vpath, code, defines, virtual_files, out)?;
+                } else if let Some(name) = rest.strip_prefix('"').and_then(|r| r.strip_suffix('"'))
+                {
+                    self.include(&self.root.join(name), defines, virtual_files, out)?;
+                } else {
+                    return Err(directive_error(n, format!("malformed #include {rest}")));
+                }
+            } else if active {
+                out.push_line(line, path, n);
+            } else {
+                out.push_line("", path, n);
+            }
+        }
+        if !conditions.is_empty() {
+            return Err(directive_error(
+                text.lines().count(),
+                "#if without #endif".into(),
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn is_set(defines: &BTreeMap<String, String>, name: &str) -> bool {
+    defines
+        .get(name)
+        .is_some_and(|v| !matches!(v.as_str(), "0" | "0u" | "false"))
+}
+
+impl Composed {
+    fn push_line(&mut self, line: &str, file: &Path, n: usize) {
+        self.text.push_str(line);
+        self.text.push('\n');
+        self.origin.push((file.to_path_buf(), n));
+    }
+
+    /// Maps a 1-based line of the composed text to (file, line).
+    pub fn origin_of(&self, line: usize) -> (PathBuf, usize) {
+        self.origin
+            .get(line.saturating_sub(1))
+            .cloned()
+            .unwrap_or_else(|| (PathBuf::from("<composed>"), line))
+    }
+
+    /// Parses and validates with naga; errors name the original file and line.
+    pub fn validate(&self) -> Result<naga::Module, ShaderError> {
+        let module = naga::front::wgsl::parse_str(&self.text).map_err(|e| {
+            let loc = e.location(&self.text);
+            self.invalid(loc, e.message().to_string())
+        })?;
+        let mut validator = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::all(),
+        );
+        validator.validate(&module).map_err(|e| {
+            let loc = e.location(&self.text);
+            let mut message = e.as_inner().to_string();
+            let mut source = std::error::Error::source(e.as_inner());
+            while let Some(s) = source {
+                message.push_str(": ");
+                message.push_str(&s.to_string());
+                source = s.source();
+            }
+            self.invalid(loc, message)
+        })?;
+        Ok(module)
+    }
+
+    fn invalid(&self, loc: Option<naga::SourceLocation>, message: String) -> ShaderError {
+        let (line, col) = loc.map_or((0, 0), |l| {
+            (l.line_number as usize, l.line_position as usize)
+        });
+        let (file, file_line) = self.origin_of(line);
+        let source_line = self
+            .text
+            .lines()
+            .nth(line.saturating_sub(1))
+            .unwrap_or("")
+            .trim()
+            .to_string();
+        ShaderError::Invalid {
+            file,
+            line: file_line,
+            col,
+            message,
+            source_line,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn library(files: &[(&str, &str)]) -> (tempdir::Dir, ShaderLibrary) {
+        let dir = tempdir::Dir::new();
+        for (name, text) in files {
+            std::fs::write(dir.path.join(name), text).unwrap();
+        }
+        let lib = ShaderLibrary::new(&dir.path);
+        (dir, lib)
+    }
+
+    mod tempdir {
+        pub struct Dir {
+            pub path: std::path::PathBuf,
+        }
+        impl Dir {
+            pub fn new() -> Self {
+                use std::sync::atomic::{AtomicU32, Ordering};
+                static N: AtomicU32 = AtomicU32::new(0);
+                let path = std::env::temp_dir().join(format!(
+                    "lightgraph-shader-{}-{}",
+                    std::process::id(),
+                    N.fetch_add(1, Ordering::Relaxed)
+                ));
+                std::fs::create_dir_all(&path).unwrap();
+                Self { path }
+            }
+        }
+        impl Drop for Dir {
+            fn drop(&mut self) {
+                let _ = std::fs::remove_dir_all(&self.path);
+            }
+        }
+    }
+
+    #[test]
+    fn includes_defines_and_conditionals() {
+        let (_d, lib) = library(&[
+            (
+                "a.wgsl",
+                "#include \"b.wgsl\"\n#if FAST\nconst X = 1;\n#else\nconst X = 2;\n#endif\n",
+            ),
+            ("b.wgsl", "const B = 3;\n"),
+        ]);
+        let defines = BTreeMap::from([("FAST".to_string(), "1".to_string())]);
+        let c = lib.compose("a.wgsl", &defines, &BTreeMap::new()).unwrap();
+        assert!(c.text.contains("const FAST = 1;"));
+        assert!(c.text.contains("const B = 3;"));
+        assert!(c.text.contains("const X = 1;"));
+        assert!(!c.text.contains("const X = 2;"));
+        c.validate().unwrap();
+    }
+
+    #[test]
+    fn errors_map_back_to_the_included_file_and_line() {
+        let (_d, lib) = library(&[
+            ("a.wgsl", "const A = 1;\n#include \"b.wgsl\"\n"),
+            (
+                "b.wgsl",
+                "const B = 3;\n\nfn f() -> f32 { return undefined_name; }\n",
+            ),
+        ]);
+        let c = lib
+            .compose("a.wgsl", &BTreeMap::new(), &BTreeMap::new())
+            .unwrap();
+        match c.validate().unwrap_err() {
+            ShaderError::Invalid { file, line, .. } => {
+                assert!(file.ends_with("b.wgsl"), "{file:?}");
+                assert_eq!(line, 3);
+            }
+            e => panic!("unexpected {e}"),
+        }
+    }
+
+    #[test]
+    fn unbalanced_if_is_reported() {
+        let (_d, lib) = library(&[("a.wgsl", "#if X\nconst A = 1;\n")]);
+        let e = lib
+            .compose("a.wgsl", &BTreeMap::new(), &BTreeMap::new())
+            .unwrap_err();
+        assert!(e.to_string().contains("#if without #endif"), "{e}");
+    }
+}

@@ -1,0 +1,8 @@
+//! WGSL handling without a GPU: composing files (includes, defines), validating with
+//! naga (errors mapped back to the original file and line), reflecting bindings.
+
+mod compose;
+mod reflect;
+
+pub use compose::{Composed, ShaderError, ShaderLibrary};
+pub use reflect::{reflect_bindings, struct_layout, BindingKind, ReflectedBinding};

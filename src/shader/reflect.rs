@@ -1,0 +1,100 @@
+use naga::{AddressSpace, ImageClass, StorageAccess, TypeInner};
+
+/// What a shader binding is, as far as matching it against a graph resource goes.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum BindingKind {
+    Uniform,
+    Storage {
+        writable: bool,
+    },
+    /// `texture_2d<f32>` and friends; `multisampled` for `texture_multisampled_2d`.
+    SampledTexture {
+        multisampled: bool,
+    },
+    DepthTexture {
+        multisampled: bool,
+    },
+    StorageTexture {
+        format: naga::StorageFormat,
+        writable: bool,
+    },
+    Sampler {
+        comparison: bool,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ReflectedBinding {
+    pub name: String,
+    pub group: u32,
+    pub binding: u32,
+    pub kind: BindingKind,
+}
+
+/// Every resource binding a module declares, in (group, binding) order.
+pub fn reflect_bindings(module: &naga::Module) -> Vec<ReflectedBinding> {
+    let mut out: Vec<ReflectedBinding> = module
+        .global_variables
+        .iter()
+        .filter_map(|(_, var)| {
+            let rb = var.binding.as_ref()?;
+            let kind = match var.space {
+                AddressSpace::Uniform => BindingKind::Uniform,
+                AddressSpace::Storage { access } => BindingKind::Storage {
+                    writable: access.contains(StorageAccess::STORE),
+                },
+                AddressSpace::Handle => match &module.types[var.ty].inner {
+                    TypeInner::Image { class, .. } => match *class {
+                        ImageClass::Sampled { multi, .. } => BindingKind::SampledTexture {
+                            multisampled: multi,
+                        },
+                        ImageClass::Depth { multi } => BindingKind::DepthTexture {
+                            multisampled: multi,
+                        },
+                        ImageClass::Storage { format, access } => BindingKind::StorageTexture {
+                            format,
+                            writable: access.contains(StorageAccess::STORE),
+                        },
+                        ImageClass::External => return None,
+                    },
+                    TypeInner::Sampler { comparison } => BindingKind::Sampler {
+                        comparison: *comparison,
+                    },
+                    _ => return None,
+                },
+                _ => return None,
+            };
+            Some(ReflectedBinding {
+                name: var.name.clone().unwrap_or_default(),
+                group: rb.group,
+                binding: rb.binding,
+                kind,
+            })
+        })
+        .collect();
+    out.sort_by_key(|b| (b.group, b.binding));
+    out
+}
+
+/// (member name, byte offset, byte size) of a WGSL struct, and its total size.
+pub fn struct_layout(module: &naga::Module, name: &str) -> Option<(Vec<(String, u32, u32)>, u32)> {
+    let (_, ty) = module
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some(name))?;
+    let TypeInner::Struct { members, span } = &ty.inner else {
+        return None;
+    };
+    let gctx = module.to_ctx();
+    let fields = members
+        .iter()
+        .map(|m| {
+            (
+                m.name.clone().unwrap_or_default(),
+                m.offset,
+                module.types[m.ty].inner.size(gctx),
+            )
+        })
+        .collect();
+    Some((fields, *span))
+}
