@@ -4,6 +4,7 @@
 //! without a GPU (see [`graph`]), then executed headless on wgpu (see [`renderer`]).
 
 pub mod gpu;
+pub mod render;
 pub mod graph;
 pub mod material;
 pub mod scene;

@@ -1,1 +1,140 @@
-//! GPU struct layouts shared with WGSL (`shaders/common/types.wgsl`).
+//! GPU struct layouts shared with WGSL (`shaders/common/types.wgsl`). A test checks
+//! every offset and size against naga's layout of the WGSL struct.
+
+use crate::scene::{Camera, Light, LightShape};
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3};
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuFrame {
+    pub view: [[f32; 4]; 4],
+    pub proj: [[f32; 4]; 4],
+    pub view_proj: [[f32; 4]; 4],
+    pub inv_proj: [[f32; 4]; 4],
+    pub camera_pos: [f32; 4],
+    pub ambient: [f32; 4],
+    pub size: [u32; 2],
+    pub light_count: u32,
+    pub _pad0: u32,
+    pub near: f32,
+    pub far: f32,
+    pub _pad1: [f32; 2],
+}
+
+impl GpuFrame {
+    pub fn new(camera: &Camera, ambient: Vec3, width: u32, height: u32, light_count: u32) -> Self {
+        let view = camera.view();
+        let proj = camera.projection(width as f32 / height as f32);
+        Self {
+            view: view.to_cols_array_2d(),
+            proj: proj.to_cols_array_2d(),
+            view_proj: (proj * view).to_cols_array_2d(),
+            inv_proj: proj.inverse().to_cols_array_2d(),
+            camera_pos: camera.eye.extend(1.0).into(),
+            ambient: ambient.extend(0.0).into(),
+            size: [width, height],
+            light_count,
+            _pad0: 0,
+            near: camera.near,
+            far: camera.far,
+            _pad1: [0.0; 2],
+        }
+    }
+    pub fn view_matrix(&self) -> Mat4 {
+        Mat4::from_cols_array_2d(&self.view)
+    }
+}
+
+/// What culling reads. Point lights have `cos_outer = -1`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuLightGeometry {
+    pub position: [f32; 3],
+    pub range: f32,
+    pub direction: [f32; 3],
+    pub cos_outer: f32,
+}
+
+/// What shading reads besides geometry; `color` is colour × intensity.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuLightProperties {
+    pub color: [f32; 3],
+    pub cos_inner: f32,
+    pub flags: u32,
+    pub material_mask: u32,
+    pub _pad: [u32; 2],
+}
+
+/// How a culling pass laid out its lists; see [`crate::graph::ListLayout`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuListParams {
+    pub tiles_x: u32,
+    pub tiles_y: u32,
+    pub tile: u32,
+    pub lists_per_tile: u32,
+    pub capacity: u32,
+    pub variant: u32,
+    pub pool_offset: u32,
+    pub _pad0: u32,
+}
+
+/// Splits lights into the two GPU arrays.
+pub fn light_buffers(lights: &[Light]) -> (Vec<GpuLightGeometry>, Vec<GpuLightProperties>) {
+    lights
+        .iter()
+        .map(|l| {
+            let (direction, cos_outer, cos_inner) = match l.shape {
+                LightShape::Point => (Vec3::ZERO, -1.0, -1.0),
+                LightShape::Spot {
+                    direction,
+                    inner_angle,
+                    outer_angle,
+                } => (
+                    direction.normalize_or_zero(),
+                    outer_angle.cos(),
+                    inner_angle.min(outer_angle).cos(),
+                ),
+            };
+            (
+                GpuLightGeometry {
+                    position: l.position.into(),
+                    range: l.range,
+                    direction: direction.into(),
+                    cos_outer,
+                },
+                GpuLightProperties {
+                    color: (l.color * l.intensity).into(),
+                    cos_inner,
+                    flags: l.flags,
+                    material_mask: l.material_mask,
+                    _pad: [0; 2],
+                },
+            )
+        })
+        .unzip()
+}
+
+/// Vertex layout of every mesh: position, normal, uv, tangent.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuVertex {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+    pub uv: [f32; 2],
+    pub tangent: [f32; 4],
+}
+
+impl GpuVertex {
+    pub const ATTRIBUTES: [wgpu::VertexAttribute; 4] =
+        wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32x4];
+    pub fn layout() -> wgpu::VertexBufferLayout<'static> {
+        wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<GpuVertex>() as u64,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &Self::ATTRIBUTES,
+        }
+    }
+}

@@ -1,0 +1,814 @@
+//! A compiled graph made ready for one scene and output size, executed as often as
+//! needed (benchmarks run it many times), with readback of the output and statistics.
+
+use super::pipelines::{Pipeline, PipelineKey};
+use super::resources::FrameResources;
+use super::scene_gpu::SceneGpu;
+use super::{RenderError, Renderer};
+use crate::gpu::readback::{read_buffer, read_rgba32f};
+use crate::gpu::structs::{GpuFrame, GpuListParams, GpuVertex};
+use crate::graph::{
+    CompiledGraph, CullVariant, Dispatch, FrameSize, LightSource, ListLayout, PassKind, ResourceDesc,
+    Slot, TextureFormat,
+};
+use crate::scene::{AlphaMode, Scene};
+use std::collections::BTreeMap;
+use std::sync::Arc;
+use wgpu::util::DeviceExt;
+
+enum PassExec {
+    Prepass {
+        depth: String,
+        clear: bool,
+        draws: Vec<Draw>,
+        bind: wgpu::BindGroup,
+    },
+    Culling {
+        pipeline: Arc<wgpu::ComputePipeline>,
+        bind: wgpu::BindGroup,
+        groups: [u32; 3],
+        lists: String,
+    },
+    Shading {
+        color: String,
+        depth: String,
+        clear: bool,
+        draws: Vec<Draw>,
+        bind: wgpu::BindGroup,
+    },
+    Compute {
+        pipeline: Arc<wgpu::ComputePipeline>,
+        bind: wgpu::BindGroup,
+        groups: [u32; 3],
+    },
+    Fullscreen {
+        pipeline: Arc<wgpu::RenderPipeline>,
+        bind: wgpu::BindGroup,
+        target: String,
+        clear: bool,
+    },
+}
+
+/// Per culling pass: what its lists held this frame.
+#[derive(Clone, Debug)]
+pub struct CullingReport {
+    pub pass: String,
+    pub layout: ListLayout,
+    /// Lists (tiles, halves or clusters) that wanted more lights than the capacity.
+    pub overflowed_lists: u32,
+    /// The longest list wanted (before clamping to the capacity).
+    pub longest_list: u32,
+    /// Kept count of every list, `lists_per_tile` consecutive entries per tile.
+    pub counts: Vec<u32>,
+}
+
+impl CullingReport {
+    /// Lights listed per tile (all its lists together), row-major.
+    pub fn per_tile(&self) -> Vec<u32> {
+        self.counts
+            .chunks(self.layout.lists_per_tile as usize)
+            .map(|c| c.iter().sum())
+            .collect()
+    }
+}
+
+/// Per-pixel light statistics over pixels that hold geometry.
+#[derive(Clone, Debug, Default)]
+pub struct LightStats {
+    pub pixels: u64,
+    pub listed_total: u64,
+    pub exact_total: u64,
+    pub max_listed: u32,
+    pub max_exact: u32,
+}
+
+impl LightStats {
+    pub fn avg_listed(&self) -> f64 {
+        self.listed_total as f64 / self.pixels.max(1) as f64
+    }
+    pub fn avg_exact(&self) -> f64 {
+        self.exact_total as f64 / self.pixels.max(1) as f64
+    }
+    /// Listed over exact: 1 means no false positives.
+    pub fn false_positive_ratio(&self) -> f64 {
+        self.listed_total as f64 / self.exact_total.max(1) as f64
+    }
+}
+
+pub struct FrameResult {
+    pub width: u32,
+    pub height: u32,
+    /// Linear HDR RGBA, row-major.
+    pub image: Vec<[f32; 4]>,
+    /// GPU milliseconds per pass, when the adapter has timestamp queries.
+    pub pass_ms: Option<Vec<(String, f64)>>,
+    pub culling: Vec<CullingReport>,
+    pub light_stats: Option<LightStats>,
+}
+
+pub struct PreparedFrame {
+    pub graph: CompiledGraph,
+    pub size: FrameSize,
+    resources: FrameResources,
+    frame_uniform: wgpu::Buffer,
+    passes: Vec<(String, PassExec)>,
+    absent: Vec<String>,
+    queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
+    stats: Option<(Arc<wgpu::ComputePipeline>, wgpu::BindGroup, wgpu::Buffer)>,
+}
+
+/// A pipeline and its bind group.
+pub(super) type PassExecParts<P> = (Arc<P>, wgpu::BindGroup);
+
+fn defines(pairs: &[(&str, String)]) -> BTreeMap<String, String> {
+    pairs.iter().map(|(k, v)| (k.to_string(), v.clone())).collect()
+}
+
+fn variant_code(v: CullVariant) -> u32 {
+    match v {
+        CullVariant::Frustum => 0,
+        CullVariant::HalfZ => 1,
+        CullVariant::DepthMask => 2,
+        CullVariant::Clustered { .. } => 3,
+    }
+}
+
+fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn depth_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Depth,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// The list layout of the culling pass that writes `lists` (even if it was culled).
+pub(super) fn list_layout_for(graph: &CompiledGraph, lists: &str, size: FrameSize) -> Option<(ListLayout, u32, u32)> {
+    graph.checked.desc.passes.iter().find_map(|p| match p.kind {
+        PassKind::LightCulling { tile, variant, capacity } if p.writes.iter().any(|w| w == lists) => Some((
+            ListLayout::new(tile, variant, capacity, size.width, size.height),
+            tile,
+            variant_code(variant),
+        )),
+        _ => None,
+    })
+}
+
+impl Renderer {
+    /// Makes a compiled graph ready to run on `scene` at `size`: resources, pipelines
+    /// (through the cache) and bind groups. `light_stats` adds the statistics pass.
+    pub fn prepare(
+        &mut self,
+        graph: CompiledGraph,
+        scene: &Scene,
+        gpu: &SceneGpu,
+        size: FrameSize,
+        light_stats: bool,
+    ) -> Result<PreparedFrame, RenderError> {
+        let device = self.ctx.device.clone();
+        let out = graph.output().to_string();
+        match graph.checked.desc.resources.iter().find(|r| r.name() == out) {
+            Some(ResourceDesc::Texture { format: TextureFormat::Rgba32Float, samples: 1, .. }) => {}
+            _ => return Err(RenderError::OutputFormat(out)),
+        }
+        let resources = FrameResources::create(&device, &graph.plan);
+        let gpu_frame = GpuFrame::new(&scene.camera, scene.ambient, size.width, size.height, gpu.light_count);
+        let frame_uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("frame"),
+            contents: bytemuck::bytes_of(&gpu_frame),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let fragment = wgpu::ShaderStages::FRAGMENT;
+        let forward_layout = |lists: bool| {
+            let mut entries = vec![
+                uniform_entry(0, vf),
+                storage_entry(1, fragment, true),
+                storage_entry(2, fragment, true),
+            ];
+            if lists {
+                entries.push(storage_entry(3, fragment, true));
+                entries.push(uniform_entry(4, fragment));
+            }
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(if lists { "forward+lists" } else { "forward" }),
+                entries: &entries,
+            })
+        };
+        let mut passes = Vec::new();
+        let first_writer = |name: &str, pass: &str| {
+            graph
+                .passes
+                .iter()
+                .find(|p| graph.checked.desc.passes[p.index].writes.iter().any(|w| w == name))
+                .is_some_and(|p| p.name == pass)
+        };
+        for sp in &graph.passes {
+            let pass_err = |message: String| RenderError::Pass {
+                pass: sp.name.clone(),
+                message,
+            };
+            let exec = match &sp.kind {
+                PassKind::DepthPrepass => {
+                    let depth = sp.roles.slot(Slot::Depth).unwrap().to_string();
+                    let samples = self.samples_of(&graph, &depth);
+                    let layout = forward_layout(false);
+                    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some(&sp.name),
+                        layout: &layout,
+                        entries: &[
+                            entry(0, &frame_uniform),
+                            entry(1, &gpu.light_geometry),
+                            entry(2, &gpu.light_properties),
+                        ],
+                    });
+                    let draws = self.material_draws(gpu, &layout, None, samples, true, &sp.name)?;
+                    PassExec::Prepass {
+                        clear: first_writer(&depth, &sp.name),
+                        depth,
+                        draws,
+                        bind,
+                    }
+                }
+                PassKind::LightCulling { tile, variant, capacity } => {
+                    let lists = sp.roles.slot(Slot::LightLists).unwrap().to_string();
+                    let depth = sp.roles.slot(Slot::Depth).unwrap();
+                    let layout = ListLayout::new(*tile, *variant, *capacity, size.width, size.height);
+                    let params = GpuListParams {
+                        tiles_x: layout.tiles_x,
+                        tiles_y: layout.tiles_y,
+                        tile: *tile,
+                        lists_per_tile: layout.lists_per_tile,
+                        capacity: *capacity,
+                        variant: variant_code(*variant),
+                        pool_offset: layout.pool_offset_words(),
+                        _pad0: 0,
+                    };
+                    let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("list params"),
+                        contents: bytemuck::bytes_of(&params),
+                        usage: wgpu::BufferUsages::UNIFORM,
+                    });
+                    let compute = wgpu::ShaderStages::COMPUTE;
+                    let bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                        label: Some("culling"),
+                        entries: &[
+                            uniform_entry(0, compute),
+                            storage_entry(1, compute, true),
+                            depth_entry(2),
+                            storage_entry(3, compute, false),
+                            uniform_entry(4, compute),
+                        ],
+                    });
+                    let key = PipelineKey {
+                        shader: "cull/tiled.wgsl".into(),
+                        defines: defines(&[
+                            ("TILE", format!("{tile}u")),
+                            ("CAPACITY", format!("{capacity}u")),
+                            ("VARIANT", format!("{}u", variant_code(*variant))),
+                        ]),
+                        virtual_code: BTreeMap::new(),
+                        state: String::new(),
+                    };
+                    let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                        label: Some("culling"),
+                        bind_group_layouts: &[Some(&bgl)],
+                        immediate_size: 0,
+                    });
+                    let pipeline = self
+                        .pipelines
+                        .get_or_build(
+                            &self.shaders,
+                            key,
+                            |_, module| {
+                                Pipeline::Compute(Arc::new(device.create_compute_pipeline(
+                                    &wgpu::ComputePipelineDescriptor {
+                                        label: Some("light culling"),
+                                        layout: Some(&pl),
+                                        module: &module,
+                                        entry_point: Some("main"),
+                                        compilation_options: Default::default(),
+                                        cache: None,
+                                    },
+                                )))
+                            },
+                            &device,
+                        )
+                        .map_err(|source| RenderError::Shader { pass: sp.name.clone(), source })?;
+                    let Pipeline::Compute(pipeline) = pipeline else { unreachable!() };
+                    let depth_view = resources.view(&graph.plan, depth).ok_or_else(|| pass_err("depth not planned".into()))?;
+                    let list_buf = resources.buffer(&graph.plan, &lists).ok_or_else(|| pass_err("lists not planned".into()))?;
+                    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some(&sp.name),
+                        layout: &bgl,
+                        entries: &[
+                            entry(0, &frame_uniform),
+                            entry(1, &gpu.light_geometry),
+                            wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(depth_view) },
+                            entry(3, list_buf),
+                            entry(4, &params),
+                        ],
+                    });
+                    PassExec::Culling {
+                        pipeline,
+                        bind,
+                        groups: [layout.tiles_x, layout.tiles_y, layout.lists_per_tile],
+                        lists,
+                    }
+                }
+                PassKind::ForwardShading { lights } => {
+                    let color = sp.roles.slot(Slot::Color).unwrap().to_string();
+                    let depth = sp.roles.slot(Slot::Depth).unwrap().to_string();
+                    let samples = self.samples_of(&graph, &color);
+                    let culled = *lights == LightSource::Culled;
+                    let layout = forward_layout(culled);
+                    let mut entries = vec![
+                        entry(0, &frame_uniform),
+                        entry(1, &gpu.light_geometry),
+                        entry(2, &gpu.light_properties),
+                    ];
+                    let params_buf;
+                    if culled {
+                        let lists = sp.roles.slot(Slot::LightLists).unwrap();
+                        let (ll, tile, variant) = list_layout_for(&graph, lists, size)
+                            .ok_or_else(|| pass_err(format!("no LightCulling pass writes '{lists}'")))?;
+                        params_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                            label: Some("list params"),
+                            contents: bytemuck::bytes_of(&GpuListParams {
+                                tiles_x: ll.tiles_x,
+                                tiles_y: ll.tiles_y,
+                                tile,
+                                lists_per_tile: ll.lists_per_tile,
+                                capacity: ll.capacity,
+                                variant,
+                                pool_offset: ll.pool_offset_words(),
+                                _pad0: 0,
+                            }),
+                            usage: wgpu::BufferUsages::UNIFORM,
+                        });
+                        let buf = resources.buffer(&graph.plan, lists).ok_or_else(|| pass_err("lists not planned".into()))?;
+                        entries.push(entry(3, buf));
+                        entries.push(entry(4, &params_buf));
+                    }
+                    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some(&sp.name),
+                        layout: &layout,
+                        entries: &entries,
+                    });
+                    let draws = self.material_draws(gpu, &layout, Some(culled), samples, false, &sp.name)?;
+                    PassExec::Shading {
+                        clear: first_writer(&color, &sp.name),
+                        color,
+                        depth,
+                        draws,
+                        bind,
+                    }
+                }
+                PassKind::Compute { dispatch, .. } => {
+                    let composed = graph.checked.shaders[sp.index].as_ref().unwrap();
+                    let (pipeline, bind) = self.generic_compute(&graph, sp, composed, &resources, &frame_uniform, gpu)?;
+                    let groups = match *dispatch {
+                        Dispatch::PerPixel { workgroup: (x, y) } => [size.width.div_ceil(x.max(1)), size.height.div_ceil(y.max(1)), 1],
+                        Dispatch::PerTile { tile } => [size.width.div_ceil(tile.max(1)), size.height.div_ceil(tile.max(1)), 1],
+                        Dispatch::PerLight { workgroup } => [gpu.light_count.div_ceil(workgroup.max(1)).max(1), 1, 1],
+                        Dispatch::Fixed(x, y, z) => [x, y, z],
+                    };
+                    PassExec::Compute { pipeline, bind, groups }
+                }
+                PassKind::Fullscreen { .. } => {
+                    let composed = graph.checked.shaders[sp.index].as_ref().unwrap();
+                    let target = sp.roles.target.clone().unwrap();
+                    let (pipeline, bind) = self.generic_fullscreen(&graph, sp, composed, &resources, &frame_uniform, gpu, &target)?;
+                    PassExec::Fullscreen {
+                        clear: first_writer(&target, &sp.name),
+                        pipeline,
+                        bind,
+                        target,
+                    }
+                }
+            };
+            passes.push((sp.name.clone(), exec));
+        }
+        let absent = graph.plan.resources.iter().filter(|r| r.absent).map(|r| r.name.clone()).collect();
+        let queries = self.ctx.has_timestamps.then(|| {
+            let count = 2 * (passes.len() as u32 + 1);
+            (
+                device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("pass timestamps"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count,
+                }),
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("timestamps"),
+                    size: 8 * count as u64,
+                    usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                    mapped_at_creation: false,
+                }),
+            )
+        });
+        let stats = if light_stats {
+            Some(self.stats_pass(&graph, &resources, &frame_uniform, gpu, &gpu_frame, size)?)
+        } else {
+            None
+        };
+        Ok(PreparedFrame {
+            graph,
+            size,
+            resources,
+            frame_uniform,
+            passes,
+            absent,
+            queries,
+            stats,
+        })
+    }
+
+    fn samples_of(&self, graph: &CompiledGraph, name: &str) -> u32 {
+        graph
+            .checked
+            .desc
+            .resources
+            .iter()
+            .find_map(|r| match r {
+                ResourceDesc::Texture { name: n, samples, .. } if n == name => Some(*samples),
+                _ => None,
+            })
+            .unwrap_or(1)
+    }
+
+    /// One pipeline per material (draws sorted by material). `lists`: None for the
+    /// depth prepass, Some(culled) for shading.
+    fn material_draws(
+        &mut self,
+        gpu: &SceneGpu,
+        layout: &wgpu::BindGroupLayout,
+        lists: Option<bool>,
+        samples: u32,
+        depth_only: bool,
+        pass: &str,
+    ) -> Result<Vec<Draw>, RenderError> {
+        let device = self.ctx.device.clone();
+        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(pass),
+            bind_group_layouts: &[Some(layout)],
+            immediate_size: 0,
+        });
+        let mut draws = Vec::new();
+        for mesh in gpu.opaque_draws() {
+            let m = &gpu.materials[gpu.meshes[mesh].material];
+            let masked = matches!(m.alpha_mode, AlphaMode::Mask(_));
+            let mut d = vec![];
+            if depth_only {
+                d.push(("DEPTH_ONLY", "1".to_string()));
+                if let AlphaMode::Mask(cutoff) = m.alpha_mode {
+                    d.push(("ALPHA_MASK", "1".into()));
+                    d.push(("ALPHA_CUTOFF", format!("{cutoff:?}")));
+                }
+            }
+            if lists == Some(true) {
+                d.push(("LIGHT_LISTS", "1".into()));
+            }
+            let key = PipelineKey {
+                shader: "forward/forward.wgsl".into(),
+                defines: defines(&d),
+                virtual_code: BTreeMap::from([("material".to_string(), m.wgsl.clone())]),
+                state: format!("samples={samples} double_sided={} depth_only={depth_only}", m.double_sided),
+            };
+            let cull_mode = (!m.double_sided).then_some(wgpu::Face::Back);
+            let pipeline = self
+                .pipelines
+                .get_or_build(
+                    &self.shaders,
+                    key,
+                    |_, module| {
+                        let fragment_entry = if depth_only { "fs_depth" } else { "fs_main" };
+                        let targets = [Some(wgpu::ColorTargetState {
+                            format: wgpu::TextureFormat::Rgba32Float,
+                            blend: None,
+                            write_mask: wgpu::ColorWrites::ALL,
+                        })];
+                        let fragment = (!depth_only || masked).then(|| wgpu::FragmentState {
+                            module: &module,
+                            entry_point: Some(fragment_entry),
+                            compilation_options: Default::default(),
+                            targets: if depth_only { &[] } else { &targets },
+                        });
+                        Pipeline::Render(Arc::new(device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                            label: Some(pass),
+                            layout: Some(&pl),
+                            vertex: wgpu::VertexState {
+                                module: &module,
+                                entry_point: Some("vs_main"),
+                                compilation_options: Default::default(),
+                                buffers: &[Some(GpuVertex::layout())],
+                            },
+                            primitive: wgpu::PrimitiveState {
+                                cull_mode,
+                                ..Default::default()
+                            },
+                            depth_stencil: Some(wgpu::DepthStencilState {
+                                format: wgpu::TextureFormat::Depth32Float,
+                                depth_write_enabled: Some(depth_only),
+                                depth_compare: Some(if depth_only {
+                                    wgpu::CompareFunction::Less
+                                } else {
+                                    wgpu::CompareFunction::LessEqual
+                                }),
+                                stencil: Default::default(),
+                                bias: Default::default(),
+                            }),
+                            multisample: wgpu::MultisampleState {
+                                count: samples,
+                                ..Default::default()
+                            },
+                            fragment,
+                            multiview_mask: None,
+                            cache: None,
+                        })))
+                    },
+                    &device,
+                )
+                .map_err(|source| RenderError::Shader {
+                    pass: format!("{pass} (material '{}')", m.name),
+                    source,
+                })?;
+            let Pipeline::Render(pipeline) = pipeline else { unreachable!() };
+            let gm = &gpu.meshes[mesh];
+            draws.push(Draw {
+                pipeline,
+                vertices: gm.vertices.clone(),
+                indices: gm.indices.clone(),
+                index_count: gm.index_count,
+            });
+        }
+        Ok(draws)
+    }
+}
+
+fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: buffer.as_entire_binding(),
+    }
+}
+
+impl PreparedFrame {
+    /// Records and submits one frame; returns GPU milliseconds per pass when the
+    /// adapter has timestamps.
+    pub fn execute(&self, r: &Renderer) -> Result<Option<Vec<(String, f64)>>, RenderError> {
+        let device = &r.ctx.device;
+        let plan = &self.graph.plan;
+        let mut encoder = device.create_command_encoder(&Default::default());
+        for name in &self.absent {
+            if let Some(b) = self.resources.buffer(plan, name) {
+                encoder.clear_buffer(b, 0, None);
+            } else if let Some(t) = self.resources.texture(plan, name) {
+                encoder.clear_texture(t, &Default::default());
+            }
+        }
+        let ts = |i: usize| {
+            self.queries.as_ref().map(|(q, _)| (q, 2 * i as u32, 2 * i as u32 + 1))
+        };
+        for (i, (name, exec)) in self.passes.iter().enumerate() {
+            let compute_ts = ts(i).map(|(q, a, b)| wgpu::ComputePassTimestampWrites {
+                query_set: q,
+                beginning_of_pass_write_index: Some(a),
+                end_of_pass_write_index: Some(b),
+            });
+            let render_ts = ts(i).map(|(q, a, b)| wgpu::RenderPassTimestampWrites {
+                query_set: q,
+                beginning_of_pass_write_index: Some(a),
+                end_of_pass_write_index: Some(b),
+            });
+            match exec {
+                PassExec::Prepass { depth, clear, draws, bind } => {
+                    let view = self.resources.view(plan, depth).unwrap();
+                    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                        label: Some(name),
+                        color_attachments: &[],
+                        depth_stencil_attachment: Some(depth_attachment(view, *clear)),
+                        timestamp_writes: render_ts,
+                        occlusion_query_set: None,
+                        multiview_mask: None,
+                    });
+                    draw_meshes(&mut pass, bind, draws);
+                }
+                PassExec::Shading { color, depth, clear, draws, bind } => {
+                    let cview = self.resources.view(plan, color).unwrap();
+                    let dview = self.resources.view(plan, depth).unwrap();
+                    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                        label: Some(name),
+                        color_attachments: &[Some(color_attachment(cview, *clear))],
+                        depth_stencil_attachment: Some(depth_attachment(dview, false)),
+                        timestamp_writes: render_ts,
+                        occlusion_query_set: None,
+                        multiview_mask: None,
+                    });
+                    draw_meshes(&mut pass, bind, draws);
+                }
+                PassExec::Culling { pipeline, bind, groups, lists } => {
+                    // Header words (pool cursor and overflow counters) start at zero.
+                    encoder.clear_buffer(self.resources.buffer(plan, lists).unwrap(), 0, Some(16));
+                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some(name),
+                        timestamp_writes: compute_ts,
+                    });
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(0, bind, &[]);
+                    pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
+                }
+                PassExec::Compute { pipeline, bind, groups } => {
+                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some(name),
+                        timestamp_writes: compute_ts,
+                    });
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(0, bind, &[]);
+                    pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
+                }
+                PassExec::Fullscreen { pipeline, bind, target, clear } => {
+                    let view = self.resources.view(plan, target).unwrap();
+                    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                        label: Some(name),
+                        color_attachments: &[Some(color_attachment(view, *clear))],
+                        depth_stencil_attachment: None,
+                        timestamp_writes: render_ts,
+                        occlusion_query_set: None,
+                        multiview_mask: None,
+                    });
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(0, bind, &[]);
+                    pass.draw(0..3, 0..1);
+                }
+            }
+        }
+        if let Some((pipeline, bind, _)) = &self.stats {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("light statistics"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, bind, &[]);
+            pass.dispatch_workgroups(self.size.width.div_ceil(8), self.size.height.div_ceil(8), 1);
+        }
+        if let Some((q, buf)) = &self.queries {
+            encoder.resolve_query_set(q, 0..2 * self.passes.len() as u32, buf, 0);
+        }
+        r.ctx.queue.submit([encoder.finish()]);
+        let Some((_, buf)) = &self.queries else {
+            device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|e| RenderError::Wgpu(e.to_string()))?;
+            return Ok(None);
+        };
+        let bytes = read_buffer(device, &r.ctx.queue, buf)?;
+        let ticks: &[u64] = bytemuck::cast_slice(&bytes);
+        let period = r.ctx.queue.get_timestamp_period() as f64;
+        Ok(Some(
+            self.passes
+                .iter()
+                .enumerate()
+                .map(|(i, (n, _))| {
+                    let dt = ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period;
+                    (n.clone(), dt / 1e6)
+                })
+                .collect(),
+        ))
+    }
+
+    /// Runs one frame and reads back the output, culling reports and statistics.
+    pub fn render(&self, r: &Renderer) -> Result<FrameResult, RenderError> {
+        let pass_ms = self.execute(r)?;
+        let device = &r.ctx.device;
+        let plan = &self.graph.plan;
+        let image = read_rgba32f(device, &r.ctx.queue, self.resources.texture(plan, self.graph.output()).unwrap())?;
+        let mut culling = Vec::new();
+        for (name, exec) in &self.passes {
+            if let PassExec::Culling { lists, .. } = exec {
+                let layout = list_layout_for(&self.graph, lists, self.size).unwrap().0;
+                let words = read_buffer(device, &r.ctx.queue, self.resources.buffer(plan, lists).unwrap())?;
+                let words: &[u32] = bytemuck::cast_slice(&words);
+                let counts = (0..layout.lists() as usize)
+                    .map(|l| words[(ListLayout::HEADER_WORDS + ListLayout::ENTRY_WORDS * l as u32 + 1) as usize])
+                    .collect();
+                culling.push(CullingReport {
+                    pass: name.clone(),
+                    layout,
+                    overflowed_lists: words[1],
+                    longest_list: words[2],
+                    counts,
+                });
+            }
+        }
+        let light_stats = match &self.stats {
+            Some((_, _, buf)) => {
+                let bytes = read_buffer(device, &r.ctx.queue, buf)?;
+                let counts: &[[u32; 2]] = bytemuck::cast_slice(&bytes);
+                let mut s = LightStats::default();
+                for &[listed, exact] in counts {
+                    if listed == 0 && exact == 0 {
+                        continue;
+                    }
+                    s.pixels += 1;
+                    s.listed_total += listed as u64;
+                    s.exact_total += exact as u64;
+                    s.max_listed = s.max_listed.max(listed);
+                    s.max_exact = s.max_exact.max(exact);
+                }
+                Some(s)
+            }
+            None => None,
+        };
+        Ok(FrameResult {
+            width: self.size.width,
+            height: self.size.height,
+            image,
+            pass_ms,
+            culling,
+            light_stats,
+        })
+    }
+
+    /// Moves the camera without re-preparing (benchmarks, the viewer).
+    pub fn set_camera(&self, r: &Renderer, scene: &Scene, light_count: u32) {
+        let f = GpuFrame::new(&scene.camera, scene.ambient, self.size.width, self.size.height, light_count);
+        r.ctx.queue.write_buffer(&self.frame_uniform, 0, bytemuck::bytes_of(&f));
+    }
+}
+
+fn depth_attachment(view: &wgpu::TextureView, clear: bool) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+    wgpu::RenderPassDepthStencilAttachment {
+        view,
+        depth_ops: Some(wgpu::Operations {
+            load: if clear { wgpu::LoadOp::Clear(1.0) } else { wgpu::LoadOp::Load },
+            store: wgpu::StoreOp::Store,
+        }),
+        stencil_ops: None,
+    }
+}
+
+fn color_attachment(view: &wgpu::TextureView, clear: bool) -> wgpu::RenderPassColorAttachment<'_> {
+    wgpu::RenderPassColorAttachment {
+        view,
+        depth_slice: None,
+        resolve_target: None,
+        ops: wgpu::Operations {
+            load: if clear { wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT) } else { wgpu::LoadOp::Load },
+            store: wgpu::StoreOp::Store,
+        },
+    }
+}
+
+fn draw_meshes(pass: &mut wgpu::RenderPass<'_>, bind: &wgpu::BindGroup, draws: &[Draw]) {
+    pass.set_bind_group(0, bind, &[]);
+    let mut current: Option<*const wgpu::RenderPipeline> = None;
+    for d in draws {
+        // Draws are sorted by material: switch pipelines only when it changes.
+        let ptr = Arc::as_ptr(&d.pipeline);
+        if current != Some(ptr) {
+            pass.set_pipeline(&d.pipeline);
+            current = Some(ptr);
+        }
+        pass.set_vertex_buffer(0, d.vertices.slice(..));
+        pass.set_index_buffer(d.indices.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..d.index_count, 0, 0..1);
+    }
+}
+
+/// One mesh drawn with its material's pipeline.
+pub(super) struct Draw {
+    pipeline: Arc<wgpu::RenderPipeline>,
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    index_count: u32,
+}

@@ -1,0 +1,55 @@
+//! Running a compiled graph on wgpu: physical resources from the plan, pipelines from
+//! the cache, one wgpu pass per graph pass with GPU timestamps around it, readback.
+
+mod frame;
+mod generic;
+pub mod materials;
+mod pipelines;
+mod resources;
+mod scene_gpu;
+
+pub use frame::{CullingReport, FrameResult, LightStats, PreparedFrame};
+pub use materials::MaterialProgram;
+pub use pipelines::{Pipeline, PipelineCache, PipelineKey};
+pub use resources::FrameResources;
+pub use scene_gpu::{GpuMesh, SceneGpu};
+
+use crate::gpu::{GpuContext, GpuError};
+use crate::shader::{ShaderError, ShaderLibrary};
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum RenderError {
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+    #[error("pass '{pass}': {source}")]
+    Shader { pass: String, source: ShaderError },
+    #[error("pass '{pass}': {message}")]
+    Pass { pass: String, message: String },
+    #[error("output '{0}' must be an Rgba32Float texture to be read back")]
+    OutputFormat(String),
+    #[error("wgpu reported: {0}")]
+    Wgpu(String),
+}
+
+/// A device, the shader library and the pipeline cache.
+pub struct Renderer {
+    pub ctx: GpuContext,
+    pub shaders: ShaderLibrary,
+    pub pipelines: PipelineCache,
+}
+
+impl Renderer {
+    pub fn new(ctx: GpuContext, shaders: ShaderLibrary) -> Self {
+        Self {
+            ctx,
+            shaders,
+            pipelines: PipelineCache::default(),
+        }
+    }
+
+    /// Opens the first adapter and uses the project's shaders/.
+    pub fn headless() -> Result<Self, GpuError> {
+        Ok(Self::new(GpuContext::new_headless()?, ShaderLibrary::builtin()))
+    }
+}

@@ -1,0 +1,65 @@
+//! Pipeline cache: keyed by shader file, defines, material and target state, so an
+//! unchanged pass reuses its pipelines across graph recompiles and frames.
+
+use crate::shader::{Composed, ShaderError, ShaderLibrary};
+use std::collections::{BTreeMap, HashMap};
+use std::sync::Arc;
+
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct PipelineKey {
+    pub shader: String,
+    pub defines: BTreeMap<String, String>,
+    /// Generated code's text (materials), part of the key so an edit rebuilds.
+    pub virtual_code: BTreeMap<String, String>,
+    /// Target formats, sample count, entry points...
+    pub state: String,
+}
+
+#[derive(Clone)]
+pub enum Pipeline {
+    Render(Arc<wgpu::RenderPipeline>),
+    Compute(Arc<wgpu::ComputePipeline>),
+}
+
+#[derive(Default)]
+pub struct PipelineCache {
+    pipelines: HashMap<PipelineKey, Pipeline>,
+    pub builds: usize,
+}
+
+impl PipelineCache {
+    /// Returns the cached pipeline or composes, validates (naga, with file:line errors)
+    /// and builds it with `build`.
+    pub fn get_or_build(
+        &mut self,
+        shaders: &ShaderLibrary,
+        key: PipelineKey,
+        build: impl FnOnce(&Composed, wgpu::ShaderModule) -> Pipeline,
+        device: &wgpu::Device,
+    ) -> Result<Pipeline, ShaderError> {
+        if let Some(p) = self.pipelines.get(&key) {
+            return Ok(p.clone());
+        }
+        let composed = shaders.compose(&key.shader, &key.defines, &key.virtual_code)?;
+        composed.validate()?;
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(&key.shader),
+            source: wgpu::ShaderSource::Wgsl(composed.text.clone().into()),
+        });
+        let pipeline = build(&composed, module);
+        self.builds += 1;
+        self.pipelines.insert(key, pipeline.clone());
+        Ok(pipeline)
+    }
+
+    pub fn len(&self) -> usize {
+        self.pipelines.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.pipelines.is_empty()
+    }
+    /// Drops every pipeline built from `file` (hot reload).
+    pub fn invalidate_file(&mut self, file: &str) {
+        self.pipelines.retain(|k, _| k.shader != file);
+    }
+}

@@ -1,0 +1,98 @@
+//! A scene uploaded to the GPU: one vertex and index buffer per mesh, the two light
+//! arrays, and one material program per scene material.
+
+use super::materials::MaterialProgram;
+use crate::gpu::structs::{light_buffers, GpuVertex};
+use crate::scene::{AlphaMode, Scene};
+use wgpu::util::DeviceExt;
+
+pub struct GpuMesh {
+    pub vertices: wgpu::Buffer,
+    pub indices: wgpu::Buffer,
+    pub index_count: u32,
+    pub material: usize,
+}
+
+pub struct SceneGpu {
+    pub meshes: Vec<GpuMesh>,
+    pub materials: Vec<MaterialProgram>,
+    pub light_geometry: wgpu::Buffer,
+    pub light_properties: wgpu::Buffer,
+    pub light_count: u32,
+}
+
+impl SceneGpu {
+    pub fn upload(device: &wgpu::Device, scene: &Scene) -> Self {
+        let mut materials: Vec<MaterialProgram> =
+            scene.materials.iter().map(MaterialProgram::from_surface).collect();
+        if materials.is_empty() {
+            materials.push(MaterialProgram::from_surface(&Default::default()));
+        }
+        Self::upload_with(device, scene, materials)
+    }
+
+    pub fn upload_with(device: &wgpu::Device, scene: &Scene, materials: Vec<MaterialProgram>) -> Self {
+        let meshes = scene
+            .meshes
+            .iter()
+            .filter(|m| !m.indices.is_empty())
+            .map(|m| {
+                let vertices: Vec<GpuVertex> = (0..m.positions.len())
+                    .map(|i| GpuVertex {
+                        position: m.positions[i].into(),
+                        normal: m.normals.get(i).copied().unwrap_or(glam::Vec3::Y).into(),
+                        uv: m.uvs.get(i).copied().unwrap_or_default().into(),
+                        tangent: m.tangents.get(i).copied().unwrap_or_default().into(),
+                    })
+                    .collect();
+                GpuMesh {
+                    vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some(&m.name),
+                        contents: bytemuck::cast_slice(&vertices),
+                        usage: wgpu::BufferUsages::VERTEX,
+                    }),
+                    indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some(&m.name),
+                        contents: bytemuck::cast_slice(&m.indices),
+                        usage: wgpu::BufferUsages::INDEX,
+                    }),
+                    index_count: m.indices.len() as u32,
+                    material: m.material.min(materials.len() - 1),
+                }
+            })
+            .collect();
+        let (geometry, properties) = light_buffers(&scene.lights);
+        // Storage bindings may not be empty: a scene without lights binds one unused entry.
+        let storage = |label: &str, bytes: &[u8]| {
+            let padded;
+            let contents = if bytes.is_empty() {
+                padded = vec![0u8; 32];
+                &padded[..]
+            } else {
+                bytes
+            };
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            })
+        };
+        Self {
+            meshes,
+            materials,
+            light_geometry: storage("light geometry", bytemuck::cast_slice(&geometry)),
+            light_properties: storage("light properties", bytemuck::cast_slice(&properties)),
+            light_count: scene.lights.len() as u32,
+        }
+    }
+
+    /// Mesh indices to draw for opaque and alpha-masked geometry, sorted by material so
+    /// pipeline changes are as few as possible.
+    pub fn opaque_draws(&self) -> Vec<usize> {
+        let mut draws: Vec<usize> = (0..self.meshes.len())
+            .filter(|&i| self.materials[self.meshes[i].material].alpha_mode != AlphaMode::Blend)
+            .collect();
+        draws.sort_by_key(|&i| self.meshes[i].material);
+        draws
+    }
+}
