@@ -4,8 +4,8 @@
 //! without a GPU (see [`graph`]), then executed headless on wgpu (see [`renderer`]).
 
 pub mod gpu;
-pub mod render;
 pub mod graph;
 pub mod material;
+pub mod render;
 pub mod scene;
 pub mod shader;

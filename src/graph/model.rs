@@ -4,6 +4,7 @@ use serde::{Deserialize, Serialize};
 
 /// A whole graph file (`graphs/*.ron`).
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(rename = "Graph", deny_unknown_fields)]
 pub struct GraphDesc {
     pub name: String,
     #[serde(default)]
@@ -144,6 +145,7 @@ impl SceneFeature {
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(rename = "Pass", deny_unknown_fields)]
 pub struct PassDesc {
     pub name: String,
     pub kind: PassKind,

@@ -232,8 +232,12 @@ fn describe(
             samples,
         } => {
             let (width, height) = texture_extent(*size, frame);
-            // Copies: readback of the output and of any texture a test inspects.
+            // Copies: readback of the output and of any texture a test inspects. Depth
+            // is also sampled by the statistics pass.
             let mut usage = T::COPY_SRC;
+            if format.is_depth() {
+                usage |= T::TEXTURE_BINDING;
+            }
             for &p in schedule {
                 let role = &roles[p];
                 let is_slot =

@@ -8,8 +8,8 @@ use super::{RenderError, Renderer};
 use crate::gpu::readback::{read_buffer, read_rgba32f};
 use crate::gpu::structs::{GpuFrame, GpuListParams, GpuVertex};
 use crate::graph::{
-    CompiledGraph, CullVariant, Dispatch, FrameSize, LightSource, ListLayout, PassKind, ResourceDesc,
-    Slot, TextureFormat,
+    CompiledGraph, CullVariant, Dispatch, FrameSize, LightSource, ListLayout, PassKind,
+    ResourceDesc, Slot, TextureFormat,
 };
 use crate::scene::{AlphaMode, Scene};
 use std::collections::BTreeMap;
@@ -121,7 +121,10 @@ pub struct PreparedFrame {
 pub(super) type PassExecParts<P> = (Arc<P>, wgpu::BindGroup);
 
 fn defines(pairs: &[(&str, String)]) -> BTreeMap<String, String> {
-    pairs.iter().map(|(k, v)| (k.to_string(), v.clone())).collect()
+    pairs
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.clone()))
+        .collect()
 }
 
 fn variant_code(v: CullVariant) -> u32 {
@@ -133,7 +136,11 @@ fn variant_code(v: CullVariant) -> u32 {
     }
 }
 
-fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+fn storage_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    read_only: bool,
+) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
@@ -173,9 +180,17 @@ fn depth_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
 }
 
 /// The list layout of the culling pass that writes `lists` (even if it was culled).
-pub(super) fn list_layout_for(graph: &CompiledGraph, lists: &str, size: FrameSize) -> Option<(ListLayout, u32, u32)> {
+pub(super) fn list_layout_for(
+    graph: &CompiledGraph,
+    lists: &str,
+    size: FrameSize,
+) -> Option<(ListLayout, u32, u32)> {
     graph.checked.desc.passes.iter().find_map(|p| match p.kind {
-        PassKind::LightCulling { tile, variant, capacity } if p.writes.iter().any(|w| w == lists) => Some((
+        PassKind::LightCulling {
+            tile,
+            variant,
+            capacity,
+        } if p.writes.iter().any(|w| w == lists) => Some((
             ListLayout::new(tile, variant, capacity, size.width, size.height),
             tile,
             variant_code(variant),
@@ -197,12 +212,28 @@ impl Renderer {
     ) -> Result<PreparedFrame, RenderError> {
         let device = self.ctx.device.clone();
         let out = graph.output().to_string();
-        match graph.checked.desc.resources.iter().find(|r| r.name() == out) {
-            Some(ResourceDesc::Texture { format: TextureFormat::Rgba32Float, samples: 1, .. }) => {}
+        match graph
+            .checked
+            .desc
+            .resources
+            .iter()
+            .find(|r| r.name() == out)
+        {
+            Some(ResourceDesc::Texture {
+                format: TextureFormat::Rgba32Float,
+                samples: 1,
+                ..
+            }) => {}
             _ => return Err(RenderError::OutputFormat(out)),
         }
         let resources = FrameResources::create(&device, &graph.plan);
-        let gpu_frame = GpuFrame::new(&scene.camera, scene.ambient, size.width, size.height, gpu.light_count);
+        let gpu_frame = GpuFrame::new(
+            &scene.camera,
+            scene.ambient,
+            size.width,
+            size.height,
+            gpu.light_count,
+        );
         let frame_uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("frame"),
             contents: bytemuck::bytes_of(&gpu_frame),
@@ -230,7 +261,12 @@ impl Renderer {
             graph
                 .passes
                 .iter()
-                .find(|p| graph.checked.desc.passes[p.index].writes.iter().any(|w| w == name))
+                .find(|p| {
+                    graph.checked.desc.passes[p.index]
+                        .writes
+                        .iter()
+                        .any(|w| w == name)
+                })
                 .is_some_and(|p| p.name == pass)
         };
         for sp in &graph.passes {
@@ -260,10 +296,15 @@ impl Renderer {
                         bind,
                     }
                 }
-                PassKind::LightCulling { tile, variant, capacity } => {
+                PassKind::LightCulling {
+                    tile,
+                    variant,
+                    capacity,
+                } => {
                     let lists = sp.roles.slot(Slot::LightLists).unwrap().to_string();
                     let depth = sp.roles.slot(Slot::Depth).unwrap();
-                    let layout = ListLayout::new(*tile, *variant, *capacity, size.width, size.height);
+                    let layout =
+                        ListLayout::new(*tile, *variant, *capacity, size.width, size.height);
                     let params = GpuListParams {
                         tiles_x: layout.tiles_x,
                         tiles_y: layout.tiles_y,
@@ -324,17 +365,29 @@ impl Renderer {
                             },
                             &device,
                         )
-                        .map_err(|source| RenderError::Shader { pass: sp.name.clone(), source })?;
-                    let Pipeline::Compute(pipeline) = pipeline else { unreachable!() };
-                    let depth_view = resources.view(&graph.plan, depth).ok_or_else(|| pass_err("depth not planned".into()))?;
-                    let list_buf = resources.buffer(&graph.plan, &lists).ok_or_else(|| pass_err("lists not planned".into()))?;
+                        .map_err(|source| RenderError::Shader {
+                            pass: sp.name.clone(),
+                            source,
+                        })?;
+                    let Pipeline::Compute(pipeline) = pipeline else {
+                        unreachable!()
+                    };
+                    let depth_view = resources
+                        .view(&graph.plan, depth)
+                        .ok_or_else(|| pass_err("depth not planned".into()))?;
+                    let list_buf = resources
+                        .buffer(&graph.plan, &lists)
+                        .ok_or_else(|| pass_err("lists not planned".into()))?;
                     let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
                         label: Some(&sp.name),
                         layout: &bgl,
                         entries: &[
                             entry(0, &frame_uniform),
                             entry(1, &gpu.light_geometry),
-                            wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(depth_view) },
+                            wgpu::BindGroupEntry {
+                                binding: 2,
+                                resource: wgpu::BindingResource::TextureView(depth_view),
+                            },
                             entry(3, list_buf),
                             entry(4, &params),
                         ],
@@ -360,8 +413,10 @@ impl Renderer {
                     let params_buf;
                     if culled {
                         let lists = sp.roles.slot(Slot::LightLists).unwrap();
-                        let (ll, tile, variant) = list_layout_for(&graph, lists, size)
-                            .ok_or_else(|| pass_err(format!("no LightCulling pass writes '{lists}'")))?;
+                        let (ll, tile, variant) =
+                            list_layout_for(&graph, lists, size).ok_or_else(|| {
+                                pass_err(format!("no LightCulling pass writes '{lists}'"))
+                            })?;
                         params_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                             label: Some("list params"),
                             contents: bytemuck::bytes_of(&GpuListParams {
@@ -376,7 +431,9 @@ impl Renderer {
                             }),
                             usage: wgpu::BufferUsages::UNIFORM,
                         });
-                        let buf = resources.buffer(&graph.plan, lists).ok_or_else(|| pass_err("lists not planned".into()))?;
+                        let buf = resources
+                            .buffer(&graph.plan, lists)
+                            .ok_or_else(|| pass_err("lists not planned".into()))?;
                         entries.push(entry(3, buf));
                         entries.push(entry(4, &params_buf));
                     }
@@ -385,7 +442,8 @@ impl Renderer {
                         layout: &layout,
                         entries: &entries,
                     });
-                    let draws = self.material_draws(gpu, &layout, Some(culled), samples, false, &sp.name)?;
+                    let draws =
+                        self.material_draws(gpu, &layout, Some(culled), samples, false, &sp.name)?;
                     PassExec::Shading {
                         clear: first_writer(&color, &sp.name),
                         color,
@@ -396,19 +454,48 @@ impl Renderer {
                 }
                 PassKind::Compute { dispatch, .. } => {
                     let composed = graph.checked.shaders[sp.index].as_ref().unwrap();
-                    let (pipeline, bind) = self.generic_compute(&graph, sp, composed, &resources, &frame_uniform, gpu)?;
+                    let (pipeline, bind) = self.generic_compute(
+                        &graph,
+                        sp,
+                        composed,
+                        &resources,
+                        &frame_uniform,
+                        gpu,
+                    )?;
                     let groups = match *dispatch {
-                        Dispatch::PerPixel { workgroup: (x, y) } => [size.width.div_ceil(x.max(1)), size.height.div_ceil(y.max(1)), 1],
-                        Dispatch::PerTile { tile } => [size.width.div_ceil(tile.max(1)), size.height.div_ceil(tile.max(1)), 1],
-                        Dispatch::PerLight { workgroup } => [gpu.light_count.div_ceil(workgroup.max(1)).max(1), 1, 1],
+                        Dispatch::PerPixel { workgroup: (x, y) } => [
+                            size.width.div_ceil(x.max(1)),
+                            size.height.div_ceil(y.max(1)),
+                            1,
+                        ],
+                        Dispatch::PerTile { tile } => [
+                            size.width.div_ceil(tile.max(1)),
+                            size.height.div_ceil(tile.max(1)),
+                            1,
+                        ],
+                        Dispatch::PerLight { workgroup } => {
+                            [gpu.light_count.div_ceil(workgroup.max(1)).max(1), 1, 1]
+                        }
                         Dispatch::Fixed(x, y, z) => [x, y, z],
                     };
-                    PassExec::Compute { pipeline, bind, groups }
+                    PassExec::Compute {
+                        pipeline,
+                        bind,
+                        groups,
+                    }
                 }
                 PassKind::Fullscreen { .. } => {
                     let composed = graph.checked.shaders[sp.index].as_ref().unwrap();
                     let target = sp.roles.target.clone().unwrap();
-                    let (pipeline, bind) = self.generic_fullscreen(&graph, sp, composed, &resources, &frame_uniform, gpu, &target)?;
+                    let (pipeline, bind) = self.generic_fullscreen(
+                        &graph,
+                        sp,
+                        composed,
+                        &resources,
+                        &frame_uniform,
+                        gpu,
+                        &target,
+                    )?;
                     PassExec::Fullscreen {
                         clear: first_writer(&target, &sp.name),
                         pipeline,
@@ -419,7 +506,13 @@ impl Renderer {
             };
             passes.push((sp.name.clone(), exec));
         }
-        let absent = graph.plan.resources.iter().filter(|r| r.absent).map(|r| r.name.clone()).collect();
+        let absent = graph
+            .plan
+            .resources
+            .iter()
+            .filter(|r| r.absent)
+            .map(|r| r.name.clone())
+            .collect();
         let queries = self.ctx.has_timestamps.then(|| {
             let count = 2 * (passes.len() as u32 + 1);
             (
@@ -460,7 +553,9 @@ impl Renderer {
             .resources
             .iter()
             .find_map(|r| match r {
-                ResourceDesc::Texture { name: n, samples, .. } if n == name => Some(*samples),
+                ResourceDesc::Texture {
+                    name: n, samples, ..
+                } if n == name => Some(*samples),
                 _ => None,
             })
             .unwrap_or(1)
@@ -502,7 +597,10 @@ impl Renderer {
                 shader: "forward/forward.wgsl".into(),
                 defines: defines(&d),
                 virtual_code: BTreeMap::from([("material".to_string(), m.wgsl.clone())]),
-                state: format!("samples={samples} double_sided={} depth_only={depth_only}", m.double_sided),
+                state: format!(
+                    "samples={samples} double_sided={} depth_only={depth_only}",
+                    m.double_sided
+                ),
             };
             let cull_mode = (!m.double_sided).then_some(wgpu::Face::Back);
             let pipeline = self
@@ -523,38 +621,40 @@ impl Renderer {
                             compilation_options: Default::default(),
                             targets: if depth_only { &[] } else { &targets },
                         });
-                        Pipeline::Render(Arc::new(device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                            label: Some(pass),
-                            layout: Some(&pl),
-                            vertex: wgpu::VertexState {
-                                module: &module,
-                                entry_point: Some("vs_main"),
-                                compilation_options: Default::default(),
-                                buffers: &[Some(GpuVertex::layout())],
-                            },
-                            primitive: wgpu::PrimitiveState {
-                                cull_mode,
-                                ..Default::default()
-                            },
-                            depth_stencil: Some(wgpu::DepthStencilState {
-                                format: wgpu::TextureFormat::Depth32Float,
-                                depth_write_enabled: Some(depth_only),
-                                depth_compare: Some(if depth_only {
-                                    wgpu::CompareFunction::Less
-                                } else {
-                                    wgpu::CompareFunction::LessEqual
+                        Pipeline::Render(Arc::new(device.create_render_pipeline(
+                            &wgpu::RenderPipelineDescriptor {
+                                label: Some(pass),
+                                layout: Some(&pl),
+                                vertex: wgpu::VertexState {
+                                    module: &module,
+                                    entry_point: Some("vs_main"),
+                                    compilation_options: Default::default(),
+                                    buffers: &[Some(GpuVertex::layout())],
+                                },
+                                primitive: wgpu::PrimitiveState {
+                                    cull_mode,
+                                    ..Default::default()
+                                },
+                                depth_stencil: Some(wgpu::DepthStencilState {
+                                    format: wgpu::TextureFormat::Depth32Float,
+                                    depth_write_enabled: Some(depth_only),
+                                    depth_compare: Some(if depth_only {
+                                        wgpu::CompareFunction::Less
+                                    } else {
+                                        wgpu::CompareFunction::LessEqual
+                                    }),
+                                    stencil: Default::default(),
+                                    bias: Default::default(),
                                 }),
-                                stencil: Default::default(),
-                                bias: Default::default(),
-                            }),
-                            multisample: wgpu::MultisampleState {
-                                count: samples,
-                                ..Default::default()
+                                multisample: wgpu::MultisampleState {
+                                    count: samples,
+                                    ..Default::default()
+                                },
+                                fragment,
+                                multiview_mask: None,
+                                cache: None,
                             },
-                            fragment,
-                            multiview_mask: None,
-                            cache: None,
-                        })))
+                        )))
                     },
                     &device,
                 )
@@ -562,7 +662,9 @@ impl Renderer {
                     pass: format!("{pass} (material '{}')", m.name),
                     source,
                 })?;
-            let Pipeline::Render(pipeline) = pipeline else { unreachable!() };
+            let Pipeline::Render(pipeline) = pipeline else {
+                unreachable!()
+            };
             let gm = &gpu.meshes[mesh];
             draws.push(Draw {
                 pipeline,
@@ -597,7 +699,9 @@ impl PreparedFrame {
             }
         }
         let ts = |i: usize| {
-            self.queries.as_ref().map(|(q, _)| (q, 2 * i as u32, 2 * i as u32 + 1))
+            self.queries
+                .as_ref()
+                .map(|(q, _)| (q, 2 * i as u32, 2 * i as u32 + 1))
         };
         for (i, (name, exec)) in self.passes.iter().enumerate() {
             let compute_ts = ts(i).map(|(q, a, b)| wgpu::ComputePassTimestampWrites {
@@ -611,7 +715,12 @@ impl PreparedFrame {
                 end_of_pass_write_index: Some(b),
             });
             match exec {
-                PassExec::Prepass { depth, clear, draws, bind } => {
+                PassExec::Prepass {
+                    depth,
+                    clear,
+                    draws,
+                    bind,
+                } => {
                     let view = self.resources.view(plan, depth).unwrap();
                     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                         label: Some(name),
@@ -623,7 +732,13 @@ impl PreparedFrame {
                     });
                     draw_meshes(&mut pass, bind, draws);
                 }
-                PassExec::Shading { color, depth, clear, draws, bind } => {
+                PassExec::Shading {
+                    color,
+                    depth,
+                    clear,
+                    draws,
+                    bind,
+                } => {
                     let cview = self.resources.view(plan, color).unwrap();
                     let dview = self.resources.view(plan, depth).unwrap();
                     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -636,7 +751,12 @@ impl PreparedFrame {
                     });
                     draw_meshes(&mut pass, bind, draws);
                 }
-                PassExec::Culling { pipeline, bind, groups, lists } => {
+                PassExec::Culling {
+                    pipeline,
+                    bind,
+                    groups,
+                    lists,
+                } => {
                     // Header words (pool cursor and overflow counters) start at zero.
                     encoder.clear_buffer(self.resources.buffer(plan, lists).unwrap(), 0, Some(16));
                     let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -647,7 +767,11 @@ impl PreparedFrame {
                     pass.set_bind_group(0, bind, &[]);
                     pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
                 }
-                PassExec::Compute { pipeline, bind, groups } => {
+                PassExec::Compute {
+                    pipeline,
+                    bind,
+                    groups,
+                } => {
                     let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                         label: Some(name),
                         timestamp_writes: compute_ts,
@@ -656,7 +780,12 @@ impl PreparedFrame {
                     pass.set_bind_group(0, bind, &[]);
                     pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
                 }
-                PassExec::Fullscreen { pipeline, bind, target, clear } => {
+                PassExec::Fullscreen {
+                    pipeline,
+                    bind,
+                    target,
+                    clear,
+                } => {
                     let view = self.resources.view(plan, target).unwrap();
                     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                         label: Some(name),
@@ -711,15 +840,26 @@ impl PreparedFrame {
         let pass_ms = self.execute(r)?;
         let device = &r.ctx.device;
         let plan = &self.graph.plan;
-        let image = read_rgba32f(device, &r.ctx.queue, self.resources.texture(plan, self.graph.output()).unwrap())?;
+        let image = read_rgba32f(
+            device,
+            &r.ctx.queue,
+            self.resources.texture(plan, self.graph.output()).unwrap(),
+        )?;
         let mut culling = Vec::new();
         for (name, exec) in &self.passes {
             if let PassExec::Culling { lists, .. } = exec {
                 let layout = list_layout_for(&self.graph, lists, self.size).unwrap().0;
-                let words = read_buffer(device, &r.ctx.queue, self.resources.buffer(plan, lists).unwrap())?;
+                let words = read_buffer(
+                    device,
+                    &r.ctx.queue,
+                    self.resources.buffer(plan, lists).unwrap(),
+                )?;
                 let words: &[u32] = bytemuck::cast_slice(&words);
                 let counts = (0..layout.lists() as usize)
-                    .map(|l| words[(ListLayout::HEADER_WORDS + ListLayout::ENTRY_WORDS * l as u32 + 1) as usize])
+                    .map(|l| {
+                        words[(ListLayout::HEADER_WORDS + ListLayout::ENTRY_WORDS * l as u32 + 1)
+                            as usize]
+                    })
                     .collect();
                 culling.push(CullingReport {
                     pass: name.clone(),
@@ -761,16 +901,31 @@ impl PreparedFrame {
 
     /// Moves the camera without re-preparing (benchmarks, the viewer).
     pub fn set_camera(&self, r: &Renderer, scene: &Scene, light_count: u32) {
-        let f = GpuFrame::new(&scene.camera, scene.ambient, self.size.width, self.size.height, light_count);
-        r.ctx.queue.write_buffer(&self.frame_uniform, 0, bytemuck::bytes_of(&f));
+        let f = GpuFrame::new(
+            &scene.camera,
+            scene.ambient,
+            self.size.width,
+            self.size.height,
+            light_count,
+        );
+        r.ctx
+            .queue
+            .write_buffer(&self.frame_uniform, 0, bytemuck::bytes_of(&f));
     }
 }
 
-fn depth_attachment(view: &wgpu::TextureView, clear: bool) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+fn depth_attachment(
+    view: &wgpu::TextureView,
+    clear: bool,
+) -> wgpu::RenderPassDepthStencilAttachment<'_> {
     wgpu::RenderPassDepthStencilAttachment {
         view,
         depth_ops: Some(wgpu::Operations {
-            load: if clear { wgpu::LoadOp::Clear(1.0) } else { wgpu::LoadOp::Load },
+            load: if clear {
+                wgpu::LoadOp::Clear(1.0)
+            } else {
+                wgpu::LoadOp::Load
+            },
             store: wgpu::StoreOp::Store,
         }),
         stencil_ops: None,
@@ -783,7 +938,11 @@ fn color_attachment(view: &wgpu::TextureView, clear: bool) -> wgpu::RenderPassCo
         depth_slice: None,
         resolve_target: None,
         ops: wgpu::Operations {
-            load: if clear { wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT) } else { wgpu::LoadOp::Load },
+            load: if clear {
+                wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
+            } else {
+                wgpu::LoadOp::Load
+            },
             store: wgpu::StoreOp::Store,
         },
     }

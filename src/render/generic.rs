@@ -42,16 +42,25 @@ impl Renderer {
                 "frame" => frame_uniform.as_entire_binding(),
                 "linear_sampler" => wgpu::BindingResource::Sampler(&linear),
                 "nearest_sampler" => wgpu::BindingResource::Sampler(&nearest),
-                _ => match graph.checked.desc.resources.iter().find(|r| r.name() == name) {
+                _ => match graph
+                    .checked
+                    .desc
+                    .resources
+                    .iter()
+                    .find(|r| r.name() == name)
+                {
                     Some(ResourceDesc::Import { from, .. }) => match from {
                         SceneResource::LightGeometry => gpu.light_geometry.as_entire_binding(),
                         SceneResource::LightProperties => gpu.light_properties.as_entire_binding(),
                         SceneResource::Geometry => return Err(missing()),
                     },
-                    Some(ResourceDesc::Buffer { .. }) => resources.buffer(plan, name).ok_or_else(missing)?.as_entire_binding(),
-                    Some(ResourceDesc::Texture { .. }) => {
-                        wgpu::BindingResource::TextureView(resources.view(plan, name).ok_or_else(missing)?)
-                    }
+                    Some(ResourceDesc::Buffer { .. }) => resources
+                        .buffer(plan, name)
+                        .ok_or_else(missing)?
+                        .as_entire_binding(),
+                    Some(ResourceDesc::Texture { .. }) => wgpu::BindingResource::TextureView(
+                        resources.view(plan, name).ok_or_else(missing)?,
+                    ),
                     None => return Err(missing()),
                 },
             };
@@ -77,7 +86,9 @@ impl Renderer {
         frame_uniform: &wgpu::Buffer,
         gpu: &SceneGpu,
     ) -> Result<PassExecParts<wgpu::ComputePipeline>, RenderError> {
-        let crate::graph::PassKind::Compute { shader, entry, .. } = &sp.kind else { unreachable!() };
+        let crate::graph::PassKind::Compute { shader, entry, .. } = &sp.kind else {
+            unreachable!()
+        };
         let device = self.ctx.device.clone();
         let key = PipelineKey {
             shader: shader.clone(),
@@ -92,20 +103,34 @@ impl Renderer {
                 &self.shaders,
                 key,
                 |_, module| {
-                    Pipeline::Compute(Arc::new(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                        label: Some(&sp.name),
-                        layout: None,
-                        module: &module,
-                        entry_point: Some(entry),
-                        compilation_options: Default::default(),
-                        cache: None,
-                    })))
+                    Pipeline::Compute(Arc::new(device.create_compute_pipeline(
+                        &wgpu::ComputePipelineDescriptor {
+                            label: Some(&sp.name),
+                            layout: None,
+                            module: &module,
+                            entry_point: Some(entry),
+                            compilation_options: Default::default(),
+                            cache: None,
+                        },
+                    )))
                 },
                 &device,
             )
-            .map_err(|source| RenderError::Shader { pass: sp.name.clone(), source })?;
-        let Pipeline::Compute(pipeline) = pipeline else { unreachable!() };
-        let bind = self.bind_generic(graph, sp, &pipeline.get_bind_group_layout(0), resources, frame_uniform, gpu)?;
+            .map_err(|source| RenderError::Shader {
+                pass: sp.name.clone(),
+                source,
+            })?;
+        let Pipeline::Compute(pipeline) = pipeline else {
+            unreachable!()
+        };
+        let bind = self.bind_generic(
+            graph,
+            sp,
+            &pipeline.get_bind_group_layout(0),
+            resources,
+            frame_uniform,
+            gpu,
+        )?;
         Ok((pipeline, bind))
     }
 
@@ -120,14 +145,18 @@ impl Renderer {
         gpu: &SceneGpu,
         target: &str,
     ) -> Result<PassExecParts<wgpu::RenderPipeline>, RenderError> {
-        let crate::graph::PassKind::Fullscreen { shader, entry } = &sp.kind else { unreachable!() };
+        let crate::graph::PassKind::Fullscreen { shader, entry } = &sp.kind else {
+            unreachable!()
+        };
         let format = graph
             .checked
             .desc
             .resources
             .iter()
             .find_map(|r| match r {
-                ResourceDesc::Texture { name, format, .. } if name == target => Some(format.to_wgpu()),
+                ResourceDesc::Texture { name, format, .. } if name == target => {
+                    Some(format.to_wgpu())
+                }
                 _ => None,
             })
             .unwrap();
@@ -140,12 +169,11 @@ impl Renderer {
             virtual_code: BTreeMap::new(),
             state: format!("fullscreen entry={entry} format={format:?}"),
         };
-        let vs_text = std::fs::read_to_string(self.shaders.root.join("common/fullscreen_vs.wgsl")).map_err(|e| {
-            RenderError::Pass {
+        let vs_text = std::fs::read_to_string(self.shaders.root.join("common/fullscreen_vs.wgsl"))
+            .map_err(|e| RenderError::Pass {
                 pass: sp.name.clone(),
                 message: format!("common/fullscreen_vs.wgsl: {e}"),
-            }
-        })?;
+            })?;
         let pipeline = self
             .pipelines
             .get_or_build(
@@ -156,33 +184,47 @@ impl Renderer {
                         label: Some(shader),
                         source: wgpu::ShaderSource::Wgsl(format!("{}\n{vs_text}", c.text).into()),
                     });
-                    Pipeline::Render(Arc::new(device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                        label: Some(&sp.name),
-                        layout: None,
-                        vertex: wgpu::VertexState {
-                            module: &module,
-                            entry_point: Some("lightgraph_fullscreen_vs"),
-                            compilation_options: Default::default(),
-                            buffers: &[],
+                    Pipeline::Render(Arc::new(device.create_render_pipeline(
+                        &wgpu::RenderPipelineDescriptor {
+                            label: Some(&sp.name),
+                            layout: None,
+                            vertex: wgpu::VertexState {
+                                module: &module,
+                                entry_point: Some("lightgraph_fullscreen_vs"),
+                                compilation_options: Default::default(),
+                                buffers: &[],
+                            },
+                            primitive: Default::default(),
+                            depth_stencil: None,
+                            multisample: Default::default(),
+                            fragment: Some(wgpu::FragmentState {
+                                module: &module,
+                                entry_point: Some(entry),
+                                compilation_options: Default::default(),
+                                targets: &[Some(format.into())],
+                            }),
+                            multiview_mask: None,
+                            cache: None,
                         },
-                        primitive: Default::default(),
-                        depth_stencil: None,
-                        multisample: Default::default(),
-                        fragment: Some(wgpu::FragmentState {
-                            module: &module,
-                            entry_point: Some(entry),
-                            compilation_options: Default::default(),
-                            targets: &[Some(format.into())],
-                        }),
-                        multiview_mask: None,
-                        cache: None,
-                    })))
+                    )))
                 },
                 &device,
             )
-            .map_err(|source| RenderError::Shader { pass: sp.name.clone(), source })?;
-        let Pipeline::Render(pipeline) = pipeline else { unreachable!() };
-        let bind = self.bind_generic(graph, sp, &pipeline.get_bind_group_layout(0), resources, frame_uniform, gpu)?;
+            .map_err(|source| RenderError::Shader {
+                pass: sp.name.clone(),
+                source,
+            })?;
+        let Pipeline::Render(pipeline) = pipeline else {
+            unreachable!()
+        };
+        let bind = self.bind_generic(
+            graph,
+            sp,
+            &pipeline.get_bind_group_layout(0),
+            resources,
+            frame_uniform,
+            gpu,
+        )?;
         Ok((pipeline, bind))
     }
 
@@ -224,19 +266,26 @@ impl Renderer {
                 &self.shaders,
                 key,
                 |_, module| {
-                    Pipeline::Compute(Arc::new(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                        label: Some("light statistics"),
-                        layout: None,
-                        module: &module,
-                        entry_point: Some("main"),
-                        compilation_options: Default::default(),
-                        cache: None,
-                    })))
+                    Pipeline::Compute(Arc::new(device.create_compute_pipeline(
+                        &wgpu::ComputePipelineDescriptor {
+                            label: Some("light statistics"),
+                            layout: None,
+                            module: &module,
+                            entry_point: Some("main"),
+                            compilation_options: Default::default(),
+                            cache: None,
+                        },
+                    )))
                 },
                 &device,
             )
-            .map_err(|source| RenderError::Shader { pass: "light statistics".into(), source })?;
-        let Pipeline::Compute(pipeline) = pipeline else { unreachable!() };
+            .map_err(|source| RenderError::Shader {
+                pass: "light statistics".into(),
+                source,
+            })?;
+        let Pipeline::Compute(pipeline) = pipeline else {
+            unreachable!()
+        };
         let counts = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("light counts"),
             size: 8 * size.width as u64 * size.height as u64,
@@ -252,12 +301,30 @@ impl Renderer {
         let plan = &graph.plan;
         let depth_view = resources.view(plan, depth).unwrap();
         let mut entries = vec![
-            wgpu::BindGroupEntry { binding: 0, resource: frame_uniform.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: gpu.light_geometry.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 2, resource: gpu.light_properties.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(depth_view) },
-            wgpu::BindGroupEntry { binding: 5, resource: counts.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 6, resource: inv.as_entire_binding() },
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: frame_uniform.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: gpu.light_geometry.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: gpu.light_properties.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: wgpu::BindingResource::TextureView(depth_view),
+            },
+            wgpu::BindGroupEntry {
+                binding: 5,
+                resource: counts.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 6,
+                resource: inv.as_entire_binding(),
+            },
         ];
         let params;
         if let Some(lists) = lists {
@@ -280,7 +347,10 @@ impl Renderer {
                 binding: 7,
                 resource: resources.buffer(plan, lists).unwrap().as_entire_binding(),
             });
-            entries.push(wgpu::BindGroupEntry { binding: 4, resource: params.as_entire_binding() });
+            entries.push(wgpu::BindGroupEntry {
+                binding: 4,
+                resource: params.as_entire_binding(),
+            });
         }
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("light statistics"),

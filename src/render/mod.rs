@@ -50,6 +50,9 @@ impl Renderer {
 
     /// Opens the first adapter and uses the project's shaders/.
     pub fn headless() -> Result<Self, GpuError> {
-        Ok(Self::new(GpuContext::new_headless()?, ShaderLibrary::builtin()))
+        Ok(Self::new(
+            GpuContext::new_headless()?,
+            ShaderLibrary::builtin(),
+        ))
     }
 }

@@ -44,12 +44,14 @@ impl FrameResources {
                     let view = texture.create_view(&Default::default());
                     Physical::Texture { texture, view }
                 }
-                PhysicalDesc::Buffer { bytes } => Physical::Buffer(device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some(&format!("physical #{i} ({})", p.serves.join(", "))),
-                    size: *bytes,
-                    usage: p.buffer_usage,
-                    mapped_at_creation: false,
-                })),
+                PhysicalDesc::Buffer { bytes } => {
+                    Physical::Buffer(device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some(&format!("physical #{i} ({})", p.serves.join(", "))),
+                        size: *bytes,
+                        usage: p.buffer_usage,
+                        mapped_at_creation: false,
+                    }))
+                }
             })
             .collect();
         Self { physical }

@@ -23,15 +23,22 @@ pub struct SceneGpu {
 
 impl SceneGpu {
     pub fn upload(device: &wgpu::Device, scene: &Scene) -> Self {
-        let mut materials: Vec<MaterialProgram> =
-            scene.materials.iter().map(MaterialProgram::from_surface).collect();
+        let mut materials: Vec<MaterialProgram> = scene
+            .materials
+            .iter()
+            .map(MaterialProgram::from_surface)
+            .collect();
         if materials.is_empty() {
             materials.push(MaterialProgram::from_surface(&Default::default()));
         }
         Self::upload_with(device, scene, materials)
     }
 
-    pub fn upload_with(device: &wgpu::Device, scene: &Scene, materials: Vec<MaterialProgram>) -> Self {
+    pub fn upload_with(
+        device: &wgpu::Device,
+        scene: &Scene,
+        materials: Vec<MaterialProgram>,
+    ) -> Self {
         let meshes = scene
             .meshes
             .iter()
