@@ -1,0 +1,6 @@
+//! Built-in procedural scenes.
+use super::types::Scene;
+pub const NAMES: &[&str] = &["atrium", "harada", "depth_discontinuity"];
+pub fn by_name(_name: &str) -> Option<Scene> {
+    None
+}
