@@ -740,7 +740,7 @@ impl Importer {
                         if i % 2 == 0 {
                             [a, b, c]
                         } else {
-                            [b, a, c]
+                            [a, c, b]
                         }
                     })
                     .collect(),
