@@ -1,5 +1,47 @@
 //! Scenes: what gets rendered. Geometry in world space, lights, a camera.
+//!
+//! [`load`] reads a scene RON (`.ron`), a glTF (`.gltf`) or a binary glTF (`.glb`);
+//! [`builtin`] has the procedural scenes; [`lights`] the procedural light sets.
 
+pub mod builtin;
+mod error;
+pub mod geometry;
+pub mod gltf_import;
+pub mod gltf_writer;
+pub mod lights;
+pub mod scene_file;
 mod types;
 
+pub use error::SceneError;
 pub use types::*;
+
+use std::path::Path;
+
+/// A loaded scene and the warnings met while loading it (missing textures, skipped
+/// primitives, lights given a finite range...). The library never prints them.
+#[derive(Clone, Debug, Default)]
+pub struct Loaded {
+    pub scene: Scene,
+    pub warnings: Vec<String>,
+}
+
+/// Loads a scene file, dispatching on the extension: `.ron` (scene file), `.gltf`, `.glb`.
+pub fn load(path: &Path) -> Result<Loaded, SceneError> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let mut loaded = match ext.as_str() {
+        "ron" => scene_file::load_scene_file(path)?,
+        "gltf" | "glb" => gltf_import::import_gltf(path)?,
+        _ => {
+            return Err(SceneError::invalid(
+                path,
+                "file name",
+                format!("unknown scene extension \"{ext}\" (expected .ron, .gltf or .glb)"),
+            ))
+        }
+    };
+    loaded.scene.source_path = Some(path.to_path_buf());
+    Ok(loaded)
+}

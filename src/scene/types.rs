@@ -183,6 +183,14 @@ pub struct SceneFeatures {
     pub has_spot_lights: bool,
     pub has_lights: bool,
     pub msaa: bool,
+    /// Some light is a point light.
+    pub has_point_lights: bool,
+    /// Some drawn material is double-sided (needs two-sided lighting / no back-face culling).
+    pub has_double_sided: bool,
+    /// Some drawn material emits light.
+    pub has_emissive: bool,
+    /// Some light is restricted to a subset of material types (`material_mask != u32::MAX`).
+    pub has_material_masks: bool,
 }
 
 /// Everything needed to render a frame.
@@ -197,6 +205,12 @@ pub struct Scene {
     pub output_size: Option<(u32, u32)>,
     /// Constant ambient radiance added to every surface (0 for reference scenes).
     pub ambient: Vec3,
+    /// Material overrides from a scene RON: (imported material name, material RON path as
+    /// written in the scene file, e.g. `materials/brushed_metal.ron`). Loaded by the material
+    /// module; names that match no material were reported as warnings at load.
+    pub material_overrides: Vec<(String, std::path::PathBuf)>,
+    /// The file this scene was loaded from (`None` for built-in scenes).
+    pub source_path: Option<std::path::PathBuf>,
 }
 
 impl Scene {
@@ -223,7 +237,24 @@ impl Scene {
                 .any(|l| matches!(l.shape, LightShape::Spot { .. })),
             has_lights: !self.lights.is_empty(),
             msaa: false,
+            has_point_lights: self
+                .lights
+                .iter()
+                .any(|l| matches!(l.shape, LightShape::Point)),
+            has_double_sided: uses(&|m| m.double_sided),
+            has_emissive: uses(&|m| m.emissive != Vec3::ZERO || m.emissive_texture.is_some()),
+            has_material_masks: self.lights.iter().any(|l| l.material_mask != u32::MAX),
         }
+    }
+
+    /// Number of triangles over all meshes.
+    pub fn triangle_count(&self) -> usize {
+        self.meshes.iter().map(|m| m.indices.len() / 3).sum()
+    }
+
+    /// Index of the material called `name`, if any.
+    pub fn material_index(&self, name: &str) -> Option<usize> {
+        self.materials.iter().position(|m| m.name == name)
     }
 
     /// Axis-aligned bounds of all geometry, or `None` for an empty scene.

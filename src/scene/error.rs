@@ -1,0 +1,72 @@
+//! Scene loading errors. Every error names the file and the element at fault.
+
+use std::fmt;
+use std::path::PathBuf;
+
+/// An error from [`crate::scene::load`] and the importers. `Display` reads
+/// `FILE: ELEMENT: MESSAGE` (or `FILE:LINE:COL: MESSAGE` for RON syntax errors).
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// A file could not be read.
+    #[error("{}: cannot read file: {source}", file.display())]
+    Io {
+        file: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// RON syntax or type error.
+    #[error("{}:{line}:{col}: {message}", file.display())]
+    Parse {
+        file: PathBuf,
+        line: usize,
+        col: usize,
+        message: String,
+    },
+    /// Bad content: names the element (e.g. `mesh 0 ("box") primitive 1 accessor 3`).
+    #[error("{}: {element}: {message}", file.display())]
+    Invalid {
+        file: PathBuf,
+        element: String,
+        message: String,
+    },
+    /// A count past a safety limit.
+    #[error("{}: {element}: {what} {count} exceeds the limit of {limit}", file.display())]
+    Limit {
+        file: PathBuf,
+        element: String,
+        what: &'static str,
+        count: u64,
+        limit: u64,
+    },
+}
+
+impl SceneError {
+    pub fn invalid(
+        file: impl Into<PathBuf>,
+        element: impl fmt::Display,
+        message: impl fmt::Display,
+    ) -> Self {
+        SceneError::Invalid {
+            file: file.into(),
+            element: element.to_string(),
+            message: message.to_string(),
+        }
+    }
+
+    pub fn io(file: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        SceneError::Io {
+            file: file.into(),
+            source,
+        }
+    }
+
+    /// The file the error is about.
+    pub fn file(&self) -> &std::path::Path {
+        match self {
+            SceneError::Io { file, .. }
+            | SceneError::Parse { file, .. }
+            | SceneError::Invalid { file, .. }
+            | SceneError::Limit { file, .. } => file,
+        }
+    }
+}
