@@ -3,9 +3,11 @@
 //! Pass graphs and materials are RON files; they are parsed, validated and compiled
 //! without a GPU (see [`graph`]), then executed headless on wgpu (see [`renderer`]).
 
+pub mod bench;
 pub mod gpu;
 pub mod render;
 pub mod graph;
 pub mod material;
+pub mod reload;
 pub mod scene;
 pub mod shader;
