@@ -56,7 +56,10 @@ fn expect_once(w: &FileWatcher, path: &Path, kind: ChangeKind, expected: &[&Path
         match w.wait_for_change(left) {
             Some(b) if b.contains(path) => break b,
             Some(b) => seen.push(b),
-            None => panic!("no batch named {} within {PRESENT:?}; saw {seen:?}", path.display()),
+            None => panic!(
+                "no batch named {} within {PRESENT:?}; saw {seen:?}",
+                path.display()
+            ),
         }
     };
     assert!(seen.is_empty(), "unexpected earlier batches {seen:?}");
@@ -103,7 +106,12 @@ fn reading_does_not_trigger() {
 fn temp_file_then_rename_over() {
     let f = fixture();
     let lit = f.root.join("shaders/lit.wgsl");
-    for tmp in ["lit.wgsl.tmp", ".tmpA1b2C3", "lit.wgsl___jb_tmp___", ".goutputstream-XYZ123"] {
+    for tmp in [
+        "lit.wgsl.tmp",
+        ".tmpA1b2C3",
+        "lit.wgsl___jb_tmp___",
+        ".goutputstream-XYZ123",
+    ] {
         let tmp = f.root.join("shaders").join(tmp);
         fs::write(&tmp, format!("// via {}\n", tmp.display())).unwrap();
         fs::rename(&tmp, &lit).unwrap();
@@ -145,7 +153,11 @@ fn vim_style_backup_rename_and_rewrite() {
 fn truncate_then_write_quickly() {
     let f = fixture();
     let lit = f.root.join("shaders/lit.wgsl");
-    let mut file = OpenOptions::new().write(true).truncate(true).open(&lit).unwrap();
+    let mut file = OpenOptions::new()
+        .write(true)
+        .truncate(true)
+        .open(&lit)
+        .unwrap();
     file.flush().unwrap();
     file.write_all(b"// rewritten\n").unwrap();
     drop(file);
@@ -156,7 +168,11 @@ fn truncate_then_write_quickly() {
 fn truncate_then_slow_write_holds_the_empty_file_back() {
     let f = fixture();
     let lit = f.root.join("shaders/lit.wgsl");
-    let mut file = OpenOptions::new().write(true).truncate(true).open(&lit).unwrap();
+    let mut file = OpenOptions::new()
+        .write(true)
+        .truncate(true)
+        .open(&lit)
+        .unwrap();
     file.flush().unwrap();
     // Several debounce periods pass with an empty file: no batch may name it.
     expect_quiet(&f.watcher);
@@ -210,7 +226,16 @@ fn delete_for_good_is_reported_as_removed() {
 fn editor_temp_files_alone_are_ignored() {
     let f = fixture();
     let dir = f.root.join("shaders");
-    for name in ["lit.wgsl.swp", ".lit.wgsl.swx", "lit.wgsl~", ".#lit.wgsl", "#lit.wgsl#", "4913", "sedAb12Cd", "x.bak"] {
+    for name in [
+        "lit.wgsl.swp",
+        ".lit.wgsl.swx",
+        "lit.wgsl~",
+        ".#lit.wgsl",
+        "#lit.wgsl#",
+        "4913",
+        "sedAb12Cd",
+        "x.bak",
+    ] {
         fs::write(dir.join(name), "junk").unwrap();
     }
     fs::remove_file(dir.join("4913")).unwrap();

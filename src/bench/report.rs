@@ -326,7 +326,7 @@ fn register_fonts() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
         for family in ["sans-serif", "serif", "monospace"] {
-            plotters::style::register_font(family, FontStyle::Normal, FONT)
+            plotters::style::register_font(family, plotters::style::FontStyle::Normal, FONT)
                 .unwrap_or_else(|_| panic!("bundled font is a valid TrueType font"));
         }
     });
@@ -418,8 +418,8 @@ fn render_plot(
                 chart
                     .configure_series_labels()
                     .position(SeriesLabelPosition::UpperLeft)
-                    .background_style(WHITE.mix(0.85))
-                    .border_style(BLACK)
+                    .background_style(&WHITE.mix(0.85))
+                    .border_style(&BLACK)
                     .draw()
                     .map_err(|e| plot_err(&e))?;
             }};

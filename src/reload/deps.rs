@@ -124,9 +124,16 @@ mod tests {
         let mut d = DependencyIndex::new();
         d.set_dependencies(
             "pipeline:forward",
-            ["shaders/forward.wgsl", "shaders/lights.wgsl", "shaders/brdf.wgsl"],
+            [
+                "shaders/forward.wgsl",
+                "shaders/lights.wgsl",
+                "shaders/brdf.wgsl",
+            ],
         );
-        d.set_dependencies("pipeline:cull", ["shaders/cull.wgsl", "shaders/lights.wgsl"]);
+        d.set_dependencies(
+            "pipeline:cull",
+            ["shaders/cull.wgsl", "shaders/lights.wgsl"],
+        );
         d.add("materials/gold.ron", "material:gold");
         d
     }
@@ -134,7 +141,10 @@ mod tests {
     #[test]
     fn affected_maps_changes_to_dependents() {
         let d = index();
-        assert_eq!(d.affected(["shaders/brdf.wgsl"]), set(&["pipeline:forward"]));
+        assert_eq!(
+            d.affected(["shaders/brdf.wgsl"]),
+            set(&["pipeline:forward"])
+        );
         assert_eq!(
             d.affected(["shaders/lights.wgsl"]),
             set(&["pipeline:cull", "pipeline:forward"])
@@ -162,10 +172,17 @@ mod tests {
         // forward no longer includes brdf.wgsl but now includes shadow.wgsl.
         d.set_dependencies(
             "pipeline:forward",
-            ["shaders/forward.wgsl", "shaders/lights.wgsl", "shaders/shadow.wgsl"],
+            [
+                "shaders/forward.wgsl",
+                "shaders/lights.wgsl",
+                "shaders/shadow.wgsl",
+            ],
         );
         assert!(d.affected(["shaders/brdf.wgsl"]).is_empty());
-        assert_eq!(d.affected(["shaders/shadow.wgsl"]), set(&["pipeline:forward"]));
+        assert_eq!(
+            d.affected(["shaders/shadow.wgsl"]),
+            set(&["pipeline:forward"])
+        );
         assert_eq!(d.dependencies_of("pipeline:forward").len(), 3);
         assert!(!d.paths().any(|p| p.ends_with("brdf.wgsl")));
     }
@@ -176,7 +193,10 @@ mod tests {
         assert!(d.remove_dependent("pipeline:cull"));
         assert!(!d.remove_dependent("pipeline:cull"));
         assert!(d.affected(["shaders/cull.wgsl"]).is_empty());
-        assert_eq!(d.dependents_of("shaders/lights.wgsl"), set(&["pipeline:forward"]));
+        assert_eq!(
+            d.dependents_of("shaders/lights.wgsl"),
+            set(&["pipeline:forward"])
+        );
         d.set_dependencies("pipeline:forward", Vec::<PathBuf>::new());
         d.remove_dependent("material:gold");
         assert!(d.is_empty());

@@ -291,10 +291,11 @@ impl FileWatcher {
     /// Start a watcher (and its debounce thread) watching nothing yet.
     pub fn new(config: WatchConfig) -> Result<Self, WatchError> {
         let (event_tx, event_rx) = mpsc::channel();
-        let watcher = notify::recommended_watcher(event_tx).map_err(|source| WatchError::Notify {
-            path: PathBuf::new(),
-            source,
-        })?;
+        let watcher =
+            notify::recommended_watcher(event_tx).map_err(|source| WatchError::Notify {
+                path: PathBuf::new(),
+                source,
+            })?;
         let (batch_tx, batches) = mpsc::channel();
         let shared = Arc::new(Mutex::new(Shared::default()));
         let shutdown = Arc::new(AtomicBool::new(false));
@@ -372,7 +373,10 @@ impl FileWatcher {
                         parent.canonicalize().map_err(io_err)?.join(name)
                     }
                 };
-                let parent = file.parent().expect("canonical file has a parent").to_path_buf();
+                let parent = file
+                    .parent()
+                    .expect("canonical file has a parent")
+                    .to_path_buf();
                 let mut shared = self.shared.lock().unwrap();
                 let covered = shared.dirs.iter().any(|d| parent.starts_with(d));
                 if !covered && !shared.parent_dirs.contains(&parent) {
@@ -443,9 +447,8 @@ const SHUTDOWN_POLL: Duration = Duration::from_millis(100);
 
 impl Debouncer {
     fn burst_deadline(&self) -> Option<Instant> {
-        self.burst.map(|(first, last)| {
-            (last + self.config.debounce).min(first + self.config.max_latency)
-        })
+        self.burst
+            .map(|(first, last)| (last + self.config.debounce).min(first + self.config.max_latency))
     }
 
     fn run(mut self) {
@@ -458,7 +461,10 @@ impl Debouncer {
             if let Some(d) = self.held.values().min() {
                 wake = wake.min(*d);
             }
-            match self.events.recv_timeout(wake.saturating_duration_since(now)) {
+            match self
+                .events
+                .recv_timeout(wake.saturating_duration_since(now))
+            {
                 Ok(Ok(event)) => self.on_event(event),
                 Ok(Err(e)) => log::warn!("file watcher: {e}"),
                 Err(RecvTimeoutError::Timeout) => {}
