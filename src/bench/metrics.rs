@@ -1,0 +1,384 @@
+//! Error metrics between a reference and a test image, both linear HDR RGB(A) `f32`, row-major.
+//!
+//! Conventions (the same for every metric here):
+//! - Differences are per channel on linear RGB; alpha is ignored.
+//! - A pixel with a NaN or infinite channel in *either* image is left out of RMSE, max-abs and
+//!   PSNR (one NaN would make them all NaN and hide the size of every other error); it is counted
+//!   in [`NonFinite`] for its image and always counts as a bad pixel.
+//! - FLIP is computed on both images tonemapped to sRGB8 by the same [`Tonemap`] (FLIP is an LDR
+//!   metric), through the `nv-flip` crate (NVIDIA's reference C++ implementation).
+
+use super::image_io::{write_png_rgb8, ImageIoError};
+use super::pixel::{luminance, HdrPixel};
+use super::tonemap::Tonemap;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// A comparison of images of different sizes, or a slice that does not match its size.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum MetricsError {
+    /// The reference and test slices do not both hold `width * height` pixels.
+    #[error("image size mismatch: {width}x{height} expects {expected} pixels, reference has {reference}, test has {test}")]
+    SizeMismatch {
+        /// Declared width.
+        width: u32,
+        /// Declared height.
+        height: u32,
+        /// `width * height`.
+        expected: usize,
+        /// Reference pixel count.
+        reference: usize,
+        /// Test pixel count.
+        test: usize,
+    },
+}
+
+/// What to compute in [`compare`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CompareOptions {
+    /// A pixel is *bad* when its largest absolute channel difference is strictly above this
+    /// (linear units), or when it is non-finite in either image.
+    pub bad_pixel_threshold: f32,
+    /// Compute the FLIP mean (costs a C++ FLIP pass; off for quick checks).
+    pub flip: bool,
+    /// Tonemapper used to bring both images to sRGB8 for FLIP.
+    pub tonemap: Tonemap,
+    /// FLIP viewing condition, pixels per degree of visual angle
+    /// (`nv_flip::DEFAULT_PIXELS_PER_DEGREE` is 67: a 0.7 m distance from a 0.7 m wide 4K screen).
+    pub pixels_per_degree: f32,
+}
+
+impl Default for CompareOptions {
+    fn default() -> Self {
+        Self {
+            bad_pixel_threshold: 1e-3,
+            flip: true,
+            tonemap: Tonemap::default(),
+            pixels_per_degree: nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+        }
+    }
+}
+
+/// NaN / infinite pixel counts of one image (a pixel counts once, NaN first).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct NonFinite {
+    /// Pixels with at least one NaN channel.
+    pub nan_pixels: usize,
+    /// Pixels with no NaN but at least one infinite channel.
+    pub inf_pixels: usize,
+}
+
+/// The result of [`compare`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ImageMetrics {
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Pixels finite in both images (the ones RMSE, max-abs and PSNR are over).
+    pub compared_pixels: usize,
+    /// Root mean square of the per-channel differences over the compared pixels (0 if none).
+    pub rmse: f64,
+    /// Largest absolute per-channel difference over the compared pixels.
+    pub max_abs: f64,
+    /// `10 log10(peak² / MSE)` in dB; `f64::INFINITY` when MSE is 0 (identical images).
+    pub psnr: f64,
+    /// The PSNR peak: the largest luminance (Rec. 709) of a finite reference pixel, or 1.0 if that
+    /// is smaller (so a dark reference does not inflate PSNR).
+    pub psnr_peak: f64,
+    /// Pixels whose largest channel difference is above the threshold, plus non-finite pixels.
+    pub bad_pixels: usize,
+    /// The threshold used for `bad_pixels`.
+    pub bad_pixel_threshold: f32,
+    /// Non-finite pixels in the reference.
+    pub reference_non_finite: NonFinite,
+    /// Non-finite pixels in the test image.
+    pub test_non_finite: NonFinite,
+    /// Mean FLIP error in `[0, 1]` of the tonemapped images, if requested and the image is not empty.
+    pub flip_mean: Option<f64>,
+}
+
+fn classify(rgb: [f32; 3]) -> (bool, bool) {
+    let nan = rgb.iter().any(|c| c.is_nan());
+    let inf = !nan && rgb.iter().any(|c| c.is_infinite());
+    (nan, inf)
+}
+
+fn check<P: HdrPixel>(
+    reference: &[P],
+    test: &[P],
+    width: u32,
+    height: u32,
+) -> Result<(), MetricsError> {
+    let expected = width as usize * height as usize;
+    if reference.len() != expected || test.len() != expected {
+        return Err(MetricsError::SizeMismatch {
+            width,
+            height,
+            expected,
+            reference: reference.len(),
+            test: test.len(),
+        });
+    }
+    Ok(())
+}
+
+/// Compare `test` against `reference` (both `width * height` pixels, row-major).
+pub fn compare<P: HdrPixel>(
+    reference: &[P],
+    test: &[P],
+    width: u32,
+    height: u32,
+    options: &CompareOptions,
+) -> Result<ImageMetrics, MetricsError> {
+    check(reference, test, width, height)?;
+    let mut sum_sq = 0.0f64;
+    let mut max_abs = 0.0f64;
+    let mut compared = 0usize;
+    let mut bad = 0usize;
+    let mut peak = 1.0f64;
+    let mut ref_nf = NonFinite::default();
+    let mut test_nf = NonFinite::default();
+    for (r, t) in reference.iter().zip(test) {
+        let (r, t) = (r.rgb(), t.rgb());
+        let (rn, ri) = classify(r);
+        let (tn, ti) = classify(t);
+        ref_nf.nan_pixels += rn as usize;
+        ref_nf.inf_pixels += ri as usize;
+        test_nf.nan_pixels += tn as usize;
+        test_nf.inf_pixels += ti as usize;
+        if rn || ri || tn || ti {
+            bad += 1;
+            continue;
+        }
+        peak = peak.max(luminance(r) as f64);
+        compared += 1;
+        let mut px_max = 0.0f64;
+        for c in 0..3 {
+            let d = (r[c] as f64 - t[c] as f64).abs();
+            sum_sq += d * d;
+            px_max = px_max.max(d);
+        }
+        max_abs = max_abs.max(px_max);
+        if px_max > options.bad_pixel_threshold as f64 {
+            bad += 1;
+        }
+    }
+    let mse = if compared == 0 {
+        0.0
+    } else {
+        sum_sq / (3 * compared) as f64
+    };
+    let psnr = if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        10.0 * (peak * peak / mse).log10()
+    };
+    let flip_mean = if options.flip && width > 0 && height > 0 {
+        Some(flip_mean_unchecked(
+            reference,
+            test,
+            width,
+            height,
+            &options.tonemap,
+            options.pixels_per_degree,
+        ))
+    } else {
+        None
+    };
+    Ok(ImageMetrics {
+        width,
+        height,
+        compared_pixels: compared,
+        rmse: mse.sqrt(),
+        max_abs,
+        psnr,
+        psnr_peak: peak,
+        bad_pixels: bad,
+        bad_pixel_threshold: options.bad_pixel_threshold,
+        reference_non_finite: ref_nf,
+        test_non_finite: test_nf,
+        flip_mean,
+    })
+}
+
+fn flip_error_map<P: HdrPixel>(
+    reference: &[P],
+    test: &[P],
+    width: u32,
+    height: u32,
+    tonemap: &Tonemap,
+    pixels_per_degree: f32,
+) -> nv_flip::FlipImageFloat {
+    let r = nv_flip::FlipImageRgb8::with_data(width, height, &tonemap.image_to_srgb8(reference));
+    let t = nv_flip::FlipImageRgb8::with_data(width, height, &tonemap.image_to_srgb8(test));
+    nv_flip::flip(r, t, pixels_per_degree)
+}
+
+fn flip_mean_unchecked<P: HdrPixel>(
+    reference: &[P],
+    test: &[P],
+    width: u32,
+    height: u32,
+    tonemap: &Tonemap,
+    pixels_per_degree: f32,
+) -> f64 {
+    let map = flip_error_map(reference, test, width, height, tonemap, pixels_per_degree);
+    nv_flip::FlipPool::from_image(&map).mean() as f64
+}
+
+/// Mean FLIP error (in `[0, 1]`) between the two images after tonemapping both with `tonemap`.
+/// Returns 0 for an empty image.
+pub fn flip_mean<P: HdrPixel>(
+    reference: &[P],
+    test: &[P],
+    width: u32,
+    height: u32,
+    tonemap: &Tonemap,
+    pixels_per_degree: f32,
+) -> Result<f64, MetricsError> {
+    check(reference, test, width, height)?;
+    if width == 0 || height == 0 {
+        return Ok(0.0);
+    }
+    Ok(flip_mean_unchecked(
+        reference,
+        test,
+        width,
+        height,
+        tonemap,
+        pixels_per_degree,
+    ))
+}
+
+/// How [`difference_heatmap`] scales `|a − b|` to the colour ramp.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum HeatScale {
+    /// The largest finite difference maps to the top of the ramp.
+    Auto,
+    /// This difference (linear units) maps to the top of the ramp; larger ones saturate.
+    Fixed(f32),
+}
+
+/// Heat-map colour of `t` in `[0, 1]`: black, purple, red, orange, yellow, white (an inferno-like ramp).
+pub fn heat_color(t: f32) -> [u8; 3] {
+    const STOPS: [[f32; 3]; 6] = [
+        [0.0, 0.0, 0.0],
+        [0.34, 0.06, 0.43],
+        [0.73, 0.21, 0.33],
+        [0.98, 0.50, 0.09],
+        [0.98, 0.85, 0.22],
+        [1.0, 1.0, 1.0],
+    ];
+    let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
+    let x = t * (STOPS.len() - 1) as f32;
+    let i = (x.floor() as usize).min(STOPS.len() - 2);
+    let f = x - i as f32;
+    let (a, b) = (STOPS[i], STOPS[i + 1]);
+    [0, 1, 2].map(|c| ((a[c] + (b[c] - a[c]) * f) * 255.0 + 0.5) as u8)
+}
+
+/// Colour of pixels that are NaN in either image in [`difference_heatmap`] (bright green).
+pub const HEATMAP_NAN_COLOR: [u8; 3] = [0, 255, 0];
+/// Colour of pixels that are infinite (and not NaN) in either image (cyan).
+pub const HEATMAP_INF_COLOR: [u8; 3] = [0, 255, 255];
+
+/// Per-pixel heat map of the largest absolute channel difference `max_c |a_c − b_c|`, as tightly
+/// packed RGB8 (the ramp is [`heat_color`]; non-finite pixels get [`HEATMAP_NAN_COLOR`] /
+/// [`HEATMAP_INF_COLOR`], colours the ramp never produces). Returns the pixels and the difference
+/// that maps to the top of the ramp.
+pub fn difference_heatmap<P: HdrPixel>(
+    reference: &[P],
+    test: &[P],
+    width: u32,
+    height: u32,
+    scale: HeatScale,
+) -> Result<(Vec<u8>, f32), MetricsError> {
+    check(reference, test, width, height)?;
+    let diffs: Vec<Result<f32, [u8; 3]>> = reference
+        .iter()
+        .zip(test)
+        .map(|(r, t)| {
+            let (r, t) = (r.rgb(), t.rgb());
+            let (rn, ri) = classify(r);
+            let (tn, ti) = classify(t);
+            if rn || tn {
+                Err(HEATMAP_NAN_COLOR)
+            } else if ri || ti {
+                Err(HEATMAP_INF_COLOR)
+            } else {
+                Ok((0..3).map(|c| (r[c] - t[c]).abs()).fold(0.0, f32::max))
+            }
+        })
+        .collect();
+    let top = match scale {
+        HeatScale::Fixed(v) => v,
+        HeatScale::Auto => diffs
+            .iter()
+            .filter_map(|d| d.as_ref().ok().copied())
+            .fold(0.0, f32::max),
+    };
+    let mut out = Vec::with_capacity(diffs.len() * 3);
+    for d in diffs {
+        let c = match d {
+            Ok(d) if top > 0.0 => heat_color(d / top),
+            Ok(_) => heat_color(0.0),
+            Err(c) => c,
+        };
+        out.extend_from_slice(&c);
+    }
+    Ok((out, top))
+}
+
+/// Error of [`write_difference_png`]: bad sizes or an unwritable file.
+#[derive(Debug, thiserror::Error)]
+pub enum DiffImageError {
+    /// The images do not match their size.
+    #[error(transparent)]
+    Metrics(#[from] MetricsError),
+    /// Writing the PNG failed.
+    #[error(transparent)]
+    Io(#[from] ImageIoError),
+}
+
+/// Write [`difference_heatmap`] as a PNG; returns the difference at the top of the ramp.
+pub fn write_difference_png<P: HdrPixel>(
+    path: impl AsRef<Path>,
+    reference: &[P],
+    test: &[P],
+    width: u32,
+    height: u32,
+    scale: HeatScale,
+) -> Result<f32, DiffImageError> {
+    let (rgb, top) = difference_heatmap(reference, test, width, height, scale)?;
+    write_png_rgb8(path, rgb, width, height)?;
+    Ok(top)
+}
+
+/// Write the FLIP error map (magma colour map, as the FLIP tool shows it) as a PNG.
+pub fn write_flip_png<P: HdrPixel>(
+    path: impl AsRef<Path>,
+    reference: &[P],
+    test: &[P],
+    width: u32,
+    height: u32,
+    options: &CompareOptions,
+) -> Result<(), DiffImageError> {
+    check(reference, test, width, height)?;
+    let path = path.as_ref();
+    if width == 0 || height == 0 {
+        write_png_rgb8(path, Vec::new(), width, height)?;
+        return Ok(());
+    }
+    let map = flip_error_map(
+        reference,
+        test,
+        width,
+        height,
+        &options.tonemap,
+        options.pixels_per_degree,
+    );
+    let rgb = map.apply_color_lut(&nv_flip::magma_lut()).to_vec();
+    write_png_rgb8(path, rgb, width, height)?;
+    Ok(())
+}

@@ -1,0 +1,23 @@
+//! Benchmark support: image error metrics (RMSE, max abs, PSNR, FLIP, bad / NaN pixels), the
+//! project's one tonemapper, HDR image I/O (EXR, tonemapped PNG), and reports (CSV, Markdown,
+//! PNG plots). Nothing here needs a GPU.
+
+pub mod image_io;
+pub mod metrics;
+pub mod pixel;
+pub mod report;
+pub mod tonemap;
+
+pub use image_io::{
+    read_exr, write_exr, write_png_rgb8, write_png_tonemapped, HdrImage, ImageIoError,
+};
+pub use metrics::{
+    compare, difference_heatmap, flip_mean, heat_color, write_difference_png, write_flip_png,
+    CompareOptions, DiffImageError, HeatScale, ImageMetrics, MetricsError, NonFinite,
+};
+pub use pixel::{luminance, HdrPixel};
+pub use report::{
+    plot_time_vs_error, plot_time_vs_lights, summarize, to_csv, to_markdown, write_csv,
+    write_markdown, write_report, BenchRow, ReportError, ReportFiles, TimingSummary,
+};
+pub use tonemap::{linear_to_srgb, srgb_to_linear, ToneCurve, Tonemap};

@@ -1,0 +1,355 @@
+//! Analytic checks of the bench metrics, image I/O and reports (no GPU).
+
+use lightgraph::bench::*;
+
+const W: u32 = 16;
+const H: u32 = 8;
+
+fn gradient() -> Vec<[f32; 4]> {
+    (0..W * H)
+        .map(|i| {
+            let x = (i % W) as f32 / W as f32;
+            let y = (i / W) as f32 / H as f32;
+            [x, y, 0.5 * (x + y), 1.0]
+        })
+        .collect()
+}
+
+fn no_flip() -> CompareOptions {
+    CompareOptions {
+        flip: false,
+        ..Default::default()
+    }
+}
+
+#[test]
+fn identical_images() {
+    let a = gradient();
+    let m = compare(&a, &a, W, H, &CompareOptions::default()).unwrap();
+    assert_eq!(m.rmse, 0.0);
+    assert_eq!(m.max_abs, 0.0);
+    assert!(m.psnr.is_infinite() && m.psnr > 0.0);
+    assert_eq!(m.bad_pixels, 0);
+    assert_eq!(m.compared_pixels, (W * H) as usize);
+    assert!(m.flip_mean.unwrap().abs() < 1e-6, "{:?}", m.flip_mean);
+    assert_eq!(m.psnr_peak, 1.0);
+}
+
+#[test]
+fn constant_offset_gives_known_rmse_and_psnr() {
+    let a = gradient();
+    let b: Vec<[f32; 4]> = a
+        .iter()
+        .map(|p| [p[0] + 0.125, p[1] + 0.125, p[2] + 0.125, p[3]])
+        .collect();
+    let m = compare(&a, &b, W, H, &no_flip()).unwrap();
+    assert!((m.rmse - 0.125).abs() < 1e-6, "{}", m.rmse);
+    assert!((m.max_abs - 0.125).abs() < 1e-6);
+    // Reference luminance stays below 1, so the peak is 1: PSNR = 10 log10(1 / 0.125²).
+    let expected = 10.0 * (1.0 / (0.125f64 * 0.125)).log10();
+    assert!((m.psnr - expected).abs() < 1e-4, "{} vs {expected}", m.psnr);
+    assert_eq!(m.bad_pixels, (W * H) as usize);
+    assert!(m.flip_mean.is_none());
+
+    // Threshold above the offset: no bad pixels.
+    let opts = CompareOptions {
+        bad_pixel_threshold: 0.2,
+        ..no_flip()
+    };
+    assert_eq!(compare(&a, &b, W, H, &opts).unwrap().bad_pixels, 0);
+}
+
+#[test]
+fn single_channel_offset_and_bright_peak() {
+    // Grey 4.0 reference: luminance 4 is the peak.
+    let a = vec![[4.0f32, 4.0, 4.0]; (W * H) as usize];
+    let b: Vec<[f32; 3]> = a.iter().map(|p| [p[0] + 0.3, p[1], p[2]]).collect();
+    let m = compare(&a, &b, W, H, &no_flip()).unwrap();
+    let mse: f64 = 0.09 / 3.0;
+    assert!((m.rmse - mse.sqrt()).abs() < 1e-6);
+    assert!((m.psnr_peak - 4.0).abs() < 1e-6);
+    assert!((m.psnr - 10.0 * (16.0 / mse).log10()).abs() < 1e-3);
+}
+
+#[test]
+fn rgb_and_rgba_agree() {
+    let a = gradient();
+    let b: Vec<[f32; 4]> = a
+        .iter()
+        .map(|p| [p[0] * 0.9, p[1], p[2] + 0.01, 0.0])
+        .collect();
+    let a3: Vec<[f32; 3]> = a.iter().map(|p| [p[0], p[1], p[2]]).collect();
+    let b3: Vec<[f32; 3]> = b.iter().map(|p| [p[0], p[1], p[2]]).collect();
+    let m4 = compare(&a, &b, W, H, &CompareOptions::default()).unwrap();
+    let m3 = compare(&a3, &b3, W, H, &CompareOptions::default()).unwrap();
+    assert_eq!(m4, m3);
+}
+
+#[test]
+fn non_finite_pixels_are_counted_and_excluded() {
+    let a = gradient();
+    let mut b = a.clone();
+    b[3][1] = f32::NAN;
+    b[7] = [f32::NAN, f32::INFINITY, 0.0, 1.0]; // NaN wins
+    b[9][2] = f32::NEG_INFINITY;
+    let mut a2 = a.clone();
+    a2[20][0] = f32::INFINITY;
+    let m = compare(&a2, &b, W, H, &CompareOptions::default()).unwrap();
+    assert_eq!(
+        m.test_non_finite,
+        NonFinite {
+            nan_pixels: 2,
+            inf_pixels: 1
+        }
+    );
+    assert_eq!(
+        m.reference_non_finite,
+        NonFinite {
+            nan_pixels: 0,
+            inf_pixels: 1
+        }
+    );
+    assert_eq!(m.compared_pixels, (W * H) as usize - 4);
+    assert_eq!(m.rmse, 0.0, "finite pixels are identical");
+    assert_eq!(m.bad_pixels, 4);
+    assert!(m.psnr.is_infinite());
+    assert!(m.flip_mean.unwrap().is_finite());
+}
+
+#[test]
+fn size_mismatch_is_an_error() {
+    let a = gradient();
+    let err = compare(&a, &a[1..], W, H, &no_flip()).unwrap_err();
+    assert!(matches!(
+        err,
+        MetricsError::SizeMismatch {
+            reference: 128,
+            test: 127,
+            ..
+        }
+    ));
+    assert!(err.to_string().contains("16x8"));
+}
+
+#[test]
+fn flip_grows_with_the_error() {
+    let a = gradient();
+    let small: Vec<[f32; 4]> = a.iter().map(|p| [p[0] + 0.02, p[1], p[2], 1.0]).collect();
+    let large: Vec<[f32; 4]> = a.iter().map(|p| [p[0] + 0.5, p[1], p[2], 1.0]).collect();
+    let t = Tonemap::default();
+    let ppd = CompareOptions::default().pixels_per_degree;
+    let fs = flip_mean(&a, &small, W, H, &t, ppd).unwrap();
+    let fl = flip_mean(&a, &large, W, H, &t, ppd).unwrap();
+    assert!(fs > 0.0 && fs < fl && fl <= 1.0, "{fs} {fl}");
+}
+
+#[test]
+fn exr_round_trip_is_bit_exact() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sub/out.exr");
+    let specials = [
+        0.0,
+        -0.0,
+        1.0,
+        -2.5,
+        1e-40, // subnormal
+        f32::MIN_POSITIVE,
+        3.4e38,
+        65504.0,
+        1.0 / 3.0,
+        std::f32::consts::PI,
+    ];
+    let pixels: Vec<[f32; 4]> = (0..W * H)
+        .map(|i| {
+            let s = specials[i as usize % specials.len()];
+            [
+                s,
+                i as f32 * 0.001_7,
+                -(i as f32).sqrt(),
+                1.0 - i as f32 / 1000.0,
+            ]
+        })
+        .collect();
+    write_exr(&path, &pixels, W, H).unwrap();
+    let back = read_exr(&path).unwrap();
+    assert_eq!((back.width, back.height), (W, H));
+    for (a, b) in pixels.iter().zip(&back.pixels) {
+        assert_eq!(a.map(f32::to_bits), b.map(f32::to_bits), "{a:?} vs {b:?}");
+    }
+
+    // RGB input gets alpha 1.
+    let rgb: Vec<[f32; 3]> = pixels.iter().map(|p| [p[0], p[1], p[2]]).collect();
+    write_exr(&path, &rgb, W, H).unwrap();
+    let back = read_exr(&path).unwrap();
+    assert!(back.pixels.iter().all(|p| p[3] == 1.0));
+    assert_eq!(back.pixels[5][0].to_bits(), rgb[5][0].to_bits());
+}
+
+#[test]
+fn exr_keeps_nan_and_inf() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("nan.exr");
+    let mut pixels = gradient();
+    pixels[0][0] = f32::NAN;
+    pixels[1][1] = f32::INFINITY;
+    write_exr(&path, &pixels, W, H).unwrap();
+    let back = read_exr(&path).unwrap();
+    assert!(back.pixels[0][0].is_nan());
+    assert_eq!(back.pixels[1][1], f32::INFINITY);
+}
+
+#[test]
+fn io_errors_name_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing.exr");
+    let err = read_exr(&missing).unwrap_err();
+    assert!(err.to_string().contains("missing.exr"), "{err}");
+    let err = write_exr(dir.path().join("bad.exr"), &gradient()[1..], W, H).unwrap_err();
+    assert!(matches!(err, ImageIoError::SizeMismatch { .. }));
+    assert!(err.to_string().contains("bad.exr"), "{err}");
+}
+
+#[test]
+fn png_is_tonemapped_srgb() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("out.png");
+    // Linear 1.0 through Reinhard is 0.5 display-linear, sRGB-encoded 0.7354 -> 188.
+    let pixels = vec![[1.0f32, 0.0, f32::NAN]; (W * H) as usize];
+    write_png_tonemapped(&path, &pixels, W, H, &Tonemap::default()).unwrap();
+    let img = image::open(&path).unwrap().into_rgb8();
+    assert_eq!(img.dimensions(), (W, H));
+    assert_eq!(img.get_pixel(3, 3).0, [188, 0, 0]);
+}
+
+#[test]
+fn difference_png_is_a_heat_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("diff.png");
+    let a = gradient();
+    let mut b = a.clone();
+    b[5][0] += 2.0;
+    b[6][2] += 1.0;
+    b[7][1] = f32::NAN;
+    let top = write_difference_png(&path, &a, &b, W, H, HeatScale::Auto).unwrap();
+    assert!((top - 2.0).abs() < 1e-6);
+    let img = image::open(&path).unwrap().into_rgb8();
+    assert_eq!(img.get_pixel(5, 0).0, heat_color(1.0));
+    assert_eq!(img.get_pixel(6, 0).0, heat_color(0.5));
+    assert_eq!(img.get_pixel(7, 0).0, metrics::HEATMAP_NAN_COLOR);
+    assert_eq!(img.get_pixel(0, 0).0, [0, 0, 0]);
+
+    let flip_path = dir.path().join("flip.png");
+    write_flip_png(&flip_path, &a, &b, W, H, &CompareOptions::default()).unwrap();
+    assert_eq!(
+        image::open(&flip_path).unwrap().into_rgb8().dimensions(),
+        (W, H)
+    );
+}
+
+fn rows() -> Vec<BenchRow> {
+    let mut rows = Vec::new();
+    for (tech, scale, err) in [
+        ("brute_force", 0.01, None),
+        ("forward_plus", 0.001, Some(1e-4)),
+        ("clustered, \"q\"", 0.0012, Some(3e-3)),
+    ] {
+        for lights in [64u32, 1024, 16384] {
+            let ms = 0.5 + scale * lights as f64;
+            rows.push(BenchRow {
+                scene: "sponza".into(),
+                technique: tech.into(),
+                params: "tile=16".into(),
+                light_count: lights,
+                width: 640,
+                height: 360,
+                adapter: "llvmpipe (LLVM 19, 256 bits)".into(),
+                frame_ms_median: ms,
+                frame_ms_p10: ms * 0.9,
+                frame_ms_p90: ms * 1.2,
+                pass_ms_median: vec![("depth".into(), 0.2), ("shade".into(), ms - 0.2)],
+                rmse: err,
+                psnr: err.map(|_| f64::INFINITY),
+                max_lights_per_tile: Some(lights / 8),
+                ..Default::default()
+            });
+        }
+    }
+    rows.push(BenchRow {
+        technique: "forward_plus".into(),
+        light_count: 1,
+        pass_ms_median: vec![("cull".into(), 0.05)],
+        ..Default::default()
+    });
+    rows
+}
+
+#[test]
+fn csv_and_markdown() {
+    let rows = rows();
+    let csv = to_csv(&rows);
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines.len(), rows.len() + 1);
+    let header: Vec<&str> = lines[0].split(',').collect();
+    assert_eq!(&header[..report::CSV_COLUMNS.len()], &report::CSV_COLUMNS);
+    assert_eq!(
+        &header[report::CSV_COLUMNS.len()..],
+        &["pass_ms:depth", "pass_ms:shade", "pass_ms:cull"]
+    );
+    assert!(csv.contains("\"clustered, \"\"q\"\"\""), "{csv}");
+    assert!(lines[4].contains(",inf,"), "{}", lines[4]);
+    assert!(
+        lines.last().unwrap().ends_with(",,,0.05"),
+        "{}",
+        lines.last().unwrap()
+    );
+
+    let md = to_markdown(&rows);
+    assert!(
+        md.contains("| sponza | forward_plus | tile=16 | 1024 | 640x360 |"),
+        "{md}"
+    );
+    assert!(md.contains("Per-pass median GPU time"));
+    assert!(md.contains("∞"));
+    let table_rows = md.lines().filter(|l| l.starts_with("| sponza")).count();
+    assert_eq!(table_rows, 2 * 9);
+}
+
+#[test]
+fn timing_summary() {
+    let s = summarize(&[5.0, 1.0, 3.0, 2.0, 4.0, f64::NAN]).unwrap();
+    assert_eq!(s.median, 3.0);
+    assert!((s.p10 - 1.4).abs() < 1e-12);
+    assert!((s.p90 - 4.6).abs() < 1e-12);
+    assert!(summarize(&[]).is_none());
+}
+
+#[test]
+fn report_writes_all_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let files = write_report(dir.path().join("bench"), &rows()).unwrap();
+    for png in [&files.time_vs_lights, &files.time_vs_error] {
+        let img = image::open(png).unwrap().into_rgb8();
+        assert_eq!(img.dimensions(), report::PLOT_SIZE);
+        // Something besides the white background was drawn.
+        assert!(img.pixels().filter(|p| p.0 != [255, 255, 255]).count() > 1000);
+    }
+    assert!(std::fs::read_to_string(&files.csv)
+        .unwrap()
+        .starts_with("scene,"));
+    assert!(std::fs::read_to_string(&files.markdown)
+        .unwrap()
+        .starts_with("| scene"));
+    // Empty input still gives valid (empty) plots.
+    write_report(dir.path().join("empty"), &[]).unwrap();
+}
+
+#[test]
+fn set_metrics_fills_error_columns() {
+    let a = gradient();
+    let m = compare(&a, &a, W, H, &CompareOptions::default()).unwrap();
+    let mut row = BenchRow::default();
+    row.set_metrics(&m);
+    assert_eq!(row.rmse, Some(0.0));
+    assert!(row.flip_mean.unwrap() < 1e-6);
+    assert_eq!(row.nan_pixels, Some(0));
+}
