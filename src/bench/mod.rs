@@ -2,6 +2,7 @@
 //! project's one tonemapper, HDR image I/O (EXR, tonemapped PNG), and reports (CSV, Markdown,
 //! PNG plots). Nothing here needs a GPU.
 
+pub mod heatmap;
 pub mod image_io;
 pub mod metrics;
 pub mod pixel;

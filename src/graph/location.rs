@@ -127,7 +127,7 @@ mod tests {
         let s = SourceText::new("g.ron", TEXT);
         assert_eq!(s.of_declaration("b").line, 5);
         assert_eq!(s.in_pass("b", "y").line, 6);
-        assert_eq!(s.in_pass("b", "y").col, 19);
+        assert_eq!(s.in_pass("b", "y").col, 20);
         // "x" is mentioned by both passes: the one inside pass b is found.
         assert_eq!(s.in_pass("b", "x").line, 6);
         assert_eq!(s.in_pass("a", "x").line, 3);
