@@ -353,3 +353,33 @@ fn set_metrics_fills_error_columns() {
     assert!(row.flip_mean.unwrap() < 1e-6);
     assert_eq!(row.nan_pixels, Some(0));
 }
+
+#[test]
+fn compare_exr_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b, small) = (
+        dir.path().join("a.exr"),
+        dir.path().join("b.exr"),
+        dir.path().join("s.exr"),
+    );
+    let img = gradient();
+    let shifted: Vec<[f32; 4]> = img
+        .iter()
+        .map(|p| [p[0] + 0.25, p[1] + 0.25, p[2] + 0.25, 1.0])
+        .collect();
+    write_exr(&a, &img, W, H).unwrap();
+    write_exr(&b, &shifted, W, H).unwrap();
+    write_exr(&small, &img[..(W * (H - 1)) as usize], W, H - 1).unwrap();
+    let m = compare_files(&a, &b, &CompareOptions::default()).unwrap();
+    assert!((m.rmse - 0.25).abs() < 1e-6);
+    let text = m.to_string();
+    assert!(
+        text.contains("RMSE") && text.contains("FLIP mean"),
+        "{text}"
+    );
+    let err = compare_files(&a, &small, &CompareOptions::default()).unwrap_err();
+    assert!(err.to_string().contains("s.exr is 16x7"), "{err}");
+    let err =
+        compare_files(&a, dir.path().join("nope.exr"), &CompareOptions::default()).unwrap_err();
+    assert!(err.to_string().contains("nope.exr"), "{err}");
+}

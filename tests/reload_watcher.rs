@@ -7,13 +7,13 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-const DEBOUNCE: Duration = Duration::from_millis(50);
-const GRACE: Duration = Duration::from_millis(600);
+const DEBOUNCE: Duration = Duration::from_millis(100);
+const GRACE: Duration = Duration::from_millis(1000);
 /// Upper bound for an expected batch to arrive (generous: CI machines are slow).
 const PRESENT: Duration = Duration::from_secs(10);
 /// How long to wait to be confident no (further) batch is coming: several debounce periods,
 /// still well inside the grace period.
-const ABSENT: Duration = Duration::from_millis(250);
+const ABSENT: Duration = Duration::from_millis(400);
 
 fn config() -> WatchConfig {
     WatchConfig {
@@ -46,31 +46,37 @@ fn fixture() -> Fixture {
     }
 }
 
-/// Wait for batches until one names `path`; assert it names exactly `expected` (each file once,
-/// by construction of the batch), then that no later batch names `path` again.
+/// Wait (bounded) until batches have named every path in `expected`, and assert that each is
+/// named in exactly one batch, that no other path is named, and that `path` ends as `kind`;
+/// then that no further batch comes. Usually all arrive in one batch; a slow (loaded) machine may
+/// split a burst, which is still correct as long as no path is reported twice.
 fn expect_once(w: &FileWatcher, path: &Path, kind: ChangeKind, expected: &[&Path]) -> ChangeBatch {
     let deadline = Instant::now() + PRESENT;
-    let mut seen = Vec::new();
-    let batch = loop {
+    let mut merged = ChangeBatch::default();
+    let mut batches = Vec::new();
+    while !expected.iter().all(|p| merged.contains(p)) {
         let left = deadline.saturating_duration_since(Instant::now());
-        match w.wait_for_change(left) {
-            Some(b) if b.contains(path) => break b,
-            Some(b) => seen.push(b),
-            None => panic!(
-                "no batch named {} within {PRESENT:?}; saw {seen:?}",
-                path.display()
-            ),
+        let Some(b) = w.wait_for_change(left) else {
+            panic!("not all of {expected:?} named within {PRESENT:?}; saw {batches:?}",);
+        };
+        for p in b.paths() {
+            assert!(
+                expected.contains(&p),
+                "unexpected path {} in {b:?}",
+                p.display()
+            );
+            assert!(
+                !merged.contains(p),
+                "{} named twice: {batches:?} then {b:?}",
+                p.display()
+            );
         }
-    };
-    assert!(seen.is_empty(), "unexpected earlier batches {seen:?}");
-    assert_eq!(batch.kind(path), Some(kind), "{batch:?}");
-    let mut names: Vec<&Path> = batch.paths().collect();
-    names.sort();
-    let mut want = expected.to_vec();
-    want.sort();
-    assert_eq!(names, want, "batch should name exactly these paths");
+        merged.merge(b.clone());
+        batches.push(b);
+    }
+    assert_eq!(merged.kind(path), Some(kind), "{batches:?}");
     expect_quiet(w);
-    batch
+    merged
 }
 
 fn expect_quiet(w: &FileWatcher) {
@@ -301,12 +307,13 @@ fn watching_a_file_that_does_not_exist_yet() {
 }
 
 #[test]
-fn drain_merges_ready_batches() {
+fn drain_and_try_next_never_block() {
     let f = fixture();
     assert!(f.watcher.drain().is_none());
+    assert!(f.watcher.try_next().is_none());
     let lit = f.root.join("shaders/lit.wgsl");
     fs::write(&lit, "// a\n").unwrap();
-    let first = f.watcher.wait_for_change(PRESENT).expect("batch");
-    assert!(first.contains(&lit));
-    assert!(f.watcher.try_next().is_none());
+    let batch = f.watcher.wait_for_change(PRESENT).expect("a batch");
+    assert!(batch.contains(&lit));
+    assert!(f.watcher.drain().is_none());
 }

@@ -8,11 +8,11 @@
 //! - FLIP is computed on both images tonemapped to sRGB8 by the same [`Tonemap`] (FLIP is an LDR
 //!   metric), through the `nv-flip` crate (NVIDIA's reference C++ implementation).
 
-use super::image_io::{write_png_rgb8, ImageIoError};
+use super::image_io::{read_exr, write_png_rgb8, ImageIoError};
 use super::pixel::{luminance, HdrPixel};
 use super::tonemap::Tonemap;
 use serde::{Deserialize, Serialize};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// A comparison of images of different sizes, or a slice that does not match its size.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -96,6 +96,77 @@ pub struct ImageMetrics {
     pub test_non_finite: NonFinite,
     /// Mean FLIP error in `[0, 1]` of the tonemapped images, if requested and the image is not empty.
     pub flip_mean: Option<f64>,
+}
+
+impl std::fmt::Display for ImageMetrics {
+    /// One line per metric, for `lightgraph compare` and test failure messages.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(f, "size        {}x{}", self.width, self.height)?;
+        writeln!(f, "RMSE        {:.6e}", self.rmse)?;
+        writeln!(f, "max abs     {:.6e}", self.max_abs)?;
+        writeln!(
+            f,
+            "PSNR        {:.3} dB (peak {:.4})",
+            self.psnr, self.psnr_peak
+        )?;
+        if let Some(flip) = self.flip_mean {
+            writeln!(f, "FLIP mean   {flip:.6}")?;
+        }
+        writeln!(
+            f,
+            "bad pixels  {} (> {} or non-finite)",
+            self.bad_pixels, self.bad_pixel_threshold
+        )?;
+        write!(
+            f,
+            "non-finite  reference: {} NaN, {} inf; test: {} NaN, {} inf",
+            self.reference_non_finite.nan_pixels,
+            self.reference_non_finite.inf_pixels,
+            self.test_non_finite.nan_pixels,
+            self.test_non_finite.inf_pixels
+        )
+    }
+}
+
+/// Error of [`compare_files`]: a file could not be read, or the sizes differ.
+#[derive(Debug, thiserror::Error)]
+pub enum CompareFilesError {
+    /// Reading one of the files failed.
+    #[error(transparent)]
+    Read(#[from] ImageIoError),
+    /// The images have different sizes.
+    #[error("{} is {}x{} but {} is {}x{}", reference.display(), reference_size.0, reference_size.1, test.display(), test_size.0, test_size.1)]
+    SizeMismatch {
+        /// Reference file.
+        reference: PathBuf,
+        /// Its size.
+        reference_size: (u32, u32),
+        /// Test file.
+        test: PathBuf,
+        /// Its size.
+        test_size: (u32, u32),
+    },
+}
+
+/// Read two HDR files (EXR) and [`compare`] them.
+pub fn compare_files(
+    reference: impl AsRef<Path>,
+    test: impl AsRef<Path>,
+    options: &CompareOptions,
+) -> Result<ImageMetrics, CompareFilesError> {
+    let (rp, tp) = (reference.as_ref(), test.as_ref());
+    let r = read_exr(rp)?;
+    let t = read_exr(tp)?;
+    if (r.width, r.height) != (t.width, t.height) {
+        return Err(CompareFilesError::SizeMismatch {
+            reference: rp.to_path_buf(),
+            reference_size: (r.width, r.height),
+            test: tp.to_path_buf(),
+            test_size: (t.width, t.height),
+        });
+    }
+    Ok(compare(&r.pixels, &t.pixels, r.width, r.height, options)
+        .expect("sizes come from the decoded images"))
 }
 
 fn classify(rgb: [f32; 3]) -> (bool, bool) {

@@ -13,8 +13,9 @@ pub use image_io::{
     read_exr, write_exr, write_png_rgb8, write_png_tonemapped, HdrImage, ImageIoError,
 };
 pub use metrics::{
-    compare, difference_heatmap, flip_mean, heat_color, write_difference_png, write_flip_png,
-    CompareOptions, DiffImageError, HeatScale, ImageMetrics, MetricsError, NonFinite,
+    compare, compare_files, difference_heatmap, flip_mean, heat_color, write_difference_png,
+    write_flip_png, CompareFilesError, CompareOptions, DiffImageError, HeatScale, ImageMetrics,
+    MetricsError, NonFinite,
 };
 pub use pixel::{luminance, HdrPixel};
 pub use report::{

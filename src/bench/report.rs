@@ -335,8 +335,27 @@ fn register_fonts() {
 /// Size of the plot PNGs.
 pub const PLOT_SIZE: (u32, u32) = (1024, 640);
 
-/// Series of (x, y, y_lo, y_hi) points per technique, sorted by x.
-type Series = BTreeMap<String, Vec<(f64, f64, f64, f64)>>;
+/// A point: (x, median, p10, p90).
+type Point = (f64, f64, f64, f64);
+/// Labelled series of points, each sorted by x, in legend order.
+type Series = Vec<(String, Vec<Point>)>;
+
+/// Axis label: integers as integers, otherwise up to 4 significant digits, scientific notation
+/// outside `[1e-3, 1e5)`.
+fn axis_label(x: f64) -> String {
+    if x == 0.0 {
+        return "0".into();
+    }
+    if x.abs() < 1e-3 || x.abs() >= 1e5 {
+        return format!("{x:.1e}");
+    }
+    if x.fract() == 0.0 {
+        return format!("{x:.0}");
+    }
+    let digits = (3 - x.abs().log10().floor() as i32).clamp(0, 6) as usize;
+    let s = format!("{x:.digits$}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
 
 fn render_plot(
     path: &Path,
@@ -355,7 +374,7 @@ fn render_plot(
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| plot_err(&e))?;
-        let pts = series.values().flatten();
+        let pts = series.iter().flat_map(|(_, p)| p);
         let (mut x0, mut x1, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
         for &(x, _, _, yh) in pts {
             x0 = x0.min(x);
@@ -387,6 +406,8 @@ fn render_plot(
                 chart
                     .configure_mesh()
                     .x_desc(x_desc)
+                    .x_label_formatter(&|x: &f64| axis_label(*x))
+                    .y_label_formatter(&|y: &f64| axis_label(*y))
                     .y_desc("frame time, median (ms); bars p10-p90")
                     .draw()
                     .map_err(|e| plot_err(&e))?;
@@ -441,7 +462,7 @@ fn render_plot(
 
 /// Plot median frame time (p10–p90 bars) against light count (log x), one line per technique.
 pub fn plot_time_vs_lights(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(), ReportError> {
-    let mut series = Series::new();
+    let mut series: BTreeMap<String, Vec<Point>> = BTreeMap::new();
     for r in rows.iter().filter(|r| r.light_count > 0) {
         series.entry(r.technique.clone()).or_default().push((
             r.light_count as f64,
@@ -450,9 +471,13 @@ pub fn plot_time_vs_lights(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<
             r.frame_ms_p90,
         ));
     }
-    for s in series.values_mut() {
-        s.sort_by(|a, b| a.0.total_cmp(&b.0));
-    }
+    let series: Series = series
+        .into_iter()
+        .map(|(name, mut points)| {
+            points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            (name, points)
+        })
+        .collect();
     render_plot(
         path.as_ref(),
         "Frame time vs light count",
@@ -462,13 +487,23 @@ pub fn plot_time_vs_lights(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<
     )
 }
 
-/// Plot median frame time (p10–p90 bars) against RMSE (linear x; rows without RMSE are left
-/// out), one series per technique, points joined in order of RMSE.
+/// Plot median frame time (p10–p90 bars) against RMSE (linear x from 0; rows without RMSE are
+/// left out), one series per technique, points joined in order of RMSE (a parameter sweep then
+/// draws its time/error trade-off curve). If the rows hold several light counts, each
+/// (technique, light count) pair is its own series, labelled `technique @ N lights`, so points
+/// of different scene sizes are never joined.
 pub fn plot_time_vs_error(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(), ReportError> {
-    let mut series = Series::new();
-    for r in rows {
-        if let Some(e) = r.rmse.filter(|e| e.is_finite()) {
-            series.entry(r.technique.clone()).or_default().push((
+    let with_error = || rows.iter().filter(|r| r.rmse.is_some_and(f64::is_finite));
+    let first_count = with_error().next().map(|r| r.light_count);
+    let several_counts = with_error().any(|r| Some(r.light_count) != first_count);
+    let mut series: BTreeMap<(String, u32), Vec<Point>> = BTreeMap::new();
+    for r in with_error() {
+        if let Some(e) = r.rmse {
+            let key = (
+                r.technique.clone(),
+                if several_counts { r.light_count } else { 0 },
+            );
+            series.entry(key).or_default().push((
                 e,
                 r.frame_ms_median,
                 r.frame_ms_p10,
@@ -476,9 +511,18 @@ pub fn plot_time_vs_error(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(
             ));
         }
     }
-    for s in series.values_mut() {
-        s.sort_by(|a, b| a.0.total_cmp(&b.0));
-    }
+    let series: Series = series
+        .into_iter()
+        .map(|((technique, lights), mut points)| {
+            points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let name = if several_counts {
+                format!("{technique} @ {lights} lights")
+            } else {
+                technique
+            };
+            (name, points)
+        })
+        .collect();
     render_plot(
         path.as_ref(),
         "Frame time vs error",
@@ -516,4 +560,19 @@ pub fn write_report(dir: impl AsRef<Path>, rows: &[BenchRow]) -> Result<ReportFi
     plot_time_vs_lights(&files.time_vs_lights, rows)?;
     plot_time_vs_error(&files.time_vs_error, rows)?;
     Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::axis_label;
+
+    #[test]
+    fn axis_labels_are_short() {
+        assert_eq!(axis_label(0.0), "0");
+        assert_eq!(axis_label(1000.0), "1000");
+        assert_eq!(axis_label(0.15000000000000002), "0.15");
+        assert_eq!(axis_label(0.39999999), "0.4");
+        assert_eq!(axis_label(12.5), "12.5");
+        assert_eq!(axis_label(2e-5), "2.0e-5");
+    }
 }

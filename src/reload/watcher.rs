@@ -559,3 +559,69 @@ impl Debouncer {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn editor_temp_files() {
+        for name in [
+            "a.wgsl~",
+            ".#a.wgsl",
+            "#a.wgsl#",
+            ".a.wgsl.swp",
+            "a.wgsl.SWO",
+            "4913",
+            "a.wgsl.tmp",
+            "a.bak",
+            "a.wgsl___jb_tmp___",
+            "a.wgsl___jb_old___",
+            ".goutputstream-ABC123",
+            ".tmpXyZ123",
+            "sedA1b2C3",
+            ".a.wgsl.kate-swp",
+        ] {
+            assert!(is_editor_temp_file(Path::new(name)), "{name}");
+        }
+        for name in [
+            "a.wgsl",
+            "forward_plus.ron",
+            "#include.wgsl",
+            "sed.wgsl",
+            "4914",
+            "tmp.wgsl",
+        ] {
+            assert!(!is_editor_temp_file(Path::new(name)), "{name}");
+        }
+    }
+
+    #[test]
+    fn normalize_is_lexical_for_missing_paths() {
+        let cwd = std::env::current_dir().unwrap().canonicalize().unwrap();
+        assert_eq!(
+            normalize_path(Path::new("no/such/./dir/../file.wgsl")),
+            cwd.join("no/such/file.wgsl")
+        );
+        assert_eq!(
+            normalize_path(Path::new("Cargo.toml")),
+            cwd.join("Cargo.toml")
+        );
+    }
+
+    #[test]
+    fn batch_merge_later_wins() {
+        let mut a = ChangeBatch::default();
+        a.changes.insert("/x/a".into(), ChangeKind::Removed);
+        a.changes.insert("/x/b".into(), ChangeKind::Modified);
+        let mut b = ChangeBatch::default();
+        b.changes.insert("/x/a".into(), ChangeKind::Modified);
+        b.changes.insert("/x/c".into(), ChangeKind::Removed);
+        a.merge(b);
+        assert_eq!(a.len(), 3);
+        assert_eq!(a.kind("/x/a"), Some(ChangeKind::Modified));
+        assert_eq!(a.modified().count(), 2);
+        assert_eq!(a.removed().collect::<Vec<_>>(), vec![Path::new("/x/c")]);
+        assert!(a.contains("/x/b") && !a.contains("/x/d"));
+    }
+}
