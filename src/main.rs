@@ -10,7 +10,11 @@ use lightgraph::shader::ShaderLibrary;
 use std::path::{Path, PathBuf};
 
 #[derive(Parser)]
-#[command(name = "lightgraph", version, about = "Render graphs for scenes with thousands of lights")]
+#[command(
+    name = "lightgraph",
+    version,
+    about = "Render graphs for scenes with thousands of lights"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -62,7 +66,8 @@ fn load_scene(path: Option<&Path>) -> Result<Scene> {
     match path {
         None => Ok(scene::builtin::atrium()),
         Some(p) => {
-            let loaded = scene::load(p).with_context(|| format!("loading scene {}", p.display()))?;
+            let loaded =
+                scene::load(p).with_context(|| format!("loading scene {}", p.display()))?;
             for w in &loaded.warnings {
                 eprintln!("warning: {w}");
             }
@@ -107,7 +112,15 @@ fn print_graph(path: &Path, scene_path: Option<&Path>, dot: bool) -> Result<()> 
     let scene = load_scene(scene_path)?;
     let checked = graph::check_file(path, &ShaderLibrary::builtin())?;
     let (w, h) = scene.output_size.unwrap_or((1280, 720));
-    let compiled = graph::compile(checked, &scene.features(), FrameSize { width: w, height: h, lights: scene.lights.len() as u32 });
+    let compiled = graph::compile(
+        checked,
+        &scene.features(),
+        FrameSize {
+            width: w,
+            height: h,
+            lights: scene.lights.len() as u32,
+        },
+    );
     if dot {
         print!("{}", compiled.to_dot());
     } else {
@@ -117,16 +130,27 @@ fn print_graph(path: &Path, scene_path: Option<&Path>, dot: bool) -> Result<()> 
         for c in &compiled.culled {
             println!("culled: {} ({:?})", c.name, c.reason);
         }
-        println!("{} physical resources for {} graph resources", compiled.plan.physical.len(), compiled.plan.resources.len());
+        println!(
+            "{} physical resources for {} graph resources",
+            compiled.plan.physical.len(),
+            compiled.plan.resources.len()
+        );
     }
     Ok(())
 }
 
 fn render(args: RenderArgs) -> Result<()> {
     let scene = load_scene(args.scene.as_deref())?;
-    let graph_path = args.graph.clone().unwrap_or_else(|| project_path("graphs/forward_plus.ron"));
+    let graph_path = args
+        .graph
+        .clone()
+        .unwrap_or_else(|| project_path("graphs/forward_plus.ron"));
     let (dw, dh) = scene.output_size.unwrap_or((1280, 720));
-    let size = FrameSize { width: args.width.unwrap_or(dw), height: args.height.unwrap_or(dh), lights: scene.lights.len() as u32 };
+    let size = FrameSize {
+        width: args.width.unwrap_or(dw),
+        height: args.height.unwrap_or(dh),
+        lights: scene.lights.len() as u32,
+    };
     if size.width == 0 || size.height == 0 {
         bail!("output size {}x{} is empty", size.width, size.height);
     }
@@ -148,10 +172,17 @@ fn render(args: RenderArgs) -> Result<()> {
             bail!("--heatmap needs a graph with a LightCulling pass");
         };
         let tile = size.width.div_ceil(c.layout.tiles_x);
-        let rgb = heatmap::heatmap_rgb8(&c.per_tile(), c.layout.tiles_x, tile, size.width, size.height);
+        let rgb = heatmap::heatmap_rgb8(
+            &c.per_tile(),
+            c.layout.tiles_x,
+            tile,
+            size.width,
+            size.height,
+        );
         bench::write_png_rgb8(path, rgb, size.width, size.height)?;
         let csv = path.with_extension("csv");
-        std::fs::write(&csv, heatmap::histogram_csv(&c.per_tile())).with_context(|| csv.display().to_string())?;
+        std::fs::write(&csv, heatmap::histogram_csv(&c.per_tile()))
+            .with_context(|| csv.display().to_string())?;
         println!("wrote {} and {}", path.display(), csv.display());
     }
     Ok(())
@@ -209,9 +240,20 @@ fn report(r: &Renderer, scene: &Scene, graph: &Path, result: &FrameResult) {
 }
 
 fn write_image(out: &Path, result: &FrameResult) -> Result<()> {
-    match out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+    match out
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
         Some("exr") => bench::write_exr(out, &result.image, result.width, result.height)?,
-        Some("png") => bench::write_png_tonemapped(out, &result.image, result.width, result.height, &Tonemap::default())?,
+        Some("png") => bench::write_png_tonemapped(
+            out,
+            &result.image,
+            result.width,
+            result.height,
+            &Tonemap::default(),
+        )?,
         _ => bail!("{}: output must end in .png or .exr", out.display()),
     }
     Ok(())
@@ -220,7 +262,13 @@ fn write_image(out: &Path, result: &FrameResult) -> Result<()> {
 fn compare(a: &Path, b: &Path) -> Result<()> {
     let ia = bench::read_exr(a)?;
     let ib = bench::read_exr(b)?;
-    let m = bench::compare(&ia.pixels, &ib.pixels, ia.width, ia.height, &Default::default())?;
+    let m = bench::compare(
+        &ia.pixels,
+        &ib.pixels,
+        ia.width,
+        ia.height,
+        &Default::default(),
+    )?;
     println!("{m:#?}");
     Ok(())
 }

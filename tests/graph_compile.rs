@@ -6,15 +6,23 @@ use lightgraph::scene::SceneFeatures;
 use lightgraph::shader::ShaderLibrary;
 use std::path::Path;
 
-const SIZE: FrameSize = FrameSize { width: 64, height: 32, lights: 10 };
+const SIZE: FrameSize = FrameSize {
+    width: 64,
+    height: 32,
+    lights: 10,
+};
 
 fn compile(text: &str, features: SceneFeatures) -> graph::CompiledGraph {
-    let checked = graph::check_text(Path::new("test.ron"), text, &ShaderLibrary::builtin()).unwrap();
+    let checked =
+        graph::check_text(Path::new("test.ron"), text, &ShaderLibrary::builtin()).unwrap();
     graph::compile(checked, &features, SIZE)
 }
 
 fn with_lights() -> SceneFeatures {
-    SceneFeatures { has_lights: true, ..Default::default() }
+    SceneFeatures {
+        has_lights: true,
+        ..Default::default()
+    }
 }
 
 /// Two full-screen passes with same-sized temporaries: `a` lives in passes 1-2, `b` in
@@ -42,10 +50,16 @@ const CHAIN: &str = r#"Graph(
 fn culls_unreachable_and_when_false_passes() {
     let g = compile(CHAIN, SceneFeatures::default());
     assert_eq!(g.pass_names(), ["make_a", "a_to_c", "c_to_b", "b_to_out"]);
-    assert_eq!(g.culled_reason("stats"), Some(&CullReason::WhenFalse("Lights".into())));
+    assert_eq!(
+        g.culled_reason("stats"),
+        Some(&CullReason::WhenFalse("Lights".into()))
+    );
     let g = compile(CHAIN, with_lights());
     assert_eq!(g.culled_reason("stats"), Some(&CullReason::Unreachable));
-    assert!(g.plan.get("unused").is_none(), "a culled pass's output is not allocated");
+    assert!(
+        g.plan.get("unused").is_none(),
+        "a culled pass's output is not allocated"
+    );
 }
 
 #[test]
@@ -62,7 +76,10 @@ fn non_overlapping_temporaries_share_one_texture() {
 
 #[test]
 fn side_effects_keep_a_pass() {
-    let text = CHAIN.replace("output: \"out\",", "output: \"out\",\n    side_effects: [\"stats\"],");
+    let text = CHAIN.replace(
+        "output: \"out\",",
+        "output: \"out\",\n    side_effects: [\"stats\"],",
+    );
     let g = compile(&text, with_lights());
     assert!(g.pass_names().contains(&"stats"));
 }
@@ -71,8 +88,15 @@ fn side_effects_keep_a_pass() {
 fn forward_plus_schedule_and_brute_force_culling() {
     let shaders = ShaderLibrary::builtin();
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("graphs");
-    let fp = graph::compile(graph::check_file(&root.join("forward_plus.ron"), &shaders).unwrap(), &with_lights(), SIZE);
-    assert_eq!(fp.pass_names(), ["depth_prepass", "light_culling", "forward_shading"]);
+    let fp = graph::compile(
+        graph::check_file(&root.join("forward_plus.ron"), &shaders).unwrap(),
+        &with_lights(),
+        SIZE,
+    );
+    assert_eq!(
+        fp.pass_names(),
+        ["depth_prepass", "light_culling", "forward_shading"]
+    );
     let lists = fp.plan.get("light_lists").unwrap();
     let bytes = match &fp.plan.physical[lists.physical].desc {
         graph::plan::PhysicalDesc::Buffer { bytes } => *bytes,
@@ -81,7 +105,10 @@ fn forward_plus_schedule_and_brute_force_culling() {
     // 4 x 2 tiles of 16 px, 256 lights each: header + entries + pool, in bytes.
     assert_eq!(bytes, 4 * (4 + 4 * 8 + 8 * 256));
     let dot = fp.to_dot();
-    assert!(dot.contains("\"light_culling\" -> \"res:light_lists\""), "{dot}");
+    assert!(
+        dot.contains("\"light_culling\" -> \"res:light_lists\""),
+        "{dot}"
+    );
 }
 
 #[test]

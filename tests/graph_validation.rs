@@ -23,19 +23,26 @@ fn every_bad_graph_gives_its_message() {
             .and_then(|l| l.strip_prefix("// expect: "))
             .unwrap_or_else(|| panic!("{} lacks an expect line", path.display()))
             .to_string();
-        let result = std::panic::catch_unwind(|| graph::check_file(&path, &ShaderLibrary::builtin()));
+        let result =
+            std::panic::catch_unwind(|| graph::check_file(&path, &ShaderLibrary::builtin()));
         match result {
             Err(_) => failures.push(format!("{}: panicked", path.display())),
             Ok(Ok(_)) => failures.push(format!("{}: was accepted", path.display())),
             Ok(Err(e)) => {
                 let message = e.to_string();
                 if !message.contains(&expect) {
-                    failures.push(format!("{}:\n  expected: {expect}\n  got: {message}", path.display()));
+                    failures.push(format!(
+                        "{}:\n  expected: {expect}\n  got: {message}",
+                        path.display()
+                    ));
                 }
                 // Every message names the file and a line.
                 let name = path.file_name().unwrap().to_str().unwrap();
                 if !message.contains(&format!("{name}:")) {
-                    failures.push(format!("{}: message does not name the file: {message}", path.display()));
+                    failures.push(format!(
+                        "{}: message does not name the file: {message}",
+                        path.display()
+                    ));
                 }
             }
         }
@@ -57,23 +64,33 @@ fn shipped_graphs_validate() {
 
 #[test]
 fn a_cycle_names_every_pass_on_it() {
-    let e = graph::check_file(&root().join("tests/bad/graphs/cycle.ron"), &ShaderLibrary::builtin()).unwrap_err();
-    let cycles: Vec<_> = e
-        .0
-        .iter()
-        .filter_map(|e| match e {
-            graph::GraphError::Cycle { passes, at } => Some((passes.clone(), at.line)),
-            _ => None,
-        })
-        .collect();
+    let e = graph::check_file(
+        &root().join("tests/bad/graphs/cycle.ron"),
+        &ShaderLibrary::builtin(),
+    )
+    .unwrap_err();
+    let cycles: Vec<_> =
+        e.0.iter()
+            .filter_map(|e| match e {
+                graph::GraphError::Cycle { passes, at } => Some((passes.clone(), at.line)),
+                _ => None,
+            })
+            .collect();
     assert_eq!(cycles, vec![(vec!["a".to_string(), "b".to_string()], 16)]);
 }
 
 #[test]
 fn broken_wgsl_names_the_shader_line() {
-    let e = graph::check_file(&root().join("tests/bad/graphs/broken_wgsl.ron"), &ShaderLibrary::builtin()).unwrap_err();
+    let e = graph::check_file(
+        &root().join("tests/bad/graphs/broken_wgsl.ron"),
+        &ShaderLibrary::builtin(),
+    )
+    .unwrap_err();
     let text = e.to_string();
     assert!(text.contains("pass 'fill'"), "{text}");
     assert!(text.contains("broken.wgsl:6:"), "{text}");
-    assert!(text.contains("scratch[0] = 1.5 + vec2<f32>(1.0);"), "{text}");
+    assert!(
+        text.contains("scratch[0] = 1.5 + vec2<f32>(1.0);"),
+        "{text}"
+    );
 }

@@ -6,8 +6,16 @@ use std::fmt::Write;
 /// Colour for a tile holding `count` lights.
 pub fn tile_color(count: u32) -> [u8; 3] {
     let t = (count.min(50) as f32) / 25.0;
-    let (r, g, b) = if t <= 1.0 { (0.0, t, 1.0 - t) } else { (t - 1.0, 2.0 - t, 0.0) };
-    [(r * 255.0).round() as u8, (g * 255.0).round() as u8, (b * 255.0).round() as u8]
+    let (r, g, b) = if t <= 1.0 {
+        (0.0, t, 1.0 - t)
+    } else {
+        (t - 1.0, 2.0 - t, 0.0)
+    };
+    [
+        (r * 255.0).round() as u8,
+        (g * 255.0).round() as u8,
+        (b * 255.0).round() as u8,
+    ]
 }
 
 /// RGB8 pixels of the heat map at output resolution, each pixel coloured by its tile.
@@ -50,6 +58,9 @@ mod tests {
 
     #[test]
     fn histogram_counts_tiles() {
-        assert_eq!(histogram_csv(&[0, 2, 2, 1]), "lights,tiles\n0,1\n1,1\n2,2\n");
+        assert_eq!(
+            histogram_csv(&[0, 2, 2, 1]),
+            "lights,tiles\n0,1\n1,1\n2,2\n"
+        );
     }
 }

@@ -1,0 +1,242 @@
+//! Every culling variant and tile size must give the brute-force image: a culled light
+//! contributes exactly zero (the range window reaches zero at the range), and lists keep
+//! ascending light order, so shading sums the same non-zero terms in the same order.
+//!
+//! Tolerance: 2e-6 relative to the pixel (or to 1e-3 of the frame's peak for dark
+//! pixels). Summation order is identical, so the only slack needed is the shader
+//! compiler contracting a multiply-add differently in the two pipelines (the list loop
+//! and the all-lights loop are different code): one f32 rounding (6e-8) per light term,
+//! accumulated over at most a few dozen non-zero terms per pixel.
+
+mod common;
+use common::*;
+use glam::Vec3;
+use lightgraph::scene::{Light, LightShape, Scene};
+
+const VARIANTS: [&str; 4] = ["Frustum", "HalfZ", "DepthMask", "Clustered(slices: 16)"];
+const TILES: [u32; 2] = [8, 16];
+const W: u32 = 333;
+const H: u32 = 197;
+
+fn graph_text(tile: u32, variant: &str, capacity: u32) -> String {
+    std::fs::read_to_string(graph_path("forward_plus.ron"))
+        .unwrap()
+        .replace(
+            "LightCulling(tile: 16, variant: Frustum, capacity: 256)",
+            &format!("LightCulling(tile: {tile}, variant: {variant}, capacity: {capacity})"),
+        )
+}
+
+fn check_scene(scene: &Scene, expect_lit: bool) {
+    let mut r = renderer();
+    let reference = render_file(&mut r, "brute_force.ron", scene, W, H);
+    assert!(
+        reference
+            .image
+            .iter()
+            .all(|p| p.iter().all(|c| c.is_finite())),
+        "{}: non-finite reference",
+        scene.name
+    );
+    let lit = reference
+        .image
+        .iter()
+        .filter(|p| p[0] + p[1] + p[2] > 0.0)
+        .count();
+    if expect_lit {
+        assert!(
+            lit > 100,
+            "{}: only {lit} lit pixels, the scene tests nothing",
+            scene.name
+        );
+    } else {
+        assert_eq!(lit, 0, "{}: expected a dark frame", scene.name);
+    }
+    let peak = reference
+        .image
+        .iter()
+        .flat_map(|p| p[..3].to_vec())
+        .fold(0.0f32, f32::max);
+    let mut failures = Vec::new();
+    for tile in TILES {
+        for variant in VARIANTS {
+            let capacity = 2048;
+            let out = render_text(&mut r, &graph_text(tile, variant, capacity), scene, W, H);
+            let c = &out.culling[0];
+            assert_eq!(
+                c.overflowed_lists, 0,
+                "{}: capacity {capacity} overflowed",
+                scene.name
+            );
+            let mut worst = (0.0f32, 0usize);
+            for (i, (a, b)) in out.image.iter().zip(&reference.image).enumerate() {
+                for ch in 0..3 {
+                    let scale = b[ch].abs().max(1e-3 * peak).max(1e-30);
+                    let d = (a[ch] - b[ch]).abs() / scale;
+                    if !(d <= worst.0) {
+                        worst = (d, i);
+                    }
+                }
+            }
+            if !(worst.0 <= 2e-6) {
+                let i = worst.1;
+                failures.push(format!(
+                    "{} tile {tile} {variant}: relative error {:e} at ({}, {}): {:?} vs {:?}",
+                    scene.name,
+                    worst.0,
+                    i as u32 % W,
+                    i as u32 / W,
+                    out.image[i],
+                    reference.image[i]
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+fn spot(position: Vec3, direction: Vec3, range: f32, outer: f32) -> Light {
+    let mut l = Light::point(position, range, Vec3::new(1.0, 0.9, 0.7), 20.0);
+    l.shape = LightShape::Spot {
+        direction: direction.normalize(),
+        inner_angle: outer * 0.6,
+        outer_angle: outer,
+    };
+    l
+}
+
+#[test]
+fn random_lights() {
+    // 301: not a multiple of either workgroup size (64, 256).
+    check_scene(&random_scene(301, 7), true);
+}
+
+#[test]
+fn depth_discontinuities() {
+    let mut s = random_scene(0, 3);
+    // A thin near pillar in front of the far wall; lights spread through depth.
+    s.meshes.push(cuboid(
+        "pillar",
+        Vec3::new(-0.3, 0.0, 2.0),
+        Vec3::new(0.3, 6.0, 2.6),
+        1,
+        false,
+    ));
+    let mut rng = Rng(11);
+    s.lights = (0..500)
+        .map(|_| {
+            random_light(
+                &mut rng,
+                Vec3::new(-6.0, 0.0, -40.0),
+                Vec3::new(6.0, 6.0, 3.0),
+                0.5,
+                3.0,
+            )
+        })
+        .collect();
+    s.name = "depth_discontinuities".into();
+    check_scene(&s, true);
+}
+
+#[test]
+fn camera_inside_lights_and_lights_at_the_near_plane() {
+    let mut s = random_scene(0, 5);
+    let eye = s.camera.eye;
+    let fwd = (s.camera.target - eye).normalize();
+    s.lights = vec![
+        Light::point(eye, 8.0, Vec3::ONE, 5.0), // camera at the centre
+        Light::point(eye + fwd * 0.05, 3.0, Vec3::new(1.0, 0.2, 0.2), 2.0), // crosses the near plane
+        Light::point(eye - fwd * 2.0, 6.0, Vec3::new(0.2, 1.0, 0.2), 8.0), // behind the camera, reaching forward
+        Light::point(eye - fwd * 30.0, 5.0, Vec3::ONE, 100.0),             // behind, out of reach
+        spot(eye - fwd, fwd, 20.0, 0.5), // behind, shining forward
+    ];
+    s.name = "camera_inside".into();
+    check_scene(&s, true);
+}
+
+#[test]
+fn tiny_and_huge_ranges() {
+    let mut s = random_scene(0, 9);
+    let mut rng = Rng(21);
+    s.lights = (0..200)
+        .map(|i| {
+            let mut l = random_light(
+                &mut rng,
+                Vec3::new(-10.0, 0.0, -35.0),
+                Vec3::new(10.0, 5.0, 0.0),
+                1.0,
+                2.0,
+            );
+            l.range = if i % 2 == 0 { 1e-2 } else { 1e3 };
+            l.intensity = if i % 2 == 0 { 1.0 } else { 0.05 };
+            l
+        })
+        .collect();
+    // A tiny light touching the floor so tiny ranges are visible at all.
+    s.lights.push(Light::point(
+        Vec3::new(0.0, 0.005, -3.0),
+        0.02,
+        Vec3::ONE,
+        1.0,
+    ));
+    s.name = "tiny_and_huge".into();
+    check_scene(&s, true);
+}
+
+#[test]
+fn spot_lights_towards_and_away_from_the_camera() {
+    let mut s = random_scene(0, 13);
+    let eye = s.camera.eye;
+    let mut rng = Rng(5);
+    s.lights = (0..240)
+        .map(|i| {
+            let p = rng.vec3(Vec3::new(-10.0, 0.5, -30.0), Vec3::new(10.0, 6.0, 0.0));
+            let towards = (eye - p).normalize();
+            let dir = match i % 3 {
+                0 => towards,
+                1 => -towards,
+                _ => Vec3::NEG_Y,
+            };
+            spot(p, dir, rng.range(2.0, 12.0), rng.range(0.1, 1.5))
+        })
+        .collect();
+    s.name = "spots".into();
+    check_scene(&s, true);
+}
+
+#[test]
+fn no_lights_and_one_light() {
+    let mut s = random_scene(0, 1);
+    s.name = "no_lights".into();
+    check_scene(&s, false);
+    s.lights = vec![Light::point(
+        Vec3::new(0.0, 2.0, -5.0),
+        10.0,
+        Vec3::ONE,
+        10.0,
+    )];
+    s.name = "one_light".into();
+    check_scene(&s, true);
+}
+
+#[test]
+fn over_a_thousand_lights() {
+    check_scene(&random_scene(1100, 17), true);
+}
+
+#[test]
+fn overflow_is_counted_and_reported() {
+    let mut r = renderer();
+    let scene = random_scene(400, 2);
+    let out = render_text(&mut r, &graph_text(16, "Frustum", 4), &scene, 160, 96);
+    let c = &out.culling[0];
+    assert!(
+        c.overflowed_lists > 0,
+        "capacity 4 must overflow with 400 lights"
+    );
+    assert!(c.longest_list > 4);
+    assert!(
+        c.counts.iter().all(|&n| n <= 4),
+        "kept counts never exceed the capacity"
+    );
+}
