@@ -36,6 +36,13 @@ enum Command {
     },
     /// Compare two EXR images: RMSE, max abs, PSNR, FLIP mean, bad pixels.
     Compare { a: PathBuf, b: PathBuf },
+    /// Time against error: run a sweep file, write CSV, Markdown and plots to --out.
+    Bench {
+        #[arg(long)]
+        sweep: Option<PathBuf>,
+        #[arg(long)]
+        out: PathBuf,
+    },
 }
 
 #[derive(clap::Args, Default)]
@@ -85,6 +92,7 @@ fn main() -> Result<()> {
         Some(Command::Validate { files }) => validate(&files),
         Some(Command::Graph { graph, scene, dot }) => print_graph(&graph, scene.as_deref(), dot),
         Some(Command::Compare { a, b }) => compare(&a, &b),
+        Some(Command::Bench { sweep, out }) => run_bench(sweep.as_deref(), &out),
     }
 }
 
@@ -270,5 +278,39 @@ fn compare(a: &Path, b: &Path) -> Result<()> {
         &Default::default(),
     )?;
     println!("{m:#?}");
+    Ok(())
+}
+
+fn run_bench(sweep: Option<&Path>, out: &Path) -> Result<()> {
+    let path = sweep
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| project_path("benches/sweeps/headline.ron"));
+    let sweep = bench::sweep::Sweep::load(&path)?;
+    let mut renderer = Renderer::headless()?;
+    if !renderer.ctx.has_timestamps {
+        eprintln!(
+            "warning: {} has no timestamp queries: no GPU times will be reported",
+            renderer.ctx.adapter_name()
+        );
+    }
+    println!("adapter: {}", renderer.ctx.adapter_name());
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let rows = bench::sweep::run(&sweep, dir, &mut renderer, |done, total, row| {
+        println!(
+            "[{done}/{total}] {} {} lights {}x{} {}: {:.3} ms (p10 {:.3}, p90 {:.3}) rmse {:?}",
+            row.scene,
+            row.light_count,
+            row.width,
+            row.height,
+            row.technique,
+            row.frame_ms_median,
+            row.frame_ms_p10,
+            row.frame_ms_p90,
+            row.rmse
+        );
+    })?;
+    std::fs::create_dir_all(out).with_context(|| out.display().to_string())?;
+    let files = bench::write_report(out, &rows)?;
+    println!("wrote {}", files.markdown.display());
     Ok(())
 }

@@ -7,6 +7,7 @@ pub mod image_io;
 pub mod metrics;
 pub mod pixel;
 pub mod report;
+pub mod sweep;
 pub mod tonemap;
 
 pub use image_io::{

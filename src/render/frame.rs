@@ -210,6 +210,27 @@ impl Renderer {
         size: FrameSize,
         light_stats: bool,
     ) -> Result<PreparedFrame, RenderError> {
+        // wgpu reports validation errors (a list buffer over the binding limit, say) as
+        // errors here instead of panicking.
+        let scope = self
+            .ctx
+            .device
+            .push_error_scope(wgpu::ErrorFilter::Validation);
+        let result = self.prepare_unscoped(graph, scene, gpu, size, light_stats);
+        match pollster::block_on(scope.pop()) {
+            Some(e) => Err(RenderError::Wgpu(e.to_string())),
+            None => result,
+        }
+    }
+
+    fn prepare_unscoped(
+        &mut self,
+        graph: CompiledGraph,
+        scene: &Scene,
+        gpu: &SceneGpu,
+        size: FrameSize,
+        light_stats: bool,
+    ) -> Result<PreparedFrame, RenderError> {
         let device = self.ctx.device.clone();
         let out = graph.output().to_string();
         match graph
@@ -688,6 +709,15 @@ impl PreparedFrame {
     /// Records and submits one frame; returns GPU milliseconds per pass when the
     /// adapter has timestamps.
     pub fn execute(&self, r: &Renderer) -> Result<Option<Vec<(String, f64)>>, RenderError> {
+        let scope = r.ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let result = self.execute_unscoped(r);
+        match pollster::block_on(scope.pop()) {
+            Some(e) => Err(RenderError::Wgpu(e.to_string())),
+            None => result,
+        }
+    }
+
+    fn execute_unscoped(&self, r: &Renderer) -> Result<Option<Vec<(String, f64)>>, RenderError> {
         let device = &r.ctx.device;
         let plan = &self.graph.plan;
         let mut encoder = device.create_command_encoder(&Default::default());

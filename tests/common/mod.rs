@@ -146,6 +146,7 @@ pub fn random_scene(n: usize, seed: u64) -> Scene {
         },
         output_size: None,
         ambient: Vec3::ZERO,
+        ..Default::default()
     }
 }
 
