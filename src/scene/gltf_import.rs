@@ -208,9 +208,22 @@ impl Importer {
         {
             use gltf::json::validation::Validate;
             let mut errors = Vec::new();
+            let mut lenient = Vec::new();
             root.validate(root, gltf::json::Path::new, &mut |path, error| {
-                errors.push(format!("{}: {error}", path()))
+                let path = path().to_string();
+                // POSITION min/max are required by the spec but often missing; bounds are
+                // computed from the data anyway.
+                if matches!(error, gltf::json::validation::Error::Missing)
+                    && (path.ends_with(".min") || path.ends_with(".max"))
+                {
+                    lenient.push(path);
+                } else {
+                    errors.push(format!("{path}: {error}"))
+                }
             });
+            if let Some(first) = lenient.first() {
+                self.warn(format!("{first}: missing (not required by this importer)"));
+            }
             if !errors.is_empty() {
                 let first = errors[0].clone();
                 let more = if errors.len() > 1 {
