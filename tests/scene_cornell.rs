@@ -18,8 +18,14 @@ fn cornell_box_imports() {
     let mat = |n: &str| &s.materials[s.material_index(n).unwrap_or_else(|| panic!("no {n}"))];
     let (left, right) = (mat("leftWall").base_color, mat("rightWall").base_color);
     // Classic Cornell box: red left wall, green right wall.
-    assert!(left.x > 2.0 * left.y && left.x > 2.0 * left.z, "left wall {left}");
-    assert!(right.y > 2.0 * right.x && right.y > 2.0 * right.z, "right wall {right}");
+    assert!(
+        left.x > 2.0 * left.y && left.x > 2.0 * left.z,
+        "left wall {left}"
+    );
+    assert!(
+        right.y > 2.0 * right.x && right.y > 2.0 * right.z,
+        "right wall {right}"
+    );
     let (lo, hi) = s.bounds().unwrap();
     let size = hi - lo;
     // About 2 units wide, deep and high; the node rotates Z-up to Y-up.

@@ -9,14 +9,19 @@ use lightgraph::scene::{self, AlphaMode, LightShape};
 use std::path::PathBuf;
 
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("lightgraph_scene_gltf_{}_{name}", std::process::id()));
+    let d = std::env::temp_dir().join(format!(
+        "lightgraph_scene_gltf_{}_{name}",
+        std::process::id()
+    ));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
 }
 
 fn checker(w: u32, a: [u8; 4], b: [u8; 4]) -> image::RgbaImage {
-    image::RgbaImage::from_fn(w, w, |x, y| image::Rgba(if (x + y) % 2 == 0 { a } else { b }))
+    image::RgbaImage::from_fn(w, w, |x, y| {
+        image::Rgba(if (x + y) % 2 == 0 { a } else { b })
+    })
 }
 
 /// A unit quad in XY facing +Z, 4 vertices, 2 triangles.
@@ -46,16 +51,31 @@ fn full_document(images: ImageStorage, jpeg_emissive: bool) -> GltfWriter {
         ImageStorage::File(_) => ImageStorage::File(n.to_string()),
         s => s.clone(),
     };
-    let base_tex = w.add_texture_png("base", &checker(4, [255, 0, 0, 255], [0, 0, 255, 255]), file("base.png"));
-    let mr_tex = w.add_texture_png("mr", &checker(2, [0, 128, 255, 255], [0, 64, 0, 255]), file("mr.png"));
+    let base_tex = w.add_texture_png(
+        "base",
+        &checker(4, [255, 0, 0, 255], [0, 0, 255, 255]),
+        file("base.png"),
+    );
+    let mr_tex = w.add_texture_png(
+        "mr",
+        &checker(2, [0, 128, 255, 255], [0, 64, 0, 255]),
+        file("mr.png"),
+    );
     let emissive_tex = if jpeg_emissive {
         let img = image::RgbImage::from_pixel(8, 8, image::Rgb([200, 100, 50]));
         let mut bytes = Vec::new();
-        img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Jpeg)
-            .unwrap();
+        img.write_to(
+            &mut std::io::Cursor::new(&mut bytes),
+            image::ImageFormat::Jpeg,
+        )
+        .unwrap();
         w.add_texture_bytes("emissive", bytes, file("emissive.jpg"))
     } else {
-        w.add_texture_png("emissive", &checker(2, [255; 4], [0, 0, 0, 255]), file("emissive.png"))
+        w.add_texture_png(
+            "emissive",
+            &checker(2, [255; 4], [0, 0, 0, 255]),
+            file("emissive.png"),
+        )
     };
     let textured = w.add_material(&MaterialDesc {
         name: "textured".into(),
@@ -84,7 +104,14 @@ fn full_document(images: ImageStorage, jpeg_emissive: bool) -> GltfWriter {
     });
     let (p, n, uv, idx) = quad();
     // Indexed, with normals and UVs (tangents generated).
-    let m0 = w.add_simple_mesh("indexed", &p, Some(&n), Some(&uv), Some(&idx), Some(textured));
+    let m0 = w.add_simple_mesh(
+        "indexed",
+        &p,
+        Some(&n),
+        Some(&uv),
+        Some(&idx),
+        Some(textured),
+    );
     // Non-indexed, no normals (generated), no UVs.
     let flat: Vec<Vec3> = idx.iter().map(|&i| p[i as usize]).collect();
     let m1 = w.add_simple_mesh("non_indexed", &flat, None, None, None, Some(masked));
@@ -95,8 +122,17 @@ fn full_document(images: ImageStorage, jpeg_emissive: bool) -> GltfWriter {
     let m2 = w.add_mesh(
         "two_prims",
         &[
-            PrimitiveDesc { positions: pa, material: Some(blended), ..Default::default() },
-            PrimitiveDesc { positions: pb, indices: Some(strip), mode: Some(5), ..Default::default() },
+            PrimitiveDesc {
+                positions: pa,
+                material: Some(blended),
+                ..Default::default()
+            },
+            PrimitiveDesc {
+                positions: pb,
+                indices: Some(strip),
+                mode: Some(5),
+                ..Default::default()
+            },
         ],
     );
     let cam = w.add_camera(0.8, 0.05, Some(50.0));
@@ -104,14 +140,24 @@ fn full_document(images: ImageStorage, jpeg_emissive: bool) -> GltfWriter {
     let spot = w.add_light("spot", Vec3::ONE, 20.0, None, Some((0.2, 0.5)));
 
     // Hierarchy: root (translate +10 x) -> child (scale 2) -> mesh 0; root -> child rotated 90° about Y -> mesh 1.
-    let leaf0 = w.add_node(&NodeDesc { name: Some("leaf0".into()), mesh: Some(m0), scale: Some(Vec3::splat(2.0)), ..Default::default() });
+    let leaf0 = w.add_node(&NodeDesc {
+        name: Some("leaf0".into()),
+        mesh: Some(m0),
+        scale: Some(Vec3::splat(2.0)),
+        ..Default::default()
+    });
     let leaf1 = w.add_node(&NodeDesc {
         name: Some("leaf1".into()),
         mesh: Some(m1),
         rotation: Some(Quat::from_rotation_y(std::f32::consts::FRAC_PI_2)),
         ..Default::default()
     });
-    let light_node = w.add_node(&NodeDesc { name: Some("light".into()), light: Some(point), translation: Some(Vec3::new(0.0, 2.0, 0.0)), ..Default::default() });
+    let light_node = w.add_node(&NodeDesc {
+        name: Some("light".into()),
+        light: Some(point),
+        translation: Some(Vec3::new(0.0, 2.0, 0.0)),
+        ..Default::default()
+    });
     let spot_node = w.add_node(&NodeDesc {
         name: Some("spot".into()),
         light: Some(spot),
@@ -126,8 +172,17 @@ fn full_document(images: ImageStorage, jpeg_emissive: bool) -> GltfWriter {
         children: vec![leaf0, leaf1, light_node, spot_node],
         ..Default::default()
     });
-    let cam_node = w.add_node(&NodeDesc { name: Some("cam".into()), camera: Some(cam), translation: Some(Vec3::new(0.0, 1.0, 5.0)), ..Default::default() });
-    let other = w.add_node(&NodeDesc { mesh: Some(m2), translation: Some(Vec3::new(0.0, 0.0, -3.0)), ..Default::default() });
+    let cam_node = w.add_node(&NodeDesc {
+        name: Some("cam".into()),
+        camera: Some(cam),
+        translation: Some(Vec3::new(0.0, 1.0, 5.0)),
+        ..Default::default()
+    });
+    let other = w.add_node(&NodeDesc {
+        mesh: Some(m2),
+        translation: Some(Vec3::new(0.0, 0.0, -3.0)),
+        ..Default::default()
+    });
     w.add_root(root);
     w.add_root(cam_node);
     w.add_root(other);
@@ -137,25 +192,49 @@ fn full_document(images: ImageStorage, jpeg_emissive: bool) -> GltfWriter {
 fn check_full(loaded: &scene::Loaded, expect_textures: bool) {
     let s = &loaded.scene;
     // 4 meshes: indexed, non-indexed, and two primitives.
-    assert_eq!(s.meshes.len(), 4, "{:?}", s.meshes.iter().map(|m| &m.name).collect::<Vec<_>>());
+    assert_eq!(
+        s.meshes.len(),
+        4,
+        "{:?}",
+        s.meshes.iter().map(|m| &m.name).collect::<Vec<_>>()
+    );
     let m0 = s.meshes.iter().find(|m| m.name == "indexed").unwrap();
     // World space: scale 2 then translate +10 x.
     assert_eq!(m0.positions[2], Vec3::new(12.0, 2.0, 0.0));
     assert_eq!(m0.indices, vec![0, 1, 2, 0, 2, 3]);
     assert_eq!(m0.tangents.len(), 4);
     // U runs along +x: tangent +x.
-    assert!((m0.tangents[0].truncate() - Vec3::X).length() < 1e-4, "{:?}", m0.tangents[0]);
+    assert!(
+        (m0.tangents[0].truncate() - Vec3::X).length() < 1e-4,
+        "{:?}",
+        m0.tangents[0]
+    );
     let m1 = s.meshes.iter().find(|m| m.name == "non_indexed").unwrap();
     assert_eq!(m1.indices, (0..6).collect::<Vec<u32>>());
     // Normal generated (+Z) then rotated 90° about Y: +X.
-    assert!((m1.normals[0] - Vec3::X).length() < 1e-5, "{:?}", m1.normals[0]);
+    assert!(
+        (m1.normals[0] - Vec3::X).length() < 1e-5,
+        "{:?}",
+        m1.normals[0]
+    );
     assert!(m1.uvs.is_empty());
     assert_eq!(m1.tangents.len(), 6);
     let strip = s.meshes.iter().find(|m| m.name == "two_prims/1").unwrap();
     assert_eq!(strip.indices, vec![0, 1, 3, 1, 2, 3]); // strip 0 1 3 2 → (0,1,3) (1,2,3)... winding kept
-    assert_eq!(s.meshes.iter().find(|m| m.name == "two_prims/0").unwrap().positions[0], Vec3::new(0.0, 0.0, -3.0));
+    assert_eq!(
+        s.meshes
+            .iter()
+            .find(|m| m.name == "two_prims/0")
+            .unwrap()
+            .positions[0],
+        Vec3::new(0.0, 0.0, -3.0)
+    );
 
-    let mat = |n: &str| &s.materials[s.material_index(n).unwrap_or_else(|| panic!("material {n}"))];
+    let mat = |n: &str| {
+        &s.materials[s
+            .material_index(n)
+            .unwrap_or_else(|| panic!("material {n}"))]
+    };
     let t = mat("textured");
     assert_eq!(t.base_color, Vec4::new(1.0, 0.5, 0.25, 1.0));
     assert_eq!((t.metallic, t.roughness), (0.25, 0.75));
@@ -174,31 +253,64 @@ fn check_full(loaded: &scene::Loaded, expect_textures: bool) {
     assert_eq!(mat("masked").alpha_mode, AlphaMode::Mask(0.3));
     assert!(mat("masked").double_sided);
     assert_eq!(mat("glass").alpha_mode, AlphaMode::Blend);
-    assert_eq!(s.meshes.iter().find(|m| m.name == "two_prims/1").map(|m| &s.materials[m.material].name).unwrap(), "default");
+    assert_eq!(
+        s.meshes
+            .iter()
+            .find(|m| m.name == "two_prims/1")
+            .map(|m| &s.materials[m.material].name)
+            .unwrap(),
+        "default"
+    );
 
     // Lights: world positions, spot direction, infinite range replaced and warned about.
     assert_eq!(s.lights.len(), 2);
-    let p = s.lights.iter().find(|l| l.shape == LightShape::Point).unwrap();
+    let p = s
+        .lights
+        .iter()
+        .find(|l| l.shape == LightShape::Point)
+        .unwrap();
     assert_eq!(p.position, Vec3::new(10.0, 2.0, 0.0));
     assert_eq!((p.range, p.intensity), (3.0, 5.0));
-    let sp = s.lights.iter().find(|l| l.shape != LightShape::Point).unwrap();
+    let sp = s
+        .lights
+        .iter()
+        .find(|l| l.shape != LightShape::Point)
+        .unwrap();
     match sp.shape {
-        LightShape::Spot { direction, inner_angle, outer_angle } => {
+        LightShape::Spot {
+            direction,
+            inner_angle,
+            outer_angle,
+        } => {
             assert!((direction - Vec3::NEG_Y).length() < 1e-5, "{direction}");
             assert_eq!((inner_angle, outer_angle), (0.2, 0.5));
         }
         _ => unreachable!(),
     }
     assert!(sp.range.is_finite() && sp.range > 0.0);
-    assert!(loaded.warnings.iter().any(|w| w.contains("no range")), "{:?}", loaded.warnings);
+    assert!(
+        loaded.warnings.iter().any(|w| w.contains("no range")),
+        "{:?}",
+        loaded.warnings
+    );
 
     // Camera from the camera node.
     assert_eq!(s.camera.eye, Vec3::new(0.0, 1.0, 5.0));
     assert!((s.camera.target - Vec3::new(0.0, 1.0, 4.0)).length() < 1e-6);
-    assert_eq!((s.camera.fov_y, s.camera.near, s.camera.far), (0.8, 0.05, 50.0));
+    assert_eq!(
+        (s.camera.fov_y, s.camera.near, s.camera.far),
+        (0.8, 0.05, 50.0)
+    );
 
     let f = s.features();
-    assert!(f.has_transparent && f.has_alpha_mask && f.has_spot_lights && f.has_point_lights && f.has_double_sided && f.has_emissive);
+    assert!(
+        f.has_transparent
+            && f.has_alpha_mask
+            && f.has_spot_lights
+            && f.has_point_lights
+            && f.has_double_sided
+            && f.has_emissive
+    );
     assert!(!f.has_shadow_casters);
 }
 
@@ -207,10 +319,18 @@ fn gltf_external_buffer_and_image_files() {
     let d = tmp("external");
     let w = full_document(ImageStorage::File(String::new()), true);
     let path = d.join("model.gltf");
-    w.write_gltf(&path, &BufferStorage::External("model data.bin".into())).unwrap();
+    w.write_gltf(&path, &BufferStorage::External("model data.bin".into()))
+        .unwrap();
     let loaded = scene::load(&path).unwrap();
     check_full(&loaded, true);
-    assert_eq!(loaded.scene.materials[0].base_color_texture.as_ref().unwrap().name, "base");
+    assert_eq!(
+        loaded.scene.materials[0]
+            .base_color_texture
+            .as_ref()
+            .unwrap()
+            .name,
+        "base"
+    );
     // The scene still loads when the whole folder is moved elsewhere (relative URIs).
     let moved = tmp("external_moved");
     for f in std::fs::read_dir(&d).unwrap() {
@@ -227,7 +347,11 @@ fn gltf_embedded_data_uris() {
     let w = full_document(ImageStorage::DataUri, false);
     let path = d.join("model.gltf");
     w.write_gltf(&path, &BufferStorage::Embedded).unwrap();
-    assert_eq!(std::fs::read_dir(&d).unwrap().count(), 1, "only the .gltf is written");
+    assert_eq!(
+        std::fs::read_dir(&d).unwrap().count(),
+        1,
+        "only the .gltf is written"
+    );
     check_full(&scene::load(&path).unwrap(), true);
 }
 
@@ -247,7 +371,8 @@ fn missing_texture_is_a_warning_not_an_error() {
     let d = tmp("missing_tex");
     let w = full_document(ImageStorage::File(String::new()), false);
     let path = d.join("model.gltf");
-    w.write_gltf(&path, &BufferStorage::External("model.bin".into())).unwrap();
+    w.write_gltf(&path, &BufferStorage::External("model.bin".into()))
+        .unwrap();
     std::fs::remove_file(d.join("base.png")).unwrap();
     std::fs::write(d.join("mr.png"), b"not a png").unwrap();
     let loaded = scene::load(&path).unwrap();
@@ -256,8 +381,14 @@ fn missing_texture_is_a_warning_not_an_error() {
     assert!(t.metallic_roughness_texture.is_none());
     assert!(t.emissive_texture.is_some());
     let w = loaded.warnings.join("\n");
-    assert!(w.contains("baseColorTexture") && w.contains("base.png"), "{w}");
-    assert!(w.contains("metallicRoughnessTexture") && w.contains("cannot decode"), "{w}");
+    assert!(
+        w.contains("baseColorTexture") && w.contains("base.png"),
+        "{w}"
+    );
+    assert!(
+        w.contains("metallicRoughnessTexture") && w.contains("cannot decode"),
+        "{w}"
+    );
     check_full(&loaded, false);
 }
 
@@ -267,7 +398,11 @@ fn mirrored_node_keeps_front_faces_and_bounds() {
     let mut w = GltfWriter::new();
     let (p, n, uv, idx) = quad();
     let m = w.add_simple_mesh("q", &p, Some(&n), Some(&uv), Some(&idx), None);
-    let node = w.add_node(&NodeDesc { mesh: Some(m), scale: Some(Vec3::new(-1.0, 1.0, 1.0)), ..Default::default() });
+    let node = w.add_node(&NodeDesc {
+        mesh: Some(m),
+        scale: Some(Vec3::new(-1.0, 1.0, 1.0)),
+        ..Default::default()
+    });
     w.add_root(node);
     let path = d.join("m.gltf");
     w.write_gltf(&path, &BufferStorage::Embedded).unwrap();
@@ -277,10 +412,20 @@ fn mirrored_node_keeps_front_faces_and_bounds() {
     // Geometric normal from the new winding agrees with the stored normal.
     let (a, b, c) = (mesh.positions[0], mesh.positions[2], mesh.positions[1]);
     let geo = (b - a).cross(c - a).normalize();
-    assert!(geo.dot(mesh.normals[0]) > 0.99, "{geo} vs {}", mesh.normals[0]);
-    assert_eq!(l.scene.bounds().unwrap(), (Vec3::new(-1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)));
+    assert!(
+        geo.dot(mesh.normals[0]) > 0.99,
+        "{geo} vs {}",
+        mesh.normals[0]
+    );
+    assert_eq!(
+        l.scene.bounds().unwrap(),
+        (Vec3::new(-1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0))
+    );
     // No camera in the file: fitted, with a warning.
-    assert!(l.warnings.iter().any(|w| w.contains("no perspective camera")));
+    assert!(l
+        .warnings
+        .iter()
+        .any(|w| w.contains("no perspective camera")));
 }
 
 #[test]

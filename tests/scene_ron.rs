@@ -6,7 +6,10 @@ use lightgraph::scene::{self, builtin, light_flags, LightShape, SceneError};
 use std::path::{Path, PathBuf};
 
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("lightgraph_scene_ron_{}_{name}", std::process::id()));
+    let d = std::env::temp_dir().join(format!(
+        "lightgraph_scene_ron_{}_{name}",
+        std::process::id()
+    ));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
@@ -23,16 +26,26 @@ fn pcg32_is_stable() {
     // Reference values of PCG32 (pcg32_srandom(42, 54)) from the PCG paper's demo program.
     let mut r = Pcg32::with_stream(42, 54);
     let got: Vec<u32> = (0..6).map(|_| r.next_u32()).collect();
-    assert_eq!(got, [0xa15c02b7, 0x7b47f409, 0xba1d3330, 0x83d2f293, 0xbfa4784b, 0xcbed606e]);
+    assert_eq!(
+        got,
+        [0xa15c02b7, 0x7b47f409, 0xba1d3330, 0x83d2f293, 0xbfa4784b, 0xcbed606e]
+    );
 }
 
 #[test]
 fn builtins_have_what_they_promise() {
     let a = builtin::atrium();
     let tris = a.triangle_count();
-    assert!((3_000..60_000).contains(&tris), "atrium has {tris} triangles");
+    assert!(
+        (3_000..60_000).contains(&tris),
+        "atrium has {tris} triangles"
+    );
     assert_eq!(a.lights.len(), 1024);
-    let spots = a.lights.iter().filter(|l| matches!(l.shape, LightShape::Spot { .. })).count();
+    let spots = a
+        .lights
+        .iter()
+        .filter(|l| matches!(l.shape, LightShape::Spot { .. }))
+        .count();
     assert_eq!(spots, 512);
     let (lo, hi) = a.bounds().unwrap();
     assert!(hi.y - lo.y > 10.0 && hi.x - lo.x > 30.0);
@@ -68,11 +81,20 @@ fn amd_generator_matches_the_sample_setup() {
     assert!(lights.iter().all(|l| (l.range - r).abs() < 1e-6));
     assert!(lights[..2048].iter().all(|l| l.shape == LightShape::Point));
     for l in &lights[2048..] {
-        let LightShape::Spot { direction, outer_angle, .. } = l.shape else { panic!() };
+        let LightShape::Spot {
+            direction,
+            outer_angle,
+            ..
+        } = l.shape
+        else {
+            panic!()
+        };
         assert!((outer_angle.cos() - AMD_SPOT_COS).abs() < 1e-5);
         assert!((direction.length() - 1.0).abs() < 1e-4);
     }
-    assert!(lights.iter().all(|l| l.position.cmpge(bounds.0).all() && l.position.cmple(bounds.1).all()));
+    assert!(lights
+        .iter()
+        .all(|l| l.position.cmpge(bounds.0).all() && l.position.cmple(bounds.1).all()));
     // Roughly uniform: mean near the centre.
     let mean = lights.iter().map(|l| l.position).sum::<Vec3>() / 4096.0;
     assert!(mean.length() < 0.4 + 3.0, "{mean}");
@@ -82,8 +104,15 @@ fn amd_generator_matches_the_sample_setup() {
     let cam = amd_camera(bounds);
     assert_eq!(cam.eye, Vec3::new(-4.5, 3.0 - 1.05, 0.0));
     assert_eq!(cam.target, Vec3::new(0.0, 3.0 - 1.05, 0.0));
-    let shadowed = AmdLights { shadow_casters: 12, ..Default::default() }.generate(bounds);
-    let n = shadowed.iter().filter(|l| l.flags & light_flags::CASTS_SHADOW != 0).count();
+    let shadowed = AmdLights {
+        shadow_casters: 12,
+        ..Default::default()
+    }
+    .generate(bounds);
+    let n = shadowed
+        .iter()
+        .filter(|l| l.flags & light_flags::CASTS_SHADOW != 0)
+        .count();
     assert_eq!(n, 24);
 }
 
@@ -111,7 +140,13 @@ fn committed_scene_files_load() {
     let s = &show.scene;
     assert_eq!(s.lights.len(), 2 + 512);
     assert!(s.features().has_indirect_lights);
-    assert_eq!(s.material_overrides, vec![("atrium_bronze".to_string(), PathBuf::from("materials/brushed_bronze.ron"))]);
+    assert_eq!(
+        s.material_overrides,
+        vec![(
+            "atrium_bronze".to_string(),
+            PathBuf::from("materials/brushed_bronze.ron")
+        )]
+    );
     assert!(show.warnings.is_empty(), "{:?}", show.warnings);
     assert_eq!(s.ambient, Vec3::new(0.01, 0.01, 0.012));
 }
@@ -125,11 +160,22 @@ fn ron_with_gltf_model_transform_and_light_sets() {
     let (p, n, uv, idx) = lightgraph::scene::gltf_writer::grid(2, 2.0);
     let m = w.add_simple_mesh("floor", &p, Some(&n), Some(&uv), Some(&idx), None);
     let light = w.add_light("lamp", Vec3::ONE, 1.0, Some(2.0), None);
-    let a = w.add_node(&NodeDesc { mesh: Some(m), ..Default::default() });
-    let b = w.add_node(&NodeDesc { light: Some(light), translation: Some(Vec3::Y), ..Default::default() });
+    let a = w.add_node(&NodeDesc {
+        mesh: Some(m),
+        ..Default::default()
+    });
+    let b = w.add_node(&NodeDesc {
+        light: Some(light),
+        translation: Some(Vec3::Y),
+        ..Default::default()
+    });
     w.add_root(a);
     w.add_root(b);
-    w.write_gltf(&d.join("models/floor.gltf"), &BufferStorage::External("floor.bin".into())).unwrap();
+    w.write_gltf(
+        &d.join("models/floor.gltf"),
+        &BufferStorage::External("floor.bin".into()),
+    )
+    .unwrap();
     let l = load_text(
         &d,
         r#"Scene(
@@ -147,42 +193,114 @@ fn ron_with_gltf_model_transform_and_light_sets() {
     let s = &l.scene;
     assert_eq!(s.name, "floor");
     assert_eq!(s.meshes.len(), 2);
-    let (lo, hi) = s.meshes[0].positions.iter().fold((Vec3::MAX, Vec3::MIN), |(a, b), p| (a.min(*p), b.max(*p)));
-    assert_eq!((lo, hi), (Vec3::new(8.0, 0.0, -2.0), Vec3::new(12.0, 0.0, 2.0)));
+    let (lo, hi) = s.meshes[0]
+        .positions
+        .iter()
+        .fold((Vec3::MAX, Vec3::MIN), |(a, b), p| (a.min(*p), b.max(*p)));
+    assert_eq!(
+        (lo, hi),
+        (Vec3::new(8.0, 0.0, -2.0), Vec3::new(12.0, 0.0, 2.0))
+    );
     // Rotated 180° about Z: faces down.
     assert!((s.meshes[1].normals[0] - Vec3::NEG_Y).length() < 1e-5);
     // 2 model lights + 1 explicit + 100 random.
     assert_eq!(s.lights.len(), 103);
     assert_eq!(s.lights[0].position, Vec3::new(10.0, 2.0, 0.0));
     assert!((s.lights[1].position - Vec3::new(0.0, -1.0, 0.0)).length() < 1e-6);
-    let spots = s.lights[3..].iter().filter(|l| matches!(l.shape, LightShape::Spot { .. })).count();
+    let spots = s.lights[3..]
+        .iter()
+        .filter(|l| matches!(l.shape, LightShape::Spot { .. }))
+        .count();
     assert_eq!(spots, 30);
-    assert!(s.lights[3..].iter().all(|l| l.flags == light_flags::CASTS_SHADOW));
-    assert!(l.warnings.iter().any(|w| w.contains("\"nope\"")), "{:?}", l.warnings);
+    assert!(s.lights[3..]
+        .iter()
+        .all(|l| l.flags == light_flags::CASTS_SHADOW));
+    assert!(
+        l.warnings.iter().any(|w| w.contains("\"nope\"")),
+        "{:?}",
+        l.warnings
+    );
 }
 
 /// Each broken scene RON and a fragment its error must contain.
 const BAD_RON: &[(&str, &[&str])] = &[
-    (r#"Scene(lights: [(name: "key", position: (0, NaN, 0), range: 1, intensity: 1)])"#, &["scene.ron", "lights[0] (\"key\")", "position"]),
-    (r#"Scene(lights: [(position: (0, 0, 0), range: 1, intensity: 1), (position: (0, 0, 0), range: inf, intensity: 1)])"#, &["lights[1]", "range"]),
-    (r#"Scene(lights: [(position: (0, 0, 0), range: 0, intensity: 1)])"#, &["lights[0]", "range 0"]),
-    (r#"Scene(lights: [(position: (0, 0, 0), range: -2, intensity: 1)])"#, &["lights[0]", "range -2"]),
-    (r#"Scene(lights: [(name: "hot", position: (0, 0, 0), range: 1, intensity: NaN)])"#, &["\"hot\"", "intensity"]),
-    (r#"Scene(lights: [(position: (0, 0, 0), range: 1, intensity: 1, color: (1, inf, 1))])"#, &["lights[0]", "color"]),
-    (r#"Scene(lights: [(position: (0, 0, 0), range: 1, intensity: 1, spot: (direction: (0, -1, 0), inner_deg: NaN, outer_deg: 30))])"#, &["lights[0]", "angles"]),
-    (r#"Scene(lights: [(position: (0, 0, 0), range: 1, intensity: 1, spot: (direction: (0, -1, 0), inner_deg: 40, outer_deg: 30))])"#, &["lights[0]", "inner"]),
-    (r#"Scene(lights: [(position: (0, 0, 0), range: 1, intensity: 1, spot: (direction: (0, 0, 0), outer_deg: 30))])"#, &["lights[0]", "direction"]),
-    (r#"Scene(builtin: "cathedral")"#, &["builtin", "cathedral", "atrium"]),
-    (r#"Scene(builtin: "atrium", light_sets: [Random(count: 2000000, placement: SceneBounds(), range: (1, 2), intensity: (1, 1))])"#, &["light_sets[0]", "exceeds the limit"]),
-    (r#"Scene(builtin: "atrium", light_sets: [Random(count: 10, placement: SceneBounds(), range: (2, 1), intensity: (1, 1))])"#, &["light_sets[0]", "range", "min > max"]),
-    (r#"Scene(builtin: "atrium", light_sets: [Random(count: 10, placement: SceneBounds(), range: (0, 1), intensity: (1, 1))])"#, &["light_sets[0]", "> 0"]),
-    (r#"Scene(light_sets: [Amd()])"#, &["light_sets[0]", "bounding box"]),
-    (r#"Scene(models: [(path: "missing.gltf")])"#, &["missing.gltf", "cannot read"]),
-    (r#"Scene(models: [(path: "a.obj")])"#, &["models[0]", ".gltf or .glb"]),
-    (r#"Scene(builtin: "atrium", output_size: (0, 720))"#, &["output_size"]),
-    (r#"Scene(builtin: "atrium", camera: LookAt(eye: (0, 0, 0), target: (0, 0, 0)))"#, &["camera"]),
+    (
+        r#"Scene(lights: [(name: "key", position: (0, NaN, 0), range: 1, intensity: 1)])"#,
+        &["scene.ron", "lights[0] (\"key\")", "position"],
+    ),
+    (
+        r#"Scene(lights: [(position: (0, 0, 0), range: 1, intensity: 1), (position: (0, 0, 0), range: inf, intensity: 1)])"#,
+        &["lights[1]", "range"],
+    ),
+    (
+        r#"Scene(lights: [(position: (0, 0, 0), range: 0, intensity: 1)])"#,
+        &["lights[0]", "range 0"],
+    ),
+    (
+        r#"Scene(lights: [(position: (0, 0, 0), range: -2, intensity: 1)])"#,
+        &["lights[0]", "range -2"],
+    ),
+    (
+        r#"Scene(lights: [(name: "hot", position: (0, 0, 0), range: 1, intensity: NaN)])"#,
+        &["\"hot\"", "intensity"],
+    ),
+    (
+        r#"Scene(lights: [(position: (0, 0, 0), range: 1, intensity: 1, color: (1, inf, 1))])"#,
+        &["lights[0]", "color"],
+    ),
+    (
+        r#"Scene(lights: [(position: (0, 0, 0), range: 1, intensity: 1, spot: (direction: (0, -1, 0), inner_deg: NaN, outer_deg: 30))])"#,
+        &["lights[0]", "angles"],
+    ),
+    (
+        r#"Scene(lights: [(position: (0, 0, 0), range: 1, intensity: 1, spot: (direction: (0, -1, 0), inner_deg: 40, outer_deg: 30))])"#,
+        &["lights[0]", "inner"],
+    ),
+    (
+        r#"Scene(lights: [(position: (0, 0, 0), range: 1, intensity: 1, spot: (direction: (0, 0, 0), outer_deg: 30))])"#,
+        &["lights[0]", "direction"],
+    ),
+    (
+        r#"Scene(builtin: "cathedral")"#,
+        &["builtin", "cathedral", "atrium"],
+    ),
+    (
+        r#"Scene(builtin: "atrium", light_sets: [Random(count: 2000000, placement: SceneBounds(), range: (1, 2), intensity: (1, 1))])"#,
+        &["light_sets[0]", "exceeds the limit"],
+    ),
+    (
+        r#"Scene(builtin: "atrium", light_sets: [Random(count: 10, placement: SceneBounds(), range: (2, 1), intensity: (1, 1))])"#,
+        &["light_sets[0]", "range", "min > max"],
+    ),
+    (
+        r#"Scene(builtin: "atrium", light_sets: [Random(count: 10, placement: SceneBounds(), range: (0, 1), intensity: (1, 1))])"#,
+        &["light_sets[0]", "> 0"],
+    ),
+    (
+        r#"Scene(light_sets: [Amd()])"#,
+        &["light_sets[0]", "bounding box"],
+    ),
+    (
+        r#"Scene(models: [(path: "missing.gltf")])"#,
+        &["missing.gltf", "cannot read"],
+    ),
+    (
+        r#"Scene(models: [(path: "a.obj")])"#,
+        &["models[0]", ".gltf or .glb"],
+    ),
+    (
+        r#"Scene(builtin: "atrium", output_size: (0, 720))"#,
+        &["output_size"],
+    ),
+    (
+        r#"Scene(builtin: "atrium", camera: LookAt(eye: (0, 0, 0), target: (0, 0, 0)))"#,
+        &["camera"],
+    ),
     (r#"Scene(lihgts: [])"#, &["scene.ron:1:", "lihgts"]),
-    ("Scene(\n  lights: [(position: (0, 0), range: 1, intensity: 1)],\n)", &["scene.ron:2:"]),
+    (
+        "Scene(\n  lights: [(position: (0, 0), range: 1, intensity: 1)],\n)",
+        &["scene.ron:2:"],
+    ),
 ];
 
 #[test]

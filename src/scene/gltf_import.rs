@@ -140,6 +140,9 @@ fn named(kind: &str, index: usize, name: Option<&str>) -> String {
     }
 }
 
+/// (element name, world matrix, (yfov, znear, zfar)).
+type FoundCamera = (String, Mat4, (f32, f32, Option<f32>));
+
 struct PendingLight {
     element: String,
     position: Vec3,
@@ -283,7 +286,7 @@ impl Importer {
             .rev()
             .map(|n| (n, Mat4::IDENTITY, 0))
             .collect();
-        let mut camera: Option<(String, Mat4, (f32, f32, Option<f32>))> = None;
+        let mut camera: Option<FoundCamera> = None;
         let mut lights = Vec::new();
         while let Some((node, parent, depth)) = stack.pop() {
             let element = named("node", node.index(), node.name());
