@@ -79,6 +79,10 @@ const CORPUS: &[(&str, Expect)] = &[
     ),
     ("node_cycle.gltf", Error(&["node", "cycle"])),
     (
+        "node_instance_explosion.gltf",
+        Error(&["node instance count", "exceeds the limit"]),
+    ),
+    (
         "inf_node_transform.gltf",
         Error(&["node 0 (\"tri_node\")", "transform is not finite"]),
     ),

@@ -306,6 +306,13 @@ const BAD_RON: &[(&str, &[&str])] = &[
 #[test]
 fn bad_scene_files_give_clear_errors() {
     let d = tmp("bad");
+    let e = scene::load(&d.join("scene.obj")).unwrap_err().to_string();
+    assert!(
+        e.contains("scene.obj") && e.contains("unknown scene extension"),
+        "{e}"
+    );
+    let e = scene::load(&d.join("absent.ron")).unwrap_err().to_string();
+    assert!(e.contains("absent.ron") && e.contains("cannot read"), "{e}");
     for (text, fragments) in BAD_RON {
         let err = match load_text(&d, text) {
             Ok(_) => panic!("loaded without error: {text}"),

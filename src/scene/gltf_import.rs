@@ -288,8 +288,17 @@ impl Importer {
             .collect();
         let mut camera: Option<FoundCamera> = None;
         let mut lights = Vec::new();
+        let mut visits = 0u64;
         while let Some((node, parent, depth)) = stack.pop() {
             let element = named("node", node.index(), node.name());
+            visits += 1;
+            // Nodes reachable along many paths (not a tree) could explode exponentially.
+            self.limit(
+                &element,
+                "node instance count",
+                visits,
+                self.limits.max_nodes,
+            )?;
             if depth > node_count {
                 return Err(self.err(element, "node hierarchy contains a cycle"));
             }

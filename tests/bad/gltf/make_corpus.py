@@ -115,3 +115,15 @@ js += b" " * ((4 - len(js) % 4) % 4)
 glb = b"glTF" + struct.pack("<II", 2, 12 + 8 + len(js)) + struct.pack("<I", len(js)) + b"JSON" + js
 open("glb_without_bin_chunk.glb", "wb").write(glb)
 open("truncated.glb", "wb").write(glb[:30])
+# Not a tree: each level's two nodes both have the next level's two nodes as children, so
+# 2^40 node instances are reachable.
+def explosion(d):
+    levels = 40
+    nodes = []
+    for i in range(levels):
+        kids = [2 * (i + 1), 2 * (i + 1) + 1] if i + 1 < levels else []
+        nodes.append({"name": "a%d" % i, "children": kids})
+        nodes.append({"name": "b%d" % i, "children": kids, "mesh": 0} if not kids else {"name": "b%d" % i, "children": kids})
+    d["nodes"] = nodes
+    d["scenes"][0]["nodes"] = [0]
+write("node_instance_explosion.gltf", doc(extra=explosion))
