@@ -144,7 +144,7 @@ fn committed_scene_files_load() {
         s.material_overrides,
         vec![(
             "atrium_bronze".to_string(),
-            PathBuf::from("materials/brushed_bronze.ron")
+            PathBuf::from("materials/brushed_metal.ron")
         )]
     );
     assert!(show.warnings.is_empty(), "{:?}", show.warnings);
