@@ -140,6 +140,9 @@ fn named(kind: &str, index: usize, name: Option<&str>) -> String {
     }
 }
 
+/// (element name, world matrix, (yfov, znear, zfar)).
+type FoundCamera = (String, Mat4, (f32, f32, Option<f32>));
+
 struct PendingLight {
     element: String,
     position: Vec3,
@@ -205,12 +208,26 @@ impl Importer {
             root.nodes.len() as u64,
             self.limits.max_nodes,
         )?;
+        self.precheck(root)?;
         {
             use gltf::json::validation::Validate;
             let mut errors = Vec::new();
+            let mut lenient = Vec::new();
             root.validate(root, gltf::json::Path::new, &mut |path, error| {
-                errors.push(format!("{}: {error}", path()))
+                let path = path().to_string();
+                // POSITION min/max are required by the spec but often missing; bounds are
+                // computed from the data anyway.
+                if matches!(error, gltf::json::validation::Error::Missing)
+                    && (path.ends_with(".min") || path.ends_with(".max"))
+                {
+                    lenient.push(path);
+                } else {
+                    errors.push(format!("{path}: {error}"))
+                }
             });
+            if let Some(first) = lenient.first() {
+                self.warn(format!("{first}: missing (not required by this importer)"));
+            }
             if !errors.is_empty() {
                 let first = errors[0].clone();
                 let more = if errors.len() > 1 {
@@ -227,28 +244,33 @@ impl Importer {
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
         self.load_buffers(&gltf)?;
-        for img in gltf.images() {
-            let (src, name) = match img.source() {
-                gltf::image::Source::Uri { uri, .. } => (
-                    ImageSource::Uri(uri.to_string()),
+        for (i, img) in root.images.iter().enumerate() {
+            // Read from the JSON: the gltf crate's `Image::source` unwraps mimeType.
+            let (src, name) = match (&img.buffer_view, &img.uri) {
+                (Some(view), _) => {
+                    let v = &root.buffer_views[view.value()];
+                    (
+                        ImageSource::View {
+                            buffer: v.buffer.value(),
+                            offset: v.byte_offset.map(|o| o.0 as usize).unwrap_or(0),
+                            length: v.byte_length.0 as usize,
+                        },
+                        format!("image{i}"),
+                    )
+                }
+                (None, Some(uri)) => (
+                    ImageSource::Uri(uri.clone()),
                     if uri.starts_with("data:") {
-                        format!("image{}", img.index())
+                        format!("image{i}")
                     } else {
-                        uri.to_string()
+                        uri.clone()
                     },
                 ),
-                gltf::image::Source::View { view, .. } => (
-                    ImageSource::View {
-                        buffer: view.buffer().index(),
-                        offset: view.offset(),
-                        length: view.length(),
-                    },
-                    format!("image{}", img.index()),
-                ),
+                (None, None) => (ImageSource::Missing, format!("image{i}")),
             };
+            let img_name = img.name.clone();
             self.image_sources.push(src);
-            self.image_names
-                .push(img.name().map(str::to_string).unwrap_or(name));
+            self.image_names.push(img_name.unwrap_or(name));
         }
 
         // Scene graph: flatten into world space.
@@ -270,10 +292,19 @@ impl Importer {
             .rev()
             .map(|n| (n, Mat4::IDENTITY, 0))
             .collect();
-        let mut camera: Option<(String, Mat4, (f32, f32, Option<f32>))> = None;
+        let mut camera: Option<FoundCamera> = None;
         let mut lights = Vec::new();
+        let mut visits = 0u64;
         while let Some((node, parent, depth)) = stack.pop() {
             let element = named("node", node.index(), node.name());
+            visits += 1;
+            // Nodes reachable along many paths (not a tree) could explode exponentially.
+            self.limit(
+                &element,
+                "node instance count",
+                visits,
+                self.limits.max_nodes,
+            )?;
             if depth > node_count {
                 return Err(self.err(element, "node hierarchy contains a cycle"));
             }
@@ -364,6 +395,51 @@ impl Importer {
         };
         if self.scene.meshes.is_empty() {
             self.warn("the scene has no triangle geometry");
+        }
+        Ok(())
+    }
+
+    /// Checks what the gltf crate's validation or accessors would panic on.
+    fn precheck(&self, root: &gltf::json::Root) -> Result<(), SceneError> {
+        use gltf::json::validation::Checked;
+        for (mi, mesh) in root.meshes.iter().enumerate() {
+            for (pi, prim) in mesh.primitives.iter().enumerate() {
+                let pos = prim
+                    .attributes
+                    .get(&Checked::Valid(gltf::Semantic::Positions));
+                if let Some(a) = pos {
+                    if a.value() >= root.accessors.len() {
+                        return Err(self.err(
+                            format!("{} primitive {pi}", named("mesh", mi, mesh.name.as_deref())),
+                            format!("POSITION accessor {} does not exist", a.value()),
+                        ));
+                    }
+                }
+            }
+        }
+        for (i, img) in root.images.iter().enumerate() {
+            if let Some(v) = &img.buffer_view {
+                if v.value() >= root.buffer_views.len() {
+                    return Err(self.err(
+                        named("image", i, img.name.as_deref()),
+                        format!("bufferView {} does not exist", v.value()),
+                    ));
+                }
+            }
+        }
+        for (i, cam) in root.cameras.iter().enumerate() {
+            use gltf::json::camera::Type;
+            let ok = match cam.type_ {
+                Checked::Valid(Type::Perspective) => cam.perspective.is_some(),
+                Checked::Valid(Type::Orthographic) => cam.orthographic.is_some(),
+                Checked::Invalid => true, // reported by validation
+            };
+            if !ok {
+                return Err(self.err(
+                    named("camera", i, cam.name.as_deref()),
+                    "the camera's projection object is missing",
+                ));
+            }
         }
         Ok(())
     }
@@ -1040,6 +1116,7 @@ impl Importer {
     fn try_decode_image(&self, index: usize) -> Result<image::RgbaImage, String> {
         let src = self.image_sources.get(index).ok_or("no such image")?;
         let bytes: Vec<u8> = match src {
+            ImageSource::Missing => return Err("the image has neither uri nor bufferView".into()),
             ImageSource::Uri(uri) => {
                 self.read_uri(uri, &format!("image {index}"))
                     .map_err(|e| match e {
@@ -1076,6 +1153,7 @@ impl Importer {
 }
 
 enum ImageSource {
+    Missing,
     Uri(String),
     View {
         buffer: usize,

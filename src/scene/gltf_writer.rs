@@ -139,7 +139,7 @@ impl GltfWriter {
     }
 
     fn push_view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let offset = self.bin.len();
@@ -519,11 +519,11 @@ impl GltfWriter {
     /// The GLB bytes (JSON chunk + binary chunk).
     pub fn to_glb(&self) -> Vec<u8> {
         let mut json = self.to_json(None).into_bytes();
-        while json.len() % 4 != 0 {
+        while !json.len().is_multiple_of(4) {
             json.push(b' ');
         }
         let mut bin = self.bin.clone();
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         let total = 12 + 8 + json.len() + if bin.is_empty() { 0 } else { 8 + bin.len() };
