@@ -10,16 +10,28 @@ pub type DepGraph = DiGraph<usize, String>;
 pub fn build(desc: &GraphDesc) -> DepGraph {
     let mut g = DepGraph::new();
     let nodes: Vec<NodeIndex> = (0..desc.passes.len()).map(|i| g.add_node(i)).collect();
+    let writers = writers_by_resource(desc);
     for (r, reader) in desc.passes.iter().enumerate() {
         for res in &reader.reads {
-            for (w, writer) in desc.passes.iter().enumerate() {
-                if w != r && writer.writes.contains(res) {
+            for &w in writers.get(res.as_str()).into_iter().flatten() {
+                if w != r {
                     g.update_edge(nodes[w], nodes[r], res.clone());
                 }
             }
         }
     }
     g
+}
+
+/// Resource name -> indices of the passes that write it, in declaration order.
+pub fn writers_by_resource(desc: &GraphDesc) -> std::collections::HashMap<&str, Vec<usize>> {
+    let mut writers: std::collections::HashMap<&str, Vec<usize>> = std::collections::HashMap::new();
+    for (i, p) in desc.passes.iter().enumerate() {
+        for w in &p.writes {
+            writers.entry(w.as_str()).or_default().push(i);
+        }
+    }
+    writers
 }
 
 /// The passes on each cycle, in declaration order of their first pass.

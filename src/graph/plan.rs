@@ -29,6 +29,8 @@ pub struct PhysicalResource {
     pub buffer_usage: wgpu::BufferUsages,
     /// Graph resources this one serves, in order of use.
     pub serves: Vec<String>,
+    /// Last schedule position of any resource it serves.
+    pub last_use: usize,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -150,24 +152,28 @@ pub fn plan(
     frame: FrameSize,
 ) -> ResourcePlan {
     let mut plan = ResourcePlan::default();
+    // Schedule positions that use each resource, from one walk over the schedule.
+    let mut positions: std::collections::HashMap<&str, Vec<usize>> =
+        std::collections::HashMap::new();
+    for (pos, &p) in schedule.iter().enumerate() {
+        let pass = &desc.passes[p];
+        for n in pass.reads.iter().chain(&pass.writes) {
+            let v = positions.entry(n.as_str()).or_default();
+            if v.last() != Some(&pos) {
+                v.push(pos);
+            }
+        }
+    }
     // Transients in order of first use.
     let mut uses: Vec<(usize, usize, &ResourceDesc)> = Vec::new();
     for r in &desc.resources {
         if matches!(r, ResourceDesc::Import { .. }) {
             continue;
         }
-        let positions: Vec<usize> = schedule
-            .iter()
-            .enumerate()
-            .filter(|(_, &p)| {
-                let pass = &desc.passes[p];
-                pass.reads.iter().chain(&pass.writes).any(|n| n == r.name())
-            })
-            .map(|(pos, _)| pos)
-            .collect();
-        let (Some(&first), Some(&last)) = (positions.first(), positions.last()) else {
+        let Some(used_at) = positions.get(r.name()) else {
             continue;
         };
+        let (first, last) = (used_at[0], *used_at.last().unwrap());
         // The output lives to the end of the frame (it is read back).
         let last = if r.name() == desc.output {
             schedule.len()
@@ -178,17 +184,18 @@ pub fn plan(
     }
     uses.sort_by_key(|u| u.0);
     for (first, last, r) in uses {
-        let (pdesc, tex_usage, buf_usage) = describe(r, desc, roles, schedule, frame);
-        let absent = !schedule
+        let users: Vec<usize> = positions[r.name()]
+            .iter()
+            .map(|&pos| schedule[pos])
+            .collect();
+        let (pdesc, tex_usage, buf_usage) = describe(r, desc, roles, &users, frame);
+        let absent = !users
             .iter()
             .any(|&p| desc.passes[p].writes.iter().any(|w| w == r.name()));
-        let reuse = plan.physical.iter().position(|ph| {
-            ph.desc == pdesc
-                && ph
-                    .serves
-                    .iter()
-                    .all(|s| plan.get(s).is_some_and(|pr| pr.last < first))
-        });
+        let reuse = plan
+            .physical
+            .iter()
+            .position(|ph| ph.desc == pdesc && ph.last_use < first);
         let physical = match reuse {
             Some(i) => i,
             None => {
@@ -197,6 +204,7 @@ pub fn plan(
                     texture_usage: wgpu::TextureUsages::empty(),
                     buffer_usage: wgpu::BufferUsages::empty(),
                     serves: Vec::new(),
+                    last_use: 0,
                 });
                 plan.physical.len() - 1
             }
@@ -205,6 +213,7 @@ pub fn plan(
         ph.texture_usage |= tex_usage;
         ph.buffer_usage |= buf_usage;
         ph.serves.push(r.name().to_string());
+        ph.last_use = ph.last_use.max(last);
         plan.resources.push(PlannedResource {
             name: r.name().to_string(),
             physical,
@@ -220,7 +229,7 @@ fn describe(
     r: &ResourceDesc,
     desc: &GraphDesc,
     roles: &[PassRoles],
-    schedule: &[usize],
+    users: &[usize],
     frame: FrameSize,
 ) -> (PhysicalDesc, wgpu::TextureUsages, wgpu::BufferUsages) {
     use wgpu::{BufferUsages as B, TextureUsages as T};
@@ -238,7 +247,7 @@ fn describe(
             if format.is_depth() {
                 usage |= T::TEXTURE_BINDING;
             }
-            for &p in schedule {
+            for &p in users {
                 let role = &roles[p];
                 let is_slot =
                     role.slots.values().any(|v| v == name) || role.target.as_deref() == Some(name);

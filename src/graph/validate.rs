@@ -157,7 +157,8 @@ fn check_writes(
     resources: &BTreeMap<&str, &ResourceDesc>,
     errors: &mut Vec<GraphError>,
 ) {
-    for pass in &desc.passes {
+    let writers = deps::writers_by_resource(desc);
+    for (index, pass) in desc.passes.iter().enumerate() {
         for name in &pass.writes {
             if let Some(ResourceDesc::Import { from, .. }) = resources.get(name.as_str()) {
                 errors.push(GraphError::Mismatch {
@@ -173,10 +174,9 @@ fn check_writes(
                 resources.get(name.as_str()),
                 Some(ResourceDesc::Import { .. })
             );
-            let written_elsewhere = desc
-                .passes
-                .iter()
-                .any(|p| p.name != pass.name && p.writes.contains(name));
+            let written_elsewhere = writers
+                .get(name.as_str())
+                .is_some_and(|w| w.iter().any(|&i| i != index));
             if !is_import && !written_elsewhere {
                 errors.push(GraphError::ReadNeverWritten {
                     at: source.in_pass(&pass.name, name),
@@ -198,10 +198,11 @@ fn check_writer_order(
     use petgraph::algo::has_path_connecting;
     use petgraph::graph::NodeIndex;
     let mut reported = BTreeSet::new();
+    let by_resource = deps::writers_by_resource(desc);
     for r in &desc.resources {
-        let writers: Vec<usize> = (0..desc.passes.len())
-            .filter(|&i| desc.passes[i].writes.iter().any(|w| w == r.name()))
-            .collect();
+        let Some(writers) = by_resource.get(r.name()) else {
+            continue;
+        };
         for (k, &a) in writers.iter().enumerate() {
             for &b in &writers[k + 1..] {
                 let (na, nb) = (NodeIndex::new(a), NodeIndex::new(b));
