@@ -1,0 +1,185 @@
+// Lobe library for layered materials. Included textually by the generated material code
+// (src/material/wgsl.rs); mirrored exactly in f64 by src/material/reference.rs, which the
+// tests compare against. Every function returns the BRDF value f(l, v) without the cosine.
+// Names are prefixed `lg_` to stay out of the way of the including shader.
+
+const LG_PI: f32 = 3.14159265358979;
+const LG_INV_PI: f32 = 0.318309886183791;
+// Smallest GGX α (glTF: α must never be 0). α = 0.002 is perceptual roughness 0.0447,
+// Filament's desktop floor; it also bounds the f32 error of D at its peak (see docs).
+const LG_ALPHA_MIN: f32 = 0.002;
+// Smallest Charlie sheen α (keeps the exponent 1/α ≤ 100).
+const LG_SHEEN_ALPHA_MIN: f32 = 0.01;
+// Cosines are clamped to at least this inside lobes: no division by zero at grazing angles.
+const LG_COS_MIN: f32 = 1e-4;
+
+// What the lobes need about (n, v, l). `s2` is |n × h|² = 1 − (n·h)², computed with a cross
+// product so it keeps its precision where n·h ≈ 1 (the GGX peak).
+struct LgDirs {
+    h: vec3<f32>,
+    nl: f32,
+    nv: f32,
+    nh: f32,
+    vh: f32,
+    s2: f32,
+    lv: f32,
+};
+
+fn lg_dirs(n: vec3<f32>, v: vec3<f32>, l: vec3<f32>) -> LgDirs {
+    var d: LgDirs;
+    let hs = l + v;
+    let len2 = dot(hs, hs);
+    if (len2 > 1e-12) {
+        d.h = hs / sqrt(len2);
+    } else {
+        d.h = n;
+    }
+    d.nl = clamp(dot(n, l), LG_COS_MIN, 1.0);
+    d.nv = clamp(dot(n, v), LG_COS_MIN, 1.0);
+    d.nh = clamp(dot(n, d.h), 0.0, 1.0);
+    let c = cross(n, d.h);
+    d.s2 = min(dot(c, c), 1.0);
+    d.vh = clamp(dot(v, d.h), 0.0, 1.0);
+    d.lv = clamp(dot(l, v), -1.0, 1.0);
+    return d;
+}
+
+fn lg_alpha(roughness: f32) -> f32 {
+    let r = clamp(roughness, 0.0, 1.0);
+    return max(r * r, LG_ALPHA_MIN);
+}
+
+fn lg_ior_f0(ior: f32) -> f32 {
+    let r = (ior - 1.0) / (ior + 1.0);
+    return r * r;
+}
+
+fn lg_schlick(f0: vec3<f32>, vh: f32) -> vec3<f32> {
+    let m = 1.0 - vh;
+    let m2 = m * m;
+    let m5 = m2 * m2 * m;
+    return f0 + (vec3<f32>(1.0) - f0) * m5;
+}
+
+fn lg_schlick1(f0: f32, vh: f32) -> f32 {
+    let m = 1.0 - vh;
+    let m2 = m * m;
+    let m5 = m2 * m2 * m;
+    return f0 + (1.0 - f0) * m5;
+}
+
+// GGX D = α² / (π ((n·h)²(α² − 1) + 1)²), with (n·h)²(α² − 1) + 1 = |n×h|² + (n·h)²α².
+fn lg_d_ggx(nh: f32, s2: f32, a: f32) -> f32 {
+    let x = s2 + nh * nh * (a * a);
+    let r = a / x;
+    return r * r * LG_INV_PI;
+}
+
+// Height-correlated Smith visibility (holds the 1 / (4 n·l n·v)).
+fn lg_v_smith(nl: f32, nv: f32, a: f32) -> f32 {
+    let a2 = a * a;
+    let gv = nl * sqrt(nv * nv * (1.0 - a2) + a2);
+    let gl = nv * sqrt(nl * nl * (1.0 - a2) + a2);
+    return 0.5 / (gv + gl);
+}
+
+fn lg_lambert(color: vec3<f32>) -> vec3<f32> {
+    return color * LG_INV_PI;
+}
+
+fn lg_ggx(f0: vec3<f32>, a: f32, d: LgDirs) -> vec3<f32> {
+    return lg_schlick(f0, d.vh) * (lg_d_ggx(d.nh, d.s2, a) * lg_v_smith(d.nl, d.nv, a));
+}
+
+// Anisotropic GGX; t, b: unit tangent and bitangent orthogonal to n.
+fn lg_ggx_aniso(
+    f0: vec3<f32>,
+    a: f32,
+    anisotropy: f32,
+    t: vec3<f32>,
+    b: vec3<f32>,
+    v: vec3<f32>,
+    l: vec3<f32>,
+    d: LgDirs,
+) -> vec3<f32> {
+    let an = clamp(anisotropy, -1.0, 1.0);
+    let at = max(a * (1.0 + an), LG_ALPHA_MIN);
+    let ab = max(a * (1.0 - an), LG_ALPHA_MIN);
+    let a2 = at * ab;
+    let w = vec3<f32>(ab * dot(t, d.h), at * dot(b, d.h), a2 * d.nh);
+    let w2 = a2 / dot(w, w);
+    let dist = a2 * w2 * w2 * LG_INV_PI;
+    let lam_v = d.nl * length(vec3<f32>(at * dot(t, v), ab * dot(b, v), d.nv));
+    let lam_l = d.nv * length(vec3<f32>(at * dot(t, l), ab * dot(b, l), d.nl));
+    let vis = 0.5 / (lam_v + lam_l);
+    return lg_schlick(f0, d.vh) * (dist * vis);
+}
+
+// Charlie sheen: D = (2 + 1/α) sin(θh)^(1/α) / (2π), V = 1 / (4 (n·l + n·v − n·l n·v)).
+fn lg_sheen(color: vec3<f32>, roughness: f32, d: LgDirs) -> vec3<f32> {
+    let r = clamp(roughness, 0.0, 1.0);
+    let a = max(r * r, LG_SHEEN_ALPHA_MIN);
+    let inv = 1.0 / a;
+    var dist = 0.0;
+    if (d.s2 > 0.0) {
+        dist = (2.0 + inv) * pow(d.s2, 0.5 * inv) * (0.5 * LG_INV_PI);
+    }
+    let vis = 1.0 / (4.0 * (d.nl + d.nv - d.nl * d.nv));
+    return color * (dist * vis);
+}
+
+// Fujii's improved Oren-Nayar ("A tiny improvement of Oren-Nayar reflectance model"),
+// σ = roughness in [0, 1]; σ = 0 is Lambert.
+fn lg_oren_nayar(color: vec3<f32>, roughness: f32, d: LgDirs) -> vec3<f32> {
+    let sigma = clamp(roughness, 0.0, 1.0);
+    let s = d.lv - d.nl * d.nv;
+    var t = 1.0;
+    if (s > 0.0) {
+        t = max(d.nl, d.nv);
+    }
+    let a = 1.0 / (1.0 + (0.5 - 2.0 / (3.0 * LG_PI)) * sigma);
+    let b = sigma * a;
+    return color * (LG_INV_PI * (a + b * s / t));
+}
+
+// The cosine of a direction refracted into a layer of IOR `ior` (≥ 1).
+fn lg_cos_inside(c: f32, ior: f32) -> f32 {
+    let s2 = (1.0 - c * c) / (ior * ior);
+    return max(sqrt(max(1.0 - s2, 0.0)), LG_COS_MIN);
+}
+
+// What a layer lets through to the layer below: transmission × (1 − weight·F(v·h)) × Beer-Lambert
+// absorption exp(−σ d (1/cos θl' + 1/cos θv')) along the refracted in and out paths.
+fn lg_through(
+    ior: f32,
+    weight: f32,
+    transmission: f32,
+    sigma_d: vec3<f32>,
+    d: LgDirs,
+) -> vec3<f32> {
+    var f = 0.0;
+    if (ior > 1.0) {
+        f = lg_schlick1(lg_ior_f0(ior), d.vh);
+    }
+    let pass_ = transmission * max(1.0 - weight * f, 0.0);
+    let path = 1.0 / lg_cos_inside(d.nl, ior) + 1.0 / lg_cos_inside(d.nv, ior);
+    return pass_ * exp(-sigma_d * path);
+}
+
+// Tangent frame: the tangent made orthogonal to n, or a branchless basis from n alone (Duff
+// et al. 2017) when the mesh has none.
+fn lg_tangent(n: vec3<f32>, tangent: vec4<f32>) -> vec3<f32> {
+    let tt = tangent.xyz - n * dot(n, tangent.xyz);
+    let l2 = dot(tt, tt);
+    if (l2 > 1e-8) {
+        return tt / sqrt(l2);
+    }
+    let s = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (s + n.z);
+    let b = n.x * n.y * a;
+    return vec3<f32>(1.0 + s * n.x * n.x * a, s * b, -s * n.x);
+}
+
+fn lg_bitangent(n: vec3<f32>, t: vec3<f32>, w: f32) -> vec3<f32> {
+    return cross(n, t) * select(1.0, -1.0, w < 0.0);
+}
