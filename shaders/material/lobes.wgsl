@@ -13,8 +13,45 @@ const LG_SHEEN_ALPHA_MIN: f32 = 0.01;
 // Cosines are clamped to at least this inside lobes: no division by zero at grazing angles.
 const LG_COS_MIN: f32 = 1e-4;
 
-// What the lobes need about (n, v, l). `s2` is |n × h|² = 1 − (n·h)², computed with a cross
-// product so it keeps its precision where n·h ≈ 1 (the GGX peak).
+// Accurate products. Cosines near 0 (grazing light or view) and |n × h| near 0 (the GGX
+// peak, sheen at h ≈ n) come out of cancellations, and plain f32 dot and cross products
+// leave an absolute error of ~1e-7 there: a large relative error. FMA-based error-free
+// transformations do not survive every Vulkan driver (lavapipe does not fuse `fma`; NIR's
+// algebraic passes fold TwoSum away and factor a·b + a·c), so the inputs (|x| ≤ 1) are
+// split instead: hi = x rounded to a 2^-11 grid, lo = x − hi (exact). The hi·hi products
+// are done in i32 (integers below 2^22, sums below 2^24): exact, and out of reach of float
+// reassociation. Only the small hi·lo and lo·b terms are rounded (≤ ~1e-11 absolute).
+fn lg_dot(a: vec3<f32>, b: vec3<f32>) -> f32 {
+    let ia = vec3<i32>(round(a * 2048.0));
+    let ib = vec3<i32>(round(b * 2048.0));
+    let ah = vec3<f32>(ia) * (1.0 / 2048.0);
+    let bh = vec3<f32>(ib) * (1.0 / 2048.0);
+    let al = a - ah;
+    let bl = b - bh;
+    let p = ia * ib;
+    let hh = f32(p.x + p.y + p.z) * (1.0 / 4194304.0);
+    return hh + (dot(ah, bl) + dot(al, b));
+}
+
+// a × b for |components| ≤ 1, each component accurate to ~1e-11 absolute.
+fn lg_cross(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
+    let ia = vec3<i32>(round(a * 2048.0));
+    let ib = vec3<i32>(round(b * 2048.0));
+    let ah = vec3<f32>(ia) * (1.0 / 2048.0);
+    let bh = vec3<f32>(ib) * (1.0 / 2048.0);
+    let al = a - ah;
+    let bl = b - bh;
+    let ic = vec3<i32>(
+        ia.y * ib.z - ia.z * ib.y,
+        ia.z * ib.x - ia.x * ib.z,
+        ia.x * ib.y - ia.y * ib.x,
+    );
+    return vec3<f32>(ic) * (1.0 / 4194304.0) + (cross(ah, bl) + cross(al, b));
+}
+
+// What the lobes need about (n, v, l). `s2` is |n × h|² = 1 − (n·h)², from an accurate
+// cross product with the unnormalised l + v (exact where l ≈ −v, by Sterbenz's lemma), so
+// it keeps its precision where n·h ≈ 1.
 struct LgDirs {
     h: vec3<f32>,
     nl: f32,
@@ -27,20 +64,25 @@ struct LgDirs {
 
 fn lg_dirs(n: vec3<f32>, v: vec3<f32>, l: vec3<f32>) -> LgDirs {
     var d: LgDirs;
+    // l + v is exact where l ≈ −v (Sterbenz). Scale it by a power of two (exact) so its
+    // largest component is in [0.5, 1): lg_dot and lg_cross then stay accurate relative to
+    // their results even when l + v is tiny (grazing mirror configurations).
+    var hq = n;
     let hs = l + v;
-    let len2 = dot(hs, hs);
-    if (len2 > 1e-12) {
-        d.h = hs / sqrt(len2);
-    } else {
-        d.h = n;
+    let big = max(max(abs(hs.x), abs(hs.y)), abs(hs.z));
+    if (big > 1e-30) {
+        hq = ldexp(hs, vec3<i32>(-frexp(big).exp));
     }
-    d.nl = clamp(dot(n, l), LG_COS_MIN, 1.0);
-    d.nv = clamp(dot(n, v), LG_COS_MIN, 1.0);
-    d.nh = clamp(dot(n, d.h), 0.0, 1.0);
-    let c = cross(n, d.h);
-    d.s2 = min(dot(c, c), 1.0);
-    d.vh = clamp(dot(v, d.h), 0.0, 1.0);
-    d.lv = clamp(dot(l, v), -1.0, 1.0);
+    let len2 = dot(hq, hq);
+    let len = sqrt(len2);
+    d.h = hq / len;
+    d.nl = clamp(lg_dot(n, l), LG_COS_MIN, 1.0);
+    d.nv = clamp(lg_dot(n, v), LG_COS_MIN, 1.0);
+    d.nh = clamp(lg_dot(n, hq) / len, 0.0, 1.0);
+    let c = lg_cross(n, hq);
+    d.s2 = min(dot(c, c) / len2, 1.0);
+    d.vh = clamp(lg_dot(v, hq) / len, 0.0, 1.0);
+    d.lv = clamp(lg_dot(l, v), -1.0, 1.0);
     return d;
 }
 
@@ -106,7 +148,7 @@ fn lg_ggx_aniso(
     let at = max(a * (1.0 + an), LG_ALPHA_MIN);
     let ab = max(a * (1.0 - an), LG_ALPHA_MIN);
     let a2 = at * ab;
-    let w = vec3<f32>(ab * dot(t, d.h), at * dot(b, d.h), a2 * d.nh);
+    let w = vec3<f32>(ab * lg_dot(t, d.h), at * lg_dot(b, d.h), a2 * d.nh);
     let w2 = a2 / dot(w, w);
     let dist = a2 * w2 * w2 * LG_INV_PI;
     let lam_v = d.nl * length(vec3<f32>(at * dot(t, v), ab * dot(b, v), d.nv));
@@ -143,9 +185,10 @@ fn lg_oren_nayar(color: vec3<f32>, roughness: f32, d: LgDirs) -> vec3<f32> {
 }
 
 // The cosine of a direction refracted into a layer of IOR `ior` (≥ 1).
+// cos θ' = sqrt(1 − (1 − c²)/η²) = sqrt((η − 1)(η + 1) + c²) / η, the second form without
+// cancellation at grazing angles.
 fn lg_cos_inside(c: f32, ior: f32) -> f32 {
-    let s2 = (1.0 - c * c) / (ior * ior);
-    return max(sqrt(max(1.0 - s2, 0.0)), LG_COS_MIN);
+    return max(sqrt((ior - 1.0) * (ior + 1.0) + c * c) / ior, LG_COS_MIN);
 }
 
 // What a layer lets through to the layer below: transmission × (1 − weight·F(v·h)) × Beer-Lambert

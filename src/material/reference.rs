@@ -65,20 +65,19 @@ pub struct Dirs {
 
 pub fn dirs(n: V3, v: V3, l: V3) -> Dirs {
     let hs = add(l, v);
+    let big = hs[0].abs().max(hs[1].abs()).max(hs[2].abs());
+    let hs = if big > 1e-30 { hs } else { n };
     let len2 = dot(hs, hs);
-    let h = if len2 > 1e-12 {
-        scale(hs, 1.0 / len2.sqrt())
-    } else {
-        n
-    };
-    let c = cross(n, h);
+    let len = len2.sqrt();
+    let h = scale(hs, 1.0 / len);
+    let c = cross(n, hs);
     Dirs {
         h,
         nl: dot(n, l).clamp(COS_MIN, 1.0),
         nv: dot(n, v).clamp(COS_MIN, 1.0),
-        nh: dot(n, h).clamp(0.0, 1.0),
-        vh: dot(v, h).clamp(0.0, 1.0),
-        s2: dot(c, c).min(1.0),
+        nh: (dot(n, hs) / len).clamp(0.0, 1.0),
+        vh: (dot(v, hs) / len).clamp(0.0, 1.0),
+        s2: (dot(c, c) / len2).min(1.0),
         lv: dot(l, v).clamp(-1.0, 1.0),
     }
 }
@@ -166,8 +165,7 @@ pub fn oren_nayar(color: V3, roughness: f64, d: &Dirs) -> V3 {
 }
 
 fn cos_inside(c: f64, ior: f64) -> f64 {
-    let s2 = (1.0 - c * c) / (ior * ior);
-    (1.0 - s2).max(0.0).sqrt().max(COS_MIN)
+    (((ior - 1.0) * (ior + 1.0) + c * c).sqrt() / ior).max(COS_MIN)
 }
 
 pub fn through(ior: f64, weight: f64, transmission: f64, sigma_d: V3, d: &Dirs) -> V3 {

@@ -251,7 +251,7 @@ pub fn generate(m: &Material, opts: &WgslOptions) -> String {
         .iter()
         .flat_map(|l| &l.lobes)
         .any(|l| matches!(l, Lobe::Clearcoat { .. }));
-    o.push_str("fn material_eval(m: MaterialSample, l: vec3<f32>) -> vec3<f32> {\n    let cos_l = dot(m.n, l);\n    if (!(cos_l > 0.0)) {\n        return vec3<f32>(0.0);\n    }\n    let d = lg_dirs(m.n, m.v, l);\n");
+    o.push_str("fn material_eval(m: MaterialSample, l: vec3<f32>) -> vec3<f32> {\n    let cos_l = lg_dot(m.n, l);\n    if (!(cos_l > 0.0)) {\n        return vec3<f32>(0.0);\n    }\n    let d = lg_dirs(m.n, m.v, l);\n");
     if has_clearcoat {
         if desc.normal_map.is_some() {
             o.push_str("    let dg = lg_dirs(m.ng, m.v, l);\n    let cc_on = select(0.0, 1.0, dot(m.ng, l) > 0.0);\n");
