@@ -79,6 +79,9 @@ pub struct Layer {
     /// Scales the interface Fresnel in `1 - F * weight` (e.g. clearcoat amount).
     #[serde(default = "one_f32")]
     pub weight: f32,
+    /// How the interface Fresnel scales what reaches the layers below.
+    #[serde(default)]
+    pub coupling: Coupling,
     /// Fraction of the non-reflected light that goes on to the next layer.
     #[serde(default = "one_f32")]
     pub transmission: f32,
@@ -89,6 +92,19 @@ pub struct Layer {
     #[serde(default)]
     pub absorption: (f32, f32, f32),
     pub lobes: Vec<Lobe>,
+}
+
+/// How a layer's interface Fresnel scales the light reaching the layers below.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Coupling {
+    /// Light crosses the interface on the way in and out: `(1 − w F(n·l)) (1 − w F(n·v))`.
+    /// Reciprocal and energy-conserving.
+    #[default]
+    Interface,
+    /// glTF's `fresnel_mix`: `1 − w F(v·h)`. Exact glTF, but not energy-conserving for
+    /// smooth layers at grazing angles (the diffuse below is not dimmed where the mirror
+    /// reflection is strong).
+    HalfVector,
 }
 
 /// One weighted BRDF lobe. Roughness is perceptual (α = roughness²).

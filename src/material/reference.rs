@@ -76,7 +76,8 @@ pub fn dirs(n: V3, v: V3, l: V3) -> Dirs {
         nl: dot(n, l).clamp(COS_MIN, 1.0),
         nv: dot(n, v).clamp(COS_MIN, 1.0),
         nh: (dot(n, hs) / len).clamp(0.0, 1.0),
-        vh: (dot(v, hs) / len).clamp(0.0, 1.0),
+        // v·h = l·h = |l + v| / 2 for unit vectors: symmetric in l and v.
+        vh: (0.5 * dot(add(l, v), add(l, v)).sqrt()).clamp(0.0, 1.0),
         s2: (dot(c, c) / len2).min(1.0),
         lv: dot(l, v).clamp(-1.0, 1.0),
     }
@@ -142,6 +143,30 @@ pub fn ggx_aniso(f0: V3, a: f64, anisotropy: f64, t: V3, b: V3, v: V3, l: V3, d:
     scale(schlick(f0, d.vh), dist * vis)
 }
 
+fn sheen_l(x: f64, a: f64) -> f64 {
+    let t = (1.0 - a) * (1.0 - a);
+    let mix = |p: f32, q: f32| p as f64 * (1.0 - t) + q as f64 * t;
+    let p0 = mix(21.5473, 25.3245);
+    let p1 = mix(3.82987, 3.32435);
+    let p2 = mix(0.19823, 0.16801);
+    let p3 = mix(-1.97760, -1.27393);
+    let p4 = mix(-4.32054, -4.85967);
+    p0 / (1.0 + p1 * x.powf(p2)) + p3 * x + p4
+}
+
+/// Estevez & Kulla's fitted Smith Λ for the Charlie distribution.
+pub fn sheen_lambda(c: f64, a: f64) -> f64 {
+    let l = if c < 0.5 {
+        sheen_l(c, a)
+    } else {
+        2.0 * sheen_l(0.5, a) - sheen_l(1.0 - c, a)
+    };
+    let m = 1.0 - c;
+    let m2 = m * m;
+    let m8 = m2 * m2 * m2 * m2;
+    (l * (1.0 + 2.0 * m8)).exp()
+}
+
 pub fn sheen(color: V3, roughness: f64, d: &Dirs) -> V3 {
     let r = roughness.clamp(0.0, 1.0);
     let a = (r * r).max(SHEEN_ALPHA_MIN);
@@ -151,7 +176,7 @@ pub fn sheen(color: V3, roughness: f64, d: &Dirs) -> V3 {
     } else {
         0.0
     };
-    let vis = 1.0 / (4.0 * (d.nl + d.nv - d.nl * d.nv));
+    let vis = 1.0 / ((1.0 + sheen_lambda(d.nv, a) + sheen_lambda(d.nl, a)) * (4.0 * d.nv * d.nl));
     scale(color, dist * vis)
 }
 
@@ -168,14 +193,32 @@ fn cos_inside(c: f64, ior: f64) -> f64 {
     (((ior - 1.0) * (ior + 1.0) + c * c).sqrt() / ior).max(COS_MIN)
 }
 
-pub fn through(ior: f64, weight: f64, transmission: f64, sigma_d: V3, d: &Dirs) -> V3 {
-    let f = if ior > 1.0 {
+fn one_minus_wf(f0: f64, w: f64, c: f64) -> f64 {
+    let f = f0 + (1.0 - f0) * (1.0 - c).powi(5);
+    (1.0 - w * f).max(0.0)
+}
+
+/// What a layer lets through (see `lg_through`): `coupling` 0 = `Interface`
+/// (1 − wF(n·l))(1 − wF(n·v)), 1 = `HalfVector` (1 − wF(v·h)), glTF's fresnel_mix.
+pub fn through(
+    ior: f64,
+    weight: f64,
+    transmission: f64,
+    sigma_d: V3,
+    coupling: u32,
+    d: &Dirs,
+) -> V3 {
+    let pass = if ior > 1.0 {
         let f0 = ior_f0(ior);
-        f0 + (1.0 - f0) * (1.0 - d.vh).powi(5)
+        transmission
+            * if coupling == 1 {
+                one_minus_wf(f0, weight, d.vh)
+            } else {
+                one_minus_wf(f0, weight, d.nl) * one_minus_wf(f0, weight, d.nv)
+            }
     } else {
-        0.0
+        transmission
     };
-    let pass = transmission * (1.0 - weight * f).max(0.0);
     let path = 1.0 / cos_inside(d.nl, ior) + 1.0 / cos_inside(d.nv, ior);
     [
         pass * (-sigma_d[0] * path).exp(),
@@ -332,6 +375,7 @@ pub fn brdf_at(m: &Material, at: &Surface, v: V3, l: V3) -> V3 {
                 layer.weight as f64,
                 layer.transmission as f64,
                 sigma_d,
+                layer.coupling as u32,
                 &d,
             );
             acc = add(s, mul(tr, acc));

@@ -285,13 +285,14 @@ pub fn generate(m: &Material, opts: &WgslOptions) -> String {
             let th = layer.thickness;
             let _ = writeln!(
                 o,
-                "    acc = s{i} + lg_through({}, {}, {}, vec3<f32>({}, {}, {}), d) * acc;",
+                "    acc = s{i} + lg_through({}, {}, {}, vec3<f32>({}, {}, {}), {}u, d) * acc;",
                 lit(layer.ior.unwrap_or(1.0)),
                 lit(layer.weight),
                 lit(layer.transmission),
                 lit(a.0 * th),
                 lit(a.1 * th),
-                lit(a.2 * th)
+                lit(a.2 * th),
+                layer.coupling as u32
             );
         }
     }
