@@ -109,6 +109,7 @@ pub enum Coupling {
 
 /// One weighted BRDF lobe. Roughness is perceptual (α = roughness²).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Lobe {
     /// ρ/π.
     Lambert {
@@ -215,6 +216,7 @@ pub enum Scalar {
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum ScalarExpr {
     /// `scale * texture.channel`.
     Tex {
@@ -237,6 +239,7 @@ pub enum Color {
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum ColorExpr {
     /// `scale * texture.rgb`.
     Tex {
