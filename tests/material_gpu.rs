@@ -343,3 +343,26 @@ fn random_layered_materials_match_f64_reference() {
     }
     println!("  {n} random layered materials × 1024 samples: max err {worst:.3e}");
 }
+
+#[test]
+fn artist_values_stay_finite_on_the_gpu() {
+    let gpu = GpuContext::new_headless().expect("GPU (lavapipe) needed");
+    let m = Material::parse(
+        "(
+        name: \"pushed\",
+        layers: [
+            (ior: Some(0.5), weight: 80, transmission: 3, thickness: 1e30, absorption: (-1, 0, 1e30), lobes: [
+                Ggx(weight: 2.5, roughness: -0.5, f0: Some((4, 1.5, 1e30))),
+                Sheen(weight: 1e9, color: (2, 2, 2), roughness: 7),
+            ]),
+            (ior: Some(3), coupling: HalfVector, weight: 5, lobes: [Clearcoat(weight: 40, roughness: 0)]),
+            (lobes: [AnisoGgx(weight: 3, roughness: 2, anisotropy: 5, ior: Some(1e9)), Lambert(weight: 2, color: (5, -1, 2))]),
+        ],
+    )",
+        "pushed.ron",
+    )
+    .unwrap();
+    assert!(!m.warnings().is_empty());
+    let worst = check_material(&gpu, &m, 16384, 4242);
+    println!("  pushed past physical ranges: max err {worst:.3e}, all finite");
+}

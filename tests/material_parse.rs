@@ -275,3 +275,54 @@ fn from_desc_round_trip_and_errors_are_typed() {
     let e = Material::parse("(layers: [])", "x.ron").unwrap_err();
     assert!(matches!(e, MaterialError::EmptyLayers { .. }), "{e}");
 }
+
+/// The contract with the forward shader: every shipped material (and a textured glTF
+/// material) composes into `shaders/forward/forward.wgsl` and validates, in both the
+/// shading and the alpha-masked depth variants.
+#[test]
+fn materials_plug_into_the_forward_shader() {
+    use lightgraph::shader::ShaderLibrary;
+    use std::collections::BTreeMap;
+    let lib = ShaderLibrary::builtin();
+    let mut mats: Vec<Material> = ron_files(&root().join("materials"))
+        .iter()
+        .map(|p| Material::load(p).unwrap())
+        .collect();
+    let img = Arc::new(TextureImage {
+        name: "t".into(),
+        width: 1,
+        height: 1,
+        rgba8: vec![255; 4],
+        srgb: false,
+    });
+    mats.push(Material::from_surface(&SurfaceMaterial {
+        base_color_texture: Some(img.clone()),
+        normal_texture: Some(img.clone()),
+        emissive_texture: Some(img),
+        ..Default::default()
+    }));
+    for m in &mats {
+        let code = m.wgsl().unwrap();
+        let virt = BTreeMap::from([("material".to_string(), code)]);
+        for defines in [
+            vec![],
+            vec![("LIGHT_LISTS", "true")],
+            vec![
+                ("DEPTH_ONLY", "true"),
+                ("ALPHA_MASK", "true"),
+                ("ALPHA_CUTOFF", "0.5"),
+            ],
+        ] {
+            let defines: BTreeMap<String, String> = defines
+                .into_iter()
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect();
+            let composed = lib
+                .compose("forward/forward.wgsl", &defines, &virt)
+                .unwrap_or_else(|e| panic!("{}: {e}", m.name()));
+            composed
+                .validate()
+                .unwrap_or_else(|e| panic!("{} {defines:?}: {e}", m.name()));
+        }
+    }
+}
