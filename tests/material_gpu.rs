@@ -333,7 +333,7 @@ fn random_material(rng: &mut Rng, k: usize) -> String {
 #[test]
 fn random_layered_materials_match_f64_reference() {
     let gpu = GpuContext::new_headless().expect("GPU (lavapipe) needed");
-    let mut rng = Rng(0xa11_ce);
+    let mut rng = Rng(0x00a1_1ce0);
     let mut worst = 0.0f64;
     let n = 24;
     for k in 0..n {
@@ -365,4 +365,179 @@ fn artist_values_stay_finite_on_the_gpu() {
     assert!(!m.warnings().is_empty());
     let worst = check_material(&gpu, &m, 16384, 4242);
     println!("  pushed past physical ranges: max err {worst:.3e}, all finite");
+}
+
+const TEXTURED_HARNESS: &str = "
+struct Sample {
+    n: vec4<f32>,
+    t: vec4<f32>,
+    v: vec4<f32>,
+    l: vec4<f32>,
+};
+@group(0) @binding(0) var<storage, read> samples: array<Sample>;
+@group(0) @binding(1) var<storage, read_write> out: array<vec4<f32>>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if (i >= arrayLength(&samples)) {
+        return;
+    }
+    let s = samples[i];
+    var p: ShadingPoint;
+    p.position = vec3<f32>(0.0);
+    p.normal = s.n.xyz;
+    p.tangent = s.t;
+    p.uv = vec2<f32>(0.5);
+    p.view = s.v.xyz;
+    let m = material_setup(p);
+    out[4u * i] = vec4<f32>(material_eval(m, s.l.xyz), material_alpha(m));
+    out[4u * i + 1u] = vec4<f32>(m.n, material_occlusion(m));
+    out[4u * i + 2u] = vec4<f32>(m.t, 0.0);
+    out[4u * i + 3u] = vec4<f32>(m.c0_0, m.r0_0);
+}
+";
+
+fn srgb_to_linear(c: f64) -> f64 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// A textured glTF material (base colour sRGB, metallic-roughness in B/G, normal map with
+/// scale, occlusion): material_setup samples the textures and perturbs the normal on the
+/// GPU; the f64 reference evaluates at the GPU's shading frame with the decoded texels.
+#[test]
+fn textured_gltf_matches_f64_reference() {
+    use lightgraph::scene::{SurfaceMaterial, TextureImage};
+    use std::sync::Arc;
+    let gpu = GpuContext::new_headless().expect("GPU (lavapipe) needed");
+    let img = |name: &str, rgba: [u8; 4], srgb: bool| {
+        Some(Arc::new(TextureImage {
+            name: name.into(),
+            width: 1,
+            height: 1,
+            rgba8: rgba.to_vec(),
+            srgb,
+        }))
+    };
+    let s = SurfaceMaterial {
+        name: "textured_gltf".into(),
+        base_color: glam::Vec4::new(0.9, 0.8, 1.0, 0.75),
+        metallic: 0.8,
+        roughness: 0.9,
+        // Linear here: lavapipe's sRGB decode deviates from the exact sRGB curve by up to
+        // 0.2 % (byte 200: 0.5766 against 0.5776), which is the texture unit's business,
+        // not the material's. The sRGB flag itself is checked in material_parse.
+        base_color_texture: img("base", [200, 90, 40, 170], false),
+        metallic_roughness_texture: img("mr", [0, 120, 150, 255], false),
+        normal_texture: img("normal", [160, 100, 230, 255], false),
+        normal_scale: 0.7,
+        occlusion_texture: img("occlusion", [100, 0, 0, 255], false),
+        occlusion_strength: 0.5,
+        ..Default::default()
+    };
+    let m = Material::from_surface(&s);
+    let images: Vec<TextureImage> = m
+        .texture_slots()
+        .iter()
+        .map(|slot| (*slot.source.load().unwrap()).clone())
+        .collect();
+    let mut texels = std::collections::BTreeMap::new();
+    for (slot, im) in m.texture_slots().iter().zip(&images) {
+        let mut t = [0.0; 4];
+        for c in 0..4 {
+            let x = im.rgba8[c] as f64 / 255.0;
+            t[c] = if im.srgb && c < 3 {
+                srgb_to_linear(x)
+            } else {
+                x
+            };
+        }
+        texels.insert(slot.name.clone(), t);
+    }
+    let code = m
+        .wgsl_with(&WgslOptions {
+            sample_level_zero: true,
+        })
+        .unwrap();
+    let wgsl = format!("{SHADING_POINT_WGSL}\n{code}\n{TEXTURED_HARNESS}");
+    let count = 16384;
+    let mut rng = Rng(2024);
+    let geos: Vec<Geo> = (0..count).map(|_| geo(&mut rng, true)).collect();
+    let mut input = Vec::new();
+    for g in &geos {
+        for x in [g.n[0], g.n[1], g.n[2], 0.0]
+            .iter()
+            .chain(&g.t)
+            .chain(&[g.v[0], g.v[1], g.v[2], 0.0])
+            .chain(&[g.l[0], g.l[1], g.l[2], 0.0])
+        {
+            input.push(*x as f32);
+        }
+    }
+    let out = f32s(&run_compute_with_textures(
+        &gpu,
+        &wgsl,
+        &to_bytes(&input),
+        (count * 64) as u64,
+        count as u32,
+        &images,
+    ));
+    let (mut worst, mut worst_n) = (0.0f64, 0.0f64);
+    for (i, g) in geos.iter().enumerate() {
+        let o = &out[i * 16..i * 16 + 16];
+        let n_gpu = [o[4] as f64, o[5] as f64, o[6] as f64];
+        let t_gpu = [o[8] as f64, o[9] as f64, o[10] as f64];
+        // The perturbed normal against f64 (glTF: n' = normalize(T x s + B y s + N z)).
+        let t0 = r::tangent(g.n, g.t);
+        let b0 = r::bitangent(g.n, t0, g.t[3]);
+        let nt = texels["normal"];
+        let k = [
+            (nt[0] * 2.0 - 1.0) * 0.7,
+            (nt[1] * 2.0 - 1.0) * 0.7,
+            nt[2] * 2.0 - 1.0,
+        ];
+        let np = r::normalize(r::add(
+            r::add(r::scale(t0, k[0]), r::scale(b0, k[1])),
+            r::scale(g.n, k[2]),
+        ));
+        for c in 0..3 {
+            worst_n = worst_n.max((n_gpu[c] - np[c]).abs());
+        }
+        // The BRDF at the GPU's frame and the decoded texels.
+        let at = r::Surface {
+            n: n_gpu,
+            tangent: [t_gpu[0], t_gpu[1], t_gpu[2], g.t[3]],
+            texels: texels.clone(),
+        };
+        let rv = r::eval_at(&m, &at, g.v, g.l);
+        for c in 0..3 {
+            assert!(o[c].is_finite(), "non-finite at {g:?}");
+            let e = err(o[c], rv[c]);
+            worst = worst.max(e);
+            assert!(
+                e <= TOL,
+                "error {e:e} (gpu {}, ref {:e}) at {g:?}",
+                o[c],
+                rv[c]
+            );
+        }
+        let alpha = texels["base_color"][3] * 0.75;
+        assert!(
+            (o[3] as f64 - alpha).abs() < 1e-6,
+            "alpha {} vs {alpha}",
+            o[3]
+        );
+        let occ = 1.0 + 0.5 * (texels["occlusion"][0] - 1.0);
+        assert!(
+            (o[7] as f64 - occ).abs() < 1e-6,
+            "occlusion {} vs {occ}",
+            o[7]
+        );
+    }
+    println!("  textured glTF (normal map): max err {worst:.3e}, perturbed normal max abs err {worst_n:.1e}");
+    assert!(worst_n < 1e-6);
 }

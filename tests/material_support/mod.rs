@@ -121,7 +121,7 @@ pub fn geo(rng: &mut Rng, below: bool) -> Geo {
     };
     let t0 = rng.unit();
     let w = if rng.f() < 0.5 { 1.0 } else { -1.0 };
-    let t = if rng.next_u64() % 5 == 0 {
+    let t = if rng.next_u64().is_multiple_of(5) {
         [0.0; 4] // no mesh tangent: the basis is built from n
     } else {
         let t = norm(add(t0, sc(n, -dot(n, t0))));
@@ -150,6 +150,19 @@ pub fn run_compute(
     input: &[u8],
     out_bytes: u64,
     items: u32,
+) -> Vec<u8> {
+    run_compute_with_textures(gpu, wgsl, input, out_bytes, items, &[])
+}
+
+/// As [`run_compute`], plus `@group(2)`: a filtering sampler at binding 0 and one texture
+/// per image at bindings 1.. (the material contract).
+pub fn run_compute_with_textures(
+    gpu: &GpuContext,
+    wgsl: &str,
+    input: &[u8],
+    out_bytes: u64,
+    items: u32,
+    images: &[lightgraph::scene::TextureImage],
 ) -> Vec<u8> {
     let device = &gpu.device;
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -189,11 +202,65 @@ pub fn run_compute(
             },
         ],
     });
+    let group2 = (!images.is_empty()).then(|| {
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let views: Vec<_> = images
+            .iter()
+            .map(|img| {
+                let tex = device.create_texture_with_data(
+                    &gpu.queue,
+                    &wgpu::TextureDescriptor {
+                        label: Some(&img.name),
+                        size: wgpu::Extent3d {
+                            width: img.width,
+                            height: img.height,
+                            depth_or_array_layers: 1,
+                        },
+                        mip_level_count: 1,
+                        sample_count: 1,
+                        dimension: wgpu::TextureDimension::D2,
+                        format: if img.srgb {
+                            wgpu::TextureFormat::Rgba8UnormSrgb
+                        } else {
+                            wgpu::TextureFormat::Rgba8Unorm
+                        },
+                        usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                        view_formats: &[],
+                    },
+                    wgpu::util::TextureDataOrder::LayerMajor,
+                    &img.rgba8,
+                );
+                tex.create_view(&Default::default())
+            })
+            .collect();
+        let mut entries = vec![wgpu::BindGroupEntry {
+            binding: 0,
+            resource: wgpu::BindingResource::Sampler(&sampler),
+        }];
+        for (i, v) in views.iter().enumerate() {
+            entries.push(wgpu::BindGroupEntry {
+                binding: i as u32 + 1,
+                resource: wgpu::BindingResource::TextureView(v),
+            });
+        }
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("material textures"),
+            layout: &pipeline.get_bind_group_layout(2),
+            entries: &entries,
+        })
+    });
     let mut enc = device.create_command_encoder(&Default::default());
     {
         let mut pass = enc.begin_compute_pass(&Default::default());
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, &bind, &[]);
+        if let Some(g2) = &group2 {
+            pass.set_bind_group(2, g2, &[]);
+        }
         pass.dispatch_workgroups(items.div_ceil(64), 1, 1);
     }
     gpu.queue.submit([enc.finish()]);
