@@ -11,6 +11,18 @@ const ROUGHNESS: [f64; 8] = [0.0, 0.02, 0.05, 0.1, 0.25, 0.5, 0.75, 1.0];
 const COS_VIEW: [f64; 7] = [1.0, 0.8, 0.5, 0.25, 0.1, 0.03, 0.005];
 const SAMPLES: usize = 1 << 15;
 
+/// The shipped `materials/*.ron`.
+fn shipped() -> Vec<std::path::PathBuf> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("materials");
+    let mut v: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
+    v.sort();
+    v
+}
+
 fn mat(src: &str) -> Material {
     Material::parse(src, "test.ron").unwrap_or_else(|e| panic!("{e}\n{src}"))
 }
@@ -163,9 +175,7 @@ fn white_furnace_layered() {
             ))
         }),
     );
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("materials");
-    for e in std::fs::read_dir(dir).unwrap() {
-        let p = e.unwrap().path();
+    for p in shipped() {
         let m = Material::load(&p).unwrap();
         let conserving = m
             .desc()
@@ -209,13 +219,10 @@ fn reciprocity() {
     ];
     let mut rng = Rng(99);
     println!("reciprocity |f(l,v) − f(v,l)| / |f| (max over 20000 samples a lobe):");
-    let layered =
-        std::fs::read_dir(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("materials"))
-            .unwrap()
-            .map(|e| {
-                let m = Material::load(e.unwrap().path()).unwrap();
-                (m.name().to_string(), m)
-            });
+    let layered = shipped().into_iter().map(|p| {
+        let m = Material::load(p).unwrap();
+        (m.name().to_string(), m)
+    });
     let singles = lobes.iter().flat_map(|(name, src)| {
         [0.0, 0.3, 1.0].map(|rough| {
             (

@@ -5,6 +5,25 @@
 //! compiles to WGSL ([`wgsl`]) that plugs into the forward light loop through
 //! `material_setup` / `material_eval` / `material_emission` / `material_alpha`.
 //! [`reference`] is the f64 CPU implementation the tests compare the GPU against.
+//!
+//! # Accuracy (f32 WGSL against the f64 reference)
+//!
+//! The hard places are cancellations: n·l and n·v at grazing angles, |n × h| at the GGX peak
+//! and at h ≈ n for sheen, v·h where l ≈ −v, and 1 − F at grazing. The lobe library
+//! (`shaders/material/lobes.wgsl`) therefore
+//! - computes dot and cross products of unit vectors with a split into a 2^-11 grid part,
+//!   whose products are done exactly in i32, and a small remainder (`lg_dot`, `lg_cross`):
+//!   FMA-based error-free transformations are not portable (lavapipe does not fuse `fma`,
+//!   and Mesa's NIR algebraic passes fold TwoSum away and factor `a·b + a·c`);
+//! - takes |n × h|² from the accurate cross product with l + v scaled by a power of two
+//!   (exact), instead of 1 − (n·h)²; v·h as |l + v| / 2 (symmetric, no cancellation);
+//! - writes 1 − w·F(c) as (1 − w) + w (1 − F0) c (1 + m + m² + m³ + m⁴), m = 1 − c;
+//! - writes the refracted cosine as sqrt((η − 1)(η + 1) + c²) / η;
+//! - clamps α ≥ 0.002 (perceptual roughness 0.045, as Filament), cosines ≥ 1e-4 inside lobes.
+//!
+//! Measured on lavapipe over 65,536 random samples a lobe (roughness 0 and 1, grazing angles,
+//! specular peaks), error |gpu − ref| / max(|ref|, 1e-3): every lobe ≤ 7.3e-5, layered
+//! materials ≤ 4.9e-5 (see `tests/material_gpu.rs`).
 
 pub mod error;
 mod gltf_map;
