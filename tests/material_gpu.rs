@@ -447,15 +447,14 @@ fn textured_gltf_matches_f64_reference() {
         .collect();
     let mut texels = std::collections::BTreeMap::new();
     for (slot, im) in m.texture_slots().iter().zip(&images) {
-        let mut t = [0.0; 4];
-        for c in 0..4 {
+        let t: [f64; 4] = std::array::from_fn(|c| {
             let x = im.rgba8[c] as f64 / 255.0;
-            t[c] = if im.srgb && c < 3 {
+            if im.srgb && c < 3 {
                 srgb_to_linear(x)
             } else {
                 x
-            };
-        }
+            }
+        });
         texels.insert(slot.name.clone(), t);
     }
     let code = m
