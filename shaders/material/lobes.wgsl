@@ -1,0 +1,279 @@
+// Lobe library for layered materials. Included textually by the generated material code
+// (src/material/wgsl.rs); mirrored exactly in f64 by src/material/reference.rs, which the
+// tests compare against. Every function returns the BRDF value f(l, v) without the cosine.
+// Names are prefixed `lg_` to stay out of the way of the including shader.
+
+const LG_PI: f32 = 3.14159265358979;
+const LG_INV_PI: f32 = 0.318309886183791;
+// Smallest GGX α (glTF: α must never be 0). α = 0.002 is perceptual roughness 0.0447,
+// Filament's desktop floor; it also bounds the f32 error of D at its peak (see docs).
+const LG_ALPHA_MIN: f32 = 0.002;
+// Smallest Charlie sheen α (keeps the exponent 1/α ≤ 100).
+const LG_SHEEN_ALPHA_MIN: f32 = 0.01;
+// Cosines are clamped to at least this inside lobes: no division by zero at grazing angles.
+const LG_COS_MIN: f32 = 1e-4;
+
+// Accurate products. Cosines near 0 (grazing light or view) and |n × h| near 0 (the GGX
+// peak, sheen at h ≈ n) come out of cancellations, and plain f32 dot and cross products
+// leave an absolute error of ~1e-7 there: a large relative error. FMA-based error-free
+// transformations do not survive every Vulkan driver (lavapipe does not fuse `fma`; NIR's
+// algebraic passes fold TwoSum away and factor a·b + a·c), so the inputs (|x| ≤ 1) are
+// split instead: hi = x rounded to a 2^-11 grid, lo = x − hi (exact). The hi·hi products
+// are done in i32 (integers below 2^22, sums below 2^24): exact, and out of reach of float
+// reassociation. Only the small hi·lo and lo·b terms are rounded (≤ ~1e-11 absolute).
+fn lg_dot(a: vec3<f32>, b: vec3<f32>) -> f32 {
+    let ia = vec3<i32>(round(a * 2048.0));
+    let ib = vec3<i32>(round(b * 2048.0));
+    let ah = vec3<f32>(ia) * (1.0 / 2048.0);
+    let bh = vec3<f32>(ib) * (1.0 / 2048.0);
+    let al = a - ah;
+    let bl = b - bh;
+    let p = ia * ib;
+    let hh = f32(p.x + p.y + p.z) * (1.0 / 4194304.0);
+    return hh + (dot(ah, bl) + dot(al, b));
+}
+
+// a × b for |components| ≤ 1, each component accurate to ~1e-11 absolute.
+fn lg_cross(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
+    let ia = vec3<i32>(round(a * 2048.0));
+    let ib = vec3<i32>(round(b * 2048.0));
+    let ah = vec3<f32>(ia) * (1.0 / 2048.0);
+    let bh = vec3<f32>(ib) * (1.0 / 2048.0);
+    let al = a - ah;
+    let bl = b - bh;
+    let ic = vec3<i32>(
+        ia.y * ib.z - ia.z * ib.y,
+        ia.z * ib.x - ia.x * ib.z,
+        ia.x * ib.y - ia.y * ib.x,
+    );
+    return vec3<f32>(ic) * (1.0 / 4194304.0) + (cross(ah, bl) + cross(al, b));
+}
+
+// What the lobes need about (n, v, l). `s2` is |n × h|² = 1 − (n·h)², from an accurate
+// cross product with the unnormalised l + v (exact where l ≈ −v, by Sterbenz's lemma), so
+// it keeps its precision where n·h ≈ 1.
+struct LgDirs {
+    h: vec3<f32>,
+    // h − n (n·h) = (n × h) × n, from the accurate cross product: t·h and b·h from it do
+    // not pick up the f32 tilt of the tangent frame out of the tangent plane.
+    hp: vec3<f32>,
+    nl: f32,
+    nv: f32,
+    nh: f32,
+    vh: f32,
+    s2: f32,
+    lv: f32,
+};
+
+fn lg_dirs(n: vec3<f32>, v: vec3<f32>, l: vec3<f32>) -> LgDirs {
+    var d: LgDirs;
+    // l + v is exact where l ≈ −v (Sterbenz). Scale it by a power of two (exact) so its
+    // largest component is in [0.5, 1): lg_dot and lg_cross then stay accurate relative to
+    // their results even when l + v is tiny (grazing mirror configurations).
+    var hq = n;
+    let hs = l + v;
+    let big = max(max(abs(hs.x), abs(hs.y)), abs(hs.z));
+    var e = 0;
+    if (big > 1e-30) {
+        e = frexp(big).exp;
+        hq = ldexp(hs, vec3<i32>(-e));
+    }
+    let len2 = dot(hq, hq);
+    let len = sqrt(len2);
+    d.h = hq / len;
+    d.nl = clamp(lg_dot(n, l), LG_COS_MIN, 1.0);
+    d.nv = clamp(lg_dot(n, v), LG_COS_MIN, 1.0);
+    d.nh = clamp(lg_dot(n, hq) / len, 0.0, 1.0);
+    let c = lg_cross(n, hq);
+    d.s2 = min(dot(c, c) / len2, 1.0);
+    d.hp = cross(c, n) / len;
+    // v·h = l·h = |l + v| / 2 for unit l, v: symmetric in l and v, and no cancellation.
+    d.vh = clamp(0.5 * ldexp(len, e), 0.0, 1.0);
+    d.lv = clamp(lg_dot(l, v), -1.0, 1.0);
+    return d;
+}
+
+fn lg_alpha(roughness: f32) -> f32 {
+    let r = clamp(roughness, 0.0, 1.0);
+    return max(r * r, LG_ALPHA_MIN);
+}
+
+fn lg_ior_f0(ior: f32) -> f32 {
+    let r = (ior - 1.0) / (ior + 1.0);
+    return r * r;
+}
+
+fn lg_schlick(f0: vec3<f32>, vh: f32) -> vec3<f32> {
+    let m = 1.0 - vh;
+    let m2 = m * m;
+    let m5 = m2 * m2 * m;
+    return f0 + (vec3<f32>(1.0) - f0) * m5;
+}
+
+fn lg_schlick1(f0: f32, vh: f32) -> f32 {
+    let m = 1.0 - vh;
+    let m2 = m * m;
+    let m5 = m2 * m2 * m;
+    return f0 + (1.0 - f0) * m5;
+}
+
+// GGX D = α² / (π ((n·h)²(α² − 1) + 1)²), with (n·h)²(α² − 1) + 1 = |n×h|² + (n·h)²α².
+fn lg_d_ggx(nh: f32, s2: f32, a: f32) -> f32 {
+    let x = s2 + nh * nh * (a * a);
+    let r = a / x;
+    return r * r * LG_INV_PI;
+}
+
+// Height-correlated Smith visibility (holds the 1 / (4 n·l n·v)).
+fn lg_v_smith(nl: f32, nv: f32, a: f32) -> f32 {
+    let a2 = a * a;
+    let gv = nl * sqrt(nv * nv * (1.0 - a2) + a2);
+    let gl = nv * sqrt(nl * nl * (1.0 - a2) + a2);
+    return 0.5 / (gv + gl);
+}
+
+fn lg_lambert(color: vec3<f32>) -> vec3<f32> {
+    return color * LG_INV_PI;
+}
+
+fn lg_ggx(f0: vec3<f32>, a: f32, d: LgDirs) -> vec3<f32> {
+    return lg_schlick(f0, d.vh) * (lg_d_ggx(d.nh, d.s2, a) * lg_v_smith(d.nl, d.nv, a));
+}
+
+// Anisotropic GGX; t, b: unit tangent and bitangent orthogonal to n.
+fn lg_ggx_aniso(
+    f0: vec3<f32>,
+    a: f32,
+    anisotropy: f32,
+    t: vec3<f32>,
+    b: vec3<f32>,
+    v: vec3<f32>,
+    l: vec3<f32>,
+    d: LgDirs,
+) -> vec3<f32> {
+    let an = clamp(anisotropy, -1.0, 1.0);
+    let at = max(a * (1.0 + an), LG_ALPHA_MIN);
+    let ab = max(a * (1.0 - an), LG_ALPHA_MIN);
+    let a2 = at * ab;
+    let w = vec3<f32>(ab * dot(t, d.hp), at * dot(b, d.hp), a2 * d.nh);
+    let w2 = a2 / dot(w, w);
+    let dist = a2 * w2 * w2 * LG_INV_PI;
+    let lam_v = d.nl * length(vec3<f32>(at * dot(t, v), ab * dot(b, v), d.nv));
+    let lam_l = d.nv * length(vec3<f32>(at * dot(t, l), ab * dot(b, l), d.nl));
+    let vis = 0.5 / (lam_v + lam_l);
+    return lg_schlick(f0, d.vh) * (dist * vis);
+}
+
+// Charlie sheen (Estevez & Kulla 2017): D = (2 + 1/α) sin(θh)^(1/α) / (2π), with their
+// fitted Smith Λ for the visibility, V = 1 / ((1 + Λ(n·v) + Λ(n·l)) 4 n·v n·l)
+// (Neubelt's cheaper 1/(4(n·l + n·v − n·l n·v)) reflects up to 3.6× the light at grazing).
+// Sheen is not a closed layer: give its layer a transmission ≤ 1 − sheen albedo.
+fn lg_sheen_l(x: f32, a: f32) -> f32 {
+    let t = (1.0 - a) * (1.0 - a);
+    let p0 = mix(21.5473, 25.3245, t);
+    let p1 = mix(3.82987, 3.32435, t);
+    let p2 = mix(0.19823, 0.16801, t);
+    let p3 = mix(-1.97760, -1.27393, t);
+    let p4 = mix(-4.32054, -4.85967, t);
+    return p0 / (1.0 + p1 * pow(x, p2)) + p3 * x + p4;
+}
+
+// Λ with Estevez & Kulla's terminator softening, Λ^(1 + 2(1 − c)^8), applied to both
+// directions (reciprocal). Without it the fitted Λ lets a smooth sheen reflect up to 2.1×
+// the light at grazing view; with it the white sheen's albedo stays below 0.47.
+fn lg_sheen_lambda(c: f32, a: f32) -> f32 {
+    var l = 2.0 * lg_sheen_l(0.5, a) - lg_sheen_l(1.0 - c, a);
+    if (c < 0.5) {
+        l = lg_sheen_l(c, a);
+    }
+    let m = 1.0 - c;
+    let m2 = m * m;
+    let m4 = m2 * m2;
+    return exp(l * (1.0 + 2.0 * m4 * m4));
+}
+
+fn lg_sheen(color: vec3<f32>, roughness: f32, d: LgDirs) -> vec3<f32> {
+    let r = clamp(roughness, 0.0, 1.0);
+    let a = max(r * r, LG_SHEEN_ALPHA_MIN);
+    let inv = 1.0 / a;
+    var dist = 0.0;
+    if (d.s2 > 0.0) {
+        dist = (2.0 + inv) * pow(d.s2, 0.5 * inv) * (0.5 * LG_INV_PI);
+    }
+    let vis = 1.0 / ((1.0 + lg_sheen_lambda(d.nv, a) + lg_sheen_lambda(d.nl, a)) * (4.0 * d.nv * d.nl));
+    return color * (dist * vis);
+}
+
+// Fujii's improved Oren-Nayar ("A tiny improvement of Oren-Nayar reflectance model"),
+// σ = roughness in [0, 1]; σ = 0 is Lambert.
+fn lg_oren_nayar(color: vec3<f32>, roughness: f32, d: LgDirs) -> vec3<f32> {
+    let sigma = clamp(roughness, 0.0, 1.0);
+    let s = d.lv - d.nl * d.nv;
+    var t = 1.0;
+    if (s > 0.0) {
+        t = max(d.nl, d.nv);
+    }
+    let a = 1.0 / (1.0 + (0.5 - 2.0 / (3.0 * LG_PI)) * sigma);
+    let b = sigma * a;
+    return color * (LG_INV_PI * (a + b * s / t));
+}
+
+// The cosine of a direction refracted into a layer of IOR `ior` (≥ 1).
+// cos θ' = sqrt(1 − (1 − c²)/η²) = sqrt((η − 1)(η + 1) + c²) / η, the second form without
+// cancellation at grazing angles.
+fn lg_cos_inside(c: f32, ior: f32) -> f32 {
+    return max(sqrt((ior - 1.0) * (ior + 1.0) + c * c) / ior, LG_COS_MIN);
+}
+
+// 1 − w·F(c) for a Schlick interface of reflectance f0 at normal incidence:
+// (1 − w) + w (1 − f0) (1 − m⁵) with 1 − m⁵ = c (1 + m + m² + m³ + m⁴), m = 1 − c: no
+// cancellation where c → 0.
+fn lg_one_minus_wf(f0: f32, w: f32, c: f32) -> f32 {
+    let m = 1.0 - c;
+    let q = c * (1.0 + m * (1.0 + m * (1.0 + m * (1.0 + m))));
+    return max((1.0 - w) + w * (1.0 - f0) * q, 0.0);
+}
+
+// What a layer lets through to the layer below, times transmission and Beer-Lambert
+// absorption exp(−σ d (1/cos θl' + 1/cos θv')) along the refracted in and out paths.
+// coupling 0 (`Interface`, the default): light crosses the interface going in and coming
+// out, (1 − w F(n·l)) (1 − w F(n·v)): reciprocal and energy-conserving.
+// coupling 1 (`HalfVector`, glTF's fresnel_mix): (1 − w F(v·h)).
+fn lg_through(
+    ior: f32,
+    weight: f32,
+    transmission: f32,
+    sigma_d: vec3<f32>,
+    coupling: u32,
+    d: LgDirs,
+) -> vec3<f32> {
+    var pass_ = transmission;
+    if (ior > 1.0) {
+        let f0 = lg_ior_f0(ior);
+        if (coupling == 1u) {
+            pass_ *= lg_one_minus_wf(f0, weight, d.vh);
+        } else {
+            pass_ *= lg_one_minus_wf(f0, weight, d.nl) * lg_one_minus_wf(f0, weight, d.nv);
+        }
+    }
+    let path = 1.0 / lg_cos_inside(d.nl, ior) + 1.0 / lg_cos_inside(d.nv, ior);
+    return pass_ * exp(-sigma_d * path);
+}
+
+// Tangent frame: the tangent made orthogonal to n, or a branchless basis from n alone (Duff
+// et al. 2017) when the mesh has none.
+fn lg_tangent(n: vec3<f32>, tangent: vec4<f32>) -> vec3<f32> {
+    let tt = tangent.xyz - n * dot(n, tangent.xyz);
+    let l2 = dot(tt, tt);
+    if (l2 > 1e-8) {
+        return tt / sqrt(l2);
+    }
+    let s = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (s + n.z);
+    let b = n.x * n.y * a;
+    return vec3<f32>(1.0 + s * n.x * n.x * a, s * b, -s * n.x);
+}
+
+fn lg_bitangent(n: vec3<f32>, t: vec3<f32>, w: f32) -> vec3<f32> {
+    return cross(n, t) * select(1.0, -1.0, w < 0.0);
+}

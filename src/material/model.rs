@@ -1,0 +1,304 @@
+//! The RON model of a layered material, as artists write it (see `materials/*.ron`).
+//!
+//! A material is a stack of layers, top first. Each layer holds weighted lobes and an
+//! interface (IOR, weight, transmission, absorption over a thickness). Light reaching
+//! layer `i + 1` is scaled by what layer `i` lets through (see [`super::reference`]).
+
+use crate::scene::AlphaMode;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialDesc {
+    #[serde(default)]
+    pub name: String,
+    /// The material's type bit for light material masks (Leo demo). Default 1.
+    #[serde(default = "one_u32")]
+    pub type_bit: u32,
+    #[serde(default)]
+    pub alpha_mode: AlphaMode,
+    #[serde(default)]
+    pub double_sided: bool,
+    /// Texture slots by name; bindings follow the name order (BTreeMap).
+    #[serde(default)]
+    pub textures: BTreeMap<String, TextureDesc>,
+    /// Coverage (glTF: base colour alpha × texture alpha). Default 1.
+    #[serde(default = "one_scalar")]
+    pub alpha: Scalar,
+    /// Emitted radiance. Default black.
+    #[serde(default)]
+    pub emissive: Option<Color>,
+    #[serde(default)]
+    pub normal_map: Option<NormalMap>,
+    #[serde(default)]
+    pub occlusion: Option<Occlusion>,
+    /// Top layer first.
+    pub layers: Vec<Layer>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TextureDesc {
+    /// Path relative to the material file.
+    pub file: String,
+    /// sRGB-encoded colour data (base colour, emissive) rather than linear data.
+    #[serde(default)]
+    pub srgb: bool,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NormalMap {
+    pub texture: String,
+    #[serde(default = "one_f32")]
+    pub scale: f32,
+}
+
+/// Ambient occlusion (glTF semantics: `1 + strength * (tex.r - 1)`); exposed to the
+/// renderer as `material_occlusion(m)`, it does not scale `material_eval` (direct light).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Occlusion {
+    pub texture: String,
+    #[serde(default)]
+    pub channel: Channel,
+    #[serde(default = "one_f32")]
+    pub strength: f32,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Layer {
+    #[serde(default)]
+    pub name: String,
+    /// Index of refraction of the layer's interface; `None` (or 1) means no interface
+    /// Fresnel. Also bends the path used for absorption.
+    #[serde(default)]
+    pub ior: Option<f32>,
+    /// Scales the interface Fresnel in `1 - F * weight` (e.g. clearcoat amount).
+    #[serde(default = "one_f32")]
+    pub weight: f32,
+    /// How the interface Fresnel scales what reaches the layers below.
+    #[serde(default)]
+    pub coupling: Coupling,
+    /// Fraction of the non-reflected light that goes on to the next layer.
+    #[serde(default = "one_f32")]
+    pub transmission: f32,
+    /// Thickness of the layer for Beer-Lambert absorption (same unit as `absorption`⁻¹).
+    #[serde(default)]
+    pub thickness: f32,
+    /// Absorption coefficient per unit thickness, per channel.
+    #[serde(default)]
+    pub absorption: (f32, f32, f32),
+    pub lobes: Vec<Lobe>,
+}
+
+/// How a layer's interface Fresnel scales the light reaching the layers below.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Coupling {
+    /// Light crosses the interface on the way in and out: `(1 − w F(n·l)) (1 − w F(n·v))`.
+    /// Reciprocal and energy-conserving.
+    #[default]
+    Interface,
+    /// glTF's `fresnel_mix`: `1 − w F(v·h)`. Exact glTF, but not energy-conserving for
+    /// smooth layers at grazing angles (the diffuse below is not dimmed where the mirror
+    /// reflection is strong).
+    HalfVector,
+}
+
+/// One weighted BRDF lobe. Roughness is perceptual (α = roughness²).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Lobe {
+    /// ρ/π.
+    Lambert {
+        #[serde(default = "one_f32")]
+        weight: f32,
+        color: Color,
+    },
+    /// Fujii's improved Oren-Nayar; `roughness` is σ in [0, 1].
+    OrenNayar {
+        #[serde(default = "one_f32")]
+        weight: f32,
+        color: Color,
+        roughness: Scalar,
+    },
+    /// glTF Appendix B microfacet lobe: GGX D, height-correlated Smith V, Schlick F
+    /// from `f0` or, when absent, from `ior` (default 1.5).
+    Ggx {
+        #[serde(default = "one_f32")]
+        weight: f32,
+        roughness: Scalar,
+        #[serde(default)]
+        f0: Option<Color>,
+        #[serde(default)]
+        ior: Option<f32>,
+    },
+    /// Anisotropic GGX (αt = α(1 + a), αb = α(1 − a)), along the tangent.
+    AnisoGgx {
+        #[serde(default = "one_f32")]
+        weight: f32,
+        roughness: Scalar,
+        anisotropy: Scalar,
+        #[serde(default)]
+        f0: Option<Color>,
+        #[serde(default)]
+        ior: Option<f32>,
+    },
+    /// A monochrome GGX on the geometric normal (not the normal map), F0 from `ior`
+    /// (default 1.5).
+    Clearcoat {
+        #[serde(default = "one_f32")]
+        weight: f32,
+        roughness: Scalar,
+        #[serde(default)]
+        ior: Option<f32>,
+    },
+    /// Charlie sheen (Estevez & Kulla D, Neubelt visibility).
+    Sheen {
+        #[serde(default = "one_f32")]
+        weight: f32,
+        color: Color,
+        roughness: Scalar,
+    },
+}
+
+impl Lobe {
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Lobe::Lambert { .. } => "Lambert",
+            Lobe::OrenNayar { .. } => "OrenNayar",
+            Lobe::Ggx { .. } => "Ggx",
+            Lobe::AnisoGgx { .. } => "AnisoGgx",
+            Lobe::Clearcoat { .. } => "Clearcoat",
+            Lobe::Sheen { .. } => "Sheen",
+        }
+    }
+
+    pub fn weight(&self) -> f32 {
+        match *self {
+            Lobe::Lambert { weight, .. }
+            | Lobe::OrenNayar { weight, .. }
+            | Lobe::Ggx { weight, .. }
+            | Lobe::AnisoGgx { weight, .. }
+            | Lobe::Clearcoat { weight, .. }
+            | Lobe::Sheen { weight, .. } => weight,
+        }
+    }
+}
+
+/// A texture channel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Channel {
+    #[default]
+    R,
+    G,
+    B,
+    A,
+}
+
+impl Channel {
+    pub fn index(self) -> usize {
+        self as usize
+    }
+    pub fn swizzle(self) -> &'static str {
+        ["x", "y", "z", "w"][self as usize]
+    }
+}
+
+/// A scalar parameter: a number, or an expression over texture channels.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Scalar {
+    Val(f32),
+    Expr(ScalarExpr),
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum ScalarExpr {
+    /// `scale * texture.channel`.
+    Tex {
+        texture: String,
+        #[serde(default)]
+        channel: Channel,
+        #[serde(default = "one_f32")]
+        scale: f32,
+    },
+    OneMinus(Box<Scalar>),
+    Mul(Box<Scalar>, Box<Scalar>),
+}
+
+/// A colour parameter: `(r, g, b)`, or an expression over textures.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Color {
+    Rgb(f32, f32, f32),
+    Expr(ColorExpr),
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum ColorExpr {
+    /// `scale * texture.rgb`.
+    Tex {
+        texture: String,
+        #[serde(default = "ones3")]
+        scale: (f32, f32, f32),
+    },
+    /// `a * (1 - t) + b * t` (WGSL `mix`).
+    Mix {
+        a: Box<Color>,
+        b: Box<Color>,
+        t: Scalar,
+    },
+    /// `color * scalar`.
+    Scale(Box<Color>, Scalar),
+}
+
+fn one_u32() -> u32 {
+    1
+}
+fn one_f32() -> f32 {
+    1.0
+}
+fn ones3() -> (f32, f32, f32) {
+    (1.0, 1.0, 1.0)
+}
+fn one_scalar() -> Scalar {
+    Scalar::Val(1.0)
+}
+
+impl Scalar {
+    /// Names of the textures this expression reads.
+    pub fn textures<'a>(&'a self, out: &mut Vec<&'a str>) {
+        match self {
+            Scalar::Val(_) => {}
+            Scalar::Expr(ScalarExpr::Tex { texture, .. }) => out.push(texture),
+            Scalar::Expr(ScalarExpr::OneMinus(a)) => a.textures(out),
+            Scalar::Expr(ScalarExpr::Mul(a, b)) => {
+                a.textures(out);
+                b.textures(out);
+            }
+        }
+    }
+}
+
+impl Color {
+    pub fn textures<'a>(&'a self, out: &mut Vec<&'a str>) {
+        match self {
+            Color::Rgb(..) => {}
+            Color::Expr(ColorExpr::Tex { texture, .. }) => out.push(texture),
+            Color::Expr(ColorExpr::Mix { a, b, t }) => {
+                a.textures(out);
+                b.textures(out);
+                t.textures(out);
+            }
+            Color::Expr(ColorExpr::Scale(c, s)) => {
+                c.textures(out);
+                s.textures(out);
+            }
+        }
+    }
+}

@@ -1,0 +1,227 @@
+//! Loading a material file: RON syntax and type errors with ron's position, then semantic
+//! checks (empty layer or lobe lists, undeclared textures, missing texture files) located
+//! by finding the offending token in the source text.
+
+use super::error::{Location, MaterialError};
+use super::model::{Lobe, MaterialDesc};
+use super::{TextureSlot, TextureSource};
+use std::path::Path;
+
+fn loc(path: &Path, line: usize, col: usize) -> Location {
+    Location {
+        file: path.to_path_buf(),
+        line,
+        col,
+    }
+}
+
+/// 1-based line and column (in characters) of a byte offset.
+pub fn line_col(src: &str, offset: usize) -> (usize, usize) {
+    let before = &src[..offset.min(src.len())];
+    let line = before.matches('\n').count() + 1;
+    let start = before.rfind('\n').map_or(0, |i| i + 1);
+    (line, before[start..].chars().count() + 1)
+}
+
+/// Byte offsets of `needle` outside `//` comments.
+fn occurrences(src: &str, needle: &str) -> Vec<usize> {
+    let mut out = Vec::new();
+    let mut base = 0;
+    for line in src.split_inclusive('\n') {
+        let code_end = line.find("//").unwrap_or(line.len());
+        let mut from = 0;
+        while let Some(i) = line[from..code_end].find(needle) {
+            out.push(base + from + i);
+            from += i + needle.len();
+        }
+        base += line.len();
+    }
+    out
+}
+
+/// Offsets of `key: [ ]` (an empty list under `key`).
+fn empty_lists(src: &str, key: &str) -> Vec<(usize, bool)> {
+    occurrences(src, key)
+        .into_iter()
+        .filter(|&i| {
+            // a whole identifier
+            let prev = src[..i].chars().next_back();
+            !prev.is_some_and(|c| c.is_alphanumeric() || c == '_')
+        })
+        .filter_map(|i| {
+            let rest = src[i + key.len()..].trim_start();
+            let rest = rest.strip_prefix(':')?.trim_start();
+            let rest = rest.strip_prefix('[')?;
+            Some((i, rest.trim_start().starts_with(']')))
+        })
+        .collect()
+}
+
+fn locate(src: &str, path: &Path, needle: &str, nth: usize) -> Location {
+    let (line, col) = occurrences(src, needle)
+        .get(nth)
+        .map_or((1, 1), |&i| line_col(src, i));
+    loc(path, line, col)
+}
+
+/// RON to the model, with syntax and type errors at ron's position.
+pub fn parse_desc(src: &str, path: &Path) -> Result<MaterialDesc, MaterialError> {
+    let desc: MaterialDesc = ron::Options::default().from_str(src).map_err(|e| {
+        let at = loc(path, e.span.start.line, e.span.start.col);
+        match e.code {
+            ron::Error::NoSuchEnumVariant {
+                expected,
+                found,
+                outer: Some(outer),
+            } if outer == "Lobe" => MaterialError::UnknownLobe {
+                at,
+                found,
+                expected: expected.join(", "),
+            },
+            ron::Error::Message(m) if m.contains("untagged enum") => {
+                let what = if m.contains("Color") {
+                    "expected a colour: (r, g, b), Tex(texture: ..), Mix(..) or Scale(..)"
+                } else {
+                    "expected a number or Tex(texture: .., channel: ..), OneMinus(..), Mul(..)"
+                };
+                MaterialError::WrongType {
+                    at,
+                    message: what.to_string(),
+                }
+            }
+            code @ (ron::Error::InvalidValueForType { .. }
+            | ron::Error::ExpectedFloat
+            | ron::Error::ExpectedInteger
+            | ron::Error::ExpectedString
+            | ron::Error::ExpectedStringEnd
+            | ron::Error::ExpectedBoolean
+            | ron::Error::ExpectedArray
+            | ron::Error::ExpectedMap
+            | ron::Error::ExpectedOption) => MaterialError::WrongType {
+                at,
+                message: code.to_string(),
+            },
+            code => MaterialError::Syntax {
+                at,
+                message: code.to_string(),
+            },
+        }
+    })?;
+    check(&desc, src, path)?;
+    Ok(desc)
+}
+
+/// Semantic checks that serde cannot express.
+fn check(desc: &MaterialDesc, src: &str, path: &Path) -> Result<(), MaterialError> {
+    if desc.layers.is_empty() {
+        let at = empty_lists(src, "layers").into_iter().find(|e| e.1).map_or(
+            loc(path, 1, 1),
+            |(i, _)| {
+                let (l, c) = line_col(src, i);
+                loc(path, l, c)
+            },
+        );
+        return Err(MaterialError::EmptyLayers { at });
+    }
+    let lists = empty_lists(src, "lobes");
+    for (i, layer) in desc.layers.iter().enumerate() {
+        if layer.lobes.is_empty() {
+            let at = lists.get(i).map_or(loc(path, 1, 1), |&(o, _)| {
+                let (l, c) = line_col(src, o);
+                loc(path, l, c)
+            });
+            return Err(MaterialError::EmptyLobes { at, layer: i });
+        }
+    }
+    // Every texture an expression names must be declared.
+    let mut used = Vec::new();
+    desc.alpha.textures(&mut used);
+    if let Some(e) = &desc.emissive {
+        e.textures(&mut used);
+    }
+    if let Some(n) = &desc.normal_map {
+        used.push(&n.texture);
+    }
+    if let Some(o) = &desc.occlusion {
+        used.push(&o.texture);
+    }
+    for layer in &desc.layers {
+        for lobe in &layer.lobes {
+            lobe_textures(lobe, &mut used);
+        }
+    }
+    for name in used {
+        if !desc.textures.contains_key(name) {
+            return Err(MaterialError::UnknownTexture {
+                at: locate(src, path, &format!("\"{name}\""), 0),
+                name: name.to_string(),
+                declared: desc.textures.keys().cloned().collect::<Vec<_>>().join(", "),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Names of the textures a lobe reads.
+pub fn lobe_textures<'a>(lobe: &'a Lobe, out: &mut Vec<&'a str>) {
+    match lobe {
+        Lobe::Lambert { color, .. } => color.textures(out),
+        Lobe::OrenNayar {
+            color, roughness, ..
+        }
+        | Lobe::Sheen {
+            color, roughness, ..
+        } => {
+            color.textures(out);
+            roughness.textures(out);
+        }
+        Lobe::Ggx { roughness, f0, .. } => {
+            roughness.textures(out);
+            if let Some(f) = f0 {
+                f.textures(out);
+            }
+        }
+        Lobe::AnisoGgx {
+            roughness,
+            anisotropy,
+            f0,
+            ..
+        } => {
+            roughness.textures(out);
+            anisotropy.textures(out);
+            if let Some(f) = f0 {
+                f.textures(out);
+            }
+        }
+        Lobe::Clearcoat { roughness, .. } => roughness.textures(out),
+    }
+}
+
+/// Texture slots of a RON material: its declared files, in name order, which must exist.
+pub fn file_slots(
+    desc: &MaterialDesc,
+    src: &str,
+    path: &Path,
+) -> Result<Vec<TextureSlot>, MaterialError> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let mut slots = Vec::new();
+    for (i, (name, tex)) in desc.textures.iter().enumerate() {
+        let resolved = dir.join(&tex.file);
+        if !resolved.is_file() {
+            return Err(MaterialError::MissingTextureFile {
+                at: locate(src, path, &format!("\"{}\"", tex.file), 0),
+                path: tex.file.clone(),
+                resolved,
+            });
+        }
+        slots.push(TextureSlot {
+            binding: i as u32 + 1,
+            name: name.clone(),
+            source: TextureSource::File {
+                path: resolved,
+                srgb: tex.srgb,
+            },
+        });
+    }
+    Ok(slots)
+}

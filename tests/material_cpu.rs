@@ -1,0 +1,305 @@
+//! The f64 reference on its own: white furnace (directional albedo), Lambert's albedo,
+//! reciprocity, and no NaN/Inf for artist values past physical ranges.
+
+mod material_support;
+
+use lightgraph::material::reference as r;
+use lightgraph::material::Material;
+use material_support::*;
+
+const ROUGHNESS: [f64; 8] = [0.0, 0.02, 0.05, 0.1, 0.25, 0.5, 0.75, 1.0];
+const COS_VIEW: [f64; 7] = [1.0, 0.8, 0.5, 0.25, 0.1, 0.03, 0.005];
+const SAMPLES: usize = 1 << 15;
+
+/// The shipped `materials/*.ron`.
+fn shipped() -> Vec<std::path::PathBuf> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("materials");
+    let mut v: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
+    v.sort();
+    v
+}
+
+fn mat(src: &str) -> Material {
+    Material::parse(src, "test.ron").unwrap_or_else(|e| panic!("{e}\n{src}"))
+}
+
+fn one_lobe(lobe: &str) -> Material {
+    mat(&format!("(layers: [(lobes: [{lobe}])])"))
+}
+
+/// Max over view angles of the largest channel of the directional albedo.
+fn max_albedo(m: &Material, tangent: [f64; 4]) -> (f64, f64) {
+    let mut worst = (0.0f64, 0.0);
+    for &c in &COS_VIEW {
+        let s = (1.0 - c * c).sqrt();
+        // views in the tangent direction and diagonally (anisotropy)
+        for v in [[s, 0.0, c], [s * 0.6, s * 0.8, c]] {
+            let at = r::Surface {
+                n: [0.0, 0.0, 1.0],
+                tangent,
+                texels: Default::default(),
+            };
+            let a = r::albedo(m, &at, v, SAMPLES);
+            let mx = a[0].max(a[1]).max(a[2]);
+            assert!(mx.is_finite(), "{}: albedo {a:?}", m.name());
+            if mx > worst.0 {
+                worst = (mx, c);
+            }
+        }
+    }
+    worst
+}
+
+fn furnace(name: &str, materials: impl IntoIterator<Item = Material>) -> f64 {
+    furnace_opt(name, materials, true)
+}
+
+/// `conserving = false`: measured and printed only (glTF's own fresnel_mix coupling).
+fn furnace_opt(name: &str, materials: impl IntoIterator<Item = Material>, conserving: bool) -> f64 {
+    let mut worst = (0.0f64, 0.0, String::new());
+    for m in materials {
+        let (a, c) = max_albedo(&m, [1.0, 0.0, 0.0, 1.0]);
+        if a > worst.0 {
+            worst = (a, c, format!("{:?}", m.desc().layers));
+        }
+    }
+    println!(
+        "  {name:22} max albedo {:.6} (at cos θv = {})",
+        worst.0, worst.1
+    );
+    assert!(
+        !conserving || worst.0 <= 1.0 + 1e-3,
+        "{name}: albedo {} > 1 + 1e-3 at cos θv = {}: {}",
+        worst.0,
+        worst.1,
+        worst.2
+    );
+    worst.0
+}
+
+#[test]
+fn white_furnace_lobes() {
+    println!("white furnace ({SAMPLES} samples a direction):");
+    furnace(
+        "ggx (F0 = 1)",
+        ROUGHNESS.map(|r| one_lobe(&format!("Ggx(roughness: {r}, f0: Some((1, 1, 1)))"))),
+    );
+    furnace(
+        "ggx_aniso (F0 = 1)",
+        ROUGHNESS.iter().flat_map(|&r| {
+            [-1.0, -0.5, 0.0, 0.5, 0.9, 1.0].map(|a| {
+                one_lobe(&format!(
+                    "AnisoGgx(roughness: {r}, anisotropy: {a}, f0: Some((1, 1, 1)))"
+                ))
+            })
+        }),
+    );
+    furnace(
+        "clearcoat",
+        ROUGHNESS.map(|r| one_lobe(&format!("Clearcoat(roughness: {r})"))),
+    );
+    furnace(
+        "sheen (white)",
+        ROUGHNESS.map(|r| one_lobe(&format!("Sheen(color: (1, 1, 1), roughness: {r})"))),
+    );
+    furnace(
+        "oren_nayar (white)",
+        ROUGHNESS.map(|r| one_lobe(&format!("OrenNayar(color: (1, 1, 1), roughness: {r})"))),
+    );
+}
+
+#[test]
+fn white_furnace_layered() {
+    println!("white furnace, layered ({SAMPLES} samples a direction):");
+    let gltf = |base: f64, metallic: f64, r: f64, coupling: &str| {
+        mat(&format!(
+            "(layers: [
+                (ior: Some(1.5), coupling: {coupling}, lobes: [Ggx(roughness: {r}, f0: Some(Mix(a: (0.04, 0.04, 0.04), b: ({base}, {base}, {base}), t: {metallic})))]),
+                (lobes: [Lambert(color: Mix(a: ({base}, {base}, {base}), b: (0, 0, 0), t: {metallic}))]),
+            ])"
+        ))
+    };
+    furnace(
+        "gltf-like, Interface",
+        ROUGHNESS
+            .iter()
+            .flat_map(|&r| [0.0, 0.5, 1.0].map(|m| gltf(1.0, m, r, "Interface"))),
+    );
+    let exact = furnace_opt(
+        "gltf exact (HalfVector)",
+        ROUGHNESS
+            .iter()
+            .flat_map(|&r| [0.0, 0.5, 1.0].map(|m| gltf(1.0, m, r, "HalfVector"))),
+        false,
+    );
+    println!(
+        "    (glTF's fresnel_mix is not energy-conserving: max albedo {exact:.4}; not asserted)"
+    );
+    furnace(
+        "clearcoat over gltf",
+        ROUGHNESS.iter().flat_map(|&r| {
+            [0.0, 0.05, 0.3].map(|cr| {
+                mat(&format!(
+                    "(layers: [
+                        (ior: Some(1.5), lobes: [Clearcoat(roughness: {cr})]),
+                        (ior: Some(1.5), lobes: [Ggx(roughness: {r}, ior: Some(1.5))]),
+                        (lobes: [Lambert(color: (1, 1, 1))]),
+                    ])"
+                ))
+            })
+        }),
+    );
+    furnace(
+        "sheen over diffuse",
+        ROUGHNESS.map(|r| {
+            mat(&format!(
+                "(layers: [
+                    (transmission: 0.5, lobes: [Sheen(color: (1, 1, 1), roughness: {r})]),
+                    (lobes: [OrenNayar(color: (1, 1, 1), roughness: 0.5)]),
+                ])"
+            ))
+        }),
+    );
+    furnace(
+        "absorbing coat",
+        ROUGHNESS.map(|r| {
+            mat(&format!(
+                "(layers: [
+                    (ior: Some(1.8), thickness: 0.5, absorption: (0.1, 1, 3), lobes: [Ggx(roughness: {r}, ior: Some(1.8))]),
+                    (lobes: [Lambert(color: (1, 1, 1))]),
+                ])"
+            ))
+        }),
+    );
+    for p in shipped() {
+        let m = Material::load(&p).unwrap();
+        let conserving = m
+            .desc()
+            .layers
+            .iter()
+            .all(|l| l.coupling == lightgraph::material::model::Coupling::Interface);
+        furnace_opt(&format!("materials/{}", m.name()), [m], conserving);
+    }
+}
+
+#[test]
+fn lambert_albedo_is_its_colour() {
+    let m = one_lobe("Lambert(color: (0.25, 0.5, 1.0))");
+    for &c in &COS_VIEW {
+        let v = [(1.0 - c * c).sqrt(), 0.0, c];
+        let a = r::albedo(&m, &r::Surface::new([0.0, 0.0, 1.0]), v, SAMPLES);
+        for (got, want) in a.iter().zip([0.25, 0.5, 1.0]) {
+            assert!(
+                (got - want).abs() <= 1e-3,
+                "Lambert albedo {a:?} at cos {c}"
+            );
+        }
+    }
+}
+
+#[test]
+fn reciprocity() {
+    let lobes = [
+        ("lambert", "Lambert(color: (0.3, 0.6, 0.9))"),
+        (
+            "oren_nayar",
+            "OrenNayar(color: (0.3, 0.6, 0.9), roughness: R)",
+        ),
+        ("ggx", "Ggx(roughness: R, f0: Some((0.9, 0.5, 0.1)))"),
+        (
+            "ggx_aniso",
+            "AnisoGgx(roughness: R, anisotropy: 0.7, f0: Some((0.9, 0.5, 0.1)))",
+        ),
+        ("clearcoat", "Clearcoat(roughness: R)"),
+        ("sheen", "Sheen(color: (0.3, 0.6, 0.9), roughness: R)"),
+    ];
+    let mut rng = Rng(99);
+    println!("reciprocity |f(l,v) − f(v,l)| / |f| (max over 20000 samples a lobe):");
+    let layered = shipped().into_iter().map(|p| {
+        let m = Material::load(p).unwrap();
+        (m.name().to_string(), m)
+    });
+    let singles = lobes.iter().flat_map(|(name, src)| {
+        [0.0, 0.3, 1.0].map(|rough| {
+            (
+                name.to_string(),
+                one_lobe(&src.replace('R', &rough.to_string())),
+            )
+        })
+    });
+    let mut report = std::collections::BTreeMap::<String, f64>::new();
+    for (name, m) in singles.chain(layered) {
+        let mut worst = 0.0f64;
+        for _ in 0..20000 {
+            let g = geo(&mut rng, false);
+            if r::dot(g.n, g.l) <= 0.0 || r::dot(g.n, g.v) <= 0.0 {
+                continue;
+            }
+            let at = r::Surface {
+                n: g.n,
+                tangent: g.t,
+                texels: Default::default(),
+            };
+            let a = r::brdf_at(&m, &at, g.v, g.l);
+            let b = r::brdf_at(&m, &at, g.l, g.v);
+            for c in 0..3 {
+                let e = (a[c] - b[c]).abs() / a[c].abs().max(b[c].abs()).max(1e-300);
+                let e = if a[c] == b[c] { 0.0 } else { e };
+                if e > 1e-5 && std::env::var("MATERIAL_DEBUG").is_ok() {
+                    println!(
+                        "{name} {e:e} {a:?} {b:?} {g:?} {:?}",
+                        r::dirs(g.n, g.v, g.l)
+                    );
+                }
+                worst = worst.max(e);
+            }
+        }
+        let w = report.entry(name).or_default();
+        *w = w.max(worst);
+    }
+    for (name, w) in &report {
+        println!("  {name:22} {w:.3e}");
+        assert!(*w <= 1e-5, "{name}: reciprocity error {w}");
+    }
+}
+
+#[test]
+fn artist_values_warn_and_stay_finite() {
+    let m = mat("(
+        name: \"pushed\",
+        alpha: 3.0,
+        layers: [
+            (ior: Some(0.5), weight: 80, transmission: 3, thickness: 1e30, absorption: (-1, 0, 1e30), lobes: [
+                Ggx(weight: 2.5, roughness: -0.5, f0: Some((4, 1.5, 1e30))),
+                Sheen(weight: 1e9, color: (2, 2, 2), roughness: 7),
+            ]),
+            (lobes: [AnisoGgx(weight: 3, roughness: 2, anisotropy: 5, ior: Some(1e9)), Lambert(weight: 2, color: (5, -1, 2))]),
+        ],
+    )");
+    assert!(m.warnings().len() >= 10, "{:#?}", m.warnings());
+    assert!(m
+        .warnings()
+        .iter()
+        .any(|w| w.contains("past the physical range")));
+    let mut rng = Rng(5);
+    for _ in 0..20000 {
+        let g = geo(&mut rng, true);
+        let at = r::Surface {
+            n: g.n,
+            tangent: g.t,
+            texels: Default::default(),
+        };
+        let f = r::eval_at(&m, &at, g.v, g.l);
+        assert!(
+            f.iter().all(|x| x.is_finite() && *x >= 0.0),
+            "{f:?} at {g:?}"
+        );
+    }
+    // Physical values warn about nothing.
+    let ok = one_lobe("Ggx(roughness: 0.5)");
+    assert!(ok.warnings().is_empty(), "{:?}", ok.warnings());
+}
