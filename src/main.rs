@@ -66,7 +66,7 @@ struct RenderArgs {
 }
 
 fn project_path(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
+    lightgraph::project_root().join(rel)
 }
 
 fn load_scene(path: Option<&Path>) -> Result<Scene> {
@@ -165,7 +165,7 @@ fn render(args: RenderArgs) -> Result<()> {
     let mut renderer = Renderer::headless()?;
     let checked = graph::check_file(&graph_path, &renderer.shaders)?;
     let compiled = graph::compile(checked, &scene.features(), size);
-    let gpu = SceneGpu::upload(&renderer.ctx.device, &scene);
+    let gpu = SceneGpu::upload(&renderer.ctx.device, &renderer.ctx.queue, &scene)?;
     let prepared = renderer.prepare(compiled, &scene, &gpu, size, true)?;
     // The first frame builds pipelines and warms caches; report the second.
     prepared.execute(&renderer)?;

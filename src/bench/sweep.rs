@@ -97,7 +97,7 @@ pub fn run(
     renderer: &mut Renderer,
     mut progress: impl FnMut(usize, usize, &BenchRow),
 ) -> Result<Vec<BenchRow>, SweepError> {
-    let graphs_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("graphs");
+    let graphs_dir = crate::project_root().join("graphs");
     let counts: Vec<Option<u32>> = if sweep.lights.is_empty() {
         vec![None]
     } else {
@@ -113,7 +113,8 @@ pub fn run(
                 Some(c) => with_light_count(&base_scene, *c),
                 None => base_scene.clone(),
             };
-            let gpu = SceneGpu::upload(&renderer.ctx.device, &scene);
+            let gpu = SceneGpu::upload(&renderer.ctx.device, &renderer.ctx.queue, &scene)
+                .map_err(|e| SweepError::Scene(spec.clone(), e.to_string()))?;
             for &(width, height) in &sweep.resolutions {
                 let size = FrameSize {
                     width,

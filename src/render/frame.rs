@@ -594,14 +594,15 @@ impl Renderer {
         pass: &str,
     ) -> Result<Vec<Draw>, RenderError> {
         let device = self.ctx.device.clone();
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(pass),
-            bind_group_layouts: &[Some(layout)],
-            immediate_size: 0,
-        });
         let mut draws = Vec::new();
         for mesh in gpu.opaque_draws() {
             let m = &gpu.materials[gpu.meshes[mesh].material];
+            let material_layout = m.bind_group.as_ref().map(|(l, _)| l.as_ref());
+            let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(pass),
+                bind_group_layouts: &[Some(layout), None, material_layout],
+                immediate_size: 0,
+            });
             let masked = matches!(m.alpha_mode, AlphaMode::Mask(_));
             let mut d = vec![];
             if depth_only {
@@ -688,6 +689,7 @@ impl Renderer {
             };
             let gm = &gpu.meshes[mesh];
             draws.push(Draw {
+                material: m.bind_group.as_ref().map(|(_, g)| g.clone()),
                 pipeline,
                 vertices: gm.vertices.clone(),
                 indices: gm.indices.clone(),
@@ -987,6 +989,9 @@ fn draw_meshes(pass: &mut wgpu::RenderPass<'_>, bind: &wgpu::BindGroup, draws: &
         if current != Some(ptr) {
             pass.set_pipeline(&d.pipeline);
             current = Some(ptr);
+            if let Some(group) = &d.material {
+                pass.set_bind_group(2, group, &[]);
+            }
         }
         pass.set_vertex_buffer(0, d.vertices.slice(..));
         pass.set_index_buffer(d.indices.slice(..), wgpu::IndexFormat::Uint32);
@@ -997,6 +1002,8 @@ fn draw_meshes(pass: &mut wgpu::RenderPass<'_>, bind: &wgpu::BindGroup, draws: &
 /// One mesh drawn with its material's pipeline.
 pub(super) struct Draw {
     pipeline: Arc<wgpu::RenderPipeline>,
+    /// The material's textures (group 2), if it has any.
+    material: Option<wgpu::BindGroup>,
     vertices: wgpu::Buffer,
     indices: wgpu::Buffer,
     index_count: u32,

@@ -1,47 +1,158 @@
-//! Materials as the renderer sees them: WGSL that fulfils the material contract of
-//! `shaders/forward/forward.wgsl` (material_setup / material_eval / material_emission /
-//! material_alpha / MATERIAL_TYPE_BIT), plus what the pipelines need to know.
+//! Materials as the renderer sees them: the layered material's generated WGSL (the
+//! `<material>` include of `shaders/forward/forward.wgsl`), its textures uploaded into
+//! bind group 2, and what the pipelines need to know.
 
-use crate::scene::{AlphaMode, SurfaceMaterial};
+use crate::material::{Material, MaterialError};
+use crate::scene::{AlphaMode, Scene};
+use std::sync::Arc;
+use wgpu::util::DeviceExt;
 
-#[derive(Clone, Debug)]
 pub struct MaterialProgram {
     pub name: String,
     /// Generated WGSL, included as `<material>`.
     pub wgsl: String,
     pub alpha_mode: AlphaMode,
     pub double_sided: bool,
-}
-
-/// A constant Lambertian material (with emission): the reference material of the
-/// culling tests and the fallback when no layered material is given.
-pub fn lambert(name: &str, albedo: [f32; 3], emissive: [f32; 3], type_bit: u32) -> String {
-    let _ = name;
-    format!(
-        "struct MaterialSample {{ n: vec3<f32>, }};
-const MATERIAL_TYPE_BIT: u32 = {type_bit}u;
-const MATERIAL_ALBEDO: vec3<f32> = vec3<f32>({:?}, {:?}, {:?});
-const MATERIAL_EMISSIVE: vec3<f32> = vec3<f32>({:?}, {:?}, {:?});
-fn material_setup(p: ShadingPoint) -> MaterialSample {{ return MaterialSample(p.normal); }}
-fn material_eval(m: MaterialSample, l: vec3<f32>) -> vec3<f32> {{
-    return MATERIAL_ALBEDO * (0.31830988618379067 * max(dot(m.n, l), 0.0));
-}}
-fn material_emission(m: MaterialSample) -> vec3<f32> {{ return MATERIAL_EMISSIVE; }}
-fn material_alpha(m: MaterialSample) -> f32 {{ return 1.0; }}
-",
-        albedo[0], albedo[1], albedo[2], emissive[0], emissive[1], emissive[2]
-    )
+    /// Group 2 (sampler + textures); None for a material without textures.
+    pub bind_group: Option<(Arc<wgpu::BindGroupLayout>, wgpu::BindGroup)>,
 }
 
 impl MaterialProgram {
-    /// The scene's material as a program (constant factors, Lambertian).
-    pub fn from_surface(m: &SurfaceMaterial) -> Self {
-        let c = m.base_color;
-        Self {
-            name: m.name.clone(),
-            wgsl: lambert(&m.name, [c.x, c.y, c.z], m.emissive.into(), m.type_bit),
-            alpha_mode: m.alpha_mode,
-            double_sided: m.double_sided,
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        material: &Material,
+        alpha_mode: AlphaMode,
+        double_sided: bool,
+    ) -> Result<Self, MaterialError> {
+        let wgsl = material.wgsl()?;
+        let slots = material.texture_slots();
+        let bind_group = if slots.is_empty() {
+            None
+        } else {
+            let mut entries = vec![wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                count: None,
+            }];
+            let mut views = Vec::new();
+            for slot in slots {
+                let image = slot.source.load()?;
+                let format = if image.srgb {
+                    wgpu::TextureFormat::Rgba8UnormSrgb
+                } else {
+                    wgpu::TextureFormat::Rgba8Unorm
+                };
+                let texture = device.create_texture_with_data(
+                    queue,
+                    &wgpu::TextureDescriptor {
+                        label: Some(&image.name),
+                        size: wgpu::Extent3d {
+                            width: image.width,
+                            height: image.height,
+                            depth_or_array_layers: 1,
+                        },
+                        mip_level_count: 1,
+                        sample_count: 1,
+                        dimension: wgpu::TextureDimension::D2,
+                        format,
+                        usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                        view_formats: &[],
+                    },
+                    wgpu::util::TextureDataOrder::LayerMajor,
+                    &image.rgba8,
+                );
+                entries.push(wgpu::BindGroupLayoutEntry {
+                    binding: slot.binding,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                });
+                views.push((slot.binding, texture.create_view(&Default::default())));
+            }
+            let layout = Arc::new(device.create_bind_group_layout(
+                &wgpu::BindGroupLayoutDescriptor {
+                    label: Some(material.name()),
+                    entries: &entries,
+                },
+            ));
+            let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("material_sampler"),
+                address_mode_u: wgpu::AddressMode::Repeat,
+                address_mode_v: wgpu::AddressMode::Repeat,
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                ..Default::default()
+            });
+            let mut bind_entries = vec![wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Sampler(&sampler),
+            }];
+            for (binding, view) in &views {
+                bind_entries.push(wgpu::BindGroupEntry {
+                    binding: *binding,
+                    resource: wgpu::BindingResource::TextureView(view),
+                });
+            }
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(material.name()),
+                layout: &layout,
+                entries: &bind_entries,
+            });
+            Some((layout, group))
+        };
+        Ok(Self {
+            name: material.name().to_string(),
+            wgsl,
+            alpha_mode,
+            double_sided,
+            bind_group,
+        })
+    }
+
+    /// One program per scene material: glTF materials map exactly onto the layered
+    /// model; `material_overrides` replace a material by name with a RON material.
+    pub fn for_scene(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+    ) -> Result<Vec<Self>, MaterialError> {
+        let mut out = Vec::new();
+        let defaults = [crate::scene::SurfaceMaterial::default()];
+        let surfaces = if scene.materials.is_empty() {
+            &defaults[..]
+        } else {
+            &scene.materials[..]
+        };
+        for surface in surfaces {
+            let material = match scene
+                .material_overrides
+                .iter()
+                .find(|(n, _)| *n == surface.name)
+            {
+                Some((_, path)) => {
+                    let base = scene.source_path.as_deref().and_then(|p| p.parent());
+                    let path = match base {
+                        Some(dir) if path.is_relative() && !path.exists() => dir.join(path),
+                        _ => path.clone(),
+                    };
+                    Material::load(&path)?
+                }
+                None => Material::from_surface(surface),
+            };
+            out.push(Self::new(
+                device,
+                queue,
+                &material,
+                surface.alpha_mode,
+                surface.double_sided,
+            )?);
         }
+        Ok(out)
     }
 }

@@ -30,6 +30,8 @@ pub enum RenderError {
     OutputFormat(String),
     #[error("wgpu reported: {0}")]
     Wgpu(String),
+    #[error(transparent)]
+    Material(#[from] crate::material::MaterialError),
 }
 
 /// A device, the shader library and the pipeline cache.

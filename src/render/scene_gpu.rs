@@ -22,16 +22,14 @@ pub struct SceneGpu {
 }
 
 impl SceneGpu {
-    pub fn upload(device: &wgpu::Device, scene: &Scene) -> Self {
-        let mut materials: Vec<MaterialProgram> = scene
-            .materials
-            .iter()
-            .map(MaterialProgram::from_surface)
-            .collect();
-        if materials.is_empty() {
-            materials.push(MaterialProgram::from_surface(&Default::default()));
-        }
-        Self::upload_with(device, scene, materials)
+    /// Uploads geometry, lights and the scene's materials (generated WGSL, textures).
+    pub fn upload(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+    ) -> Result<Self, crate::material::MaterialError> {
+        let materials = MaterialProgram::for_scene(device, queue, scene)?;
+        Ok(Self::upload_with(device, scene, materials))
     }
 
     pub fn upload_with(

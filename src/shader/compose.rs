@@ -47,7 +47,7 @@ impl ShaderLibrary {
 
     /// The project's own shaders/ folder (next to Cargo.toml).
     pub fn builtin() -> Self {
-        Self::new(Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders"))
+        Self::new(crate::project_root().join("shaders"))
     }
 
     /// Reads `file` (relative to the root), expands includes and `#if`, and prepends the

@@ -192,7 +192,7 @@ pub fn render_text(
         lights: scene.lights.len() as u32,
     };
     let compiled = graph::compile(checked, &scene.features(), size);
-    let gpu = SceneGpu::upload(&r.ctx.device, scene);
+    let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, scene).expect("materials");
     let prepared = r
         .prepare(compiled, scene, &gpu, size, true)
         .expect("prepare");
