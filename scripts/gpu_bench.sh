@@ -4,7 +4,8 @@
 #   scripts/gpu_bench.sh
 set -u
 for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig
-out="${OUT:-results}"
+final="${OUT:-results}"
+out="$final/r"
 mkdir -p "$out"
 export XDG_RUNTIME_DIR=/tmp
 nvidia-smi --query-gpu=name,driver_version --format=csv > "$out/gpu.txt" 2>&1
@@ -15,4 +16,6 @@ nvidia-smi --query-gpu=name,driver_version --format=csv > "$out/gpu.txt" 2>&1
 ./.gpu/lightgraph render --scene scenes/depth_discontinuity.ron --graph graphs/forward_plus_clustered.ron > "$out/dd_clustered.txt" 2>&1
 ./.gpu/lightgraph bench --sweep benches/sweeps/seeds.ron --out "$out/seeds" > "$out/seeds.log" 2>&1
 ./.gpu/lightgraph bench --sweep benches/sweeps/headline.ron --out "$out/headline" > "$out/headline.log" 2>&1
-tail -3 "$out"/*.txt "$out"/*.log
+cat "$out"/render_atrium.txt "$out"/seeds/results.md "$out"/headline/results.md
+# The device tool brings back few files: pack everything into one archive.
+tar -czf "$final/results.tar.gz" -C "$final" r && rm -rf "$out"
