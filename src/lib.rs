@@ -4,6 +4,7 @@
 //! without a GPU (see [`graph`]), then executed headless on wgpu (see [`render`]).
 
 pub mod bench;
+pub mod cull;
 pub mod gpu;
 pub mod graph;
 pub mod material;

@@ -34,6 +34,12 @@ enum Command {
         #[arg(long)]
         dot: bool,
     },
+    /// Check a layered material; with --wgsl print the WGSL generated for it.
+    Material {
+        file: PathBuf,
+        #[arg(long)]
+        wgsl: bool,
+    },
     /// Compare two EXR images: RMSE, max abs, PSNR, FLIP mean, bad pixels.
     Compare { a: PathBuf, b: PathBuf },
     /// Time against error: run a sweep file, write CSV, Markdown and plots to --out.
@@ -78,7 +84,21 @@ fn load_scene(path: Option<&Path>) -> Result<Scene> {
             for w in &loaded.warnings {
                 eprintln!("warning: {w}");
             }
-            Ok(loaded.scene)
+            let mut scene = loaded.scene;
+            if scene.lights.is_empty() {
+                if let Some(bounds) = scene.bounds() {
+                    let l = scene::lights::fallback_light(bounds);
+                    eprintln!(
+                        "warning: {} has no lights; added a point light at {:.2?} (range {:.2}, {:.2} cd)",
+                        p.display(),
+                        l.position,
+                        l.range,
+                        l.intensity
+                    );
+                    scene.lights.push(l);
+                }
+            }
+            Ok(scene)
         }
     }
 }
@@ -92,6 +112,7 @@ fn main() -> Result<()> {
         Some(Command::Validate { files }) => validate(&files),
         Some(Command::Graph { graph, scene, dot }) => print_graph(&graph, scene.as_deref(), dot),
         Some(Command::Compare { a, b }) => compare(&a, &b),
+        Some(Command::Material { file, wgsl }) => material(&file, wgsl),
         Some(Command::Bench { sweep, out }) => run_bench(sweep.as_deref(), &out),
     }
 }
@@ -100,13 +121,27 @@ fn validate(files: &[PathBuf]) -> Result<()> {
     let shaders = ShaderLibrary::builtin();
     let mut failed = false;
     for f in files {
-        match graph::check_file(f, &shaders) {
-            Ok(_) => println!("{}: ok", f.display()),
-            Err(errors) => {
+        let text = std::fs::read_to_string(f).unwrap_or_default();
+        // Graphs, scenes and materials are all RON: the top-level name tells them apart.
+        let head = text
+            .lines()
+            .map(str::trim)
+            .find(|l| !l.is_empty() && !l.starts_with("//"))
+            .unwrap_or("");
+        let result: Result<(), String> = if head.starts_with("Graph") {
+            graph::check_file(f, &shaders).map(|_| ()).map_err(|e| e.to_string())
+        } else if head.starts_with("Scene") || !f.extension().is_some_and(|e| e == "ron") {
+            scene::load(f).map(|_| ()).map_err(|e| e.to_string())
+        } else {
+            lightgraph::material::Material::load(f)
+                .and_then(|m| m.wgsl().map(|_| ()))
+                .map_err(|e| e.to_string())
+        };
+        match result {
+            Ok(()) => println!("{}: ok", f.display()),
+            Err(e) => {
                 failed = true;
-                for e in &errors.0 {
-                    eprintln!("{e}");
-                }
+                eprintln!("{e}");
             }
         }
     }
@@ -312,5 +347,19 @@ fn run_bench(sweep: Option<&Path>, out: &Path) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| out.display().to_string())?;
     let files = bench::write_report(out, &rows)?;
     println!("wrote {}", files.markdown.display());
+    Ok(())
+}
+
+fn material(path: &Path, wgsl: bool) -> Result<()> {
+    let m = lightgraph::material::Material::load(path)?;
+    for w in m.warnings() {
+        eprintln!("warning: {w}");
+    }
+    let code = m.wgsl()?;
+    if wgsl {
+        print!("{code}");
+    } else {
+        println!("{}: ok ({} texture slots, type bit {})", path.display(), m.texture_slots().len(), m.type_bit());
+    }
     Ok(())
 }
