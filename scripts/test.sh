@@ -12,4 +12,4 @@ if ! ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1 && ! ls /etc/vulkan/icd.d
 fi
 # Headless: no display server or runtime dir is needed.
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp}"
-cargo test --release --all-targets -- --test-threads=2
+cargo test --release --all-targets

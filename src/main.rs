@@ -129,7 +129,9 @@ fn validate(files: &[PathBuf]) -> Result<()> {
             .find(|l| !l.is_empty() && !l.starts_with("//"))
             .unwrap_or("");
         let result: Result<(), String> = if head.starts_with("Graph") {
-            graph::check_file(f, &shaders).map(|_| ()).map_err(|e| e.to_string())
+            graph::check_file(f, &shaders)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
         } else if head.starts_with("Scene") || !f.extension().is_some_and(|e| e == "ron") {
             scene::load(f).map(|_| ()).map_err(|e| e.to_string())
         } else {
@@ -359,7 +361,12 @@ fn material(path: &Path, wgsl: bool) -> Result<()> {
     if wgsl {
         print!("{code}");
     } else {
-        println!("{}: ok ({} texture slots, type bit {})", path.display(), m.texture_slots().len(), m.type_bit());
+        println!(
+            "{}: ok ({} texture slots, type bit {})",
+            path.display(),
+            m.texture_slots().len(),
+            m.type_bit()
+        );
     }
     Ok(())
 }

@@ -25,7 +25,14 @@ fn point_in_tile(inv: Mat4, tx: u32, ty: u32, u: f32, v: f32, z: f32) -> Vec3 {
 fn tile(inv: Mat4, tx: u32, ty: u32) -> TileFrustum {
     let x0 = tx as f32 * TILE;
     let y0 = ty as f32 * TILE;
-    tile_frustum(inv, Vec2::new(W, H), x0, y0, (x0 + TILE).min(W), (y0 + TILE).min(H))
+    tile_frustum(
+        inv,
+        Vec2::new(W, H),
+        x0,
+        y0,
+        (x0 + TILE).min(W),
+        (y0 + TILE).min(H),
+    )
 }
 
 prop_compose! {
@@ -100,11 +107,26 @@ fn far_lights_and_lights_behind_are_culled() {
     // The property tests only check one direction; culling must also cull.
     let inv = setup();
     let t = tile(inv, 10, 6);
-    let behind = ViewLight { position: Vec3::new(0.0, 0.0, 5.0), range: 1.0, direction: Vec3::Z, cos_outer: -1.0 };
+    let behind = ViewLight {
+        position: Vec3::new(0.0, 0.0, 5.0),
+        range: 1.0,
+        direction: Vec3::Z,
+        cos_outer: -1.0,
+    };
     assert!(!light_touches_tile(&behind, &t, 1.0, 10.0, None));
-    let beyond = ViewLight { position: Vec3::new(0.0, 0.0, -30.0), range: 1.0, direction: Vec3::Z, cos_outer: -1.0 };
+    let beyond = ViewLight {
+        position: Vec3::new(0.0, 0.0, -30.0),
+        range: 1.0,
+        direction: Vec3::Z,
+        cos_outer: -1.0,
+    };
     assert!(!light_touches_tile(&beyond, &t, 1.0, 10.0, None));
     // A spot in the tile's depth range pointing away from it.
-    let away = ViewLight { position: Vec3::new(0.0, 0.0, -5.0), range: 3.0, direction: Vec3::Z, cos_outer: 0.95 };
+    let away = ViewLight {
+        position: Vec3::new(0.0, 0.0, -5.0),
+        range: 3.0,
+        direction: Vec3::Z,
+        cos_outer: 0.95,
+    };
     assert!(!light_touches_tile(&away, &t, 5.5, 10.0, None));
 }

