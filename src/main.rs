@@ -132,7 +132,7 @@ fn validate(files: &[PathBuf]) -> Result<()> {
             graph::check_file(f, &shaders)
                 .map(|_| ())
                 .map_err(|e| e.to_string())
-        } else if head.starts_with("Scene") || !f.extension().is_some_and(|e| e == "ron") {
+        } else if head.starts_with("Scene") || f.extension().is_none_or(|e| e != "ron") {
             scene::load(f).map(|_| ()).map_err(|e| e.to_string())
         } else {
             lightgraph::material::Material::load(f)

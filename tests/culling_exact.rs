@@ -79,12 +79,13 @@ fn check_scene(scene: &Scene, expect_lit: bool) {
                 for ch in 0..3 {
                     let scale = b[ch].abs().max(1e-3 * peak).max(1e-30);
                     let d = (a[ch] - b[ch]).abs() / scale;
-                    if !(d <= worst.0) {
+                    // NaN counts as the worst error.
+                    if d.is_nan() || d > worst.0 {
                         worst = (d, i);
                     }
                 }
             }
-            if !(worst.0 <= 2e-6) {
+            if worst.0.is_nan() || worst.0 > 2e-6 {
                 let i = worst.1;
                 failures.push(format!(
                     "{} tile {tile} {variant}: relative error {:e} at ({}, {}): {:?} vs {:?}",

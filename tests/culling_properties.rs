@@ -42,7 +42,7 @@ prop_compose! {
         range in prop_oneof![0.001f32..0.1, 0.1f32..5.0, 5.0f32..500.0],
         spot in prop::bool::ANY,
         dir in (-1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0),
-        outer in 0.01f32..1.5707,
+        outer in 0.01f32..std::f32::consts::FRAC_PI_2,
     ) -> ViewLight {
         // Positions around the frustum, some near or behind the camera.
         let depth = if near { pos.2 * 2.0 - 1.0 } else { pos.2 * 60.0 };

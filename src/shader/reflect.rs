@@ -76,8 +76,11 @@ pub fn reflect_bindings(module: &naga::Module) -> Vec<ReflectedBinding> {
     out
 }
 
-/// (member name, byte offset, byte size) of a WGSL struct, and its total size.
-pub fn struct_layout(module: &naga::Module, name: &str) -> Option<(Vec<(String, u32, u32)>, u32)> {
+/// (member name, byte offset, byte size) of each member of a struct.
+pub type MemberLayout = Vec<(String, u32, u32)>;
+
+/// The members of a WGSL struct and its total size.
+pub fn struct_layout(module: &naga::Module, name: &str) -> Option<(MemberLayout, u32)> {
     let (_, ty) = module
         .types
         .iter()
