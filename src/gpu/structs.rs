@@ -81,6 +81,31 @@ pub struct GpuListParams {
     pub _pad0: u32,
 }
 
+impl GpuListParams {
+    pub fn new(layout: &crate::graph::ListLayout, tile: u32, variant: u32) -> Self {
+        Self {
+            tiles_x: layout.tiles_x,
+            tiles_y: layout.tiles_y,
+            tile,
+            lists_per_tile: layout.lists_per_tile,
+            capacity: layout.capacity,
+            variant,
+            pool_offset: layout.pool_offset_words(),
+            _pad0: 0,
+        }
+    }
+
+    /// A uniform buffer holding these parameters.
+    pub fn buffer(&self, device: &wgpu::Device) -> wgpu::Buffer {
+        use wgpu::util::DeviceExt;
+        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("list params"),
+            contents: bytemuck::bytes_of(self),
+            usage: wgpu::BufferUsages::UNIFORM,
+        })
+    }
+}
+
 /// Splits lights into the two GPU arrays.
 pub fn light_buffers(lights: &[Light]) -> (Vec<GpuLightGeometry>, Vec<GpuLightProperties>) {
     lights

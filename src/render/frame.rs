@@ -326,21 +326,8 @@ impl Renderer {
                     let depth = sp.roles.slot(Slot::Depth).unwrap();
                     let layout =
                         ListLayout::new(*tile, *variant, *capacity, size.width, size.height);
-                    let params = GpuListParams {
-                        tiles_x: layout.tiles_x,
-                        tiles_y: layout.tiles_y,
-                        tile: *tile,
-                        lists_per_tile: layout.lists_per_tile,
-                        capacity: *capacity,
-                        variant: variant_code(*variant),
-                        pool_offset: layout.pool_offset_words(),
-                        _pad0: 0,
-                    };
-                    let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some("list params"),
-                        contents: bytemuck::bytes_of(&params),
-                        usage: wgpu::BufferUsages::UNIFORM,
-                    });
+                    let params =
+                        GpuListParams::new(&layout, *tile, variant_code(*variant)).buffer(&device);
                     let compute = wgpu::ShaderStages::COMPUTE;
                     let bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                         label: Some("culling"),
@@ -373,16 +360,13 @@ impl Renderer {
                             &self.shaders,
                             key,
                             |_, module| {
-                                Pipeline::Compute(Arc::new(device.create_compute_pipeline(
-                                    &wgpu::ComputePipelineDescriptor {
-                                        label: Some("light culling"),
-                                        layout: Some(&pl),
-                                        module: &module,
-                                        entry_point: Some("main"),
-                                        compilation_options: Default::default(),
-                                        cache: None,
-                                    },
-                                )))
+                                Pipeline::compute(
+                                    &device,
+                                    "light culling",
+                                    Some(&pl),
+                                    &module,
+                                    "main",
+                                )
                             },
                             &device,
                         )
@@ -438,20 +422,7 @@ impl Renderer {
                             list_layout_for(&graph, lists, size).ok_or_else(|| {
                                 pass_err(format!("no LightCulling pass writes '{lists}'"))
                             })?;
-                        params_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                            label: Some("list params"),
-                            contents: bytemuck::bytes_of(&GpuListParams {
-                                tiles_x: ll.tiles_x,
-                                tiles_y: ll.tiles_y,
-                                tile,
-                                lists_per_tile: ll.lists_per_tile,
-                                capacity: ll.capacity,
-                                variant,
-                                pool_offset: ll.pool_offset_words(),
-                                _pad0: 0,
-                            }),
-                            usage: wgpu::BufferUsages::UNIFORM,
-                        });
+                        params_buf = GpuListParams::new(&ll, tile, variant).buffer(&device);
                         let buf = resources
                             .buffer(&graph.plan, lists)
                             .ok_or_else(|| pass_err("lists not planned".into()))?;

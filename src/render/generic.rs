@@ -102,18 +102,7 @@ impl Renderer {
             .get_or_build(
                 &self.shaders,
                 key,
-                |_, module| {
-                    Pipeline::Compute(Arc::new(device.create_compute_pipeline(
-                        &wgpu::ComputePipelineDescriptor {
-                            label: Some(&sp.name),
-                            layout: None,
-                            module: &module,
-                            entry_point: Some(entry),
-                            compilation_options: Default::default(),
-                            cache: None,
-                        },
-                    )))
-                },
+                |_, module| Pipeline::compute(&device, &sp.name, None, &module, entry),
                 &device,
             )
             .map_err(|source| RenderError::Shader {
@@ -265,18 +254,7 @@ impl Renderer {
             .get_or_build(
                 &self.shaders,
                 key,
-                |_, module| {
-                    Pipeline::Compute(Arc::new(device.create_compute_pipeline(
-                        &wgpu::ComputePipelineDescriptor {
-                            label: Some("light statistics"),
-                            layout: None,
-                            module: &module,
-                            entry_point: Some("main"),
-                            compilation_options: Default::default(),
-                            cache: None,
-                        },
-                    )))
-                },
+                |_, module| Pipeline::compute(&device, "light statistics", None, &module, "main"),
                 &device,
             )
             .map_err(|source| RenderError::Shader {
@@ -329,20 +307,7 @@ impl Renderer {
         let params;
         if let Some(lists) = lists {
             let (ll, tile, variant) = super::frame::list_layout_for(graph, lists, size).unwrap();
-            params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("list params"),
-                contents: bytemuck::bytes_of(&crate::gpu::structs::GpuListParams {
-                    tiles_x: ll.tiles_x,
-                    tiles_y: ll.tiles_y,
-                    tile,
-                    lists_per_tile: ll.lists_per_tile,
-                    capacity: ll.capacity,
-                    variant,
-                    pool_offset: ll.pool_offset_words(),
-                    _pad0: 0,
-                }),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
+            params = crate::gpu::structs::GpuListParams::new(&ll, tile, variant).buffer(&device);
             entries.push(wgpu::BindGroupEntry {
                 binding: 7,
                 resource: resources.buffer(plan, lists).unwrap().as_entire_binding(),

@@ -21,6 +21,28 @@ pub enum Pipeline {
     Compute(Arc<wgpu::ComputePipeline>),
 }
 
+impl Pipeline {
+    /// A compute pipeline; `layout: None` derives the layout from the shader.
+    pub fn compute(
+        device: &wgpu::Device,
+        label: &str,
+        layout: Option<&wgpu::PipelineLayout>,
+        module: &wgpu::ShaderModule,
+        entry: &str,
+    ) -> Self {
+        Pipeline::Compute(Arc::new(device.create_compute_pipeline(
+            &wgpu::ComputePipelineDescriptor {
+                label: Some(label),
+                layout,
+                module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            },
+        )))
+    }
+}
+
 #[derive(Default)]
 pub struct PipelineCache {
     pipelines: HashMap<PipelineKey, Pipeline>,
