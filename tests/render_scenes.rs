@@ -153,3 +153,17 @@ fn cornell_box_has_red_and_green_walls_and_a_lit_interior() {
     let c = out.image[(h / 2 * w + w / 2) as usize];
     assert!(c[0] > 0.01 && c[1] > 0.01 && c[2] > 0.01, "centre {c:?}");
 }
+
+#[test]
+fn a_light_lights_only_the_materials_in_its_mask() {
+    let mut r = renderer();
+    // The analytic material has type bit 1 (the default).
+    let mut scene = analytic_scene(2, Vec3::NEG_Z);
+    scene.lights[0].material_mask = !1; // every material but this one
+    scene.lights[1].material_mask = 1;
+    let out = render_file(&mut r, "forward_plus.ron", &scene, 32, 24);
+    // Only the second light (pi/2) reaches the surface: radiance 0.25.
+    for p in &out.image {
+        assert!((p[0] - 0.25).abs() < 1e-3, "{p:?}");
+    }
+}
