@@ -167,3 +167,36 @@ fn a_light_lights_only_the_materials_in_its_mask() {
         assert!((p[0] - 0.25).abs() < 1e-3, "{p:?}");
     }
 }
+
+#[test]
+fn alpha_masked_geometry_is_cut_out_in_prepass_and_shading() {
+    let mut r = renderer();
+    let mut scene = random_scene(40, 4);
+    let reference = render_file(&mut r, "forward_plus.ron", &scene, 96, 64);
+    // A masked panel right in front of the camera, alpha 0.2 under a 0.5 cutoff: fully cut out.
+    let eye = scene.camera.eye;
+    scene.materials.push(SurfaceMaterial {
+        name: "masked".into(),
+        base_color: glam::Vec4::new(1.0, 1.0, 1.0, 0.2),
+        alpha_mode: scene::AlphaMode::Mask(0.5),
+        double_sided: true,
+        ..Default::default()
+    });
+    let masked = scene.materials.len() - 1;
+    scene.meshes.push(cuboid(
+        "panel",
+        eye + Vec3::new(-3.0, -3.0, -1.2),
+        eye + Vec3::new(3.0, 3.0, -1.0),
+        masked,
+        false,
+    ));
+    assert!(scene.features().has_alpha_mask);
+    let cut = render_file(&mut r, "forward_plus.ron", &scene, 96, 64);
+    let (d, at) = max_rel_diff(&cut.image, &reference.image);
+    assert!(d < 1e-6, "the masked panel changed pixel {at} by {d}");
+    // With alpha above the cutoff the panel is there.
+    scene.materials[masked].base_color.w = 0.9;
+    let solid = render_file(&mut r, "forward_plus.ron", &scene, 96, 64);
+    let (d, _) = max_rel_diff(&solid.image, &reference.image);
+    assert!(d > 0.1, "an opaque-enough panel must show: {d}");
+}

@@ -81,6 +81,13 @@ fn fs_depth(in: VertexOut, @builtin(front_facing) front: bool) {
 fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
     let p = shading_point(in, front);
     let m = material_setup(p);
+#if ALPHA_MASK
+    // The prepass discarded these fragments; shading must too, or a masked surface
+    // nearer than the depth buffer would pass the LessEqual test.
+    if (material_alpha(m) < ALPHA_CUTOFF) {
+        discard;
+    }
+#endif
     let view_z = -(frame.view * vec4<f32>(in.world, 1.0)).z;
     var color = material_emission(m) + frame.ambient.rgb * material_eval(m, p.normal);
     let range = light_range(in.clip.xy, view_z);

@@ -578,10 +578,10 @@ impl Renderer {
             let mut d = vec![];
             if depth_only {
                 d.push(("DEPTH_ONLY", "1".to_string()));
-                if let AlphaMode::Mask(cutoff) = m.alpha_mode {
-                    d.push(("ALPHA_MASK", "1".into()));
-                    d.push(("ALPHA_CUTOFF", format!("{cutoff:?}")));
-                }
+            }
+            if let AlphaMode::Mask(cutoff) = m.alpha_mode {
+                d.push(("ALPHA_MASK", "1".into()));
+                d.push(("ALPHA_CUTOFF", format!("{cutoff:?}")));
             }
             if lists == Some(true) {
                 d.push(("LIGHT_LISTS", "1".into()));
