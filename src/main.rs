@@ -203,7 +203,8 @@ fn render(args: RenderArgs) -> Result<()> {
     let checked = graph::check_file(&graph_path, &renderer.shaders)?;
     let compiled = graph::compile(checked, &scene.features(), size);
     let gpu = SceneGpu::upload(&renderer.ctx.device, &renderer.ctx.queue, &scene)?;
-    let prepared = renderer.prepare(compiled, &scene, &gpu, size, true)?;
+    let stats = compiled.has_forward_shading();
+    let prepared = renderer.prepare(compiled, &scene, &gpu, size, stats)?;
     // The first frame builds pipelines and warms caches; report the second.
     prepared.execute(&renderer)?;
     let result = prepared.render(&renderer)?;

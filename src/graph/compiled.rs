@@ -44,6 +44,12 @@ impl CompiledGraph {
             .find(|c| c.name == pass)
             .map(|c| &c.reason)
     }
+    /// Whether a forward shading pass runs (light statistics need one).
+    pub fn has_forward_shading(&self) -> bool {
+        self.passes
+            .iter()
+            .any(|p| matches!(p.kind, PassKind::ForwardShading { .. }))
+    }
     pub fn output(&self) -> &str {
         &self.checked.desc.output
     }
