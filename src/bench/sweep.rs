@@ -156,7 +156,13 @@ pub fn run(
                     }
                     let result = prepared.render(renderer)?;
                     let stats_frame = renderer
-                        .prepare(prepared.graph.clone(), &scene, &gpu, size, true)?
+                        .prepare(
+                            prepared.graph.clone(),
+                            &scene,
+                            &gpu,
+                            size,
+                            prepared.graph.has_forward_shading(),
+                        )?
                         .render(renderer)?;
                     let mut row = BenchRow {
                         scene: scene.name.clone(),
