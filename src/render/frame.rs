@@ -762,27 +762,13 @@ impl PreparedFrame {
                 } => {
                     // Header words (pool cursor and overflow counters) start at zero.
                     encoder.clear_buffer(self.resources.buffer(plan, lists).unwrap(), 0, Some(16));
-                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                        label: Some(name),
-                        timestamp_writes: compute_ts,
-                    });
-                    pass.set_pipeline(pipeline);
-                    pass.set_bind_group(0, bind, &[]);
-                    pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
+                    dispatch(&mut encoder, name, compute_ts, pipeline, bind, *groups);
                 }
                 PassExec::Compute {
                     pipeline,
                     bind,
                     groups,
-                } => {
-                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                        label: Some(name),
-                        timestamp_writes: compute_ts,
-                    });
-                    pass.set_pipeline(pipeline);
-                    pass.set_bind_group(0, bind, &[]);
-                    pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
-                }
+                } => dispatch(&mut encoder, name, compute_ts, pipeline, bind, *groups),
                 PassExec::Fullscreen {
                     pipeline,
                     bind,
@@ -805,13 +791,15 @@ impl PreparedFrame {
             }
         }
         if let Some((pipeline, bind, _)) = &self.stats {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("light statistics"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, bind, &[]);
-            pass.dispatch_workgroups(self.size.width.div_ceil(8), self.size.height.div_ceil(8), 1);
+            let groups = [self.size.width.div_ceil(8), self.size.height.div_ceil(8), 1];
+            dispatch(
+                &mut encoder,
+                "light statistics",
+                None,
+                pipeline,
+                bind,
+                groups,
+            );
         }
         if let Some((q, buf)) = &self.queries {
             encoder.resolve_query_set(q, 0..2 * self.passes.len() as u32, buf, 0);
@@ -915,6 +903,24 @@ impl PreparedFrame {
             .queue
             .write_buffer(&self.frame_uniform, 0, bytemuck::bytes_of(&f));
     }
+}
+
+/// One compute pass with one dispatch.
+fn dispatch(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    pipeline: &wgpu::ComputePipeline,
+    bind: &wgpu::BindGroup,
+    groups: [u32; 3],
+) {
+    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(label),
+        timestamp_writes: timestamps,
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, bind, &[]);
+    pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
 }
 
 fn depth_attachment(
