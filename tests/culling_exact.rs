@@ -247,3 +247,33 @@ fn overflow_is_counted_and_reported() {
         "kept counts never exceed the capacity"
     );
 }
+
+#[test]
+fn tiled_deferred_matches_forward_brute_force() {
+    // The compute path shades the same G-buffer values with the same material and light
+    // loop, so it is held to the same tolerance as the culling variants.
+    let scene = random_scene(301, 7);
+    let mut r = renderer();
+    let reference = render_file(&mut r, "brute_force.ron", &scene, W, H);
+    let peak = reference
+        .image
+        .iter()
+        .flat_map(|p| p[..3].to_vec())
+        .fold(0.0f32, f32::max);
+    for graph in [
+        "deferred_brute_force.ron",
+        "tiled_deferred.ron",
+        "tiled_deferred_depth_mask.ron",
+    ] {
+        let out = render_file(&mut r, graph, &scene, W, H);
+        let mut worst = 0.0f32;
+        for (a, b) in out.image.iter().zip(&reference.image) {
+            for ch in 0..3 {
+                let d = (a[ch] - b[ch]).abs() / b[ch].abs().max(1e-3 * peak).max(1e-30);
+                assert!(!d.is_nan(), "{graph}: NaN");
+                worst = worst.max(d);
+            }
+        }
+        assert!(worst <= 2e-6, "{graph}: relative error {worst:e}");
+    }
+}

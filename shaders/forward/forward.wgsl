@@ -24,6 +24,7 @@ struct ShadingPoint {
 };
 
 #include <material>
+#include "common/light_loop.wgsl"
 
 struct VertexIn {
     @location(0) position: vec3<f32>,
@@ -66,6 +67,27 @@ fn shading_point(in: VertexOut, front: bool) -> ShadingPoint {
     return p;
 }
 
+#if GBUFFER
+// Deferred shading's G-buffer: world position with the material index in w (-1 where
+// nothing was drawn), and the shading normal (already facing the viewer).
+struct GBufferOut {
+    @location(0) position: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+};
+
+@fragment
+fn fs_gbuffer(in: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
+    let p = shading_point(in, front);
+#if ALPHA_MASK
+    let m = material_setup(p);
+    if (material_alpha(m) < ALPHA_CUTOFF) {
+        discard;
+    }
+#endif
+    return GBufferOut(vec4<f32>(in.world, f32(MATERIAL_INDEX)), vec4<f32>(p.normal, 0.0));
+}
+#endif
+
 #if DEPTH_ONLY
 @fragment
 fn fs_depth(in: VertexOut, @builtin(front_facing) front: bool) {
@@ -89,19 +111,7 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> @location(0) ve
     }
 #endif
     let view_z = -(frame.view * vec4<f32>(in.world, 1.0)).z;
-    var color = material_emission(m) + frame.ambient.rgb * material_eval(m, p.normal);
-    let range = light_range(in.clip.xy, view_z);
-    for (var k = 0u; k < range.count; k++) {
-        let i = light_at(range, k);
-        let props = light_properties[i];
-        if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
-            continue;
-        }
-        let inc = incident_light(light_geometry[i], props, in.world);
-        if (any(inc.radiance > vec3<f32>(0.0))) {
-            color += inc.radiance * material_eval(m, inc.dir);
-        }
-    }
+    let color = shade_surface(p, m, in.clip.xy, view_z);
     return vec4<f32>(color, material_alpha(m));
 }
 #endif

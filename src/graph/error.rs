@@ -14,7 +14,7 @@ pub enum GraphError {
         context: String,
         message: String,
     },
-    #[error("{at}: pass '{pass}': unknown pass kind '{kind}' (known: DepthPrepass, LightCulling, ForwardShading, Compute, Fullscreen)")]
+    #[error("{at}: pass '{pass}': unknown pass kind '{kind}' (known: DepthPrepass, LightCulling, ForwardShading, GBuffer, DeferredShading, Compute, Fullscreen)")]
     UnknownPassKind {
         at: Location,
         pass: String,

@@ -216,6 +216,15 @@ pub enum PassKind {
         #[serde(default)]
         lights: LightSource,
     },
+    /// Geometry into a G-buffer: a depth texture and two Rgba32Float textures, in this
+    /// order in `writes`: world position (material index in w), shading normal.
+    GBuffer,
+    /// Lighting in a compute shader from the G-buffer (tiled deferred with `Culled`):
+    /// reads the G-buffer's two textures in order, writes an Rgba32Float texture.
+    DeferredShading {
+        #[serde(default)]
+        lights: LightSource,
+    },
     /// A compute shader the graph file names; bindings are matched by name.
     Compute {
         shader: String,
@@ -247,6 +256,8 @@ impl PassKind {
             PassKind::DepthPrepass => "DepthPrepass",
             PassKind::LightCulling { .. } => "LightCulling",
             PassKind::ForwardShading { .. } => "ForwardShading",
+            PassKind::GBuffer => "GBuffer",
+            PassKind::DeferredShading { .. } => "DeferredShading",
             PassKind::Compute { .. } => "Compute",
             PassKind::Fullscreen { .. } => "Fullscreen",
         }

@@ -251,7 +251,14 @@ fn describe(
                 let role = &roles[p];
                 let is_slot =
                     role.slots.values().any(|v| v == name) || role.target.as_deref() == Some(name);
-                if is_slot {
+                if is_slot && matches!(desc.passes[p].kind, PassKind::DeferredShading { .. }) {
+                    // Reads the G-buffer as textures, stores its output as a storage texture.
+                    usage |= if desc.passes[p].writes.iter().any(|w| w == name) {
+                        T::STORAGE_BINDING
+                    } else {
+                        T::TEXTURE_BINDING
+                    };
+                } else if is_slot {
                     usage |= T::RENDER_ATTACHMENT;
                     if format.is_depth()
                         && matches!(desc.passes[p].kind, PassKind::LightCulling { .. })

@@ -16,6 +16,10 @@ pub enum Slot {
     LightProperties,
     Geometry,
     LightLists,
+    /// G-buffer world positions (material index in w).
+    GPosition,
+    /// G-buffer shading normals.
+    GNormal,
 }
 
 /// Binding names every generic shader may use without declaring them.
@@ -82,6 +86,15 @@ impl RoleCtx<'_> {
             _ => None,
         }
     }
+    fn is_rgba32f(&self, name: &str) -> bool {
+        matches!(
+            self.resources.get(name),
+            Some(ResourceDesc::Texture {
+                format: super::model::TextureFormat::Rgba32Float,
+                ..
+            })
+        )
+    }
     fn is_buffer(&self, name: &str) -> bool {
         matches!(self.resources.get(name), Some(ResourceDesc::Buffer { .. }))
     }
@@ -112,6 +125,14 @@ impl RoleCtx<'_> {
                 }
                 (None, Some(_)) => put(&mut roles, Slot::Depth, name, &mut errors),
                 _ if self.is_buffer(name) => put(&mut roles, Slot::LightLists, name, &mut errors),
+                _ if matches!(pass.kind, PassKind::DeferredShading { .. }) => {
+                    let slot = if roles.slots.contains_key(&Slot::GPosition) {
+                        Slot::GNormal
+                    } else {
+                        Slot::GPosition
+                    };
+                    put(&mut roles, slot, name, &mut errors)
+                }
                 _ => errors.push(self.mismatch(
                     pass,
                     name,
@@ -125,6 +146,13 @@ impl RoleCtx<'_> {
             }
             if self.depth_texture(name).is_some() {
                 put(&mut roles, Slot::Depth, name, &mut errors);
+            } else if self.color_texture(name).is_some() && matches!(pass.kind, PassKind::GBuffer) {
+                let slot = if roles.slots.contains_key(&Slot::GPosition) {
+                    Slot::GNormal
+                } else {
+                    Slot::GPosition
+                };
+                put(&mut roles, slot, name, &mut errors);
             } else if self.color_texture(name).is_some() {
                 put(&mut roles, Slot::Color, name, &mut errors);
             } else {
@@ -262,6 +290,112 @@ impl RoleCtx<'_> {
                     if cs != ds {
                         errors.push(self.mismatch(pass, c, format!("colour target has {cs} sample(s) but depth '{d}' has {ds}: MSAA needs both multisampled")));
                     }
+                }
+            }
+            PassKind::GBuffer => {
+                need(
+                    &roles,
+                    Slot::Depth,
+                    "a depth texture in writes",
+                    &mut errors,
+                );
+                need(
+                    &roles,
+                    Slot::GPosition,
+                    "two Rgba32Float textures in writes (positions, normals)",
+                    &mut errors,
+                );
+                need(
+                    &roles,
+                    Slot::GNormal,
+                    "two Rgba32Float textures in writes (positions, normals)",
+                    &mut errors,
+                );
+                for slot in [Slot::GPosition, Slot::GNormal] {
+                    if let Some(name) = roles.slot(slot) {
+                        if !self.is_rgba32f(name) || self.color_texture(name) != Some(1) {
+                            errors.push(self.mismatch(
+                                pass,
+                                name,
+                                "G-buffer textures are single-sample Rgba32Float",
+                            ));
+                        }
+                    }
+                }
+                if let Some(name) = roles.slot(Slot::Depth) {
+                    if self.depth_texture(name) != Some(1) {
+                        errors.push(self.mismatch(pass, name, "the G-buffer is single-sample"));
+                    }
+                }
+                for slot in [
+                    Slot::Color,
+                    Slot::LightLists,
+                    Slot::LightGeometry,
+                    Slot::LightProperties,
+                ] {
+                    if let Some(name) = roles.slot(slot) {
+                        errors.push(self.mismatch(pass, name, "a G-buffer pass uses no lights and writes only depth and its two textures"));
+                    }
+                }
+            }
+            PassKind::DeferredShading { lights } => {
+                need(
+                    &roles,
+                    Slot::GPosition,
+                    "the G-buffer's two textures in reads (positions, normals)",
+                    &mut errors,
+                );
+                need(
+                    &roles,
+                    Slot::GNormal,
+                    "the G-buffer's two textures in reads (positions, normals)",
+                    &mut errors,
+                );
+                need(
+                    &roles,
+                    Slot::Color,
+                    "an Rgba32Float texture in writes",
+                    &mut errors,
+                );
+                need(
+                    &roles,
+                    Slot::LightGeometry,
+                    "an Import of LightGeometry in reads",
+                    &mut errors,
+                );
+                need(
+                    &roles,
+                    Slot::LightProperties,
+                    "an Import of LightProperties in reads",
+                    &mut errors,
+                );
+                match (lights, roles.slot(Slot::LightLists)) {
+                    (LightSource::Culled, None) => errors.push(self.bad(
+                        pass,
+                        "lights: Culled needs the culling pass's light-list buffer in reads",
+                    )),
+                    (LightSource::AllLights, Some(name)) => errors.push(self.mismatch(
+                        pass,
+                        name,
+                        "lights: AllLights reads no light lists",
+                    )),
+                    _ => {}
+                }
+                if let Some(name) = roles.slot(Slot::Color) {
+                    if !self.is_rgba32f(name) || self.color_texture(name) != Some(1) {
+                        errors.push(self.mismatch(
+                            pass,
+                            name,
+                            "deferred shading stores into a single-sample Rgba32Float texture",
+                        ));
+                    }
+                }
+                if let Some(name) = roles.slot(Slot::Depth) {
+                    errors.push(self.mismatch(
+                        pass,
+                        name,
+                        "deferred shading reads positions from the G-buffer, not depth",
+                    ));
                 }
             }
             PassKind::Compute { .. } | PassKind::Fullscreen { .. } => {

@@ -36,6 +36,19 @@ enum PassExec {
         draws: Vec<Draw>,
         bind: wgpu::BindGroup,
     },
+    GBuffer {
+        depth: String,
+        positions: String,
+        normals: String,
+        draws: Vec<Draw>,
+        bind: wgpu::BindGroup,
+    },
+    /// One compute dispatch per material over the frame.
+    Deferred {
+        pipelines: Vec<Arc<wgpu::ComputePipeline>>,
+        bind: wgpu::BindGroup,
+        groups: [u32; 3],
+    },
     Compute {
         pipeline: Arc<wgpu::ComputePipeline>,
         bind: wgpu::BindGroup,
@@ -309,7 +322,14 @@ impl Renderer {
                             entry(2, &gpu.light_properties),
                         ],
                     });
-                    let draws = self.material_draws(gpu, &layout, None, samples, true, &sp.name)?;
+                    let draws = self.material_draws(
+                        gpu,
+                        &layout,
+                        None,
+                        samples,
+                        DrawMode::DepthOnly,
+                        &sp.name,
+                    )?;
                     PassExec::Prepass {
                         clear: first_writer(&depth, &sp.name),
                         depth,
@@ -404,6 +424,163 @@ impl Renderer {
                         lists,
                     }
                 }
+                PassKind::GBuffer => {
+                    let depth = sp.roles.slot(Slot::Depth).unwrap().to_string();
+                    let layout = forward_layout(false);
+                    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some(&sp.name),
+                        layout: &layout,
+                        entries: &[
+                            entry(0, &frame_uniform),
+                            entry(1, &gpu.light_geometry),
+                            entry(2, &gpu.light_properties),
+                        ],
+                    });
+                    let draws =
+                        self.material_draws(gpu, &layout, None, 1, DrawMode::GBuffer, &sp.name)?;
+                    PassExec::GBuffer {
+                        depth,
+                        positions: sp.roles.slot(Slot::GPosition).unwrap().to_string(),
+                        normals: sp.roles.slot(Slot::GNormal).unwrap().to_string(),
+                        draws,
+                        bind,
+                    }
+                }
+                PassKind::DeferredShading { lights } => {
+                    let culled = *lights == LightSource::Culled;
+                    let compute = wgpu::ShaderStages::COMPUTE;
+                    let texture = |binding| wgpu::BindGroupLayoutEntry {
+                        binding,
+                        visibility: compute,
+                        ty: wgpu::BindingType::Texture {
+                            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                            view_dimension: wgpu::TextureViewDimension::D2,
+                            multisampled: false,
+                        },
+                        count: None,
+                    };
+                    let mut layout_entries = vec![
+                        uniform_entry(0, compute),
+                        storage_entry(1, compute, true),
+                        storage_entry(2, compute, true),
+                        texture(5),
+                        texture(6),
+                        wgpu::BindGroupLayoutEntry {
+                            binding: 7,
+                            visibility: compute,
+                            ty: wgpu::BindingType::StorageTexture {
+                                access: wgpu::StorageTextureAccess::WriteOnly,
+                                format: wgpu::TextureFormat::Rgba32Float,
+                                view_dimension: wgpu::TextureViewDimension::D2,
+                            },
+                            count: None,
+                        },
+                    ];
+                    let view_of = |slot: Slot| {
+                        let name = sp.roles.slot(slot).unwrap();
+                        resources
+                            .view(&graph.plan, name)
+                            .ok_or_else(|| pass_err(format!("'{name}' not planned")))
+                    };
+                    let mut entries = vec![
+                        entry(0, &frame_uniform),
+                        entry(1, &gpu.light_geometry),
+                        entry(2, &gpu.light_properties),
+                        wgpu::BindGroupEntry {
+                            binding: 5,
+                            resource: wgpu::BindingResource::TextureView(view_of(Slot::GPosition)?),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 6,
+                            resource: wgpu::BindingResource::TextureView(view_of(Slot::GNormal)?),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 7,
+                            resource: wgpu::BindingResource::TextureView(view_of(Slot::Color)?),
+                        },
+                    ];
+                    let params_buf;
+                    if culled {
+                        let lists = sp.roles.slot(Slot::LightLists).unwrap();
+                        let (ll, tile, variant) =
+                            list_layout_for(&graph, lists, size).ok_or_else(|| {
+                                pass_err(format!("no LightCulling pass writes '{lists}'"))
+                            })?;
+                        params_buf = GpuListParams::new(&ll, tile, variant).buffer(&device);
+                        let buf = resources
+                            .buffer(&graph.plan, lists)
+                            .ok_or_else(|| pass_err("lists not planned".into()))?;
+                        layout_entries.push(storage_entry(3, compute, true));
+                        layout_entries.push(uniform_entry(4, compute));
+                        entries.push(entry(3, buf));
+                        entries.push(entry(4, &params_buf));
+                    }
+                    let bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                        label: Some("deferred shading"),
+                        entries: &layout_entries,
+                    });
+                    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some(&sp.name),
+                        layout: &bgl,
+                        entries: &entries,
+                    });
+                    let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                        label: Some("deferred shading"),
+                        bind_group_layouts: &[Some(&bgl)],
+                        immediate_size: 0,
+                    });
+                    let mut pipelines = Vec::new();
+                    for (index, m) in gpu.materials.iter().enumerate() {
+                        if m.bind_group.is_some() {
+                            return Err(pass_err(format!(
+                                "material '{}' has textures; deferred shading supports untextured materials only (the G-buffer holds no UVs or tangents yet)",
+                                m.name
+                            )));
+                        }
+                        let mut d = vec![("MATERIAL_INDEX", index.to_string())];
+                        if culled {
+                            d.push(("LIGHT_LISTS", "1".into()));
+                        }
+                        let key = PipelineKey {
+                            shader: "deferred/shade.wgsl".into(),
+                            defines: defines(&d),
+                            virtual_code: BTreeMap::from([(
+                                "material".to_string(),
+                                m.wgsl.clone(),
+                            )]),
+                            state: String::new(),
+                        };
+                        let pipeline = self
+                            .pipelines
+                            .get_or_build(
+                                &self.shaders,
+                                key,
+                                |_, module| {
+                                    Pipeline::compute(
+                                        &device,
+                                        "deferred shading",
+                                        Some(&pl),
+                                        &module,
+                                        "main",
+                                    )
+                                },
+                                &device,
+                            )
+                            .map_err(|source| RenderError::Shader {
+                                pass: format!("{} (material '{}')", sp.name, m.name),
+                                source,
+                            })?;
+                        let Pipeline::Compute(p) = pipeline else {
+                            unreachable!()
+                        };
+                        pipelines.push(p);
+                    }
+                    PassExec::Deferred {
+                        pipelines,
+                        bind,
+                        groups: [size.width.div_ceil(8), size.height.div_ceil(8), 1],
+                    }
+                }
                 PassKind::ForwardShading { lights } => {
                     let color = sp.roles.slot(Slot::Color).unwrap().to_string();
                     let depth = sp.roles.slot(Slot::Depth).unwrap().to_string();
@@ -434,8 +611,14 @@ impl Renderer {
                         layout: &layout,
                         entries: &entries,
                     });
-                    let draws =
-                        self.material_draws(gpu, &layout, Some(culled), samples, false, &sp.name)?;
+                    let draws = self.material_draws(
+                        gpu,
+                        &layout,
+                        Some(culled),
+                        samples,
+                        DrawMode::Shade,
+                        &sp.name,
+                    )?;
                     PassExec::Shading {
                         clear: first_writer(&color, &sp.name),
                         color,
@@ -554,20 +737,24 @@ impl Renderer {
     }
 
     /// One pipeline per material (draws sorted by material). `lists`: None for the
-    /// depth prepass, Some(culled) for shading.
+    /// depth prepass and the G-buffer, Some(culled) for shading.
     fn material_draws(
         &mut self,
         gpu: &SceneGpu,
         layout: &wgpu::BindGroupLayout,
         lists: Option<bool>,
         samples: u32,
-        depth_only: bool,
+        mode: DrawMode,
         pass: &str,
     ) -> Result<Vec<Draw>, RenderError> {
+        let depth_only = mode == DrawMode::DepthOnly;
+        let gbuffer = mode == DrawMode::GBuffer;
+        let writes_depth = mode != DrawMode::Shade;
         let device = self.ctx.device.clone();
         let mut draws = Vec::new();
         for mesh in gpu.opaque_draws() {
-            let m = &gpu.materials[gpu.meshes[mesh].material];
+            let material_index = gpu.meshes[mesh].material;
+            let m = &gpu.materials[material_index];
             let material_layout = m.bind_group.as_ref().map(|(l, _)| l.as_ref());
             let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some(pass),
@@ -578,6 +765,10 @@ impl Renderer {
             let mut d = vec![];
             if depth_only {
                 d.push(("DEPTH_ONLY", "1".to_string()));
+            }
+            if gbuffer {
+                d.push(("GBUFFER", "1".to_string()));
+                d.push(("MATERIAL_INDEX", material_index.to_string()));
             }
             if let AlphaMode::Mask(cutoff) = m.alpha_mode {
                 d.push(("ALPHA_MASK", "1".into()));
@@ -591,7 +782,7 @@ impl Renderer {
                 defines: defines(&d),
                 virtual_code: BTreeMap::from([("material".to_string(), m.wgsl.clone())]),
                 state: format!(
-                    "samples={samples} double_sided={} depth_only={depth_only}",
+                    "samples={samples} double_sided={} mode={mode:?}",
                     m.double_sided
                 ),
             };
@@ -602,17 +793,26 @@ impl Renderer {
                     &self.shaders,
                     key,
                     |_, module| {
-                        let fragment_entry = if depth_only { "fs_depth" } else { "fs_main" };
-                        let targets = [Some(wgpu::ColorTargetState {
+                        let fragment_entry = match mode {
+                            DrawMode::DepthOnly => "fs_depth",
+                            DrawMode::GBuffer => "fs_gbuffer",
+                            DrawMode::Shade => "fs_main",
+                        };
+                        let target = Some(wgpu::ColorTargetState {
                             format: wgpu::TextureFormat::Rgba32Float,
                             blend: None,
                             write_mask: wgpu::ColorWrites::ALL,
-                        })];
+                        });
+                        let targets = [target.clone(), target];
                         let fragment = (!depth_only || masked).then(|| wgpu::FragmentState {
                             module: &module,
                             entry_point: Some(fragment_entry),
                             compilation_options: Default::default(),
-                            targets: if depth_only { &[] } else { &targets },
+                            targets: match mode {
+                                DrawMode::DepthOnly => &[],
+                                DrawMode::GBuffer => &targets,
+                                DrawMode::Shade => &targets[..1],
+                            },
                         });
                         Pipeline::Render(Arc::new(device.create_render_pipeline(
                             &wgpu::RenderPipelineDescriptor {
@@ -630,8 +830,8 @@ impl Renderer {
                                 },
                                 depth_stencil: Some(wgpu::DepthStencilState {
                                     format: wgpu::TextureFormat::Depth32Float,
-                                    depth_write_enabled: Some(depth_only),
-                                    depth_compare: Some(if depth_only {
+                                    depth_write_enabled: Some(writes_depth),
+                                    depth_compare: Some(if writes_depth {
                                         wgpu::CompareFunction::Less
                                     } else {
                                         wgpu::CompareFunction::LessEqual
@@ -769,6 +969,57 @@ impl PreparedFrame {
                     bind,
                     groups,
                 } => dispatch(&mut encoder, name, compute_ts, pipeline, bind, *groups),
+                PassExec::GBuffer {
+                    depth,
+                    positions,
+                    normals,
+                    draws,
+                    bind,
+                } => {
+                    let dview = self.resources.view(plan, depth).unwrap();
+                    let clear = |view| wgpu::RenderPassColorAttachment {
+                        view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            // w = -1 marks pixels where nothing was drawn.
+                            load: wgpu::LoadOp::Clear(wgpu::Color {
+                                r: 0.0,
+                                g: 0.0,
+                                b: 0.0,
+                                a: -1.0,
+                            }),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    };
+                    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                        label: Some(name),
+                        color_attachments: &[
+                            Some(clear(self.resources.view(plan, positions).unwrap())),
+                            Some(clear(self.resources.view(plan, normals).unwrap())),
+                        ],
+                        depth_stencil_attachment: Some(depth_attachment(dview, true)),
+                        timestamp_writes: render_ts,
+                        occlusion_query_set: None,
+                        multiview_mask: None,
+                    });
+                    draw_meshes(&mut pass, bind, draws);
+                }
+                PassExec::Deferred {
+                    pipelines,
+                    bind,
+                    groups,
+                } => {
+                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some(name),
+                        timestamp_writes: compute_ts,
+                    });
+                    pass.set_bind_group(0, bind, &[]);
+                    for p in pipelines {
+                        pass.set_pipeline(p);
+                        pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
+                    }
+                }
                 PassExec::Fullscreen {
                     pipeline,
                     bind,
@@ -974,6 +1225,14 @@ fn draw_meshes(pass: &mut wgpu::RenderPass<'_>, bind: &wgpu::BindGroup, draws: &
         pass.set_index_buffer(d.indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..d.index_count, 0, 0..1);
     }
+}
+
+/// What a material draw writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum DrawMode {
+    DepthOnly,
+    GBuffer,
+    Shade,
 }
 
 /// One mesh drawn with its material's pipeline.

@@ -193,8 +193,9 @@ pub fn render_text(
     };
     let compiled = graph::compile(checked, &scene.features(), size);
     let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, scene).expect("materials");
+    let stats = compiled.has_forward_shading();
     let prepared = r
-        .prepare(compiled, scene, &gpu, size, true)
+        .prepare(compiled, scene, &gpu, size, stats)
         .expect("prepare");
     prepared.render(r).expect("render")
 }

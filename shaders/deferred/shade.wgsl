@@ -1,0 +1,61 @@
+// Deferred shading in a compute shader: one dispatch per material over the whole frame;
+// each invocation shades the pixel if the G-buffer holds this material there, with the
+// same material code and light loop as forward shading. On GPUs where few SMs run
+// fragment work (GH100) this is where the lighting throughput is.
+// Defines: MATERIAL_INDEX, LIGHT_LISTS.
+
+#include "common/types.wgsl"
+#include "common/lighting.wgsl"
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
+@group(0) @binding(2) var<storage, read> light_properties: array<LightProperties>;
+#if LIGHT_LISTS
+@group(0) @binding(3) var<storage, read> light_lists: array<u32>;
+@group(0) @binding(4) var<uniform> list_params: ListParams;
+#endif
+@group(0) @binding(5) var g_position: texture_2d<f32>;
+@group(0) @binding(6) var g_normal: texture_2d<f32>;
+@group(0) @binding(7) var hdr: texture_storage_2d<rgba32float, write>;
+
+#include "common/light_lists.wgsl"
+
+struct ShadingPoint {
+    position: vec3<f32>,
+    normal: vec3<f32>,
+    tangent: vec4<f32>,
+    uv: vec2<f32>,
+    view: vec3<f32>,
+};
+
+#include <material>
+#include "common/light_loop.wgsl"
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (any(id.xy >= frame.size)) {
+        return;
+    }
+    let g = textureLoad(g_position, id.xy, 0);
+    let here = i32(round(g.w));
+    if (here < 0) {
+        // Nothing drawn: the first material's dispatch clears the pixel.
+        if (MATERIAL_INDEX == 0) {
+            textureStore(hdr, id.xy, vec4<f32>(0.0));
+        }
+        return;
+    }
+    if (here != MATERIAL_INDEX) {
+        return;
+    }
+    var p: ShadingPoint;
+    p.position = g.xyz;
+    p.normal = textureLoad(g_normal, id.xy, 0).xyz;
+    p.view = normalize(frame.camera_pos.xyz - p.position);
+    p.tangent = vec4<f32>(0.0);
+    p.uv = vec2<f32>(0.0);
+    let m = material_setup(p);
+    let view_z = -(frame.view * vec4<f32>(p.position, 1.0)).z;
+    let pixel = vec2<f32>(id.xy) + 0.5;
+    textureStore(hdr, id.xy, vec4<f32>(shade_surface(p, m, pixel, view_z), material_alpha(m)));
+}
