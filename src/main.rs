@@ -34,6 +34,21 @@ enum Command {
         #[arg(long)]
         dot: bool,
     },
+    /// Hot reload, headless: re-render on every change to shaders/, materials/, the
+    /// graph or the scene; print the reload latency or the error (the last good frame
+    /// stays in --out).
+    Watch {
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        #[arg(long)]
+        graph: Option<PathBuf>,
+        #[arg(long, default_value_t = 640)]
+        width: u32,
+        #[arg(long, default_value_t = 360)]
+        height: u32,
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Check a layered material; with --wgsl print the WGSL generated for it.
     Material {
         file: PathBuf,
@@ -113,6 +128,13 @@ fn main() -> Result<()> {
         Some(Command::Graph { graph, scene, dot }) => print_graph(&graph, scene.as_deref(), dot),
         Some(Command::Compare { a, b }) => compare(&a, &b),
         Some(Command::Material { file, wgsl }) => material(&file, wgsl),
+        Some(Command::Watch {
+            scene,
+            graph,
+            width,
+            height,
+            out,
+        }) => watch(scene, graph, width, height, &out),
         Some(Command::Bench { sweep, out }) => run_bench(sweep.as_deref(), &out),
     }
 }
@@ -370,4 +392,52 @@ fn material(path: &Path, wgsl: bool) -> Result<()> {
         );
     }
     Ok(())
+}
+
+fn watch(
+    scene: Option<PathBuf>,
+    graph: Option<PathBuf>,
+    width: u32,
+    height: u32,
+    out: &Path,
+) -> Result<()> {
+    use lightgraph::reload::{ReloadSession, SceneSource};
+    let graph = graph.unwrap_or_else(|| project_path("graphs/forward_plus.ron"));
+    let source = match scene {
+        Some(p) => SceneSource::File(p),
+        None => SceneSource::Fixed(Box::new(load_scene(None)?)),
+    };
+    let renderer = Renderer::headless()?;
+    let materials = vec![project_path("materials")];
+    let mut session = ReloadSession::new(renderer, &graph, source, width, height, &materials)
+        .map_err(anyhow::Error::msg)?;
+    let write = |s: &ReloadSession| -> Result<()> {
+        write_image(out, s.frame.as_ref().expect("a first frame"))
+    };
+    write(&session)?;
+    println!(
+        "watching; wrote {} (edit a shader, material, graph or the scene; Ctrl-C stops)",
+        out.display()
+    );
+    loop {
+        let Some(reload) = session.wait(std::time::Duration::from_secs(3600)) else {
+            continue;
+        };
+        let names: Vec<String> = reload
+            .changed
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        match &reload.outcome {
+            Ok(latency) => {
+                write(&session)?;
+                println!(
+                    "reloaded in {:.1} ms: {}",
+                    latency.as_secs_f64() * 1e3,
+                    names.join(", ")
+                );
+            }
+            Err(e) => eprintln!("error (still showing the last good frame):\n{e}"),
+        }
+    }
 }

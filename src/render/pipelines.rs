@@ -45,7 +45,8 @@ impl Pipeline {
 
 #[derive(Default)]
 pub struct PipelineCache {
-    pipelines: HashMap<PipelineKey, Pipeline>,
+    /// Each pipeline with every shader file that went into it (includes too).
+    pipelines: HashMap<PipelineKey, (Pipeline, Vec<std::path::PathBuf>)>,
     pub builds: usize,
 }
 
@@ -59,7 +60,7 @@ impl PipelineCache {
         build: impl FnOnce(&Composed, wgpu::ShaderModule) -> Pipeline,
         device: &wgpu::Device,
     ) -> Result<Pipeline, ShaderError> {
-        if let Some(p) = self.pipelines.get(&key) {
+        if let Some((p, _)) = self.pipelines.get(&key) {
             return Ok(p.clone());
         }
         let composed = shaders.compose(&key.shader, &key.defines, &key.virtual_code)?;
@@ -70,7 +71,8 @@ impl PipelineCache {
         });
         let pipeline = build(&composed, module);
         self.builds += 1;
-        self.pipelines.insert(key, pipeline.clone());
+        self.pipelines
+            .insert(key, (pipeline.clone(), composed.files.clone()));
         Ok(pipeline)
     }
 
@@ -80,8 +82,17 @@ impl PipelineCache {
     pub fn is_empty(&self) -> bool {
         self.pipelines.is_empty()
     }
-    /// Drops every pipeline built from `file` (hot reload).
-    pub fn invalidate_file(&mut self, file: &str) {
-        self.pipelines.retain(|k, _| k.shader != file);
+    /// Drops every pipeline built from any of `files`, directly or through an include
+    /// (hot reload); returns how many were dropped.
+    pub fn invalidate_files(&mut self, files: &[std::path::PathBuf]) -> usize {
+        let same = |a: &std::path::Path, b: &std::path::Path| {
+            a == b
+                || (a.canonicalize().ok().is_some()
+                    && a.canonicalize().ok() == b.canonicalize().ok())
+        };
+        let before = self.pipelines.len();
+        self.pipelines
+            .retain(|_, (_, used)| !used.iter().any(|u| files.iter().any(|f| same(u, f))));
+        before - self.pipelines.len()
     }
 }
