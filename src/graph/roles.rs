@@ -258,30 +258,7 @@ impl RoleCtx<'_> {
                     "a depth texture in reads or writes",
                     &mut errors,
                 );
-                need(
-                    &roles,
-                    Slot::LightGeometry,
-                    "an Import of LightGeometry in reads",
-                    &mut errors,
-                );
-                need(
-                    &roles,
-                    Slot::LightProperties,
-                    "an Import of LightProperties in reads",
-                    &mut errors,
-                );
-                match (lights, roles.slot(Slot::LightLists)) {
-                    (LightSource::Culled, None) => errors.push(self.bad(
-                        pass,
-                        "lights: Culled needs the culling pass's light-list buffer in reads",
-                    )),
-                    (LightSource::AllLights, Some(name)) => errors.push(self.mismatch(
-                        pass,
-                        name,
-                        "lights: AllLights reads no light lists",
-                    )),
-                    _ => {}
-                }
+                self.check_light_inputs(pass, *lights, &roles, &mut errors);
                 if let (Some(c), Some(d)) = (roles.slot(Slot::Color), roles.slot(Slot::Depth)) {
                     let (cs, ds) = (
                         self.color_texture(c).unwrap_or(1),
@@ -357,30 +334,7 @@ impl RoleCtx<'_> {
                     "an Rgba32Float texture in writes",
                     &mut errors,
                 );
-                need(
-                    &roles,
-                    Slot::LightGeometry,
-                    "an Import of LightGeometry in reads",
-                    &mut errors,
-                );
-                need(
-                    &roles,
-                    Slot::LightProperties,
-                    "an Import of LightProperties in reads",
-                    &mut errors,
-                );
-                match (lights, roles.slot(Slot::LightLists)) {
-                    (LightSource::Culled, None) => errors.push(self.bad(
-                        pass,
-                        "lights: Culled needs the culling pass's light-list buffer in reads",
-                    )),
-                    (LightSource::AllLights, Some(name)) => errors.push(self.mismatch(
-                        pass,
-                        name,
-                        "lights: AllLights reads no light lists",
-                    )),
-                    _ => {}
-                }
+                self.check_light_inputs(pass, *lights, &roles, &mut errors);
                 if let Some(name) = roles.slot(Slot::Color) {
                     if !self.is_rgba32f(name) || self.color_texture(name) != Some(1) {
                         errors.push(self.mismatch(
@@ -406,6 +360,38 @@ impl RoleCtx<'_> {
             Ok(roles)
         } else {
             Err(errors)
+        }
+    }
+
+    /// What every shading pass (forward or deferred) needs to read its lights.
+    fn check_light_inputs(
+        &self,
+        pass: &PassDesc,
+        lights: LightSource,
+        roles: &PassRoles,
+        errors: &mut Vec<GraphError>,
+    ) {
+        let kind = pass.kind.label();
+        for (slot, what) in [
+            (Slot::LightGeometry, "an Import of LightGeometry in reads"),
+            (
+                Slot::LightProperties,
+                "an Import of LightProperties in reads",
+            ),
+        ] {
+            if !roles.slots.contains_key(&slot) {
+                errors.push(self.bad(pass, format!("{kind} needs {what}")));
+            }
+        }
+        match (lights, roles.slot(Slot::LightLists)) {
+            (LightSource::Culled, None) => errors.push(self.bad(
+                pass,
+                "lights: Culled needs the culling pass's light-list buffer in reads",
+            )),
+            (LightSource::AllLights, Some(name)) => {
+                errors.push(self.mismatch(pass, name, "lights: AllLights reads no light lists"))
+            }
+            _ => {}
         }
     }
 

@@ -499,21 +499,20 @@ impl Renderer {
                             resource: wgpu::BindingResource::TextureView(view_of(Slot::Color)?),
                         },
                     ];
-                    let params_buf;
-                    if culled {
+                    let lists = if culled {
                         let lists = sp.roles.slot(Slot::LightLists).unwrap();
-                        let (ll, tile, variant) =
-                            list_layout_for(&graph, lists, size).ok_or_else(|| {
-                                pass_err(format!("no LightCulling pass writes '{lists}'"))
-                            })?;
-                        params_buf = GpuListParams::new(&ll, tile, variant).buffer(&device);
-                        let buf = resources
-                            .buffer(&graph.plan, lists)
-                            .ok_or_else(|| pass_err("lists not planned".into()))?;
+                        Some(
+                            list_buffers(&graph, &resources, lists, size, &device)
+                                .map_err(pass_err)?,
+                        )
+                    } else {
+                        None
+                    };
+                    if let Some((buf, params)) = &lists {
                         layout_entries.push(storage_entry(3, compute, true));
                         layout_entries.push(uniform_entry(4, compute));
                         entries.push(entry(3, buf));
-                        entries.push(entry(4, &params_buf));
+                        entries.push(entry(4, params));
                     }
                     let bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                         label: Some("deferred shading"),
@@ -592,19 +591,18 @@ impl Renderer {
                         entry(1, &gpu.light_geometry),
                         entry(2, &gpu.light_properties),
                     ];
-                    let params_buf;
-                    if culled {
+                    let lists = if culled {
                         let lists = sp.roles.slot(Slot::LightLists).unwrap();
-                        let (ll, tile, variant) =
-                            list_layout_for(&graph, lists, size).ok_or_else(|| {
-                                pass_err(format!("no LightCulling pass writes '{lists}'"))
-                            })?;
-                        params_buf = GpuListParams::new(&ll, tile, variant).buffer(&device);
-                        let buf = resources
-                            .buffer(&graph.plan, lists)
-                            .ok_or_else(|| pass_err("lists not planned".into()))?;
+                        Some(
+                            list_buffers(&graph, &resources, lists, size, &device)
+                                .map_err(pass_err)?,
+                        )
+                    } else {
+                        None
+                    };
+                    if let Some((buf, params)) = &lists {
                         entries.push(entry(3, buf));
-                        entries.push(entry(4, &params_buf));
+                        entries.push(entry(4, params));
                     }
                     let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
                         label: Some(&sp.name),
@@ -1154,6 +1152,26 @@ impl PreparedFrame {
             .queue
             .write_buffer(&self.frame_uniform, 0, bytemuck::bytes_of(&f));
     }
+}
+
+/// The light-list buffer a culling pass writes, and a uniform with its layout, for a
+/// pass that reads `lists`.
+pub(super) fn list_buffers(
+    graph: &CompiledGraph,
+    resources: &FrameResources,
+    lists: &str,
+    size: FrameSize,
+    device: &wgpu::Device,
+) -> Result<(wgpu::Buffer, wgpu::Buffer), String> {
+    let (layout, tile, variant) = list_layout_for(graph, lists, size)
+        .ok_or_else(|| format!("no LightCulling pass writes '{lists}'"))?;
+    let buffer = resources
+        .buffer(&graph.plan, lists)
+        .ok_or_else(|| format!("'{lists}' is not planned"))?;
+    Ok((
+        buffer.clone(),
+        GpuListParams::new(&layout, tile, variant).buffer(device),
+    ))
 }
 
 /// One compute pass with one dispatch.

@@ -304,13 +304,21 @@ impl Renderer {
                 resource: inv.as_entire_binding(),
             },
         ];
-        let params;
-        if let Some(lists) = lists {
-            let (ll, tile, variant) = super::frame::list_layout_for(graph, lists, size).unwrap();
-            params = crate::gpu::structs::GpuListParams::new(&ll, tile, variant).buffer(&device);
+        let list_buffers = match lists {
+            Some(lists) => Some(
+                super::frame::list_buffers(graph, resources, lists, size, &device).map_err(
+                    |message| RenderError::Pass {
+                        pass: "light statistics".into(),
+                        message,
+                    },
+                )?,
+            ),
+            None => None,
+        };
+        if let Some((buf, params)) = &list_buffers {
             entries.push(wgpu::BindGroupEntry {
                 binding: 7,
-                resource: resources.buffer(plan, lists).unwrap().as_entire_binding(),
+                resource: buf.as_entire_binding(),
             });
             entries.push(wgpu::BindGroupEntry {
                 binding: 4,
