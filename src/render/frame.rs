@@ -626,15 +626,8 @@ impl Renderer {
                     }
                 }
                 PassKind::Compute { dispatch, .. } => {
-                    let composed = graph.checked.shaders[sp.index].as_ref().unwrap();
-                    let (pipeline, bind) = self.generic_compute(
-                        &graph,
-                        sp,
-                        composed,
-                        &resources,
-                        &frame_uniform,
-                        gpu,
-                    )?;
+                    let (pipeline, bind) =
+                        self.generic_compute(&graph, sp, &resources, &frame_uniform, gpu)?;
                     let groups = match *dispatch {
                         Dispatch::PerPixel { workgroup: (x, y) } => [
                             size.width.div_ceil(x.max(1)),
@@ -658,12 +651,10 @@ impl Renderer {
                     }
                 }
                 PassKind::Fullscreen { .. } => {
-                    let composed = graph.checked.shaders[sp.index].as_ref().unwrap();
                     let target = sp.roles.target.clone().unwrap();
                     let (pipeline, bind) = self.generic_fullscreen(
                         &graph,
                         sp,
-                        composed,
                         &resources,
                         &frame_uniform,
                         gpu,

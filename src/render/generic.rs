@@ -8,7 +8,6 @@ use super::scene_gpu::SceneGpu;
 use super::{RenderError, Renderer};
 use crate::gpu::structs::GpuFrame;
 use crate::graph::{CompiledGraph, FrameSize, ResourceDesc, SceneResource, ScheduledPass, Slot};
-use crate::shader::Composed;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
@@ -81,7 +80,6 @@ impl Renderer {
         &mut self,
         graph: &CompiledGraph,
         sp: &ScheduledPass,
-        composed: &Composed,
         resources: &FrameResources,
         frame_uniform: &wgpu::Buffer,
         gpu: &SceneGpu,
@@ -96,7 +94,6 @@ impl Renderer {
             virtual_code: BTreeMap::new(),
             state: format!("compute entry={entry}"),
         };
-        let _ = composed;
         let pipeline = self
             .pipelines
             .get_or_build(
@@ -123,12 +120,10 @@ impl Renderer {
         Ok((pipeline, bind))
     }
 
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn generic_fullscreen(
         &mut self,
         graph: &CompiledGraph,
         sp: &ScheduledPass,
-        composed: &Composed,
         resources: &FrameResources,
         frame_uniform: &wgpu::Buffer,
         gpu: &SceneGpu,
@@ -150,7 +145,6 @@ impl Renderer {
             })
             .unwrap();
         let device = self.ctx.device.clone();
-        let _ = composed;
         // The user's fragment shader, with the built-in full-screen triangle appended.
         let key = PipelineKey {
             shader: shader.clone(),
