@@ -12,6 +12,14 @@ if ! ls /usr/share/vulkan/icd.d/lvp_icd*.json /etc/vulkan/icd.d/lvp_icd*.json >/
     $SUDO apt-get update -qq
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq mesa-vulkan-drivers >/dev/null
 fi
-# Headless: no display server or runtime dir is needed.
+# The viewer's test opens a real window on a virtual X server.
+if ! command -v xvfb-run >/dev/null 2>&1; then
+    echo "no Xvfb found: installing xvfb (for the viewer's window test)"
+    SUDO=""
+    [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+    $SUDO apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq xvfb xauth >/dev/null
+fi
+# Headless tests need no display server; the runtime dir quiets winit and Mesa.
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp}"
 cargo test --release --all-targets

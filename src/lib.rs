@@ -12,6 +12,7 @@ pub mod reload;
 pub mod render;
 pub mod scene;
 pub mod shader;
+pub mod view;
 
 /// Where the project's shaders/, graphs/ and materials/ are: `LIGHTGRAPH_ROOT` if set,
 /// else the source tree the binary was built from, else the current directory (a

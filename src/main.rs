@@ -49,6 +49,9 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// A window onto a hot-reloading graph: fly/orbit camera, per-pass GPU times, light
+    /// statistics, reload errors and graph variants in an overlay.
+    View(ViewArgs),
     /// Check a layered material; with --wgsl print the WGSL generated for it.
     Material {
         file: PathBuf,
@@ -84,6 +87,32 @@ struct RenderArgs {
     /// Lights-per-tile heat map (PNG); a histogram CSV is written beside it.
     #[arg(long)]
     heatmap: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
+struct ViewArgs {
+    /// Scene: .ron, .gltf or .glb (default: the built-in atrium). Watched and reloaded.
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    /// Graph file (default: graphs/forward_plus.ron); the other graphs in its folder are
+    /// offered as variants.
+    #[arg(long)]
+    graph: Option<PathBuf>,
+    #[arg(long, default_value_t = 1280)]
+    width: u32,
+    #[arg(long, default_value_t = 720)]
+    height: u32,
+    /// Render size relative to the window (0.5 shades a quarter of the pixels).
+    #[arg(long, default_value_t = 1.0)]
+    scale: f32,
+    /// Exposure in stops.
+    #[arg(long, default_value_t = 0.0)]
+    exposure: f32,
+    /// Save what the window shows to this PNG after --frames frames, then exit.
+    #[arg(long)]
+    screenshot: Option<PathBuf>,
+    #[arg(long, default_value_t = 10)]
+    frames: u32,
 }
 
 fn project_path(rel: &str) -> PathBuf {
@@ -136,6 +165,7 @@ fn main() -> Result<()> {
             out,
         }) => watch(scene, graph, width, height, &out),
         Some(Command::Bench { sweep, out }) => run_bench(sweep.as_deref(), &out),
+        Some(Command::View(args)) => view(args),
     }
 }
 
@@ -440,4 +470,44 @@ fn watch(
             Err(e) => eprintln!("error (still showing the last good frame):\n{e}"),
         }
     }
+}
+
+fn view(args: ViewArgs) -> Result<()> {
+    use lightgraph::reload::SceneSource;
+    use lightgraph::view::{self, ViewOptions};
+    if !(args.scale > 0.0 && args.scale <= 4.0) {
+        bail!("--scale must be in (0, 4], got {}", args.scale);
+    }
+    let graph = args
+        .graph
+        .unwrap_or_else(|| project_path("graphs/forward_plus.ron"));
+    let folder = graph.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let mut variants: Vec<PathBuf> = std::fs::read_dir(&folder)
+        .with_context(|| format!("listing graph variants in {}", folder.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
+    variants.sort();
+    let (scene, scene_name) = match args.scene {
+        Some(p) => {
+            let name = p.display().to_string();
+            (SceneSource::File(p), name)
+        }
+        None => (
+            SceneSource::Fixed(Box::new(load_scene(None)?)),
+            "atrium (built-in)".to_string(),
+        ),
+    };
+    view::run(ViewOptions {
+        scene,
+        scene_name,
+        graph,
+        variants,
+        watch: vec![project_path("materials")],
+        window_size: [args.width, args.height],
+        render_scale: args.scale,
+        exposure_ev: args.exposure,
+        screenshot: args.screenshot.map(|p| (p, args.frames.max(1))),
+    })?;
+    Ok(())
 }

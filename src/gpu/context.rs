@@ -25,18 +25,28 @@ pub struct GpuContext {
 impl GpuContext {
     /// Opens the first adapter wgpu finds (Vulkan), without a window.
     pub fn new_headless() -> Result<Self, GpuError> {
-        pollster::block_on(Self::new_async())
-    }
-
-    async fn new_async() -> Result<Self, GpuError> {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
         desc.backends = wgpu::Backends::VULKAN;
-        let instance = wgpu::Instance::new(desc);
+        pollster::block_on(Self::open(&wgpu::Instance::new(desc), None))
+    }
+
+    /// Opens an adapter that can present to `surface` (the viewer's window).
+    pub fn for_surface(
+        instance: &wgpu::Instance,
+        surface: &wgpu::Surface<'_>,
+    ) -> Result<Self, GpuError> {
+        pollster::block_on(Self::open(instance, Some(surface)))
+    }
+
+    async fn open(
+        instance: &wgpu::Instance,
+        compatible_surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<Self, GpuError> {
         let adapter = instance
             .request_adapter(&wgpu::RequestAdapterOptions {
                 power_preference: wgpu::PowerPreference::HighPerformance,
                 force_fallback_adapter: false,
-                compatible_surface: None,
+                compatible_surface,
                 apply_limit_buckets: false,
             })
             .await

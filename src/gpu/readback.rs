@@ -52,8 +52,19 @@ pub fn read_rgba32f(
     queue: &wgpu::Queue,
     texture: &wgpu::Texture,
 ) -> Result<Vec<[f32; 4]>, GpuError> {
+    let bytes = read_texture(device, queue, texture, 16)?;
+    Ok(bytemuck::pod_collect_to_vec(&bytes))
+}
+
+/// Reads a single-sample 2D texture (COPY_SRC usage) of `texel` bytes per texel back
+/// as tightly packed rows.
+pub fn read_texture(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+    texel: u32,
+) -> Result<Vec<u8>, GpuError> {
     let (w, h) = (texture.width(), texture.height());
-    let texel = 16u32;
     let padded = (w * texel).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
         * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let size = padded as u64 * h as u64;
@@ -82,10 +93,9 @@ pub fn read_rgba32f(
     );
     queue.submit([encoder.finish()]);
     let bytes = map_and_copy(device, &staging, size as usize)?;
-    let mut out = Vec::with_capacity((w * h) as usize);
+    let mut out = Vec::with_capacity((w * h * texel) as usize);
     for row in bytes.chunks_exact(padded as usize) {
-        let texels: &[[f32; 4]] = bytemuck::cast_slice(&row[..(w * texel) as usize]);
-        out.extend_from_slice(texels);
+        out.extend_from_slice(&row[..(w * texel) as usize]);
     }
     Ok(out)
 }

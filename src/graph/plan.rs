@@ -244,7 +244,8 @@ fn describe(
             // Copies: readback of the output and of any texture a test inspects. Depth
             // is also sampled by the statistics pass.
             let mut usage = T::COPY_SRC;
-            if format.is_depth() {
+            // The viewer samples the output to draw it into its window.
+            if format.is_depth() || *name == desc.output {
                 usage |= T::TEXTURE_BINDING;
             }
             for &p in users {

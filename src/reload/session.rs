@@ -5,7 +5,7 @@
 
 use super::{FileWatcher, WatchConfig, WatchError};
 use crate::graph::{self, FrameSize};
-use crate::render::{FrameResult, Renderer, SceneGpu};
+use crate::render::{FrameResult, PreparedFrame, Renderer, SceneGpu};
 use crate::scene::{self, Scene};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -35,6 +35,8 @@ pub struct ReloadSession {
     watcher: FileWatcher,
     /// The last frame that rendered.
     pub frame: Option<FrameResult>,
+    /// The graph of the last good frame, ready to run again (the viewer executes it).
+    prepared: Option<PreparedFrame>,
     /// The current error, if the last reload failed.
     pub error: Option<String>,
 }
@@ -80,6 +82,7 @@ impl ReloadSession {
             height,
             watcher,
             frame: None,
+            prepared: None,
             error: None,
         };
         let first = session.render()?;
@@ -101,7 +104,62 @@ impl ReloadSession {
             .renderer
             .prepare(compiled, &self.scene, &self.gpu, size, stats)
             .map_err(|e| e.to_string())?;
-        prepared.render(&self.renderer).map_err(|e| e.to_string())
+        let frame = prepared.render(&self.renderer).map_err(|e| e.to_string())?;
+        self.prepared = Some(prepared);
+        Ok(frame)
+    }
+
+    /// The last good graph, prepared: execute it to draw another frame.
+    pub fn prepared(&self) -> Option<&PreparedFrame> {
+        self.prepared.as_ref()
+    }
+
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    pub fn graph_path(&self) -> &Path {
+        &self.graph_path
+    }
+
+    /// Reloads whatever changed since the last call, without waiting.
+    pub fn poll(&mut self) -> Option<Reload> {
+        self.wait(Duration::ZERO)
+    }
+
+    /// Switches to another graph file (a variant). On error the old graph keeps rendering.
+    pub fn set_graph(&mut self, path: &Path) -> Result<(), String> {
+        let old = std::mem::replace(&mut self.graph_path, path.to_path_buf());
+        match self.render() {
+            Ok(frame) => {
+                self.frame = Some(frame);
+                self.error = None;
+                self.watcher
+                    .watch(path)
+                    .map(|_| ())
+                    .map_err(|e| e.to_string())
+            }
+            Err(e) => {
+                self.graph_path = old;
+                Err(e)
+            }
+        }
+    }
+
+    /// Renders at a new size (the viewer's window was resized).
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<(), String> {
+        let old = (self.width, self.height);
+        (self.width, self.height) = (width.max(1), height.max(1));
+        match self.render() {
+            Ok(frame) => {
+                self.frame = Some(frame);
+                Ok(())
+            }
+            Err(e) => {
+                (self.width, self.height) = old;
+                Err(e)
+            }
+        }
     }
 
     /// Waits up to `timeout` for a change, then reloads what it touched. `None` if

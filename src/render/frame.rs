@@ -11,7 +11,8 @@ use crate::graph::{
     CompiledGraph, CullVariant, Dispatch, FrameSize, LightSource, ListLayout, PassKind,
     ResourceDesc, Slot, TextureFormat,
 };
-use crate::scene::{AlphaMode, Scene};
+use crate::scene::{AlphaMode, Camera, Scene};
+use glam::Vec3;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
@@ -1069,13 +1070,33 @@ impl PreparedFrame {
     /// Runs one frame and reads back the output, culling reports and statistics.
     pub fn render(&self, r: &Renderer) -> Result<FrameResult, RenderError> {
         let pass_ms = self.execute(r)?;
+        let image = read_rgba32f(&r.ctx.device, &r.ctx.queue, self.output_texture())?;
+        let (culling, light_stats) = self.read_reports(r)?;
+        Ok(FrameResult {
+            width: self.size.width,
+            height: self.size.height,
+            image,
+            pass_ms,
+            culling,
+            light_stats,
+        })
+    }
+
+    /// The graph's output texture (Rgba32Float; sampled by the viewer).
+    pub fn output_texture(&self) -> &wgpu::Texture {
+        self.resources
+            .texture(&self.graph.plan, self.graph.output())
+            .expect("validation makes the output a planned texture")
+    }
+
+    /// Reads back what the last executed frame's culling passes and statistics pass
+    /// counted (not the image).
+    pub fn read_reports(
+        &self,
+        r: &Renderer,
+    ) -> Result<(Vec<CullingReport>, Option<LightStats>), RenderError> {
         let device = &r.ctx.device;
         let plan = &self.graph.plan;
-        let image = read_rgba32f(
-            device,
-            &r.ctx.queue,
-            self.resources.texture(plan, self.graph.output()).unwrap(),
-        )?;
         let mut culling = Vec::new();
         for (name, exec) in &self.passes {
             if let PassExec::Culling { lists, .. } = exec {
@@ -1120,21 +1141,19 @@ impl PreparedFrame {
             }
             None => None,
         };
-        Ok(FrameResult {
-            width: self.size.width,
-            height: self.size.height,
-            image,
-            pass_ms,
-            culling,
-            light_stats,
-        })
+        Ok((culling, light_stats))
     }
 
     /// Moves the camera without re-preparing (benchmarks, the viewer).
     pub fn set_camera(&self, r: &Renderer, scene: &Scene, light_count: u32) {
+        self.set_view(r, &scene.camera, scene.ambient, light_count);
+    }
+
+    /// Writes the frame uniform for `camera`: the next `execute` renders from there.
+    pub fn set_view(&self, r: &Renderer, camera: &Camera, ambient: Vec3, light_count: u32) {
         let f = GpuFrame::new(
-            &scene.camera,
-            scene.ambient,
+            camera,
+            ambient,
             self.size.width,
             self.size.height,
             light_count,

@@ -1,0 +1,146 @@
+//! The viewer's overlay (egui): per-pass GPU times, light statistics, the current error,
+//! and the controls: graph variant, camera mode, exposure.
+
+use super::camera::CameraMode;
+use crate::render::{CullingReport, LightStats};
+use std::path::PathBuf;
+
+/// What the overlay shows; refreshed by the viewer.
+#[derive(Default)]
+pub struct FrameInfo {
+    pub adapter: String,
+    pub scene: String,
+    pub lights: usize,
+    pub render_size: [u32; 2],
+    /// Smoothed GPU milliseconds per pass; `None` without timestamp queries.
+    pub pass_ms: Option<Vec<(String, f64)>>,
+    /// Smoothed CPU milliseconds per displayed frame.
+    pub frame_ms: f64,
+    pub culling: Vec<CullingReport>,
+    pub light_stats: Option<LightStats>,
+    /// The error of the last reload (file:line), shown until a good save.
+    pub error: Option<String>,
+    /// The last successful reload, for example "lighting.wgsl: 85 ms".
+    pub last_reload: Option<String>,
+}
+
+/// A change the user asked for this frame.
+#[derive(Clone, Debug, PartialEq)]
+pub enum OverlayAction {
+    SelectGraph(PathBuf),
+    CameraMode(CameraMode),
+}
+
+pub struct Overlay {
+    /// Graph files offered as variants, with the one in use.
+    pub graphs: Vec<PathBuf>,
+    pub current_graph: PathBuf,
+    pub camera_mode: CameraMode,
+    pub exposure_ev: f32,
+    pub visible: bool,
+}
+
+fn graph_label(path: &std::path::Path) -> String {
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.display().to_string())
+}
+
+impl Overlay {
+    /// Draws the overlay and returns what the user changed.
+    pub fn ui(&mut self, ctx: &egui::Context, info: &FrameInfo) -> Vec<OverlayAction> {
+        let mut actions = Vec::new();
+        if !self.visible {
+            return actions;
+        }
+        egui::Window::new("lightgraph")
+            .default_pos([8.0, 8.0])
+            .default_width(300.0)
+            .show(ctx, |ui| {
+                ui.label(format!(
+                    "{} · {} lights · {}×{}",
+                    info.scene, info.lights, info.render_size[0], info.render_size[1]
+                ));
+                ui.label(format!("{} · {:.1} ms/frame", info.adapter, info.frame_ms));
+                if let Some(e) = &info.error {
+                    ui.separator();
+                    ui.colored_label(
+                        egui::Color32::from_rgb(255, 110, 110),
+                        "Reload failed; the last good version keeps rendering:",
+                    );
+                    ui.monospace(e);
+                } else if let Some(r) = &info.last_reload {
+                    ui.label(format!("reloaded: {r}"));
+                }
+                ui.separator();
+                self.pass_times(ui, info);
+                self.light_statistics(ui, info);
+                ui.separator();
+                self.controls(ui, &mut actions);
+                ui.small(
+                    "drag: rotate · wheel: zoom/speed · WASD QE: move · Tab: mode · F1: overlay",
+                );
+            });
+        actions
+    }
+
+    fn pass_times(&self, ui: &mut egui::Ui, info: &FrameInfo) {
+        match &info.pass_ms {
+            Some(passes) => {
+                egui::Grid::new("passes").striped(true).show(ui, |ui| {
+                    for (name, ms) in passes {
+                        ui.label(name);
+                        ui.monospace(format!("{ms:8.3} ms"));
+                        ui.end_row();
+                    }
+                    ui.strong("GPU total");
+                    let total: f64 = passes.iter().map(|p| p.1).sum();
+                    ui.monospace(format!("{total:8.3} ms"));
+                    ui.end_row();
+                });
+            }
+            None => {
+                ui.label("this adapter has no timestamp queries: no per-pass GPU times");
+            }
+        }
+    }
+
+    fn light_statistics(&self, ui: &mut egui::Ui, info: &FrameInfo) {
+        for c in &info.culling {
+            ui.label(format!(
+                "{}: longest list {} (capacity {}), {} lists overflowed",
+                c.pass, c.longest_list, c.layout.capacity, c.overflowed_lists
+            ));
+        }
+        if let Some(s) = &info.light_stats {
+            ui.label(format!(
+                "lights per pixel: listed {:.2}, reaching {:.2} (listed/exact {:.2}); max listed {}",
+                s.avg_listed(),
+                s.avg_exact(),
+                s.false_positive_ratio(),
+                s.max_listed
+            ));
+        }
+    }
+
+    fn controls(&mut self, ui: &mut egui::Ui, actions: &mut Vec<OverlayAction>) {
+        ui.label("graph variant");
+        for g in &self.graphs {
+            if ui.radio(*g == self.current_graph, graph_label(g)).clicked()
+                && *g != self.current_graph
+            {
+                actions.push(OverlayAction::SelectGraph(g.clone()));
+            }
+        }
+        ui.horizontal(|ui| {
+            ui.label("camera");
+            for (mode, label) in [(CameraMode::Orbit, "orbit"), (CameraMode::Fly, "fly")] {
+                if ui.radio(self.camera_mode == mode, label).clicked() && self.camera_mode != mode {
+                    self.camera_mode = mode;
+                    actions.push(OverlayAction::CameraMode(mode));
+                }
+            }
+        });
+        ui.add(egui::Slider::new(&mut self.exposure_ev, -10.0..=10.0).text("exposure (EV)"));
+    }
+}
