@@ -1,5 +1,5 @@
 //! Whole-scene renders checked by pixel values: the analytic sphere (exact radiance) and
-//! the Cornell box glTF from ../shared/assets (red and green walls, lit interior).
+//! the Cornell box glTF in scenes/cornell_box (copied from the shared assets) (red and green walls, lit interior).
 
 mod common;
 use common::*;
@@ -100,7 +100,7 @@ fn analytic_sphere_has_radiance_one_half() {
 }
 
 fn cornell_path() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/cornell_box/scene.gltf")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_box/scene.gltf")
 }
 
 #[test]
