@@ -264,6 +264,8 @@ fn tiled_deferred_matches_forward_brute_force() {
         "deferred_brute_force.ron",
         "tiled_deferred.ron",
         "tiled_deferred_depth_mask.ron",
+        // The G-buffer tests against the prepass's depth instead of writing its own.
+        "tiled_deferred_prepass.ron",
     ] {
         let out = render_file(&mut r, graph, &scene, W, H);
         let mut worst = 0.0f32;

@@ -273,7 +273,7 @@ impl RoleCtx<'_> {
                 need(
                     &roles,
                     Slot::Depth,
-                    "a depth texture in writes",
+                    "a depth texture (in writes, or in reads after a depth prepass)",
                     &mut errors,
                 );
                 need(

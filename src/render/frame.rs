@@ -39,6 +39,8 @@ enum PassExec {
     },
     GBuffer {
         depth: String,
+        /// False after a depth prepass: load its depth and only test against it.
+        clear_depth: bool,
         positions: String,
         normals: String,
         draws: Vec<Draw>,
@@ -427,6 +429,9 @@ impl Renderer {
                 }
                 PassKind::GBuffer => {
                     let depth = sp.roles.slot(Slot::Depth).unwrap().to_string();
+                    // After a depth prepass the G-buffer only tests depth: each pixel is
+                    // written once instead of once per overlapping surface.
+                    let writes_depth = graph.checked.desc.passes[sp.index].writes.contains(&depth);
                     let layout = forward_layout(false);
                     let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
                         label: Some(&sp.name),
@@ -438,9 +443,10 @@ impl Renderer {
                         ],
                     });
                     let draws =
-                        self.material_draws(gpu, &layout, None, 1, DrawMode::GBuffer, &sp.name)?;
+                        self.material_draws(gpu, &layout, None, 1, DrawMode::GBuffer { writes_depth }, &sp.name)?;
                     PassExec::GBuffer {
                         depth,
+                        clear_depth: writes_depth,
                         positions: sp.roles.slot(Slot::GPosition).unwrap().to_string(),
                         normals: sp.roles.slot(Slot::GNormal).unwrap().to_string(),
                         draws,
@@ -738,8 +744,12 @@ impl Renderer {
         pass: &str,
     ) -> Result<Vec<Draw>, RenderError> {
         let depth_only = mode == DrawMode::DepthOnly;
-        let gbuffer = mode == DrawMode::GBuffer;
-        let writes_depth = mode != DrawMode::Shade;
+        let gbuffer = matches!(mode, DrawMode::GBuffer { .. });
+        let writes_depth = match mode {
+            DrawMode::DepthOnly => true,
+            DrawMode::GBuffer { writes_depth } => writes_depth,
+            DrawMode::Shade => false,
+        };
         let device = self.ctx.device.clone();
         let mut draws = Vec::new();
         for mesh in gpu.opaque_draws() {
@@ -785,7 +795,7 @@ impl Renderer {
                     |_, module| {
                         let fragment_entry = match mode {
                             DrawMode::DepthOnly => "fs_depth",
-                            DrawMode::GBuffer => "fs_gbuffer",
+                            DrawMode::GBuffer { .. } => "fs_gbuffer",
                             DrawMode::Shade => "fs_main",
                         };
                         let target = Some(wgpu::ColorTargetState {
@@ -800,7 +810,7 @@ impl Renderer {
                             compilation_options: Default::default(),
                             targets: match mode {
                                 DrawMode::DepthOnly => &[],
-                                DrawMode::GBuffer => &targets,
+                                DrawMode::GBuffer { .. } => &targets,
                                 DrawMode::Shade => &targets[..1],
                             },
                         });
@@ -961,6 +971,7 @@ impl PreparedFrame {
                 } => dispatch(&mut encoder, name, compute_ts, pipeline, bind, *groups),
                 PassExec::GBuffer {
                     depth,
+                    clear_depth,
                     positions,
                     normals,
                     draws,
@@ -988,7 +999,7 @@ impl PreparedFrame {
                             Some(clear(self.resources.view(plan, positions).unwrap())),
                             Some(clear(self.resources.view(plan, normals).unwrap())),
                         ],
-                        depth_stencil_attachment: Some(depth_attachment(dview, true)),
+                        depth_stencil_attachment: Some(depth_attachment(dview, *clear_depth)),
                         timestamp_writes: render_ts,
                         occlusion_query_set: None,
                         multiview_mask: None,
@@ -1259,7 +1270,7 @@ fn draw_meshes(pass: &mut wgpu::RenderPass<'_>, bind: &wgpu::BindGroup, draws: &
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum DrawMode {
     DepthOnly,
-    GBuffer,
+    GBuffer { writes_depth: bool },
     Shade,
 }
 
