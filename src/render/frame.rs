@@ -442,8 +442,14 @@ impl Renderer {
                             entry(2, &gpu.light_properties),
                         ],
                     });
-                    let draws =
-                        self.material_draws(gpu, &layout, None, 1, DrawMode::GBuffer { writes_depth }, &sp.name)?;
+                    let draws = self.material_draws(
+                        gpu,
+                        &layout,
+                        None,
+                        1,
+                        DrawMode::GBuffer { writes_depth },
+                        &sp.name,
+                    )?;
                     PassExec::GBuffer {
                         depth,
                         clear_depth: writes_depth,

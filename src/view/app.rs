@@ -391,7 +391,7 @@ impl Viewer {
             scene.lights.len() as u32,
         );
         let result = prepared.execute(&session.renderer);
-        if self.frames % REPORT_EVERY == 0 {
+        if self.frames.is_multiple_of(REPORT_EVERY) {
             if let Ok((culling, stats)) = prepared.read_reports(&session.renderer) {
                 self.info.culling = culling;
                 self.info.light_stats = stats;

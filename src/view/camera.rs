@@ -69,7 +69,7 @@ impl CameraController {
             distance,
             // Cross the orbit distance in about two seconds.
             speed: distance * 0.5,
-            lens: camera.clone(),
+            lens: *camera,
         }
     }
 
@@ -87,7 +87,7 @@ impl CameraController {
             eye: self.eye(),
             target: self.target,
             up: Vec3::Y,
-            ..self.lens.clone()
+            ..self.lens
         }
     }
 
