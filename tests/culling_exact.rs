@@ -18,12 +18,16 @@ const TILES: [u32; 2] = [8, 16];
 const W: u32 = 333;
 const H: u32 = 197;
 
-fn graph_text(tile: u32, variant: &str, capacity: u32) -> String {
+/// `coarse: None` keeps the default coarse stage (4×4 tiles).
+fn graph_text(tile: u32, variant: &str, capacity: u32, coarse: Option<u32>) -> String {
+    let coarse = coarse.map(|c| format!(", coarse: {c}")).unwrap_or_default();
     std::fs::read_to_string(graph_path("forward_plus.ron"))
         .unwrap()
         .replace(
             "LightCulling(tile: 16, variant: Frustum, capacity: 256)",
-            &format!("LightCulling(tile: {tile}, variant: {variant}, capacity: {capacity})"),
+            &format!(
+                "LightCulling(tile: {tile}, variant: {variant}, capacity: {capacity}{coarse})"
+            ),
         )
 }
 
@@ -67,8 +71,41 @@ fn check_scene(scene: &Scene, expect_lit: bool) {
             } else {
                 1024
             };
-            let out = render_text(&mut r, &graph_text(tile, variant, capacity), scene, W, H);
+            let out = render_text(
+                &mut r,
+                &graph_text(tile, variant, capacity, None),
+                scene,
+                W,
+                H,
+            );
             let c = &out.culling[0];
+            // The coarse stage only narrows the candidates: no list grows, and the lights
+            // it drops reach no pixel of their tile, so the image is the same to the bit.
+            // (Lists may shrink: a spot's cone can meet a tile's bounding sphere outside
+            // the tile yet miss the coarse tile's sphere.)
+            let direct = render_text(
+                &mut r,
+                &graph_text(tile, variant, capacity, Some(0)),
+                scene,
+                W,
+                H,
+            );
+            let grew = c
+                .counts
+                .iter()
+                .zip(&direct.culling[0].counts)
+                .filter(|(with, without)| with > without)
+                .count();
+            assert_eq!(
+                grew, 0,
+                "{} tile {tile} {variant}: the coarse stage grew {grew} lists",
+                scene.name
+            );
+            assert!(
+                out.image == direct.image,
+                "{} tile {tile} {variant}: the coarse stage changed the image",
+                scene.name
+            );
             assert_eq!(
                 c.overflowed_lists, 0,
                 "{}: capacity {capacity} overflowed",
@@ -235,7 +272,7 @@ fn over_a_thousand_lights() {
 fn overflow_is_counted_and_reported() {
     let mut r = renderer();
     let scene = random_scene(400, 2);
-    let out = render_text(&mut r, &graph_text(16, "Frustum", 4), &scene, 160, 96);
+    let out = render_text(&mut r, &graph_text(16, "Frustum", 4, None), &scene, 160, 96);
     let c = &out.culling[0];
     assert!(
         c.overflowed_lists > 0,

@@ -3,7 +3,12 @@
 // non-negative, so their bits order like integers), tests every light against the
 // tile's frustum, builds the list in workgroup memory in ascending light order, then
 // reserves room in the shared pool with one global atomic.
-// Defines: TILE (8 or 16), CAPACITY, VARIANT (see types.wgsl).
+// With COARSE > 1 a first dispatch (`coarse`) culls every light against coarse tiles of
+// COARSE×COARSE tiles; each tile then tests only its coarse tile's lights. Reading every
+// light in every tile is what bounds culling at high light counts (memory traffic).
+// The coarse test is the same conservative test on a larger frustum and depth range,
+// so the tiles' lists are exactly those without it.
+// Defines: TILE (8 or 16), CAPACITY, VARIANT (see types.wgsl), COARSE, COARSE_CAPACITY.
 
 #include "common/types.wgsl"
 
@@ -12,6 +17,9 @@
 @group(0) @binding(2) var depth: texture_depth_2d;
 @group(0) @binding(3) var<storage, read_write> light_lists: array<atomic<u32>>;
 @group(0) @binding(4) var<uniform> list_params: ListParams;
+// Per coarse tile: its light count, then up to COARSE_CAPACITY light indices ascending.
+// A count over the capacity sends its tiles back to testing every light.
+@group(0) @binding(5) var<storage, read_write> coarse_lists: array<u32>;
 
 const THREADS: u32 = TILE * TILE;
 const MASK_WORDS: u32 = THREADS / 32u;
@@ -24,6 +32,12 @@ var<workgroup> hits: array<atomic<u32>, MASK_WORDS>;
 var<workgroup> list: array<u32, CAPACITY>;
 var<workgroup> list_len: u32;
 var<workgroup> pool_base: u32;
+var<workgroup> coarse_count: u32;
+
+const COARSE_STRIDE: u32 = COARSE_CAPACITY + 1u;
+// 1e-4 of the distance: a thousand times the rounding it covers, and still far below
+// a tile's width at any distance (a 64-pixel coarse tile spans ~5e-2 of it at 60°).
+const COARSE_REACH: f32 = 1e-4;
 
 // Positive view-space distance along -z of a depth-buffer value.
 fn view_depth(d: f32) -> f32 {
@@ -104,76 +118,52 @@ fn main(
         atomicOr(&depth_mask, 1u << cell_of(z, tile_min, tile_max));
     }
 
-    // 3. Side planes through the eye and the tile's edges (normals point inwards).
-    let size = vec2<f32>(frame.size);
-    let x0 = f32(group.x * TILE);
-    let y0 = f32(group.y * TILE);
-    let x1 = min(x0 + f32(TILE), size.x);
-    let y1 = min(y0 + f32(TILE), size.y);
-    let c00 = view_ray(vec2<f32>(x0, y0));
-    let c10 = view_ray(vec2<f32>(x1, y0));
-    let c11 = view_ray(vec2<f32>(x1, y1));
-    let c01 = view_ray(vec2<f32>(x0, y1));
-    let planes = array<vec3<f32>, 4>(
-        normalize(cross(c00, c10)),
-        normalize(cross(c10, c11)),
-        normalize(cross(c11, c01)),
-        normalize(cross(c01, c00)),
-    );
-    // Bounding sphere of the tile's frustum slice [lo, hi], for the cone test.
-    var tile_center = vec3<f32>(0.0);
-    var tile_radius = 0.0;
-    if (!empty) {
-        var corners: array<vec3<f32>, 8>;
-        let rays = array<vec3<f32>, 4>(c00, c10, c11, c01);
-        for (var i = 0u; i < 4u; i++) {
-            corners[i] = rays[i] * (lo / -rays[i].z);
-            corners[i + 4u] = rays[i] * (hi / -rays[i].z);
-            tile_center += corners[i] + corners[i + 4u];
-        }
-        tile_center /= 8.0;
-        for (var i = 0u; i < 8u; i++) {
-            tile_radius = max(tile_radius, distance(tile_center, corners[i]));
-        }
-    }
+    // 3. Side planes and bounding sphere of the tile's frustum slice.
+    let bounds = tile_bounds(group.xy * TILE, TILE, lo, hi, empty);
     workgroupBarrier();
     let tile_mask = atomicLoad(&depth_mask);
 
-    // 4. Lights in batches of THREADS; ranks within a batch from a bit mask keep the
-    //    list in ascending light order.
-    let count = frame.light_count;
+    // 4. Candidates: the coarse tile's lights, or every light. In batches of THREADS;
+    //    ranks within a batch from a bit mask keep the list in ascending light order.
+    var count = frame.light_count;
+    var coarse_base = 0u;
+    var from_coarse = false;
+    if (COARSE > 1u) {
+        let coarse_x = (list_params.tiles_x + COARSE - 1u) / COARSE;
+        coarse_base = ((group.y / COARSE) * coarse_x + group.x / COARSE) * COARSE_STRIDE;
+        if (local == 0u) {
+            coarse_count = coarse_lists[coarse_base];
+        }
+        let n = workgroupUniformLoad(&coarse_count);
+        if (n <= COARSE_CAPACITY) {
+            count = n;
+            from_coarse = true;
+        }
+    }
     var total = 0u;
     for (var base = 0u; base < count; base += THREADS) {
         if (local < MASK_WORDS) {
             atomicStore(&hits[local], 0u);
         }
         workgroupBarrier();
-        let i = base + local;
+        let k = base + local;
+        var i = k;
         var hit = false;
-        if (!empty && i < count) {
-            hit = light_touches_tile(light_geometry[i], planes, lo, hi, tile_center, tile_radius, tile_mask, tile_min, tile_max);
+        if (!empty && k < count) {
+            if (from_coarse) {
+                i = coarse_lists[coarse_base + 1u + k];
+            }
+            hit = light_touches_tile(light_geometry[i], bounds, lo, hi, tile_mask, tile_min, tile_max, 0.0);
         }
         if (hit) {
             atomicOr(&hits[local / 32u], 1u << (local % 32u));
         }
         workgroupBarrier();
-        if (hit) {
-            var rank = 0u;
-            let word = local / 32u;
-            for (var w = 0u; w < word; w++) {
-                rank += countOneBits(atomicLoad(&hits[w]));
-            }
-            rank += countOneBits(atomicLoad(&hits[word]) & ((1u << (local % 32u)) - 1u));
-            let slot = total + rank;
-            if (slot < CAPACITY) {
-                list[slot] = i;
-            }
+        let slot = total + rank_in_batch(local);
+        if (hit && slot < CAPACITY) {
+            list[slot] = i;
         }
-        var batch = 0u;
-        for (var w = 0u; w < MASK_WORDS; w++) {
-            batch += countOneBits(atomicLoad(&hits[w]));
-        }
-        total += batch;
+        total += hits_in_batch();
         workgroupBarrier();
     }
 
@@ -199,17 +189,80 @@ fn main(
     }
 }
 
+// Side planes through the eye and a (coarse) tile's edges, normals pointing inwards, and
+// the bounding sphere of its frustum slice [lo, hi] (for the cone test).
+struct TileBounds {
+    planes: array<vec3<f32>, 4>,
+    center: vec3<f32>,
+    radius: f32,
+}
+
+fn tile_bounds(origin: vec2<u32>, span: u32, lo: f32, hi: f32, empty: bool) -> TileBounds {
+    let size = vec2<f32>(frame.size);
+    let x0 = f32(origin.x);
+    let y0 = f32(origin.y);
+    let x1 = min(x0 + f32(span), size.x);
+    let y1 = min(y0 + f32(span), size.y);
+    let c00 = view_ray(vec2<f32>(x0, y0));
+    let c10 = view_ray(vec2<f32>(x1, y0));
+    let c11 = view_ray(vec2<f32>(x1, y1));
+    let c01 = view_ray(vec2<f32>(x0, y1));
+    var b: TileBounds;
+    b.planes = array<vec3<f32>, 4>(
+        normalize(cross(c00, c10)),
+        normalize(cross(c10, c11)),
+        normalize(cross(c11, c01)),
+        normalize(cross(c01, c00)),
+    );
+    b.center = vec3<f32>(0.0);
+    b.radius = 0.0;
+    if (!empty) {
+        var corners: array<vec3<f32>, 8>;
+        let rays = array<vec3<f32>, 4>(c00, c10, c11, c01);
+        for (var i = 0u; i < 4u; i++) {
+            corners[i] = rays[i] * (lo / -rays[i].z);
+            corners[i + 4u] = rays[i] * (hi / -rays[i].z);
+            b.center += corners[i] + corners[i + 4u];
+        }
+        b.center /= 8.0;
+        for (var i = 0u; i < 8u; i++) {
+            b.radius = max(b.radius, distance(b.center, corners[i]));
+        }
+    }
+    return b;
+}
+
+// How many lights before this invocation's in the batch hit (its place in the list).
+fn rank_in_batch(local: u32) -> u32 {
+    var rank = 0u;
+    let word = local / 32u;
+    for (var w = 0u; w < word; w++) {
+        rank += countOneBits(atomicLoad(&hits[w]));
+    }
+    return rank + countOneBits(atomicLoad(&hits[word]) & ((1u << (local % 32u)) - 1u));
+}
+
+fn hits_in_batch() -> u32 {
+    var n = 0u;
+    for (var w = 0u; w < MASK_WORDS; w++) {
+        n += countOneBits(atomicLoad(&hits[w]));
+    }
+    return n;
+}
+
 // Conservative: a light that reaches any point of the tile between lo and hi is kept.
+// `reach` widens every test by that fraction of the light's distance from the eye: the
+// coarse stage's planes are the same planes as its tiles' edges, but computed from other
+// corners, so they round differently (about 1e-7 of the distance).
 fn light_touches_tile(
     g: LightGeometry,
-    planes: array<vec3<f32>, 4>,
+    bounds: TileBounds,
     lo: f32,
     hi: f32,
-    tile_center: vec3<f32>,
-    tile_radius: f32,
     tile_mask: u32,
     tile_min: f32,
     tile_max: f32,
+    reach: f32,
 ) -> bool {
     let pos = (frame.view * vec4<f32>(g.position, 1.0)).xyz;
     let dir = (frame.view * vec4<f32>(g.direction, 0.0)).xyz;
@@ -230,13 +283,14 @@ fn light_touches_tile(
         }
     }
     // Float slack so rounding never culls a light that touches the boundary.
-    radius = radius * 1.0001 + 1e-5;
+    let widen = reach * length(center);
+    radius = radius * 1.0001 + 1e-5 + widen;
     let z = -center.z;
     if (z + radius < lo || z - radius > hi) {
         return false;
     }
     for (var p = 0u; p < 4u; p++) {
-        if (dot(planes[p], center) < -radius) {
+        if (dot(bounds.planes[p], center) < -radius) {
             return false;
         }
     }
@@ -249,16 +303,82 @@ fn light_touches_tile(
     }
     if (is_spot) {
         // Cone against the tile's bounding sphere.
-        let v = tile_center - pos;
+        let v = bounds.center - pos;
         let v_len_sq = dot(v, v);
         let v1 = dot(v, dir);
         let c = g.cos_outer;
         let s = sqrt(max(1.0 - c * c, 0.0));
         let closest = c * sqrt(max(v_len_sq - v1 * v1, 0.0)) - v1 * s;
-        let r = tile_radius * 1.0001 + 1e-5;
+        let r = bounds.radius * 1.0001 + 1e-5 + reach * length(bounds.center);
         if (closest > r || v1 > r + g.range || v1 < -r) {
             return false;
         }
     }
     return true;
+}
+
+// The coarse stage: one workgroup per coarse tile of COARSE×COARSE tiles; each
+// invocation covers COARSE×COARSE pixels for the depth range. No depth mask: every
+// fine tile applies its own.
+@compute @workgroup_size(TILE, TILE, 1)
+fn coarse(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+    @builtin(local_invocation_id) lid: vec3<u32>,
+) {
+    if (local == 0u) {
+        atomicStore(&z_min_bits, FAR_BITS);
+        atomicStore(&z_max_bits, 0u);
+    }
+    workgroupBarrier();
+    let span = TILE * COARSE;
+    let origin = group.xy * span;
+    for (var dy = 0u; dy < COARSE; dy++) {
+        for (var dx = 0u; dx < COARSE; dx++) {
+            let pixel = origin + lid.xy * COARSE + vec2<u32>(dx, dy);
+            if (all(pixel < frame.size)) {
+                let d = textureLoad(depth, pixel, 0);
+                if (d < 1.0) {
+                    let z = view_depth(d);
+                    atomicMin(&z_min_bits, bitcast<u32>(z));
+                    atomicMax(&z_max_bits, bitcast<u32>(z));
+                }
+            }
+        }
+    }
+    workgroupBarrier();
+    let lo = bitcast<f32>(atomicLoad(&z_min_bits));
+    let hi = bitcast<f32>(atomicLoad(&z_max_bits));
+    let empty = atomicLoad(&z_max_bits) == 0u;
+    let bounds = tile_bounds(origin, span, lo, hi, empty);
+    let coarse_x = (list_params.tiles_x + COARSE - 1u) / COARSE;
+    let base_word = (group.y * coarse_x + group.x) * COARSE_STRIDE;
+
+    let count = frame.light_count;
+    var total = 0u;
+    for (var base = 0u; base < count; base += THREADS) {
+        if (local < MASK_WORDS) {
+            atomicStore(&hits[local], 0u);
+        }
+        workgroupBarrier();
+        let i = base + local;
+        var hit = false;
+        if (!empty && i < count) {
+            // An all-ones mask: the depth-mask test passes here.
+            hit = light_touches_tile(light_geometry[i], bounds, lo, hi, 0xffffffffu, lo, hi, COARSE_REACH);
+        }
+        if (hit) {
+            atomicOr(&hits[local / 32u], 1u << (local % 32u));
+        }
+        workgroupBarrier();
+        let slot = total + rank_in_batch(local);
+        if (hit && slot < COARSE_CAPACITY) {
+            coarse_lists[base_word + 1u + slot] = i;
+        }
+        total += hits_in_batch();
+        workgroupBarrier();
+    }
+    if (local == 0u) {
+        coarse_lists[base_word] = total;
+    }
 }

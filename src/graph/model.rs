@@ -210,6 +210,10 @@ pub enum PassKind {
         /// Most lights a tile (or a half, or a cluster) can list.
         #[serde(default = "default_capacity")]
         capacity: u32,
+        /// Tiles per side of a coarse tile culled first: fine tiles then test only
+        /// their coarse tile's lights instead of every light. 0 or 1 turns it off.
+        #[serde(default = "default_coarse")]
+        coarse: u32,
     },
     /// Forward shading of the scene's materials through the light loop.
     ForwardShading {
@@ -242,6 +246,9 @@ pub enum PassKind {
 
 fn default_capacity() -> u32 {
     256
+}
+fn default_coarse() -> u32 {
+    4
 }
 fn default_entry() -> String {
     "main".into()

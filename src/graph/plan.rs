@@ -133,6 +133,7 @@ fn buffer_bytes(name: &str, size: BufferSize, desc: &GraphDesc, frame: FrameSize
                     tile,
                     variant,
                     capacity,
+                    ..
                 } if p.writes.iter().any(|w| w == name) => Some(
                     ListLayout::new(tile, variant, capacity, frame.width, frame.height).bytes(),
                 ),

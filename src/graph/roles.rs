@@ -200,6 +200,7 @@ impl RoleCtx<'_> {
                 tile,
                 variant,
                 capacity,
+                coarse,
             } => {
                 need(&roles, Slot::Depth, "a depth texture in reads", &mut errors);
                 need(
@@ -236,6 +237,9 @@ impl RoleCtx<'_> {
                 }
                 if *capacity == 0 || *capacity > 4096 {
                     errors.push(self.bad(pass, format!("capacity {capacity} must be in 1..=4096")));
+                }
+                if *coarse > 16 {
+                    errors.push(self.bad(pass, format!("coarse {coarse} must be in 0..=16 tiles per side (0 or 1: no coarse stage)")));
                 }
                 if let super::model::CullVariant::Clustered { slices } = variant {
                     if *slices == 0 || *slices > 64 {

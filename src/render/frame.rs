@@ -25,6 +25,8 @@ enum PassExec {
         bind: wgpu::BindGroup,
     },
     Culling {
+        /// The coarse stage, run first in the same pass.
+        coarse: Option<(Arc<wgpu::ComputePipeline>, [u32; 3])>,
         pipeline: Arc<wgpu::ComputePipeline>,
         bind: wgpu::BindGroup,
         groups: [u32; 3],
@@ -133,6 +135,10 @@ pub struct PreparedFrame {
     stats: Option<(Arc<wgpu::ComputePipeline>, wgpu::BindGroup, wgpu::Buffer)>,
 }
 
+/// Most lights a coarse culling tile lists; a tile with more sends its fine tiles back
+/// to testing every light.
+const COARSE_CAPACITY: u64 = 8192;
+
 /// A pipeline and its bind group.
 pub(super) type PassExecParts<P> = (Arc<P>, wgpu::BindGroup);
 
@@ -206,6 +212,7 @@ pub(super) fn list_layout_for(
             tile,
             variant,
             capacity,
+            ..
         } if p.writes.iter().any(|w| w == lists) => Some((
             ListLayout::new(tile, variant, capacity, size.width, size.height),
             tile,
@@ -344,6 +351,7 @@ impl Renderer {
                     tile,
                     variant,
                     capacity,
+                    coarse,
                 } => {
                     let lists = sp.roles.slot(Slot::LightLists).unwrap().to_string();
                     let depth = sp.roles.slot(Slot::Depth).unwrap();
@@ -360,7 +368,27 @@ impl Renderer {
                             depth_entry(2),
                             storage_entry(3, compute, false),
                             uniform_entry(4, compute),
+                            storage_entry(5, compute, false),
                         ],
+                    });
+                    let coarse = (*coarse).max(1);
+                    let coarse_groups = [
+                        layout.tiles_x.div_ceil(coarse),
+                        layout.tiles_y.div_ceil(coarse),
+                        1,
+                    ];
+                    // Each coarse tile: a count and up to COARSE_CAPACITY indices (a
+                    // single unused word without a coarse stage).
+                    let coarse_words = if coarse > 1 {
+                        coarse_groups[0] as u64 * coarse_groups[1] as u64 * (COARSE_CAPACITY + 1)
+                    } else {
+                        1
+                    };
+                    let coarse_lists = device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("coarse light lists"),
+                        size: coarse_words * 4,
+                        usage: wgpu::BufferUsages::STORAGE,
+                        mapped_at_creation: false,
                     });
                     let key = PipelineKey {
                         shader: "cull/tiled.wgsl".into(),
@@ -368,6 +396,8 @@ impl Renderer {
                             ("TILE", format!("{tile}u")),
                             ("CAPACITY", format!("{capacity}u")),
                             ("VARIANT", format!("{}u", variant_code(*variant))),
+                            ("COARSE", format!("{coarse}u")),
+                            ("COARSE_CAPACITY", format!("{COARSE_CAPACITY}u")),
                         ]),
                         virtual_code: BTreeMap::new(),
                         state: String::new(),
@@ -377,28 +407,35 @@ impl Renderer {
                         bind_group_layouts: &[Some(&bgl)],
                         immediate_size: 0,
                     });
-                    let pipeline = self
-                        .pipelines
-                        .get_or_build(
-                            &self.shaders,
-                            key,
-                            |_, module| {
-                                Pipeline::compute(
-                                    &device,
-                                    "light culling",
-                                    Some(&pl),
-                                    &module,
-                                    "main",
-                                )
-                            },
-                            &device,
-                        )
-                        .map_err(|source| RenderError::Shader {
-                            pass: sp.name.clone(),
-                            source,
-                        })?;
-                    let Pipeline::Compute(pipeline) = pipeline else {
-                        unreachable!()
+                    let mut build = |entry: &str, state: &str| {
+                        let key = PipelineKey {
+                            state: state.to_string(),
+                            ..key.clone()
+                        };
+                        let pipeline = self
+                            .pipelines
+                            .get_or_build(
+                                &self.shaders,
+                                key,
+                                |_, module| {
+                                    Pipeline::compute(&device, entry, Some(&pl), &module, entry)
+                                },
+                                &device,
+                            )
+                            .map_err(|source| RenderError::Shader {
+                                pass: sp.name.clone(),
+                                source,
+                            })?;
+                        let Pipeline::Compute(pipeline) = pipeline else {
+                            unreachable!("built as a compute pipeline")
+                        };
+                        Ok::<_, RenderError>(pipeline)
+                    };
+                    let pipeline = build("main", "")?;
+                    let coarse_stage = if coarse > 1 {
+                        Some((build("coarse", "coarse")?, coarse_groups))
+                    } else {
+                        None
                     };
                     let depth_view = resources
                         .view(&graph.plan, depth)
@@ -418,9 +455,11 @@ impl Renderer {
                             },
                             entry(3, list_buf),
                             entry(4, &params),
+                            entry(5, &coarse_lists),
                         ],
                     });
                     PassExec::Culling {
+                        coarse: coarse_stage,
                         pipeline,
                         bind,
                         groups: [layout.tiles_x, layout.tiles_y, layout.lists_per_tile],
@@ -961,6 +1000,7 @@ impl PreparedFrame {
                     draw_meshes(&mut pass, bind, draws);
                 }
                 PassExec::Culling {
+                    coarse,
                     pipeline,
                     bind,
                     groups,
@@ -968,7 +1008,18 @@ impl PreparedFrame {
                 } => {
                     // Header words (pool cursor and overflow counters) start at zero.
                     encoder.clear_buffer(self.resources.buffer(plan, lists).unwrap(), 0, Some(16));
-                    dispatch(&mut encoder, name, compute_ts, pipeline, bind, *groups);
+                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some(name),
+                        timestamp_writes: compute_ts,
+                    });
+                    pass.set_bind_group(0, bind, &[]);
+                    if let Some((coarse_pipeline, coarse_groups)) = coarse {
+                        pass.set_pipeline(coarse_pipeline);
+                        let [x, y, z] = *coarse_groups;
+                        pass.dispatch_workgroups(x, y, z);
+                    }
+                    pass.set_pipeline(pipeline);
+                    pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
                 }
                 PassExec::Compute {
                     pipeline,
