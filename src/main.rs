@@ -383,7 +383,7 @@ fn point_summary(row: &bench::BenchRow) -> String {
     let time = match row.frame_ms {
         Some(t) => format!("{:.3} ms (p10 {:.3}, p90 {:.3})", t.median, t.p10, t.p90),
         None => format!(
-            "no GPU time ({})",
+            "no GPU time: {}",
             row.untimed.as_deref().unwrap_or("not measured")
         ),
     };
