@@ -372,7 +372,7 @@ fn run_bench(sweep: Option<&Path>, out: &Path) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| out.display().to_string())?;
     let files = bench::write_report(out, &rows)?;
     if let Some(reason) = &files.plots_skipped {
-        println!("time plots not drawn: {reason}");
+        println!("time plots not drawn: no GPU times ({reason})");
     }
     println!("wrote {}", files.markdown.display());
     Ok(())

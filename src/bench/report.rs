@@ -308,7 +308,7 @@ pub fn untimed_reason(rows: &[BenchRow]) -> Option<String> {
         .collect();
     reasons.sort_unstable();
     reasons.dedup();
-    Some(format!("no GPU times: {}", reasons.join("; ")))
+    Some(reasons.join("; "))
 }
 
 fn md_cell(s: &str) -> String {
@@ -363,7 +363,7 @@ pub fn to_markdown(rows: &[BenchRow]) -> String {
     if let Some(reason) = untimed_reason(rows).filter(|_| !rows.is_empty()) {
         let _ = writeln!(
             out,
-            "\n{reason}: the time columns are empty and the time plots were not drawn."
+            "\nNo GPU times ({reason}): the time columns are empty and the time plots were not drawn."
         );
     }
     let passes = pass_names(rows);

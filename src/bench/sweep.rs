@@ -318,7 +318,7 @@ fn measure(
     row.frame_ms = summarize(&frames);
     if row.frame_ms.is_none() {
         row.untimed = Some(if sweep.frames == 0 {
-            "the sweep times no frames (frames: 0)".into()
+            "the sweep sets frames: 0".into()
         } else if !renderer.ctx.has_timestamps {
             format!("{} has no timestamp queries", renderer.ctx.adapter_name())
         } else {
