@@ -81,3 +81,18 @@ fn bad_cases_are_reported_with_file_and_line() {
     assert!(err.starts_with("s.ron: 6:"), "{err}");
     assert!(err.contains("fra"), "{err}");
 }
+
+#[test]
+fn every_shipped_sweep_parses() {
+    let dir = lightgraph::project_root().join("benches/sweeps");
+    let mut count = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "ron") {
+            let sweep = Sweep::load(&path).unwrap_or_else(|e| panic!("{e}"));
+            assert!(sweep.point_count() > 0, "{}", path.display());
+            count += 1;
+        }
+    }
+    assert!(count >= 7, "only {count} sweep files in {}", dir.display());
+}
