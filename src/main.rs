@@ -372,37 +372,88 @@ fn compare(a: &Path, b: &Path) -> Result<()> {
 }
 
 fn run_bench(sweep: Option<&Path>, out: &Path) -> Result<()> {
+    use bench::sweep::SweepEvent;
     let path = sweep
         .map(Path::to_path_buf)
         .unwrap_or_else(|| project_path("benches/sweeps/headline.ron"));
     let sweep = bench::sweep::Sweep::load(&path)?;
     let mut renderer = Renderer::headless()?;
+    let progress = bench::progress::SweepProgress::new(sweep.point_count());
+    progress.println(&format!("adapter: {}", renderer.ctx.adapter_name()));
     if !renderer.ctx.has_timestamps {
-        eprintln!(
-            "warning: {} has no timestamp queries: no GPU times will be reported",
+        progress.warn(&format!(
+            "{} has no timestamp queries: no GPU times will be reported (time columns stay empty, no time plots)",
             renderer.ctx.adapter_name()
-        );
+        ));
     }
-    println!("adapter: {}", renderer.ctx.adapter_name());
     let dir = path.parent().unwrap_or(Path::new("."));
-    let rows = bench::sweep::run(&sweep, dir, &mut renderer, |done, total, row| {
-        println!(
-            "[{done}/{total}] {} {} lights {}x{} {}: {:.3} ms (p10 {:.3}, p90 {:.3}) rmse {:?}",
-            row.scene,
-            row.light_count,
-            row.width,
-            row.height,
-            row.technique,
-            row.frame_ms_median,
-            row.frame_ms_p10,
-            row.frame_ms_p90,
-            row.rmse
-        );
-    })?;
+    let rows = bench::sweep::run(&sweep, dir, &mut renderer, |event| match event {
+        SweepEvent::Start { point, .. } => progress.start(point),
+        SweepEvent::Done { done, total, row } => {
+            progress.finish_point();
+            progress.println(&format!("[{done}/{total}] {}", point_summary(row)));
+            if let Some(warning) = non_finite_warning(row) {
+                progress.warn(&warning);
+            }
+        }
+    });
+    progress.finish();
+    let rows = rows?;
     std::fs::create_dir_all(out).with_context(|| out.display().to_string())?;
     let files = bench::write_report(out, &rows)?;
+    if let Some(reason) = &files.plots_skipped {
+        println!("time plots not drawn: no GPU times ({reason})");
+    }
     println!("wrote {}", files.markdown.display());
     Ok(())
+}
+
+/// One log line per point: time, error against the reference, NaN / Inf counts.
+fn point_summary(row: &bench::BenchRow) -> String {
+    let time = match row.frame_ms {
+        Some(t) => format!("{:.3} ms (p10 {:.3}, p90 {:.3})", t.median, t.p10, t.p90),
+        None => format!(
+            "no GPU time: {}",
+            row.untimed.as_deref().unwrap_or("not measured")
+        ),
+    };
+    let error = match (row.rmse, row.max_abs, row.max_rel) {
+        (Some(rmse), Some(abs), Some(rel)) => {
+            format!("rmse {rmse:.3e} max abs {abs:.3e} max rel {rel:.3e}")
+        }
+        _ => "no reference".into(),
+    };
+    format!(
+        "{} {} {} lights {}x{}: {time}, {error}, NaN px {}, Inf px {}",
+        row.scene,
+        row.technique,
+        row.light_count,
+        row.width,
+        row.height,
+        row.nan_pixels.unwrap_or(0),
+        row.inf_pixels.unwrap_or(0)
+    )
+}
+
+/// A warning naming the first NaN / Inf pixels of a point, if it has any.
+fn non_finite_warning(row: &bench::BenchRow) -> Option<String> {
+    if row.non_finite_examples.is_empty() {
+        return None;
+    }
+    let listed: Vec<String> = row
+        .non_finite_examples
+        .iter()
+        .take(4)
+        .map(|p| format!("{} at ({}, {})", p.kind(), p.x, p.y))
+        .collect();
+    Some(format!(
+        "{} {}: {} NaN and {} Inf pixels, first {}",
+        row.scene,
+        row.technique,
+        row.nan_pixels.unwrap_or(0),
+        row.inf_pixels.unwrap_or(0),
+        listed.join(", ")
+    ))
 }
 
 fn material(path: &Path, wgsl: bool) -> Result<()> {

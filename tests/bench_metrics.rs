@@ -263,10 +263,11 @@ fn rows() -> Vec<BenchRow> {
                 width: 640,
                 height: 360,
                 adapter: "llvmpipe (LLVM 19, 256 bits)".into(),
-                frame_ms_median: ms,
-                frame_ms_p10: ms * 0.9,
-                frame_ms_p90: ms * 1.2,
-                pass_ms_median: vec![("depth".into(), 0.2), ("shade".into(), ms - 0.2)],
+                frame_ms: Some(spread(ms)),
+                pass_ms: vec![
+                    ("depth".into(), spread(0.2)),
+                    ("shade".into(), spread(ms - 0.2)),
+                ],
                 rmse: err,
                 psnr: err.map(|_| f64::INFINITY),
                 max_lights_per_tile: Some(lights / 8),
@@ -277,10 +278,19 @@ fn rows() -> Vec<BenchRow> {
     rows.push(BenchRow {
         technique: "forward_plus".into(),
         light_count: 1,
-        pass_ms_median: vec![("cull".into(), 0.05)],
+        pass_ms: vec![("cull".into(), spread(0.05))],
         ..Default::default()
     });
     rows
+}
+
+/// A timing with p10 at 0.9 and p90 at 1.2 of the median.
+fn spread(median: f64) -> TimingSummary {
+    TimingSummary {
+        median,
+        p10: median * 0.9,
+        p90: median * 1.2,
+    }
 }
 
 #[test]
@@ -293,12 +303,25 @@ fn csv_and_markdown() {
     assert_eq!(&header[..report::CSV_COLUMNS.len()], &report::CSV_COLUMNS);
     assert_eq!(
         &header[report::CSV_COLUMNS.len()..],
-        &["pass_ms:depth", "pass_ms:shade", "pass_ms:cull"]
+        &[
+            "pass_ms:depth",
+            "pass_ms_p10:depth",
+            "pass_ms_p90:depth",
+            "pass_ms:shade",
+            "pass_ms_p10:shade",
+            "pass_ms_p90:shade",
+            "pass_ms:cull",
+            "pass_ms_p10:cull",
+            "pass_ms_p90:cull"
+        ]
     );
     assert!(csv.contains("\"clustered, \"\"q\"\"\""), "{csv}");
     assert!(lines[4].contains(",inf,"), "{}", lines[4]);
     assert!(
-        lines.last().unwrap().ends_with(",,,0.05"),
+        lines
+            .last()
+            .unwrap()
+            .ends_with(",,,,,,,0.05,0.045000000000000005,0.06"),
         "{}",
         lines.last().unwrap()
     );
@@ -308,7 +331,14 @@ fn csv_and_markdown() {
         md.contains("| sponza | forward_plus | tile=16 | 1024 | 640x360 |"),
         "{md}"
     );
-    assert!(md.contains("Per-pass median GPU time"));
+    assert!(md.contains("Per-pass GPU time, ms: median (p10–p90)"));
+    assert!(md.contains("| 0.200 (0.180–0.240) |"), "{md}");
+    // The untimed row has empty time cells, not zeros.
+    assert!(
+        md.contains("| forward_plus |  | 1 | 0x0 |  | – | – | – |"),
+        "{md}"
+    );
+    assert!(!md.contains("No GPU times"), "some rows are timed: {md}");
     assert!(md.contains("∞"));
     let table_rows = md.lines().filter(|l| l.starts_with("| sponza")).count();
     assert_eq!(table_rows, 2 * 9);
@@ -327,7 +357,9 @@ fn timing_summary() {
 fn report_writes_all_files() {
     let dir = tempfile::tempdir().unwrap();
     let files = write_report(dir.path().join("bench"), &rows()).unwrap();
+    assert_eq!(files.plots_skipped, None);
     for png in [&files.time_vs_lights, &files.time_vs_error] {
+        let png = png.as_ref().expect("timed rows are plotted");
         let img = image::open(png).unwrap().into_rgb8();
         assert_eq!(img.dimensions(), report::PLOT_SIZE);
         // Something besides the white background was drawn.
@@ -339,8 +371,96 @@ fn report_writes_all_files() {
     assert!(std::fs::read_to_string(&files.markdown)
         .unwrap()
         .starts_with("| scene"));
-    // Empty input still gives valid (empty) plots.
-    write_report(dir.path().join("empty"), &[]).unwrap();
+    assert_eq!(
+        std::fs::read_to_string(&files.non_finite).unwrap(),
+        "scene,technique,params,light_count,width,height,kind,x,y,r,g,b\n"
+    );
+    // Empty input gives empty tables and no plots.
+    let empty = write_report(dir.path().join("empty"), &[]).unwrap();
+    assert_eq!(empty.plots_skipped.as_deref(), Some("no rows"));
+}
+
+#[test]
+fn untimed_rows_say_why_and_draw_no_plots() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench");
+    // A stale plot from a timed run must not survive an untimed one.
+    write_report(&out, &rows()).unwrap();
+    let mut rows = rows();
+    for r in &mut rows {
+        r.frame_ms = None;
+        r.pass_ms.clear();
+        r.untimed = Some("llvmpipe has no timestamp queries".into());
+    }
+    let files = write_report(&out, &rows).unwrap();
+    let reason = "llvmpipe has no timestamp queries";
+    assert_eq!(files.plots_skipped.as_deref(), Some(reason));
+    assert_eq!((files.time_vs_lights, files.time_vs_error), (None, None));
+    assert!(!out.join("time_vs_lights.png").exists());
+    assert!(!out.join("time_vs_error.png").exists());
+    let md = std::fs::read_to_string(&files.markdown).unwrap();
+    assert!(
+        md.contains("No GPU times (llvmpipe has no timestamp queries): the time columns are empty"),
+        "{md}"
+    );
+    assert!(!md.contains("Per-pass"), "{md}");
+    let csv = to_csv(&rows);
+    let line = csv.lines().nth(1).unwrap();
+    assert!(
+        line.contains("256 bits)\",,,,"),
+        "time columns are empty: {line}"
+    );
+}
+
+#[test]
+fn non_finite_pixels_are_listed_with_their_position() {
+    let mut img = gradient();
+    img[W as usize * 2 + 3][0] = f32::NAN;
+    img[W as usize * 5 + 1][2] = f32::INFINITY;
+    img[W as usize * 7 + 15] = [f32::NAN, f32::INFINITY, 0.0, 1.0];
+    let (counts, first) = non_finite_pixels(&img, W, 2);
+    assert_eq!(
+        counts,
+        NonFinite {
+            nan_pixels: 2,
+            inf_pixels: 1
+        }
+    );
+    assert_eq!(first.len(), 2, "only the first two are listed");
+    assert_eq!((first[0].x, first[0].y, first[0].kind()), (3, 2, "NaN"));
+    assert_eq!((first[1].x, first[1].y, first[1].kind()), (1, 5, "Inf"));
+    let row = BenchRow {
+        scene: "s".into(),
+        technique: "t".into(),
+        non_finite_examples: first,
+        ..Default::default()
+    };
+    let csv = non_finite_csv(&[row]);
+    assert_eq!(
+        csv.lines().nth(1).unwrap(),
+        "s,t,,0,0,0,NaN,3,2,NaN,0.25,0.21875"
+    );
+    assert_eq!(
+        csv.lines().nth(2).unwrap(),
+        "s,t,,0,0,0,Inf,1,5,0.0625,0.625,inf"
+    );
+}
+
+#[test]
+fn relative_error_uses_the_pixel_or_a_floor_of_the_peak() {
+    let a = vec![[4.0, 0.0, 1.0, 1.0], [0.0, 0.0, 0.0, 1.0]];
+    // Bright channel off by 1e-3 relative; a black pixel off by 1e-3 (absolute).
+    let b = vec![[4.004, 0.0, 1.0, 1.0], [0.001, 0.0, 0.0, 1.0]];
+    let m = compare(&a, &b, 2, 1, &no_flip()).unwrap();
+    assert!(
+        (m.max_rel_floor - 4e-3).abs() < 1e-12,
+        "{}",
+        m.max_rel_floor
+    );
+    // The black pixel's error against the floor (1e-3 / 4e-3) dominates.
+    assert!((m.max_rel - 0.25).abs() < 1e-6, "{}", m.max_rel);
+    let m = compare(&a, &a, 2, 1, &no_flip()).unwrap();
+    assert_eq!(m.max_rel, 0.0);
 }
 
 #[test]

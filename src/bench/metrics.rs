@@ -68,6 +68,14 @@ pub struct NonFinite {
     pub inf_pixels: usize,
 }
 
+/// Relative errors are measured against `max(|ref|, REL_ERROR_FLOOR × peak)`, the peak being the
+/// brightest reference channel. A pure relative error is meaningless where the reference is 0
+/// or nearly so (any residue is "infinitely" wrong); an error below a thousandth of the frame's
+/// peak is also under what an 8-bit display resolves once exposed for that peak (1/255), so it
+/// is judged against that floor. The floor scales with the image, so scenes lit at 1e-6 and at
+/// 1e6 are held to the same standard.
+pub const REL_ERROR_FLOOR: f64 = 1e-3;
+
 /// The result of [`compare`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ImageMetrics {
@@ -81,6 +89,12 @@ pub struct ImageMetrics {
     pub rmse: f64,
     /// Largest absolute per-channel difference over the compared pixels.
     pub max_abs: f64,
+    /// Largest per-channel `|test − ref| / max(|ref|, max_rel_floor)` over the compared pixels:
+    /// the error relative to the pixel, or to the floor for dark pixels.
+    pub max_rel: f64,
+    /// The floor of `max_rel`: [`REL_ERROR_FLOOR`] × the largest finite reference channel
+    /// (`f64::MIN_POSITIVE` for a black reference, so any light there counts as huge).
+    pub max_rel_floor: f64,
     /// `10 log10(peak² / MSE)` in dB; `f64::INFINITY` when MSE is 0 (identical images).
     pub psnr: f64,
     /// The PSNR peak: the largest luminance (Rec. 709) of a finite reference pixel, or 1.0 if that
@@ -104,6 +118,11 @@ impl std::fmt::Display for ImageMetrics {
         writeln!(f, "size        {}x{}", self.width, self.height)?;
         writeln!(f, "RMSE        {:.6e}", self.rmse)?;
         writeln!(f, "max abs     {:.6e}", self.max_abs)?;
+        writeln!(
+            f,
+            "max rel     {:.6e} (floor {:.3e})",
+            self.max_rel, self.max_rel_floor
+        )?;
         writeln!(
             f,
             "PSNR        {:.3} dB (peak {:.4})",
@@ -169,6 +188,53 @@ pub fn compare_files(
         .expect("sizes come from the decoded images"))
 }
 
+/// A NaN or infinite pixel and where it is.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct NonFinitePixel {
+    /// Column.
+    pub x: u32,
+    /// Row (0 at the top).
+    pub y: u32,
+    /// Linear RGB as rendered.
+    pub rgb: [f32; 3],
+}
+
+impl NonFinitePixel {
+    /// "NaN" or "Inf" (NaN wins, as in [`NonFinite`]).
+    pub fn kind(&self) -> &'static str {
+        if classify(self.rgb).0 {
+            "NaN"
+        } else {
+            "Inf"
+        }
+    }
+}
+
+/// NaN and infinite pixel counts of one image (row-major, `width` wide), and the first `limit`
+/// such pixels in row-major order.
+pub fn non_finite_pixels<P: HdrPixel>(
+    image: &[P],
+    width: u32,
+    limit: usize,
+) -> (NonFinite, Vec<NonFinitePixel>) {
+    let mut counts = NonFinite::default();
+    let mut first = Vec::new();
+    for (i, p) in image.iter().enumerate() {
+        let rgb = p.rgb();
+        let (nan, inf) = classify(rgb);
+        counts.nan_pixels += nan as usize;
+        counts.inf_pixels += inf as usize;
+        if (nan || inf) && first.len() < limit {
+            first.push(NonFinitePixel {
+                x: (i % width.max(1) as usize) as u32,
+                y: (i / width.max(1) as usize) as u32,
+                rgb,
+            });
+        }
+    }
+    (counts, first)
+}
+
 fn classify(rgb: [f32; 3]) -> (bool, bool) {
     let nan = rgb.iter().any(|c| c.is_nan());
     let inf = !nan && rgb.iter().any(|c| c.is_infinite());
@@ -203,6 +269,13 @@ pub fn compare<P: HdrPixel>(
     options: &CompareOptions,
 ) -> Result<ImageMetrics, MetricsError> {
     check(reference, test, width, height)?;
+    let peak_channel = reference
+        .iter()
+        .flat_map(|p| p.rgb())
+        .filter(|c| c.is_finite())
+        .fold(0.0f64, |m, c| m.max(c.abs() as f64));
+    let rel_floor = (REL_ERROR_FLOOR * peak_channel).max(f64::MIN_POSITIVE);
+    let mut max_rel = 0.0f64;
     let mut sum_sq = 0.0f64;
     let mut max_abs = 0.0f64;
     let mut compared = 0usize;
@@ -229,6 +302,7 @@ pub fn compare<P: HdrPixel>(
             let d = (r[c] as f64 - t[c] as f64).abs();
             sum_sq += d * d;
             px_max = px_max.max(d);
+            max_rel = max_rel.max(d / (r[c].abs() as f64).max(rel_floor));
         }
         max_abs = max_abs.max(px_max);
         if px_max > options.bad_pixel_threshold as f64 {
@@ -263,6 +337,8 @@ pub fn compare<P: HdrPixel>(
         compared_pixels: compared,
         rmse: mse.sqrt(),
         max_abs,
+        max_rel,
+        max_rel_floor: rel_floor,
         psnr,
         psnr_peak: peak,
         bad_pixels: bad,

@@ -2,10 +2,12 @@
 //! project's one tonemapper, HDR image I/O (EXR, tonemapped PNG), and reports (CSV, Markdown,
 //! PNG plots). Nothing here needs a GPU.
 
+pub mod cases;
 pub mod heatmap;
 pub mod image_io;
 pub mod metrics;
 pub mod pixel;
+pub mod progress;
 pub mod report;
 pub mod sweep;
 pub mod tonemap;
@@ -13,14 +15,16 @@ pub mod tonemap;
 pub use image_io::{
     read_exr, write_exr, write_png_rgb8, write_png_tonemapped, HdrImage, ImageIoError,
 };
+pub use metrics::non_finite_pixels;
 pub use metrics::{
     compare, compare_files, difference_heatmap, flip_mean, heat_color, write_difference_png,
     write_flip_png, CompareFilesError, CompareOptions, DiffImageError, HeatScale, ImageMetrics,
-    MetricsError, NonFinite,
+    MetricsError, NonFinite, NonFinitePixel, REL_ERROR_FLOOR,
 };
 pub use pixel::{luminance, HdrPixel};
 pub use report::{
-    plot_time_vs_error, plot_time_vs_lights, summarize, to_csv, to_markdown, write_csv,
-    write_markdown, write_report, BenchRow, ReportError, ReportFiles, TimingSummary,
+    non_finite_csv, plot_time_vs_error, plot_time_vs_lights, summarize, to_csv, to_markdown,
+    untimed_reason, write_csv, write_markdown, write_report, BenchRow, ReportError, ReportFiles,
+    TimingSummary,
 };
 pub use tonemap::{linear_to_srgb, srgb_to_linear, ToneCurve, Tonemap};

@@ -5,7 +5,7 @@
 //! (DejaVu Sans Mono, `src/bench/fonts/`, Bitstream Vera licence), so they need no system fonts
 //! and render the same on CI. The PNGs are encoded by the `image` crate.
 
-use super::metrics::ImageMetrics;
+use super::metrics::{ImageMetrics, NonFinitePixel};
 use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -30,18 +30,20 @@ pub struct BenchRow {
     pub height: u32,
     /// `wgpu::AdapterInfo::name`.
     pub adapter: String,
-    /// Median GPU frame time, ms.
-    pub frame_ms_median: f64,
-    /// 10th percentile frame time, ms.
-    pub frame_ms_p10: f64,
-    /// 90th percentile frame time, ms.
-    pub frame_ms_p90: f64,
-    /// Median GPU time of each pass, ms, in schedule order.
-    pub pass_ms_median: Vec<(String, f64)>,
+    /// GPU frame time (the sum of the per-pass timestamps) over the timed frames, ms; `None`
+    /// when nothing was timed (the adapter has no timestamp queries).
+    pub frame_ms: Option<TimingSummary>,
+    /// Why `frame_ms` is `None` (e.g. "the adapter has no timestamp queries").
+    pub untimed: Option<String>,
+    /// GPU time of each pass over the timed frames, ms, in schedule order (empty when untimed).
+    pub pass_ms: Vec<(String, TimingSummary)>,
     /// RMSE against the reference (linear).
     pub rmse: Option<f64>,
     /// Largest absolute channel error against the reference.
     pub max_abs: Option<f64>,
+    /// Largest relative channel error against the reference (floor: see
+    /// [`super::metrics::REL_ERROR_FLOOR`]).
+    pub max_rel: Option<f64>,
     /// PSNR against the reference, dB (`inf` when identical).
     pub psnr: Option<f64>,
     /// Mean FLIP against the reference.
@@ -52,24 +54,37 @@ pub struct BenchRow {
     pub max_lights_per_tile: Option<u32>,
     /// Tiles whose list overflowed.
     pub overflow_tiles: Option<u32>,
-    /// NaN pixels in the output.
+    /// Pixels of the output with a NaN channel.
     pub nan_pixels: Option<u64>,
+    /// Pixels of the output with an infinite channel and no NaN.
+    pub inf_pixels: Option<u64>,
+    /// The first NaN / infinite pixels of the output, row-major (all of them are counted above).
+    pub non_finite_examples: Vec<NonFinitePixel>,
+    /// Pixels of the output with some non-zero channel: 0 means the point shows no light at all.
+    pub lit_pixels: Option<u64>,
 }
 
 impl BenchRow {
-    /// Fill the error fields (RMSE, max abs, PSNR, FLIP mean, NaN pixels of the test image)
-    /// from a comparison against the reference.
+    /// Fill the error fields (RMSE, max abs, max rel, PSNR, FLIP mean, NaN and Inf pixels of the
+    /// test image) from a comparison against the reference.
     pub fn set_metrics(&mut self, m: &ImageMetrics) {
         self.rmse = Some(m.rmse);
         self.max_abs = Some(m.max_abs);
+        self.max_rel = Some(m.max_rel);
         self.psnr = Some(m.psnr);
         self.flip_mean = m.flip_mean;
         self.nan_pixels = Some(m.test_non_finite.nan_pixels as u64);
+        self.inf_pixels = Some(m.test_non_finite.inf_pixels as u64);
+    }
+
+    /// Sum of the per-pass median times, if any pass was timed.
+    pub fn passes_ms_total(&self) -> Option<f64> {
+        (!self.pass_ms.is_empty()).then(|| self.pass_ms.iter().map(|(_, t)| t.median).sum())
     }
 }
 
 /// Median and 10th / 90th percentiles of a set of timings.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct TimingSummary {
     /// Median.
     pub median: f64,
@@ -145,7 +160,7 @@ fn write_file(path: &Path, text: &str) -> Result<(), ReportError> {
 fn pass_names(rows: &[BenchRow]) -> Vec<String> {
     let mut names: Vec<String> = Vec::new();
     for row in rows {
-        for (name, _) in &row.pass_ms_median {
+        for (name, _) in &row.pass_ms {
             if !names.contains(name) {
                 names.push(name.clone());
             }
@@ -154,11 +169,8 @@ fn pass_names(rows: &[BenchRow]) -> Vec<String> {
     names
 }
 
-fn pass_ms(row: &BenchRow, name: &str) -> Option<f64> {
-    row.pass_ms_median
-        .iter()
-        .find(|(n, _)| n == name)
-        .map(|(_, v)| *v)
+fn pass_ms(row: &BenchRow, name: &str) -> Option<TimingSummary> {
+    row.pass_ms.iter().find(|(n, _)| n == name).map(|(_, t)| *t)
 }
 
 fn csv_field(s: &str) -> String {
@@ -173,9 +185,10 @@ fn opt<T: ToString>(v: Option<T>) -> String {
     v.map(|v| v.to_string()).unwrap_or_default()
 }
 
-/// The fixed CSV columns, in order; per-pass columns `pass_ms:<name>` follow, one per pass name
-/// seen in any row (first-seen order), empty where a row lacks that pass.
-pub const CSV_COLUMNS: [&str; 20] = [
+/// The fixed CSV columns, in order; per-pass columns follow, three per pass name seen in any
+/// row (first-seen order): `pass_ms:<name>` (median), `pass_ms_p10:<name>`, `pass_ms_p90:<name>`,
+/// empty where a row lacks that pass. Time columns are empty, not 0, for untimed rows.
+pub const CSV_COLUMNS: [&str; 23] = [
     "scene",
     "technique",
     "params",
@@ -188,12 +201,15 @@ pub const CSV_COLUMNS: [&str; 20] = [
     "frame_ms_p90",
     "rmse",
     "max_abs",
+    "max_rel",
     "psnr",
     "flip_mean",
     "listed_exact_ratio",
     "max_lights_per_tile",
     "overflow_tiles",
     "nan_pixels",
+    "inf_pixels",
+    "lit_pixels",
     "pass_count",
     "passes_ms_total",
 ];
@@ -204,11 +220,15 @@ pub fn to_csv(rows: &[BenchRow]) -> String {
     let passes = pass_names(rows);
     let mut out = String::new();
     let mut header: Vec<String> = CSV_COLUMNS.iter().map(|s| s.to_string()).collect();
-    header.extend(passes.iter().map(|p| csv_field(&format!("pass_ms:{p}"))));
+    for p in &passes {
+        for column in ["pass_ms", "pass_ms_p10", "pass_ms_p90"] {
+            header.push(csv_field(&format!("{column}:{p}")));
+        }
+    }
     out.push_str(&header.join(","));
     out.push('\n');
     for r in rows {
-        let total: f64 = r.pass_ms_median.iter().map(|(_, v)| v).sum();
+        let t = r.frame_ms;
         let mut f = vec![
             csv_field(&r.scene),
             csv_field(&r.technique),
@@ -217,25 +237,78 @@ pub fn to_csv(rows: &[BenchRow]) -> String {
             r.width.to_string(),
             r.height.to_string(),
             csv_field(&r.adapter),
-            r.frame_ms_median.to_string(),
-            r.frame_ms_p10.to_string(),
-            r.frame_ms_p90.to_string(),
+            opt(t.map(|t| t.median)),
+            opt(t.map(|t| t.p10)),
+            opt(t.map(|t| t.p90)),
             opt(r.rmse),
             opt(r.max_abs),
+            opt(r.max_rel),
             opt(r.psnr),
             opt(r.flip_mean),
             opt(r.listed_exact_ratio),
             opt(r.max_lights_per_tile),
             opt(r.overflow_tiles),
             opt(r.nan_pixels),
-            r.pass_ms_median.len().to_string(),
-            total.to_string(),
+            opt(r.inf_pixels),
+            opt(r.lit_pixels),
+            r.pass_ms.len().to_string(),
+            opt(r.passes_ms_total()),
         ];
-        f.extend(passes.iter().map(|p| opt(pass_ms(r, p))));
+        for p in &passes {
+            let t = pass_ms(r, p);
+            f.extend([
+                opt(t.map(|t| t.median)),
+                opt(t.map(|t| t.p10)),
+                opt(t.map(|t| t.p90)),
+            ]);
+        }
         out.push_str(&f.join(","));
         out.push('\n');
     }
     out
+}
+
+/// The non-finite pixels the rows list, as CSV: one line per pixel with its point.
+pub fn non_finite_csv(rows: &[BenchRow]) -> String {
+    let mut out = String::from("scene,technique,params,light_count,width,height,kind,x,y,r,g,b\n");
+    for r in rows {
+        for p in &r.non_finite_examples {
+            let _ = writeln!(
+                out,
+                "{},{},{},{},{},{},{},{},{},{},{},{}",
+                csv_field(&r.scene),
+                csv_field(&r.technique),
+                csv_field(&r.params),
+                r.light_count,
+                r.width,
+                r.height,
+                p.kind(),
+                p.x,
+                p.y,
+                p.rgb[0],
+                p.rgb[1],
+                p.rgb[2]
+            );
+        }
+    }
+    out
+}
+
+/// Why time plots cannot be drawn for these rows, if they cannot.
+pub fn untimed_reason(rows: &[BenchRow]) -> Option<String> {
+    if rows.is_empty() {
+        return Some("no rows".into());
+    }
+    if rows.iter().any(|r| r.frame_ms.is_some()) {
+        return None;
+    }
+    let mut reasons: Vec<&str> = rows
+        .iter()
+        .map(|r| r.untimed.as_deref().unwrap_or("not measured"))
+        .collect();
+    reasons.sort_unstable();
+    reasons.dedup();
+    Some(reasons.join("; "))
 }
 
 fn md_cell(s: &str) -> String {
@@ -251,16 +324,19 @@ fn md_num(v: Option<f64>, digits: usize) -> String {
     }
 }
 
-/// The rows as GitHub-flavoured Markdown: a results table, then a per-pass median table
-/// (one column per pass name) if any row has passes.
+/// The rows as GitHub-flavoured Markdown: a results table, a note when nothing was timed, then
+/// a per-pass table (median, p10–p90 per pass name) if any row has timed passes.
 pub fn to_markdown(rows: &[BenchRow]) -> String {
     let mut out = String::new();
-    out.push_str("| scene | technique | params | lights | size | adapter | median ms | p10 | p90 | RMSE | max abs | PSNR dB | FLIP | listed/exact | max/tile | overflow | NaN px |\n");
-    out.push_str("|---|---|---|--:|--:|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n");
+    out.push_str("| scene | technique | params | lights | size | adapter | median ms | p10 | p90 | RMSE | max abs | max rel | PSNR dB | FLIP | listed/exact | max/tile | overflow | NaN px | Inf px | lit px |\n");
+    out.push_str(
+        "|---|---|---|--:|--:|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n",
+    );
     for r in rows {
+        let t = r.frame_ms;
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {} | {}x{} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {}x{} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             md_cell(&r.scene),
             md_cell(&r.technique),
             md_cell(&r.params),
@@ -268,22 +344,33 @@ pub fn to_markdown(rows: &[BenchRow]) -> String {
             r.width,
             r.height,
             md_cell(&r.adapter),
-            md_num(Some(r.frame_ms_median), 3),
-            md_num(Some(r.frame_ms_p10), 3),
-            md_num(Some(r.frame_ms_p90), 3),
+            md_num(t.map(|t| t.median), 3),
+            md_num(t.map(|t| t.p10), 3),
+            md_num(t.map(|t| t.p90), 3),
             md_num(r.rmse, 5),
             md_num(r.max_abs, 4),
+            md_num(r.max_rel, 4),
             md_num(r.psnr, 2),
             md_num(r.flip_mean, 4),
             md_num(r.listed_exact_ratio, 3),
             opt(r.max_lights_per_tile),
             opt(r.overflow_tiles),
             opt(r.nan_pixels),
+            opt(r.inf_pixels),
+            opt(r.lit_pixels),
+        );
+    }
+    if let Some(reason) = untimed_reason(rows).filter(|_| !rows.is_empty()) {
+        let _ = writeln!(
+            out,
+            "\nNo GPU times ({reason}): the time columns are empty and the time plots were not drawn."
         );
     }
     let passes = pass_names(rows);
     if !passes.is_empty() {
-        out.push_str("\nPer-pass median GPU time (ms):\n\n| scene | technique | params | lights |");
+        out.push_str(
+            "\nPer-pass GPU time, ms: median (p10–p90):\n\n| scene | technique | params | lights |",
+        );
         for p in &passes {
             let _ = write!(out, " {} |", md_cell(p));
         }
@@ -302,7 +389,16 @@ pub fn to_markdown(rows: &[BenchRow]) -> String {
                 r.light_count
             );
             for p in &passes {
-                let _ = write!(out, " {} |", md_num(pass_ms(r, p), 3));
+                let cell = match pass_ms(r, p) {
+                    Some(t) => format!(
+                        "{} ({}–{})",
+                        md_num(Some(t.median), 3),
+                        md_num(Some(t.p10), 3),
+                        md_num(Some(t.p90), 3)
+                    ),
+                    None => "–".into(),
+                };
+                let _ = write!(out, " {cell} |");
             }
             out.push('\n');
         }
@@ -464,12 +560,14 @@ fn render_plot(
 pub fn plot_time_vs_lights(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(), ReportError> {
     let mut series: BTreeMap<String, Vec<Point>> = BTreeMap::new();
     for r in rows.iter().filter(|r| r.light_count > 0) {
-        series.entry(r.technique.clone()).or_default().push((
-            r.light_count as f64,
-            r.frame_ms_median,
-            r.frame_ms_p10,
-            r.frame_ms_p90,
-        ));
+        if let Some(t) = r.frame_ms {
+            series.entry(r.technique.clone()).or_default().push((
+                r.light_count as f64,
+                t.median,
+                t.p10,
+                t.p90,
+            ));
+        }
     }
     let series: Series = series
         .into_iter()
@@ -493,22 +591,23 @@ pub fn plot_time_vs_lights(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<
 /// (technique, light count) pair is its own series, labelled `technique @ N lights`, so points
 /// of different scene sizes are never joined.
 pub fn plot_time_vs_error(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(), ReportError> {
-    let with_error = || rows.iter().filter(|r| r.rmse.is_some_and(f64::is_finite));
+    let with_error = || {
+        rows.iter()
+            .filter(|r| r.rmse.is_some_and(f64::is_finite) && r.frame_ms.is_some())
+    };
     let first_count = with_error().next().map(|r| r.light_count);
     let several_counts = with_error().any(|r| Some(r.light_count) != first_count);
     let mut series: BTreeMap<(String, u32), Vec<Point>> = BTreeMap::new();
     for r in with_error() {
-        if let Some(e) = r.rmse {
+        if let (Some(e), Some(t)) = (r.rmse, r.frame_ms) {
             let key = (
                 r.technique.clone(),
                 if several_counts { r.light_count } else { 0 },
             );
-            series.entry(key).or_default().push((
-                e,
-                r.frame_ms_median,
-                r.frame_ms_p10,
-                r.frame_ms_p90,
-            ));
+            series
+                .entry(key)
+                .or_default()
+                .push((e, t.median, t.p10, t.p90));
         }
     }
     let series: Series = series
@@ -539,26 +638,52 @@ pub struct ReportFiles {
     pub csv: PathBuf,
     /// `results.md`
     pub markdown: PathBuf,
-    /// `time_vs_lights.png`
-    pub time_vs_lights: PathBuf,
-    /// `time_vs_error.png`
-    pub time_vs_error: PathBuf,
+    /// `non_finite_pixels.csv`: the listed NaN / Inf pixels of every row.
+    pub non_finite: PathBuf,
+    /// `time_vs_lights.png`, unless no row was timed.
+    pub time_vs_lights: Option<PathBuf>,
+    /// `time_vs_error.png`, unless no row was timed.
+    pub time_vs_error: Option<PathBuf>,
+    /// Why the plots were not drawn, if they were not.
+    pub plots_skipped: Option<String>,
 }
 
-/// Write `results.csv`, `results.md`, `time_vs_lights.png` and `time_vs_error.png` into `dir`
-/// (created if missing).
+/// Write `results.csv`, `results.md`, `non_finite_pixels.csv` and, when some row was timed,
+/// `time_vs_lights.png` and `time_vs_error.png` into `dir` (created if missing). Without times
+/// the plots would be nonsense: they are left out (a stale one from an earlier run is removed)
+/// and `plots_skipped` says why.
 pub fn write_report(dir: impl AsRef<Path>, rows: &[BenchRow]) -> Result<ReportFiles, ReportError> {
     let dir = dir.as_ref();
+    let lights_png = dir.join("time_vs_lights.png");
+    let error_png = dir.join("time_vs_error.png");
+    let skipped = untimed_reason(rows);
     let files = ReportFiles {
         csv: dir.join("results.csv"),
         markdown: dir.join("results.md"),
-        time_vs_lights: dir.join("time_vs_lights.png"),
-        time_vs_error: dir.join("time_vs_error.png"),
+        non_finite: dir.join("non_finite_pixels.csv"),
+        time_vs_lights: skipped.is_none().then(|| lights_png.clone()),
+        time_vs_error: skipped.is_none().then(|| error_png.clone()),
+        plots_skipped: skipped,
     };
     write_csv(&files.csv, rows)?;
     write_markdown(&files.markdown, rows)?;
-    plot_time_vs_lights(&files.time_vs_lights, rows)?;
-    plot_time_vs_error(&files.time_vs_error, rows)?;
+    write_file(&files.non_finite, &non_finite_csv(rows))?;
+    match (&files.time_vs_lights, &files.time_vs_error) {
+        (Some(l), Some(e)) => {
+            plot_time_vs_lights(l, rows)?;
+            plot_time_vs_error(e, rows)?;
+        }
+        _ => {
+            for stale in [&lights_png, &error_png] {
+                match std::fs::remove_file(stale) {
+                    Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                        return Err(io_err(stale)(e))
+                    }
+                    _ => {}
+                }
+            }
+        }
+    }
     Ok(files)
 }
 

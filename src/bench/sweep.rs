@@ -2,7 +2,9 @@
 //! the GPU (warm-up, then N frames, median and spread per pass) and compared with the
 //! brute-force image of the same scene.
 
-use super::report::{summarize, BenchRow};
+use super::cases::SceneCase;
+use super::metrics::non_finite_pixels;
+use super::report::{summarize, BenchRow, TimingSummary};
 use super::{compare, CompareOptions};
 use crate::graph::{self, FrameSize};
 use crate::render::{RenderError, Renderer, SceneGpu};
@@ -11,6 +13,8 @@ use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
+/// A sweep file (RON, scene-file extensions: `Some(..)` may be left out, `Random(count: ..)`).
+/// Every point is a scene × case × light count × resolution × graph.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(rename = "Sweep", deny_unknown_fields)]
 pub struct Sweep {
@@ -22,6 +26,11 @@ pub struct Sweep {
     /// in the scene bounds (AMD sample: radius 0.075 × |half-extent|, half spots).
     #[serde(default)]
     pub lights: Vec<u32>,
+    /// Variations of every scene (lights, ranges, intensities, near/far, camera at a light's
+    /// centre), applied after the light count: see [`SceneCase`]. Empty runs the scenes as
+    /// they are.
+    #[serde(default)]
+    pub cases: Vec<SceneCase>,
     pub resolutions: Vec<(u32, u32)>,
     #[serde(default = "default_warmup")]
     pub warmup: u32,
@@ -30,8 +39,15 @@ pub struct Sweep {
     /// Above this many lights the brute-force reference is not run (no error columns).
     #[serde(default = "default_brute_force_limit")]
     pub brute_force_limit: u32,
+    /// Render an extra frame per point for the light statistics (the listed/exact column);
+    /// it costs as much as a brute-force frame.
+    #[serde(default = "yes")]
+    pub light_stats: bool,
 }
 
+fn yes() -> bool {
+    true
+}
 fn default_warmup() -> u32 {
     5
 }
@@ -55,15 +71,59 @@ pub enum SweepError {
 }
 
 impl Sweep {
+    /// Reads and checks a sweep file; errors name the file and line.
     pub fn load(path: &Path) -> Result<Self, SweepError> {
         let text = std::fs::read_to_string(path).map_err(|e| SweepError::File {
             file: path.to_path_buf(),
             message: e.to_string(),
         })?;
-        ron::from_str(&text).map_err(|e| SweepError::File {
+        Self::parse(&text, path)
+    }
+
+    /// Parses and checks sweep text (`path` names it in messages).
+    pub fn parse(text: &str, path: &Path) -> Result<Self, SweepError> {
+        let error = |message: String| SweepError::File {
             file: path.to_path_buf(),
-            message: format!("{}:{}: {}", e.span.start.line, e.span.start.col, e.code),
-        })
+            message,
+        };
+        let sweep: Sweep = crate::scene::scene_file::ron_options()
+            .from_str(text)
+            .map_err(|e: ron::error::SpannedError| {
+                error(format!(
+                    "{}:{}: {}",
+                    e.span.start.line, e.span.start.col, e.code
+                ))
+            })?;
+        // Line of the first occurrence of `needle`, for errors found after parsing.
+        let line_of = |needle: &str| {
+            text.lines()
+                .position(|l| l.contains(needle))
+                .map_or(String::new(), |i| format!("{}: ", i + 1))
+        };
+        for (i, c) in sweep.cases.iter().enumerate() {
+            c.check().map_err(|m| {
+                let line = line_of(&format!("\"{}\"", c.name));
+                error(format!("{line}cases[{i}] (\"{}\"): {m}", c.name))
+            })?;
+        }
+        for &(w, h) in &sweep.resolutions {
+            if w == 0 || h == 0 || w > 16384 || h > 16384 {
+                let line = line_of("resolutions");
+                return Err(error(format!(
+                    "{line}resolution ({w}, {h}) must lie in 1..=16384"
+                )));
+            }
+        }
+        Ok(sweep)
+    }
+
+    /// Number of points the sweep runs.
+    pub fn point_count(&self) -> usize {
+        self.scenes.len()
+            * self.cases.len().max(1)
+            * self.lights.len().max(1)
+            * self.resolutions.len()
+            * self.graphs.len()
     }
 }
 
@@ -90,12 +150,31 @@ pub fn with_light_count(scene: &Scene, count: u32) -> Scene {
     s
 }
 
-/// Runs the sweep; `progress` is called after each point with (done, total).
+/// How far a sweep is, for [`run`]'s callback.
+pub enum SweepEvent<'a> {
+    /// Point `index` (from 0) of `total` is starting; `point` names it.
+    Start {
+        index: usize,
+        total: usize,
+        point: &'a str,
+    },
+    /// `done` points of `total` have finished, the last one gave `row`.
+    Done {
+        done: usize,
+        total: usize,
+        row: &'a BenchRow,
+    },
+}
+
+/// How many NaN / Inf pixels a row lists by position (all are counted).
+pub const NON_FINITE_EXAMPLES: usize = 16;
+
+/// Runs the sweep; `progress` hears when each point starts and ends.
 pub fn run(
     sweep: &Sweep,
     sweep_dir: &Path,
     renderer: &mut Renderer,
-    mut progress: impl FnMut(usize, usize, &BenchRow),
+    mut progress: impl FnMut(SweepEvent),
 ) -> Result<Vec<BenchRow>, SweepError> {
     let graphs_dir = crate::project_root().join("graphs");
     let counts: Vec<Option<u32>> = if sweep.lights.is_empty() {
@@ -103,118 +182,183 @@ pub fn run(
     } else {
         sweep.lights.iter().map(|&c| Some(c)).collect()
     };
-    let total = sweep.scenes.len() * counts.len() * sweep.resolutions.len() * sweep.graphs.len();
-    let adapter = renderer.ctx.adapter_name();
+    let cases: Vec<Option<&SceneCase>> = if sweep.cases.is_empty() {
+        vec![None]
+    } else {
+        sweep.cases.iter().map(Some).collect()
+    };
+    let total = sweep.point_count();
     let mut rows = Vec::new();
     for spec in &sweep.scenes {
         let base_scene = load_scene(spec, sweep_dir)?;
-        for count in &counts {
-            let scene = match count {
-                Some(c) => with_light_count(&base_scene, *c),
-                None => base_scene.clone(),
-            };
-            let gpu = SceneGpu::upload(&renderer.ctx.device, &renderer.ctx.queue, &scene)
-                .map_err(|e| SweepError::Scene(spec.clone(), e.to_string()))?;
-            for &(width, height) in &sweep.resolutions {
-                let size = FrameSize {
-                    width,
-                    height,
-                    lights: scene.lights.len() as u32,
+        for case in &cases {
+            for count in &counts {
+                let scene = match count {
+                    Some(c) => with_light_count(&base_scene, *c),
+                    None => base_scene.clone(),
                 };
-                let reference = if size.lights <= sweep.brute_force_limit {
-                    Some(render_once(
-                        renderer,
-                        &graphs_dir.join("brute_force.ron"),
-                        &scene,
-                        &gpu,
-                        size,
-                    )?)
-                } else {
-                    None
+                let scene = match case {
+                    Some(case) => case
+                        .apply(&scene)
+                        .map_err(|m| SweepError::Scene(format!("{spec} case {}", case.name), m))?,
+                    None => scene,
                 };
-                for g in &sweep.graphs {
-                    let path = graphs_dir.join(g);
-                    let checked = graph::check_file(&path, &renderer.shaders)
-                        .map_err(|e| SweepError::Graph(g.clone(), e.to_string()))?;
-                    let compiled = graph::compile(checked, &scene.features(), size);
-                    let prepared = renderer.prepare(compiled, &scene, &gpu, size, false)?;
-                    for _ in 0..sweep.warmup {
-                        prepared.execute(renderer)?;
-                    }
-                    let mut frames = Vec::new();
-                    let mut per_pass: Vec<(String, Vec<f64>)> = Vec::new();
-                    for _ in 0..sweep.frames {
-                        if let Some(times) = prepared.execute(renderer)? {
-                            frames.push(times.iter().map(|t| t.1).sum::<f64>());
-                            for (name, ms) in times {
-                                match per_pass.iter_mut().find(|p| p.0 == name) {
-                                    Some(p) => p.1.push(ms),
-                                    None => per_pass.push((name, vec![ms])),
-                                }
-                            }
-                        }
-                    }
-                    let result = prepared.render(renderer)?;
-                    let stats_frame = renderer
-                        .prepare(
-                            prepared.graph.clone(),
+                let gpu = SceneGpu::upload(&renderer.ctx.device, &renderer.ctx.queue, &scene)
+                    .map_err(|e| SweepError::Scene(spec.clone(), e.to_string()))?;
+                for &(width, height) in &sweep.resolutions {
+                    let size = FrameSize {
+                        width,
+                        height,
+                        lights: scene.lights.len() as u32,
+                    };
+                    let reference = if size.lights <= sweep.brute_force_limit {
+                        Some(render_once(
+                            renderer,
+                            &graphs_dir.join("brute_force.ron"),
                             &scene,
                             &gpu,
                             size,
-                            prepared.graph.has_forward_shading(),
-                        )?
-                        .render(renderer)?;
-                    let mut row = BenchRow {
-                        scene: scene.name.clone(),
-                        technique: g.trim_end_matches(".ron").to_string(),
-                        params: String::new(),
-                        light_count: size.lights,
-                        width,
-                        height,
-                        adapter: adapter.clone(),
-                        ..Default::default()
+                        )?)
+                    } else {
+                        None
                     };
-                    if let Some(t) = summarize(&frames) {
-                        row.frame_ms_median = t.median;
-                        row.frame_ms_p10 = t.p10;
-                        row.frame_ms_p90 = t.p90;
-                    }
-                    row.pass_ms_median = per_pass
-                        .iter()
-                        .filter_map(|(n, v)| summarize(v).map(|t| (n.clone(), t.median)))
-                        .collect();
-                    if let Some(reference) = &reference {
-                        let m = compare(
-                            reference,
-                            &result.image,
+                    for g in &sweep.graphs {
+                        let technique = g.trim_end_matches(".ron");
+                        let point = format!(
+                            "{} {technique} {} lights {width}x{height}",
+                            scene.name, size.lights
+                        );
+                        progress(SweepEvent::Start {
+                            index: rows.len(),
+                            total,
+                            point: &point,
+                        });
+                        let mut row = BenchRow {
+                            scene: scene.name.clone(),
+                            technique: technique.to_string(),
+                            light_count: size.lights,
                             width,
                             height,
-                            &CompareOptions::default(),
-                        )
-                        .map_err(|e| SweepError::Graph(g.clone(), e.to_string()))?;
-                        row.set_metrics(&m);
+                            adapter: renderer.ctx.adapter_name(),
+                            ..Default::default()
+                        };
+                        let point = Point {
+                            scene: &scene,
+                            gpu: &gpu,
+                            size,
+                            reference: reference.as_deref(),
+                        };
+                        measure(sweep, &graphs_dir, g, &point, renderer, &mut row)?;
+                        rows.push(row);
+                        progress(SweepEvent::Done {
+                            done: rows.len(),
+                            total,
+                            row: rows.last().expect("just pushed"),
+                        });
                     }
-                    row.nan_pixels = Some(
-                        result
-                            .image
-                            .iter()
-                            .filter(|p| p.iter().any(|c| !c.is_finite()))
-                            .count() as u64,
-                    );
-                    if let Some(c) = stats_frame.culling.first() {
-                        row.max_lights_per_tile = c.per_tile().into_iter().max();
-                        row.overflow_tiles = Some(c.overflowed_lists);
-                    }
-                    if let Some(s) = &stats_frame.light_stats {
-                        row.listed_exact_ratio = Some(s.false_positive_ratio());
-                    }
-                    rows.push(row);
-                    progress(rows.len(), total, rows.last().unwrap());
                 }
             }
         }
     }
     Ok(rows)
+}
+
+/// What one point renders: a scene at a size, and the reference image if there is one.
+struct Point<'a> {
+    scene: &'a Scene,
+    gpu: &'a SceneGpu,
+    size: FrameSize,
+    reference: Option<&'a [[f32; 4]]>,
+}
+
+/// Times one graph on one point (warm-up, then the sweep's frames), compares its image with
+/// the reference and fills the row.
+fn measure(
+    sweep: &Sweep,
+    graphs_dir: &Path,
+    graph_name: &str,
+    point: &Point,
+    renderer: &mut Renderer,
+    row: &mut BenchRow,
+) -> Result<(), SweepError> {
+    let Point {
+        scene, gpu, size, ..
+    } = *point;
+    let checked = graph::check_file(&graphs_dir.join(graph_name), &renderer.shaders)
+        .map_err(|e| SweepError::Graph(graph_name.into(), e.to_string()))?;
+    let compiled = graph::compile(checked, &scene.features(), size);
+    let prepared = renderer.prepare(compiled, scene, gpu, size, false)?;
+    for _ in 0..sweep.warmup {
+        prepared.execute(renderer)?;
+    }
+    let mut frames = Vec::new();
+    let mut per_pass: Vec<(String, Vec<f64>)> = Vec::new();
+    for _ in 0..sweep.frames {
+        if let Some(times) = prepared.execute(renderer)? {
+            frames.push(times.iter().map(|t| t.1).sum::<f64>());
+            for (name, ms) in times {
+                match per_pass.iter_mut().find(|p| p.0 == name) {
+                    Some(p) => p.1.push(ms),
+                    None => per_pass.push((name, vec![ms])),
+                }
+            }
+        }
+    }
+    let result = prepared.render(renderer)?;
+    // Light statistics cost a frame of their own (an exact count is a brute-force pass), and
+    // only forward shading gathers them.
+    let light_stats = if sweep.light_stats && prepared.graph.has_forward_shading() {
+        renderer
+            .prepare(prepared.graph.clone(), scene, gpu, size, true)?
+            .render(renderer)?
+            .light_stats
+    } else {
+        None
+    };
+    row.frame_ms = summarize(&frames);
+    if row.frame_ms.is_none() {
+        row.untimed = Some(if sweep.frames == 0 {
+            "the sweep sets frames: 0".into()
+        } else if !renderer.ctx.has_timestamps {
+            format!("{} has no timestamp queries", renderer.ctx.adapter_name())
+        } else {
+            "no timestamps came back".into()
+        });
+    }
+    row.pass_ms = per_pass
+        .iter()
+        .filter_map(|(n, v)| summarize(v).map(|t: TimingSummary| (n.clone(), t)))
+        .collect();
+    if let Some(reference) = point.reference {
+        let m = compare(
+            reference,
+            &result.image,
+            size.width,
+            size.height,
+            &CompareOptions::default(),
+        )
+        .map_err(|e| SweepError::Graph(graph_name.into(), e.to_string()))?;
+        row.set_metrics(&m);
+    }
+    let (non_finite, examples) = non_finite_pixels(&result.image, size.width, NON_FINITE_EXAMPLES);
+    row.nan_pixels = Some(non_finite.nan_pixels as u64);
+    row.inf_pixels = Some(non_finite.inf_pixels as u64);
+    row.non_finite_examples = examples;
+    row.lit_pixels = Some(
+        result
+            .image
+            .iter()
+            .filter(|p| p[..3].iter().any(|&c| c != 0.0))
+            .count() as u64,
+    );
+    if let Some(c) = result.culling.first() {
+        row.max_lights_per_tile = c.per_tile().into_iter().max();
+        row.overflow_tiles = Some(c.overflowed_lists);
+    }
+    if let Some(s) = &light_stats {
+        row.listed_exact_ratio = Some(s.false_positive_ratio());
+    }
+    Ok(())
 }
 
 fn render_once(
