@@ -1,11 +1,12 @@
 //! Benchmark support: image error metrics (RMSE, max abs, PSNR, FLIP, bad / NaN pixels), the
 //! project's one tonemapper, HDR image I/O (EXR, tonemapped PNG), and reports (CSV, Markdown,
-//! PNG plots). Nothing here needs a GPU.
+//! PNG plots). Only the sweeps and the hot-reload latency benchmark need a GPU.
 
 pub mod heatmap;
 pub mod image_io;
 pub mod metrics;
 pub mod pixel;
+pub mod reload_latency;
 pub mod report;
 pub mod sweep;
 pub mod tonemap;
