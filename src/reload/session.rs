@@ -377,11 +377,12 @@ impl ReloadSession {
         let scene = scene.unwrap_or(&self.scene);
         let gpu = gpu.unwrap_or(&self.gpu);
         let size = self.frame_size(scene);
-        let stats = graph.has_forward_shading();
         let start = Instant::now();
+        // No light statistics: that brute-force pass would run on every frame a viewer
+        // executes and is most of a reload's time on a CPU adapter (lavapipe).
         let prepared = self
             .renderer
-            .prepare_reusing(graph, scene, gpu, size, stats, self.prepared.as_ref())
+            .prepare_reusing(graph, scene, gpu, size, false, self.prepared.as_ref())
             .map_err(|e| e.to_string())?;
         let prepare_time = start.elapsed();
         let start = Instant::now();
