@@ -418,7 +418,7 @@ fn reload_bench(args: &ReloadBenchArgs) -> Result<()> {
     println!("adapter: {adapter}");
     let result = rl::run(&config, gpu, |s| {
         println!(
-            "{:<8} #{:<3} {:>8.1} ms  (watch {:.1}, compose {:.1}, build {:.1}, render {:.1}; {} pipelines built, {} resources reused, {} created)",
+            "{:<8} #{:<3} {:>8.1} ms  (watch {:.1}, compose {:.1}, build {:.1}, render {:.1} [again {:.1}]; {} pipelines built, {} resources reused, {} created)",
             s.kind.to_string(),
             s.index,
             s.total_ms,
@@ -426,6 +426,7 @@ fn reload_bench(args: &ReloadBenchArgs) -> Result<()> {
             s.shader_compose_ms,
             s.pipeline_build_ms,
             s.render_ms,
+            s.rerender_ms,
             s.pipelines_built,
             s.resources_reused,
             s.resources_created

@@ -102,6 +102,9 @@ pub struct ReloadSample {
     pub prepare_other_ms: f64,
     /// Executing the frame and reading it back.
     pub render_ms: f64,
+    /// The same frame rendered again right after (not part of the latency): what of
+    /// `render_ms` was the frame itself rather than first-use work in the driver.
+    pub rerender_ms: f64,
     pub pipelines_built: usize,
     pub resources_created: usize,
     pub resources_reused: usize,
@@ -267,11 +270,16 @@ pub fn run(
             std::fs::write(&t.file, &text).map_err(io(&t.file))?;
             let written = Instant::now();
             let reload = reload_of(&mut session, &t.file).map_err(failed)?;
-            let stats = session
-                .prepared()
-                .map(|p| p.stats().clone())
-                .unwrap_or_default();
             let ms = |d: Duration| d.as_secs_f64() * 1e3;
+            let (stats, rerender_ms) = match session.prepared() {
+                Some(p) => {
+                    let start = Instant::now();
+                    p.render(&session.renderer)
+                        .map_err(|e| failed(e.to_string()))?;
+                    (p.stats().clone(), ms(start.elapsed()))
+                }
+                None => (Default::default(), f64::NAN),
+            };
             let tm = reload.timings;
             let sample = ReloadSample {
                 kind: t.kind,
@@ -286,6 +294,7 @@ pub fn run(
                     .prepare
                     .saturating_sub(tm.shader_compose + tm.pipeline_build)),
                 render_ms: ms(tm.render),
+                rerender_ms,
                 pipelines_built: stats.pipelines_built.len(),
                 resources_created: stats.resources_created,
                 resources_reused: stats.resources_reused,
@@ -327,7 +336,7 @@ pub struct KindSummary {
 
 type Part = (&'static str, fn(&ReloadSample) -> f64);
 
-const PARTS: [Part; 7] = [
+const PARTS: [Part; 8] = [
     ("watch (debounce + events)", |s| s.watch_ms),
     ("material/scene load", |s| s.assets_ms),
     ("graph compile", |s| s.graph_ms),
@@ -335,6 +344,7 @@ const PARTS: [Part; 7] = [
     ("pipeline build", |s| s.pipeline_build_ms),
     ("other prepare", |s| s.prepare_other_ms),
     ("render + readback", |s| s.render_ms),
+    ("(same frame again)", |s| s.rerender_ms),
 ];
 
 pub fn summarize_kinds(samples: &[ReloadSample]) -> Vec<KindSummary> {
@@ -365,12 +375,12 @@ pub fn summarize_kinds(samples: &[ReloadSample]) -> Vec<KindSummary> {
 pub fn to_csv(samples: &[ReloadSample]) -> String {
     let mut out = String::from(
         "kind,index,total_ms,watch_ms,assets_ms,graph_ms,shader_compose_ms,pipeline_build_ms,\
-         prepare_other_ms,render_ms,pipelines_built,resources_created,resources_reused\n",
+         prepare_other_ms,render_ms,rerender_ms,pipelines_built,resources_created,resources_reused\n",
     );
     for s in samples {
         let _ = writeln!(
             out,
-            "{},{},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{},{},{}",
+            "{},{},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{},{},{}",
             s.kind,
             s.index,
             s.total_ms,
@@ -381,6 +391,7 @@ pub fn to_csv(samples: &[ReloadSample]) -> String {
             s.pipeline_build_ms,
             s.prepare_other_ms,
             s.render_ms,
+            s.rerender_ms,
             s.pipelines_built,
             s.resources_created,
             s.resources_reused
@@ -420,7 +431,12 @@ pub fn to_markdown(
             k.kind, k.total.median, k.total.p10, k.total.p90
         );
     }
-    let _ = writeln!(out, "\nMedian of each part (ms):\n");
+    let _ = writeln!(
+        out,
+        "\nMedian of each part (ms); the parts before \"(same frame again)\" add up to the \
+         total, which does not include that last one: the new frame rendered a second time, \
+         to tell the frame itself from first-use work in the driver.\n"
+    );
     let _ = write!(out, "| edit |");
     for (name, _) in PARTS {
         let _ = write!(out, " {name} |");
