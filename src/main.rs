@@ -505,10 +505,14 @@ fn watch(
             .map(|p| p.display().to_string())
             .collect();
         match &reload.outcome {
+            Ok(_) if reload.rebuilt.is_empty() => {
+                println!("not used by this frame: {}", names.join(", "));
+            }
             Ok(latency) => {
                 write(&session)?;
                 println!(
-                    "reloaded in {:.1} ms: {}",
+                    "reloaded {} in {:.1} ms after the change was seen: {}",
+                    reload.rebuilt.join(", "),
                     latency.as_secs_f64() * 1e3,
                     names.join(", ")
                 );
