@@ -67,6 +67,25 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Hot-reload latency: time real shader, material and graph edits from the file
+    /// write to the new frame; write CSV and Markdown to --out.
+    ReloadBench(ReloadBenchArgs),
+}
+
+#[derive(clap::Args)]
+struct ReloadBenchArgs {
+    #[arg(long)]
+    out: PathBuf,
+    #[arg(long, default_value_t = 160)]
+    width: u32,
+    #[arg(long, default_value_t = 90)]
+    height: u32,
+    /// Random lights in the benchmark scene.
+    #[arg(long, default_value_t = 1024)]
+    lights: u32,
+    /// Edits of each kind.
+    #[arg(long, default_value_t = 10)]
+    repeats: usize,
 }
 
 #[derive(clap::Args, Default)]
@@ -166,6 +185,7 @@ fn main() -> Result<()> {
         }) => watch(scene, graph, width, height, &out),
         Some(Command::Bench { sweep, out }) => run_bench(sweep.as_deref(), &out),
         Some(Command::View(args)) => view(args),
+        Some(Command::ReloadBench(args)) => reload_bench(&args),
     }
 }
 
@@ -456,6 +476,62 @@ fn non_finite_warning(row: &bench::BenchRow) -> Option<String> {
     ))
 }
 
+fn reload_bench(args: &ReloadBenchArgs) -> Result<()> {
+    use lightgraph::bench::reload_latency as rl;
+    if args.width == 0 || args.height == 0 || args.repeats == 0 {
+        bail!("--width, --height and --repeats must be positive");
+    }
+    // A fresh folder of our own to copy the inputs into and edit.
+    let work = std::env::temp_dir().join(format!("lightgraph-reload-bench-{}", std::process::id()));
+    if work.exists() {
+        std::fs::remove_dir_all(&work).with_context(|| work.display().to_string())?;
+    }
+    let config = rl::ReloadBenchConfig {
+        project: lightgraph::project_root(),
+        work: work.clone(),
+        width: args.width,
+        height: args.height,
+        lights: args.lights,
+        repeats: args.repeats,
+    };
+    let gpu = lightgraph::gpu::GpuContext::new_headless()?;
+    let adapter = gpu.adapter_name();
+    println!("adapter: {adapter}");
+    let result = rl::run(&config, gpu, |s| {
+        println!(
+            "{:<8} #{:<3} {:>8.1} ms  (watch {:.1}, compose {:.1}, build {:.1}, render {:.1} [again {:.1}]; {} pipelines built, {} resources reused, {} created)",
+            s.kind.to_string(),
+            s.index,
+            s.total_ms,
+            s.watch_ms,
+            s.shader_compose_ms,
+            s.pipeline_build_ms,
+            s.render_ms,
+            s.rerender_ms,
+            s.pipelines_built,
+            s.resources_reused,
+            s.resources_created
+        );
+    });
+    let _ = std::fs::remove_dir_all(&work);
+    let samples = result?;
+    std::fs::create_dir_all(&args.out).with_context(|| args.out.display().to_string())?;
+    let csv = args.out.join("reload_latency.csv");
+    std::fs::write(&csv, rl::to_csv(&samples)).with_context(|| csv.display().to_string())?;
+    let md = args.out.join("reload_latency.md");
+    let watch = lightgraph::reload::WatchConfig::default();
+    std::fs::write(&md, rl::to_markdown(&samples, &config, &adapter, &watch))
+        .with_context(|| md.display().to_string())?;
+    for k in rl::summarize_kinds(&samples) {
+        println!(
+            "{}: median {:.1} ms, p10 {:.1}, p90 {:.1}",
+            k.kind, k.total.median, k.total.p10, k.total.p90
+        );
+    }
+    println!("wrote {} and {}", csv.display(), md.display());
+    Ok(())
+}
+
 fn material(path: &Path, wgsl: bool) -> Result<()> {
     let m = lightgraph::material::Material::load(path)?;
     for w in m.warnings() {
@@ -510,10 +586,14 @@ fn watch(
             .map(|p| p.display().to_string())
             .collect();
         match &reload.outcome {
+            Ok(_) if reload.rebuilt.is_empty() => {
+                println!("not used by this frame: {}", names.join(", "));
+            }
             Ok(latency) => {
                 write(&session)?;
                 println!(
-                    "reloaded in {:.1} ms: {}",
+                    "reloaded {} in {:.1} ms after the change was seen: {}",
+                    reload.rebuilt.join(", "),
                     latency.as_secs_f64() * 1e3,
                     names.join(", ")
                 );

@@ -7,7 +7,8 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-const DEBOUNCE: Duration = Duration::from_millis(100);
+/// The default debounce: the save styles below must work with what sessions use.
+const DEBOUNCE: Duration = WatchConfig::DEFAULT_DEBOUNCE;
 const GRACE: Duration = Duration::from_millis(1000);
 /// Upper bound for an expected batch to arrive (generous: CI machines are slow).
 const PRESENT: Duration = Duration::from_secs(10);

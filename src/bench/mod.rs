@@ -1,6 +1,6 @@
 //! Benchmark support: image error metrics (RMSE, max abs, PSNR, FLIP, bad / NaN pixels), the
 //! project's one tonemapper, HDR image I/O (EXR, tonemapped PNG), and reports (CSV, Markdown,
-//! PNG plots). Nothing here needs a GPU.
+//! PNG plots). Only the sweeps and the hot-reload latency benchmark need a GPU.
 
 pub mod cases;
 pub mod heatmap;
@@ -8,6 +8,7 @@ pub mod image_io;
 pub mod metrics;
 pub mod pixel;
 pub mod progress;
+pub mod reload_latency;
 pub mod report;
 pub mod sweep;
 pub mod tonemap;

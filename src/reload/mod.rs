@@ -22,7 +22,7 @@ pub mod session;
 pub mod watcher;
 
 pub use deps::DependencyIndex;
-pub use session::{Reload, ReloadSession, SceneSource};
+pub use session::{Reload, ReloadSession, ReloadTimings, SceneSource};
 pub use watcher::{
     is_editor_temp_file, normalize_path, ChangeBatch, ChangeKind, FileWatcher, WatchConfig,
     WatchError,

@@ -1,12 +1,23 @@
 //! A headless hot-reload session: renders a graph for a scene, watches the shader
-//! folder, the graph file and the scene's files, and on every change rebuilds only what
-//! depends on it. A broken edit never loses the frame: the last good result stays and
-//! the error (with file:line) is kept beside it until the next good save.
+//! folder, the graph file, the scene file and every material file the scene uses, and on
+//! every change rebuilds only what depends on it:
+//! - a shader edit drops the pipelines whose composed source used the file;
+//! - a material edit reloads that material alone (other materials' pipelines are cache
+//!   hits, and depth-only draws never depended on it);
+//! - a graph edit recompiles the graph; pipelines whose key did not change are cache hits
+//!   and physical textures and buffers whose descriptor did not change are taken over
+//!   from the live frame;
+//! - a scene edit reloads and uploads the scene.
+//!
+//! A broken edit never loses the frame: the last good [`PreparedFrame`] and image stay
+//! and the error (with file:line) is kept beside it. What failed to load is retried on
+//! every later change, so the error stays until that file is fixed.
 
-use super::{FileWatcher, WatchConfig, WatchError};
-use crate::graph::{self, FrameSize};
-use crate::render::{FrameResult, PreparedFrame, Renderer, SceneGpu};
+use super::{normalize_path, ChangeBatch, DependencyIndex, FileWatcher, WatchConfig, WatchError};
+use crate::graph::{self, CompiledGraph, FrameSize};
+use crate::render::{FrameResult, MaterialProgram, PreparedFrame, Renderer, SceneGpu};
 use crate::scene::{self, Scene};
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -16,12 +27,49 @@ pub enum SceneSource {
     Fixed(Box<Scene>),
 }
 
+/// Where the time of one reload went. `shader_compose` and `pipeline_build` are part of
+/// `prepare`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ReloadTimings {
+    /// Reading, validating and uploading changed scene and material files.
+    pub assets: Duration,
+    /// Parsing, validating and compiling the graph.
+    pub graph: Duration,
+    /// `Renderer::prepare` in total: pipelines, resources, bind groups.
+    pub prepare: Duration,
+    /// Composing shader sources and validating them with naga (pipeline-cache misses).
+    pub shader_compose: Duration,
+    /// Creating shader modules and pipelines (pipeline-cache misses).
+    pub pipeline_build: Duration,
+    /// Executing the new frame and reading it back.
+    pub render: Duration,
+}
+
 /// What one reload did.
 #[derive(Debug)]
 pub struct Reload {
     pub changed: Vec<PathBuf>,
-    /// Edit-to-new-frame latency, or the error that kept the last good frame.
+    /// Time from the batch's arrival to the new frame, or the error that kept the last
+    /// good frame. The watcher's debounce came before `received` and is not included:
+    /// measure edit-to-frame from the file write to `finished`.
     pub outcome: Result<Duration, String>,
+    /// When the watcher delivered the batch.
+    pub received: Instant,
+    /// When the new frame was ready (or the reload gave up).
+    pub finished: Instant,
+    /// What was reloaded: `graph`, `scene`, `material <name>`, `shaders`; empty when the
+    /// batch touched nothing the frame uses.
+    pub rebuilt: Vec<String>,
+    pub timings: ReloadTimings,
+}
+
+/// Dependency-index keys of what a session loads from files.
+const GRAPH: &str = "graph";
+const SCENE: &str = "scene";
+const MATERIAL: &str = "material ";
+
+fn material_key(name: &str) -> String {
+    format!("{MATERIAL}{name}")
 }
 
 pub struct ReloadSession {
@@ -33,10 +81,17 @@ pub struct ReloadSession {
     width: u32,
     height: u32,
     watcher: FileWatcher,
+    shader_root: PathBuf,
+    /// Files → what is loaded from them (graph, scene, each overridden material).
+    deps: DependencyIndex,
+    /// What changed on disk but has not loaded yet (retried on every reload).
+    stale: BTreeSet<String>,
+    /// The last frame that prepared and rendered, ready to execute again.
+    prepared: Option<PreparedFrame>,
+    /// Whether frames include the light statistics pass.
+    light_stats: bool,
     /// The last frame that rendered.
     pub frame: Option<FrameResult>,
-    /// The graph of the last good frame, ready to run again (the viewer executes it).
-    prepared: Option<PreparedFrame>,
     /// The current error, if the last reload failed.
     pub error: Option<String>,
 }
@@ -48,9 +103,54 @@ fn load_scene(source: &SceneSource) -> Result<Scene, String> {
     }
 }
 
+/// Each overridden material's name with the files it was read from.
+type MaterialFiles = Vec<(String, Vec<PathBuf>)>;
+
+/// Uploads a scene; also returns, for each material the scene overrides, the files it
+/// was read from (the override RON and its textures).
+fn upload_scene(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    scene: &Scene,
+) -> Result<(SceneGpu, MaterialFiles), String> {
+    if scene.materials.is_empty() {
+        // The default material: nothing to override, nothing to watch.
+        let gpu = SceneGpu::upload(device, queue, scene).map_err(|e| e.to_string())?;
+        return Ok((gpu, Vec::new()));
+    }
+    let mut programs = Vec::new();
+    let mut files = Vec::new();
+    for surface in &scene.materials {
+        let (program, used) = MaterialProgram::for_surface(device, queue, scene, surface)
+            .map_err(|e| e.to_string())?;
+        if !used.is_empty() {
+            files.push((surface.name.clone(), used));
+        }
+        programs.push(program);
+    }
+    Ok((SceneGpu::upload_with(device, scene, programs), files))
+}
+
+/// A candidate state, built beside the live one and swapped in only if it rendered.
+struct Candidate {
+    /// The stale dependents it loaded.
+    resolved: BTreeSet<String>,
+    /// A reloaded scene, its GPU data and its overridden materials' files.
+    scene: Option<(Scene, MaterialFiles)>,
+    /// New GPU data (a reloaded scene, or the live one with some materials replaced).
+    gpu: Option<SceneGpu>,
+    /// The files of materials reloaded alone.
+    materials: MaterialFiles,
+    prepared: PreparedFrame,
+    frame: FrameResult,
+    prepare_time: Duration,
+    render_time: Duration,
+}
+
 impl ReloadSession {
     /// Renders once and starts watching the renderer's shader folder, the graph file,
-    /// the scene file and `extra` paths (material folders).
+    /// the scene file, every material file the scene overrides a material with (wherever
+    /// it lies, with its textures) and `extra` paths (material folders).
     pub fn new(
         renderer: Renderer,
         graph_path: &Path,
@@ -60,84 +160,103 @@ impl ReloadSession {
         extra: &[PathBuf],
     ) -> Result<Self, String> {
         let scene = load_scene(&source)?;
-        let gpu = SceneGpu::upload(&renderer.ctx.device, &renderer.ctx.queue, &scene)
-            .map_err(|e| e.to_string())?;
+        let (gpu, materials) = upload_scene(&renderer.ctx.device, &renderer.ctx.queue, &scene)?;
         let watch_err = |e: WatchError| e.to_string();
         let mut watcher = FileWatcher::new(WatchConfig::default()).map_err(watch_err)?;
-        watcher.watch(&renderer.shaders.root).map_err(watch_err)?;
-        watcher.watch(graph_path).map_err(watch_err)?;
-        if let SceneSource::File(p) = &source {
-            watcher.watch(p).map_err(watch_err)?;
-        }
+        let shader_root = watcher.watch(&renderer.shaders.root).map_err(watch_err)?;
         for p in extra {
             watcher.watch(p).map_err(watch_err)?;
         }
         let mut session = Self {
             renderer,
-            graph_path: graph_path.to_path_buf(),
+            graph_path: normalize_path(graph_path),
             source,
             scene,
             gpu,
             width,
             height,
             watcher,
-            frame: None,
+            shader_root,
+            deps: DependencyIndex::new(),
+            stale: BTreeSet::new(),
             prepared: None,
+            light_stats: false,
+            frame: None,
             error: None,
         };
-        let first = session.render()?;
-        session.frame = Some(first);
+        session.watch_dependency(GRAPH, vec![session.graph_path.clone()])?;
+        if let SceneSource::File(p) = &session.source {
+            let p = p.clone();
+            session.watch_dependency(SCENE, vec![p])?;
+        }
+        for (name, files) in materials {
+            session.watch_dependency(&material_key(&name), files)?;
+        }
+        let graph = session.compile_graph(&session.scene)?;
+        let candidate = session.prepare_and_render(graph, None, None)?;
+        session.commit(candidate);
         Ok(session)
     }
 
-    fn render(&mut self) -> Result<FrameResult, String> {
-        let checked = graph::check_file(&self.graph_path, &self.renderer.shaders)
-            .map_err(|e| e.to_string())?;
-        let size = FrameSize {
-            width: self.width,
-            height: self.height,
-            lights: self.scene.lights.len() as u32,
-        };
-        let compiled = graph::compile(checked, &self.scene.features(), size);
-        let stats = compiled.has_forward_shading();
-        let prepared = self
-            .renderer
-            .prepare(compiled, &self.scene, &self.gpu, size, stats)
-            .map_err(|e| e.to_string())?;
-        let frame = prepared.render(&self.renderer).map_err(|e| e.to_string())?;
-        self.prepared = Some(prepared);
-        Ok(frame)
-    }
-
-    /// The last good graph, prepared: execute it to draw another frame.
+    /// The last good prepared frame (what `frame` was rendered from), to execute again
+    /// without readback, e.g. by a window viewer.
     pub fn prepared(&self) -> Option<&PreparedFrame> {
         self.prepared.as_ref()
     }
 
+    /// The scene the live frame shows.
     pub fn scene(&self) -> &Scene {
         &self.scene
     }
 
+    /// The graph file the session renders (normalised).
     pub fn graph_path(&self) -> &Path {
         &self.graph_path
     }
 
-    /// Reloads whatever changed since the last call, without waiting.
-    pub fn poll(&mut self) -> Option<Reload> {
-        self.wait(Duration::ZERO)
+    /// Every file the session reloads something from, except shaders (watched as a
+    /// folder): the graph, the scene file, material overrides and their textures.
+    pub fn watched_files(&self) -> Vec<PathBuf> {
+        self.deps.paths().map(Path::to_path_buf).collect()
     }
 
-    /// Switches to another graph file (a variant). On error the old graph keeps rendering.
+    /// Waits up to `timeout` for a change, then reloads what it touched. `None` if
+    /// nothing changed in time.
+    pub fn wait(&mut self, timeout: Duration) -> Option<Reload> {
+        let mut batch = self.watcher.wait_for_change(timeout)?;
+        let received = Instant::now();
+        if let Some(more) = self.watcher.drain() {
+            batch.merge(more);
+        }
+        Some(self.apply(batch, received))
+    }
+
+    /// Reloads what the changes ready now touched, without waiting; `None` if there are
+    /// none.
+    pub fn poll(&mut self) -> Option<Reload> {
+        let batch = self.watcher.drain()?;
+        Some(self.apply(batch, Instant::now()))
+    }
+
+    /// Switches to another graph file: watches it, compiles it and prepares it, taking
+    /// over the live frame's resources where they fit. On error the old graph and frame
+    /// stay and the error (with file:line) is returned.
     pub fn set_graph(&mut self, path: &Path) -> Result<(), String> {
-        let old = std::mem::replace(&mut self.graph_path, path.to_path_buf());
-        match self.render() {
-            Ok(frame) => {
-                self.frame = Some(frame);
-                self.error = None;
-                self.watcher
-                    .watch(path)
-                    .map(|_| ())
-                    .map_err(|e| e.to_string())
+        let path = normalize_path(path);
+        self.watcher.watch(&path).map_err(|e| e.to_string())?;
+        let old = std::mem::replace(&mut self.graph_path, path.clone());
+        let candidate = self
+            .compile_graph(&self.scene)
+            .and_then(|graph| self.prepare_and_render(graph, None, None));
+        match candidate {
+            Ok(mut c) => {
+                self.deps.set_dependencies(GRAPH, [path]);
+                c.resolved.insert(GRAPH.to_string());
+                self.commit(c);
+                if self.stale.is_empty() {
+                    self.error = None;
+                }
+                Ok(())
             }
             Err(e) => {
                 self.graph_path = old;
@@ -146,51 +265,215 @@ impl ReloadSession {
         }
     }
 
-    /// Renders at a new size (the viewer's window was resized).
+    /// Renders at a new size (the viewer's window was resized). On error the old size
+    /// and frame stay.
     pub fn resize(&mut self, width: u32, height: u32) -> Result<(), String> {
         let old = (self.width, self.height);
         (self.width, self.height) = (width.max(1), height.max(1));
-        match self.render() {
-            Ok(frame) => {
-                self.frame = Some(frame);
-                Ok(())
-            }
-            Err(e) => {
-                (self.width, self.height) = old;
-                Err(e)
-            }
+        let result = self.reprepare();
+        if result.is_err() {
+            (self.width, self.height) = old;
         }
+        result
     }
 
-    /// Waits up to `timeout` for a change, then reloads what it touched. `None` if
-    /// nothing changed in time.
-    pub fn wait(&mut self, timeout: Duration) -> Option<Reload> {
-        let batch = self.watcher.wait_for_change(timeout)?;
-        let start = Instant::now();
+    /// Adds or removes the per-pixel light statistics pass (listed against exact lights
+    /// per pixel). It is a brute-force pass, so it is off unless asked for.
+    pub fn set_light_stats(&mut self, on: bool) -> Result<(), String> {
+        let old = std::mem::replace(&mut self.light_stats, on);
+        let result = self.reprepare();
+        if result.is_err() {
+            self.light_stats = old;
+        }
+        result
+    }
+
+    /// Prepares the live graph again with the current settings.
+    fn reprepare(&mut self) -> Result<(), String> {
+        let candidate = self
+            .compile_graph(&self.scene)
+            .and_then(|graph| self.prepare_and_render(graph, None, None))?;
+        self.commit(candidate);
+        Ok(())
+    }
+
+    /// Reloads what `batch` touched (and whatever still failed to load before).
+    fn apply(&mut self, batch: ChangeBatch, received: Instant) -> Reload {
         let changed: Vec<PathBuf> = batch.paths().map(Path::to_path_buf).collect();
         // Shader edits rebuild only the pipelines whose composed source used the file.
         self.renderer.pipelines.invalidate_files(&changed);
-        let shader_root = &self.renderer.shaders.root;
-        let scene_touched = changed
-            .iter()
-            .any(|p| !p.starts_with(shader_root) && *p != self.graph_path);
-        let outcome = self.reload(scene_touched).map(|frame| {
-            self.frame = Some(frame);
-            start.elapsed()
-        });
+        let shaders = changed.iter().any(|p| p.starts_with(&self.shader_root));
+        self.stale.extend(self.deps.affected(&changed));
+        let mut rebuilt: Vec<String> = self.stale.iter().cloned().collect();
+        if shaders {
+            rebuilt.push("shaders".into());
+        }
+        let mut timings = ReloadTimings::default();
+        let outcome = if rebuilt.is_empty() {
+            // Nothing the frame uses (another material in a watched folder, say).
+            Ok(received.elapsed())
+        } else {
+            self.reload(shaders, &mut timings).map(|candidate| {
+                self.commit(candidate);
+                received.elapsed()
+            })
+        };
         self.error = outcome.as_ref().err().cloned();
-        Some(Reload { changed, outcome })
+        Reload {
+            changed,
+            outcome,
+            received,
+            finished: Instant::now(),
+            rebuilt,
+            timings,
+        }
     }
 
-    fn reload(&mut self, scene_touched: bool) -> Result<FrameResult, String> {
-        if scene_touched {
-            // Scenes and materials: load both before replacing anything.
-            let scene = load_scene(&self.source)?;
-            let gpu = SceneGpu::upload(&self.renderer.ctx.device, &self.renderer.ctx.queue, &scene)
-                .map_err(|e| e.to_string())?;
+    /// Builds the new state from the stale dependents and renders it, replacing nothing.
+    fn reload(&mut self, shaders: bool, t: &mut ReloadTimings) -> Result<Candidate, String> {
+        let start = Instant::now();
+        let device = self.renderer.ctx.device.clone();
+        let queue = self.renderer.ctx.queue.clone();
+        let mut scene = None;
+        let mut gpu = None;
+        let mut materials = Vec::new();
+        if self.stale.contains(SCENE) {
+            let s = load_scene(&self.source)?;
+            let (g, files) = upload_scene(&device, &queue, &s)?;
+            gpu = Some(g);
+            scene = Some((s, files));
+        } else {
+            // Materials alone: a copy of the live scene's GPU data with those replaced.
+            for key in &self.stale {
+                let Some(name) = key.strip_prefix(MATERIAL) else {
+                    continue;
+                };
+                let mut files = Vec::new();
+                for (i, surface) in self.scene.materials.iter().enumerate() {
+                    if surface.name != name {
+                        continue;
+                    }
+                    let (program, used) =
+                        MaterialProgram::for_surface(&device, &queue, &self.scene, surface)
+                            .map_err(|e| e.to_string())?;
+                    gpu.get_or_insert_with(|| self.gpu.clone()).materials[i] = program;
+                    files = used;
+                }
+                materials.push((name.to_string(), files));
+            }
+        }
+        t.assets = start.elapsed();
+        let start = Instant::now();
+        let graph_unchanged = scene.is_none() && !shaders && !self.stale.contains(GRAPH);
+        let graph = match (&self.prepared, graph_unchanged) {
+            // A material edit changes neither the graph nor the scene's features.
+            (Some(p), true) => p.graph.clone(),
+            _ => self.compile_graph(scene.as_ref().map_or(&self.scene, |(s, _)| s))?,
+        };
+        t.graph = start.elapsed();
+        let mut c = self.prepare_and_render(graph, scene.as_ref().map(|(s, _)| s), gpu.as_ref())?;
+        t.prepare = c.prepare_time;
+        t.render = c.render_time;
+        t.shader_compose = c.prepared.stats().shader_compose;
+        t.pipeline_build = c.prepared.stats().pipeline_build;
+        c.resolved = self.stale.clone();
+        c.scene = scene;
+        c.gpu = gpu;
+        c.materials = materials;
+        Ok(c)
+    }
+
+    fn compile_graph(&self, scene: &Scene) -> Result<CompiledGraph, String> {
+        let checked = graph::check_file(&self.graph_path, &self.renderer.shaders)
+            .map_err(|e| e.to_string())?;
+        Ok(graph::compile(
+            checked,
+            &scene.features(),
+            self.frame_size(scene),
+        ))
+    }
+
+    fn frame_size(&self, scene: &Scene) -> FrameSize {
+        FrameSize {
+            width: self.width,
+            height: self.height,
+            lights: scene.lights.len() as u32,
+        }
+    }
+
+    /// Prepares `graph` for the given scene and GPU data (default: the live ones), taking
+    /// resources from the live frame where they fit, and renders it.
+    fn prepare_and_render(
+        &mut self,
+        graph: CompiledGraph,
+        scene: Option<&Scene>,
+        gpu: Option<&SceneGpu>,
+    ) -> Result<Candidate, String> {
+        let scene = scene.unwrap_or(&self.scene);
+        let gpu = gpu.unwrap_or(&self.gpu);
+        let size = self.frame_size(scene);
+        let start = Instant::now();
+        // Light statistics only when asked for: that brute-force pass would run on every
+        // frame a viewer executes and is most of a reload's time on a CPU adapter.
+        let stats = self.light_stats && graph.has_forward_shading();
+        let prepared = self
+            .renderer
+            .prepare_reusing(graph, scene, gpu, size, stats, self.prepared.as_ref())
+            .map_err(|e| e.to_string())?;
+        let prepare_time = start.elapsed();
+        let start = Instant::now();
+        let frame = prepared.render(&self.renderer).map_err(|e| e.to_string())?;
+        Ok(Candidate {
+            resolved: BTreeSet::new(),
+            scene: None,
+            gpu: None,
+            materials: Vec::new(),
+            prepared,
+            frame,
+            prepare_time,
+            render_time: start.elapsed(),
+        })
+    }
+
+    /// Swaps a candidate in and re-registers the files of what it reloaded.
+    fn commit(&mut self, c: Candidate) {
+        let generation = c.prepared.stats().cache_generation;
+        let mut materials = c.materials;
+        if let Some((scene, files)) = c.scene {
+            // A new scene may override other materials, from other files.
+            let old: Vec<String> = self
+                .deps
+                .dependents()
+                .filter(|d| d.starts_with(MATERIAL))
+                .map(str::to_string)
+                .collect();
+            for d in old {
+                self.deps.remove_dependent(&d);
+            }
             self.scene = scene;
+            materials = files;
+        }
+        if let Some(gpu) = c.gpu {
             self.gpu = gpu;
         }
-        self.render()
+        self.prepared = Some(c.prepared);
+        self.frame = Some(c.frame);
+        self.stale.retain(|d| !c.resolved.contains(d));
+        // Pipelines that only replaced frames used (old material versions) are dropped.
+        self.renderer.pipelines.evict_unused_since(generation);
+        for (name, files) in materials {
+            // The frame is in; a file that cannot be watched only loses future reloads.
+            if let Err(e) = self.watch_dependency(&material_key(&name), files) {
+                log::warn!("hot reload: {e}");
+            }
+        }
+    }
+
+    fn watch_dependency(&mut self, key: &str, files: Vec<PathBuf>) -> Result<(), String> {
+        for f in &files {
+            self.watcher.watch(f).map_err(|e| e.to_string())?;
+        }
+        self.deps.set_dependencies(key, files);
+        Ok(())
     }
 }

@@ -2,6 +2,7 @@
 //! needed (benchmarks run it many times), with readback of the output and statistics.
 
 use super::pipelines::{Pipeline, PipelineKey};
+use super::prepare_stats::PrepareStats;
 use super::resources::FrameResources;
 use super::scene_gpu::SceneGpu;
 use super::{RenderError, Renderer};
@@ -133,6 +134,7 @@ pub struct PreparedFrame {
     absent: Vec<String>,
     queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
     stats: Option<(Arc<wgpu::ComputePipeline>, wgpu::BindGroup, wgpu::Buffer)>,
+    prepare_stats: PrepareStats,
 }
 
 /// Most lights a coarse culling tile lists; a tile with more sends its fine tiles back
@@ -233,16 +235,50 @@ impl Renderer {
         size: FrameSize,
         light_stats: bool,
     ) -> Result<PreparedFrame, RenderError> {
+        self.prepare_reusing(graph, scene, gpu, size, light_stats, None)
+    }
+
+    /// Like [`prepare`](Self::prepare) for a frame that replaces `previous` (hot reload,
+    /// switching graphs): physical textures and buffers whose descriptor and usage did
+    /// not change are taken from it instead of created. `previous` stays usable (the
+    /// handles are shared), so it can keep running if this frame is never used.
+    pub fn prepare_reusing(
+        &mut self,
+        graph: CompiledGraph,
+        scene: &Scene,
+        gpu: &SceneGpu,
+        size: FrameSize,
+        light_stats: bool,
+        previous: Option<&PreparedFrame>,
+    ) -> Result<PreparedFrame, RenderError> {
         // wgpu reports validation errors (a list buffer over the binding limit, say) as
         // errors here instead of panicking.
         let scope = self
             .ctx
             .device
             .push_error_scope(wgpu::ErrorFilter::Validation);
-        let result = self.prepare_unscoped(graph, scene, gpu, size, light_stats);
+        let generation = self.pipelines.next_generation();
+        let before = self.pipelines.counters();
+        self.pipelines.take_built();
+        let pool = previous.map(|p| &p.resources);
+        let result = self.prepare_unscoped(graph, scene, gpu, size, light_stats, pool);
+        let built = self
+            .pipelines
+            .take_built()
+            .iter()
+            .map(|k| k.describe())
+            .collect();
+        let stats = PrepareStats::from_cache(self.pipelines.counters() - before, built, generation);
         match pollster::block_on(scope.pop()) {
             Some(e) => Err(RenderError::Wgpu(e.to_string())),
-            None => result,
+            None => result.map(|mut frame| {
+                frame.prepare_stats = PrepareStats {
+                    resources_created: frame.resources.created(),
+                    resources_reused: frame.resources.reused(),
+                    ..stats
+                };
+                frame
+            }),
         }
     }
 
@@ -253,6 +289,7 @@ impl Renderer {
         gpu: &SceneGpu,
         size: FrameSize,
         light_stats: bool,
+        pool: Option<&FrameResources>,
     ) -> Result<PreparedFrame, RenderError> {
         let device = self.ctx.device.clone();
         let out = graph.output().to_string();
@@ -270,7 +307,7 @@ impl Renderer {
             }) => {}
             _ => return Err(RenderError::OutputFormat(out)),
         }
-        let resources = FrameResources::create(&device, &graph.plan);
+        let resources = FrameResources::create_reusing(&device, &graph.plan, pool);
         let gpu_frame = GpuFrame::new(
             &scene.camera,
             scene.ambient,
@@ -759,6 +796,7 @@ impl Renderer {
             absent,
             queries,
             stats,
+            prepare_stats: PrepareStats::default(),
         })
     }
 
@@ -822,10 +860,18 @@ impl Renderer {
             if lists == Some(true) {
                 d.push(("LIGHT_LISTS", "1".into()));
             }
+            // A prepass or G-buffer draw of an opaque, untextured material never calls the
+            // material code: key it with a neutral material, so editing the material
+            // rebuilds only the pipelines that shade with it.
+            let material_unused = !masked && mode != DrawMode::Shade && m.bind_group.is_none();
+            let code = match neutral_material_wgsl() {
+                Some(neutral) if material_unused => neutral.to_string(),
+                _ => m.wgsl.clone(),
+            };
             let key = PipelineKey {
                 shader: "forward/forward.wgsl".into(),
                 defines: defines(&d),
-                virtual_code: BTreeMap::from([("material".to_string(), m.wgsl.clone())]),
+                virtual_code: BTreeMap::from([("material".to_string(), code)]),
                 state: format!(
                     "samples={samples} double_sided={} mode={mode:?}",
                     m.double_sided
@@ -916,6 +962,22 @@ impl Renderer {
     }
 }
 
+/// Material code for pipelines that include the material but never call it (`None`
+/// only if generating it failed, then each material keys with its own code).
+fn neutral_material_wgsl() -> Option<&'static str> {
+    static CODE: std::sync::OnceLock<Option<String>> = std::sync::OnceLock::new();
+    CODE.get_or_init(|| {
+        let neutral = crate::scene::SurfaceMaterial {
+            name: "neutral".into(),
+            ..Default::default()
+        };
+        crate::material::Material::from_surface(&neutral)
+            .wgsl()
+            .ok()
+    })
+    .as_deref()
+}
+
 fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
     wgpu::BindGroupEntry {
         binding,
@@ -924,6 +986,11 @@ fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
 }
 
 impl PreparedFrame {
+    /// What preparing this frame built, reused and created.
+    pub fn stats(&self) -> &PrepareStats {
+        &self.prepare_stats
+    }
+
     /// Records and submits one frame; returns GPU milliseconds per pass when the
     /// adapter has timestamps.
     pub fn execute(&self, r: &Renderer) -> Result<Option<Vec<(String, f64)>>, RenderError> {

@@ -2,11 +2,13 @@
 //! `<material>` include of `shaders/forward/forward.wgsl`), its textures uploaded into
 //! bind group 2, and what the pipelines need to know.
 
-use crate::material::{Material, MaterialError};
-use crate::scene::{AlphaMode, Scene};
+use crate::material::{Material, MaterialError, TextureSource};
+use crate::scene::{AlphaMode, Scene, SurfaceMaterial};
+use std::path::PathBuf;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
+#[derive(Clone)]
 pub struct MaterialProgram {
     pub name: String,
     /// Generated WGSL, included as `<material>`.
@@ -122,37 +124,61 @@ impl MaterialProgram {
         queue: &wgpu::Queue,
         scene: &Scene,
     ) -> Result<Vec<Self>, MaterialError> {
-        let mut out = Vec::new();
         let defaults = [crate::scene::SurfaceMaterial::default()];
         let surfaces = if scene.materials.is_empty() {
             &defaults[..]
         } else {
             &scene.materials[..]
         };
-        for surface in surfaces {
-            let material = match scene
-                .material_overrides
-                .iter()
-                .find(|(n, _)| *n == surface.name)
-            {
-                Some((_, path)) => {
-                    let base = scene.source_path.as_deref().and_then(|p| p.parent());
-                    let path = match base {
-                        Some(dir) if path.is_relative() && !path.exists() => dir.join(path),
-                        _ => path.clone(),
-                    };
-                    Material::load(&path)?
-                }
-                None => Material::from_surface(surface),
-            };
-            out.push(Self::new(
-                device,
-                queue,
-                &material,
-                surface.alpha_mode,
-                surface.double_sided,
-            )?);
-        }
-        Ok(out)
+        surfaces
+            .iter()
+            .map(|surface| Self::for_surface(device, queue, scene, surface).map(|(p, _)| p))
+            .collect()
     }
+
+    /// The program for one scene material, and the files it was read from (the override
+    /// RON and its texture files; none for a material mapped from glTF).
+    pub fn for_surface(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        surface: &SurfaceMaterial,
+    ) -> Result<(Self, Vec<PathBuf>), MaterialError> {
+        let (material, files) = match override_path(scene, &surface.name) {
+            Some(path) => {
+                let material = Material::load(&path)?;
+                let mut files = vec![path];
+                files.extend(
+                    material
+                        .texture_slots()
+                        .iter()
+                        .filter_map(|s| match &s.source {
+                            TextureSource::File { path, .. } => Some(path.clone()),
+                            TextureSource::Image(_) => None,
+                        }),
+                );
+                (material, files)
+            }
+            None => (Material::from_surface(surface), Vec::new()),
+        };
+        let program = Self::new(
+            device,
+            queue,
+            &material,
+            surface.alpha_mode,
+            surface.double_sided,
+        )?;
+        Ok((program, files))
+    }
+}
+
+/// The material RON that replaces the scene material `name`, if the scene overrides it:
+/// the path as written if it exists, else relative to the scene file's folder.
+pub fn override_path(scene: &Scene, name: &str) -> Option<PathBuf> {
+    let (_, path) = scene.material_overrides.iter().find(|(n, _)| n == name)?;
+    let base = scene.source_path.as_deref().and_then(|p| p.parent());
+    Some(match base {
+        Some(dir) if path.is_relative() && !path.exists() => dir.join(path),
+        _ => path.clone(),
+    })
 }

@@ -5,12 +5,14 @@ mod frame;
 mod generic;
 pub mod materials;
 mod pipelines;
+mod prepare_stats;
 mod resources;
 mod scene_gpu;
 
 pub use frame::{CullingReport, FrameResult, LightStats, PreparedFrame};
 pub use materials::MaterialProgram;
-pub use pipelines::{Pipeline, PipelineCache, PipelineKey};
+pub use pipelines::{CacheCounters, Pipeline, PipelineCache, PipelineKey};
+pub use prepare_stats::PrepareStats;
 pub use resources::FrameResources;
 pub use scene_gpu::{GpuMesh, SceneGpu};
 

@@ -6,6 +6,7 @@ use crate::gpu::structs::{light_buffers, GpuVertex};
 use crate::scene::{AlphaMode, Scene};
 use wgpu::util::DeviceExt;
 
+#[derive(Clone)]
 pub struct GpuMesh {
     pub vertices: wgpu::Buffer,
     pub indices: wgpu::Buffer,
@@ -13,6 +14,9 @@ pub struct GpuMesh {
     pub material: usize,
 }
 
+/// Cheap to clone (the GPU objects are shared handles): hot reload builds a changed copy
+/// beside the live one.
+#[derive(Clone)]
 pub struct SceneGpu {
     pub meshes: Vec<GpuMesh>,
     pub materials: Vec<MaterialProgram>,

@@ -191,6 +191,7 @@ impl Viewer {
             camera_mode: camera.mode,
             exposure_ev: options.exposure_ev,
             visible: true,
+            light_stats: false,
         };
         window.request_redraw();
         Ok(Self {
@@ -344,7 +345,7 @@ impl Viewer {
     }
 
     fn reload_if_changed(&mut self) {
-        if let Some(reload) = self.session.poll() {
+        if let Some(reload) = self.session.poll().filter(|r| !r.rebuilt.is_empty()) {
             let names: Vec<String> = reload
                 .changed
                 .iter()
@@ -489,6 +490,12 @@ impl Viewer {
                 Err(e) => self.info.error = Some(e),
             },
             OverlayAction::CameraMode(mode) => self.set_camera_mode(mode),
+            OverlayAction::LightStats(on) => {
+                if let Err(e) = self.session.set_light_stats(on) {
+                    self.info.error = Some(e);
+                }
+                self.info.light_stats = None;
+            }
         }
     }
 

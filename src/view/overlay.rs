@@ -29,6 +29,8 @@ pub struct FrameInfo {
 pub enum OverlayAction {
     SelectGraph(PathBuf),
     CameraMode(CameraMode),
+    /// Add or drop the per-pixel light statistics pass.
+    LightStats(bool),
 }
 
 pub struct Overlay {
@@ -38,6 +40,7 @@ pub struct Overlay {
     pub camera_mode: CameraMode,
     pub exposure_ev: f32,
     pub visible: bool,
+    pub light_stats: bool,
 }
 
 fn graph_label(path: &std::path::Path) -> String {
@@ -142,5 +145,14 @@ impl Overlay {
             }
         });
         ui.add(egui::Slider::new(&mut self.exposure_ev, -10.0..=10.0).text("exposure (EV)"));
+        if ui
+            .checkbox(
+                &mut self.light_stats,
+                "lights per pixel (adds a brute-force pass)",
+            )
+            .changed()
+        {
+            actions.push(OverlayAction::LightStats(self.light_stats));
+        }
     }
 }

@@ -1,0 +1,267 @@
+//! Hot reload of materials and graphs on the real adapter, with what each edit rebuilds:
+//! a scene file in a temp dir overrides the harada boxes' material with a material file
+//! beside it (outside any watched folder: the session watches it because the scene uses
+//! it). Editing the albedo scales exactly those pixels; broken saves name file:line and
+//! keep the frame bit for bit; a graph edit keeps every unchanged resource and pipeline;
+//! switching graphs keeps the old one on error. Waits are bounded waits on the watcher.
+
+mod common;
+use common::max_rel_diff;
+use lightgraph::reload::{Reload, ReloadSession, SceneSource};
+use lightgraph::render::Renderer;
+use lightgraph::shader::ShaderLibrary;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// The material file; `{color}` is the Lambert albedo, on line 7.
+fn material(color: &str) -> String {
+    format!(
+        "// The harada boxes' material in the hot-reload test.
+(
+    name: \"box\",
+    layers: [
+        (
+            lobes: [
+                Lambert(color: {color}),
+            ],
+        ),
+    ],
+)
+"
+    )
+}
+
+const SCENE: &str = r#"Scene(
+    name: "material_reload",
+    builtin: "harada",
+    keep_model_lights: false,
+    light_sets: [
+        Random(count: 48, spot_fraction: 0.3, placement: Box(min: (-20, 0.1, -20), max: (20, 3, 20)),
+               range: (4, 8), intensity: (1, 4), seed: 11),
+    ],
+    material_overrides: { "harada_box": "box.ron" },
+    ambient: (0, 0, 0),
+)
+"#;
+
+/// The reload that handled `file` (bounded wait).
+fn reload_of(s: &mut ReloadSession, file: &Path) -> Reload {
+    let deadline = Instant::now() + Duration::from_secs(100);
+    while let Some(left) = deadline.checked_duration_since(Instant::now()) {
+        if let Some(r) = s.wait(left) {
+            if r.changed.iter().any(|c| c.file_name() == file.file_name()) {
+                return r;
+            }
+        }
+    }
+    panic!("no reload of {} within 100 s", file.display());
+}
+
+fn image(s: &ReloadSession) -> Vec<[f32; 4]> {
+    s.frame.as_ref().unwrap().image.clone()
+}
+
+fn built(s: &ReloadSession) -> Vec<String> {
+    s.prepared().unwrap().stats().pipelines_built.clone()
+}
+
+struct Fixture {
+    _dir: tempfile::TempDir,
+    root: PathBuf,
+    session: ReloadSession,
+}
+
+fn fixture() -> Fixture {
+    let project = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path().canonicalize().unwrap();
+    for g in ["forward_plus.ron", "brute_force.ron"] {
+        std::fs::copy(project.join("graphs").join(g), root.join(g)).unwrap();
+    }
+    std::fs::write(root.join("box.ron"), material("(0.4, 0.4, 0.4)")).unwrap();
+    std::fs::write(root.join("scene.ron"), SCENE).unwrap();
+    let renderer = Renderer::new(
+        lightgraph::gpu::GpuContext::new_headless().unwrap(),
+        ShaderLibrary::builtin(),
+    );
+    let session = ReloadSession::new(
+        renderer,
+        &root.join("forward_plus.ron"),
+        SceneSource::File(root.join("scene.ron")),
+        96,
+        64,
+        &[],
+    )
+    .unwrap();
+    Fixture {
+        _dir: dir,
+        root,
+        session,
+    }
+}
+
+#[test]
+fn material_edits_rebuild_only_that_material_and_errors_keep_the_frame() {
+    let Fixture {
+        _dir,
+        root,
+        session: mut s,
+    } = fixture();
+    let box_ron = root.join("box.ron");
+    assert!(
+        s.watched_files().contains(&box_ron),
+        "the override file is watched: {:?}",
+        s.watched_files()
+    );
+    assert!(s.poll().is_none(), "nothing changed yet");
+    let first = image(&s);
+
+    // 1. Albedo (0.4, 0.4, 0.4) -> (0.2, 0.4, 0.1): box pixels scale by (0.5, 1, 0.25)
+    //    (Lambert is linear in its colour), every other pixel stays bit for bit.
+    let edited = material("(0.2, 0.4, 0.1)");
+    std::fs::write(&box_ron, &edited).unwrap();
+    let r = reload_of(&mut s, &box_ron);
+    r.outcome.as_ref().expect("the edited material loads");
+    assert_eq!(r.rebuilt, vec!["material harada_box".to_string()]);
+    let second = image(&s);
+    let (mut scaled, mut same_lit) = (0, 0);
+    for (a, b) in second.iter().zip(&first) {
+        if a == b {
+            same_lit += usize::from(b[0] > 0.0);
+            continue;
+        }
+        for (c, ratio) in [0.5f32, 1.0, 0.25].into_iter().enumerate() {
+            let want = ratio * b[c];
+            assert!(
+                (a[c] - want).abs() <= 1e-5 * want.abs().max(1e-3),
+                "channel {c}: {a:?} vs {ratio} x {b:?}"
+            );
+        }
+        scaled += 1;
+    }
+    let pixels = first.len();
+    println!("material edit: {scaled} box pixels scaled, {same_lit} lit pixels unchanged of {pixels}; {r:?}");
+    assert!(scaled > pixels / 20, "{scaled} box pixels");
+    assert!(same_lit > pixels / 20, "{same_lit} floor pixels");
+    // Only the box's shading pipeline was built: its depth prepass never ran the
+    // material code, the floor's pipelines are cache hits; no resource was created.
+    let stats = s.prepared().unwrap().stats().clone();
+    assert_eq!(built(&s).len(), 1, "{:?}", built(&s));
+    assert!(built(&s)[0].contains("material `box`"), "{:?}", built(&s));
+    assert!(stats.pipeline_hits >= 3, "{stats:?}");
+    assert_eq!((stats.resources_reused, stats.resources_created), (3, 0));
+
+    // 2. A save that does not parse: the error names box.ron and the line, the frame
+    //    and the prepared frame stay.
+    let bad = edited.replace(
+        "Lambert(color: (0.2, 0.4, 0.1)),",
+        "Lambert(color: (0.2, 0.4, 0.1)) oops,",
+    );
+    assert_ne!(bad, edited);
+    std::fs::write(&box_ron, &bad).unwrap();
+    let err = reload_of(&mut s, &box_ron)
+        .outcome
+        .expect_err("a material that does not parse must not load");
+    assert!(err.contains("box.ron:7:"), "{err}");
+    assert_eq!(image(&s), second, "the last good frame stays");
+    assert_eq!(s.error.as_deref(), Some(err.as_str()));
+
+    // 3. A save that parses but fails validation (a layer without lobes).
+    let invalid = material("(0.2, 0.4, 0.1)").replace(
+        "lobes: [\n                Lambert(color: (0.2, 0.4, 0.1)),\n            ],",
+        "lobes: [],",
+    );
+    assert!(invalid.contains("lobes: [],"));
+    std::fs::write(&box_ron, &invalid).unwrap();
+    let err = reload_of(&mut s, &box_ron)
+        .outcome
+        .expect_err("a material without lobes must not load");
+    assert!(err.contains("box.ron:6:"), "{err}");
+    assert_eq!(image(&s), second, "the last good frame stays");
+
+    // 4. Fixing it brings the frame back bit for bit; so does the original albedo.
+    std::fs::write(&box_ron, &edited).unwrap();
+    reload_of(&mut s, &box_ron)
+        .outcome
+        .expect("the fixed material loads");
+    assert_eq!(image(&s), second);
+    assert!(s.error.is_none());
+    std::fs::write(&box_ron, material("(0.4, 0.4, 0.4)")).unwrap();
+    reload_of(&mut s, &box_ron)
+        .outcome
+        .expect("the original material loads");
+    assert_eq!(image(&s), first);
+}
+
+#[test]
+fn graph_edits_keep_unchanged_resources_and_pipelines() {
+    let Fixture {
+        _dir,
+        root,
+        session: mut s,
+    } = fixture();
+    let first = image(&s);
+    let graph = root.join("forward_plus.ron");
+    let text = std::fs::read_to_string(&graph).unwrap();
+
+    // 1. One pass parameter: list capacity 256 -> 128. The list buffer changes size; depth
+    //    and hdr are the same textures as before; only the culling pipeline is rebuilt.
+    let before = s.prepared().unwrap().graph.plan.physical.len();
+    std::fs::write(&graph, text.replace("capacity: 256", "capacity: 128")).unwrap();
+    let r = reload_of(&mut s, &graph);
+    r.outcome.as_ref().expect("the edited graph compiles");
+    let stats = s.prepared().unwrap().stats().clone();
+    println!("graph edit: {stats:?}; {r:?}");
+    assert_eq!(before, 3);
+    assert_eq!((stats.resources_reused, stats.resources_created), (2, 1));
+    assert_eq!(stats.pipelines_built.len(), 1, "{stats:?}");
+    assert!(
+        stats.pipelines_built[0].starts_with("cull/tiled.wgsl"),
+        "{stats:?}"
+    );
+    assert!(stats.pipeline_hits >= 4, "{stats:?}");
+    // 48 lights never overflow 128 entries: the same image.
+    let (d, _) = max_rel_diff(&image(&s), &first);
+    assert!(d < 2e-6, "{d}");
+
+    // 2. Back to 256: again only the list buffer is new.
+    std::fs::write(&graph, &text).unwrap();
+    reload_of(&mut s, &graph)
+        .outcome
+        .expect("the original graph");
+    let stats = s.prepared().unwrap().stats().clone();
+    assert_eq!((stats.resources_reused, stats.resources_created), (2, 1));
+    assert_eq!(image(&s), first);
+
+    // 3. Switching to a graph with an error keeps the old graph and frame.
+    let broken = root.join("broken.ron");
+    std::fs::write(&broken, text.replace("output: \"hdr\"", "output: \"nope\"")).unwrap();
+    let line = std::fs::read_to_string(&broken)
+        .unwrap()
+        .lines()
+        .position(|l| l.contains("\"nope\""))
+        .unwrap()
+        + 1;
+    let err = s.set_graph(&broken).expect_err("a broken graph");
+    assert!(err.contains(&format!("broken.ron:{line}:")), "{err}");
+    assert_eq!(s.graph_path(), graph.as_path());
+    assert_eq!(
+        s.prepared().unwrap().graph.checked.desc.name,
+        "forward_plus"
+    );
+    assert_eq!(image(&s), first);
+
+    // 4. Switching to brute force: the same image (no list overflows), the colour target
+    //    is taken over, the old graph file no longer triggers anything.
+    let brute = root.join("brute_force.ron");
+    s.set_graph(&brute).expect("brute force");
+    assert_eq!(s.prepared().unwrap().graph.checked.desc.name, "brute_force");
+    let stats = s.prepared().unwrap().stats().clone();
+    assert!(stats.resources_reused >= 1, "{stats:?}");
+    let (d, _) = max_rel_diff(&image(&s), &first);
+    assert!(d < 1e-5, "{d}");
+    std::fs::write(&graph, text.replace("capacity: 256", "capacity: 64")).unwrap();
+    let r = reload_of(&mut s, &graph);
+    assert!(r.rebuilt.is_empty(), "{r:?}");
+    assert_eq!(s.prepared().unwrap().graph.checked.desc.name, "brute_force");
+}
