@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Runs the benchmark sweeps on the GPU machine (see ../shared/gpu/README.md); results go
-# to $OUT (or results/). Usage from the project root after ../shared/gpu/prepare.sh:
+# Runs the benchmark sweeps and the hot-reload latency benchmark on the GPU machine (see
+# ../shared/gpu/README.md); results go to $OUT (or results/). Usage from the project root
+# after ../shared/gpu/prepare.sh target/release/lightgraph:
 #   scripts/gpu_bench.sh
 set -u
 for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig
@@ -8,14 +9,17 @@ final="${OUT:-results}"
 out="$final/r"
 mkdir -p "$out"
 export XDG_RUNTIME_DIR=/tmp
+lg=./.gpu/lightgraph
 nvidia-smi --query-gpu=name,driver_version --format=csv > "$out/gpu.txt" 2>&1
-./.gpu/lightgraph render --out "$out/atrium.png" --heatmap "$out/atrium_heat.png" > "$out/render_atrium.txt" 2>&1
-./.gpu/lightgraph render --scene scenes/depth_discontinuity.ron --graph graphs/forward_plus.ron > "$out/dd_frustum.txt" 2>&1
-./.gpu/lightgraph render --scene scenes/depth_discontinuity.ron --graph graphs/forward_plus_depth_mask.ron > "$out/dd_depth_mask.txt" 2>&1
-./.gpu/lightgraph render --scene scenes/depth_discontinuity.ron --graph graphs/forward_plus_half_z.ron > "$out/dd_half_z.txt" 2>&1
-./.gpu/lightgraph render --scene scenes/depth_discontinuity.ron --graph graphs/forward_plus_clustered.ron > "$out/dd_clustered.txt" 2>&1
-./.gpu/lightgraph bench --sweep benches/sweeps/seeds.ron --out "$out/seeds" > "$out/seeds.log" 2>&1
-./.gpu/lightgraph bench --sweep benches/sweeps/headline.ron --out "$out/headline" > "$out/headline.log" 2>&1
-cat "$out"/render_atrium.txt "$out"/seeds/results.md "$out"/headline/results.md
+$lg render --out "$out/atrium.png" --heatmap "$out/atrium_heat.png" > "$out/render_atrium.txt" 2>&1
+for v in forward_plus forward_plus_depth_mask forward_plus_half_z forward_plus_clustered; do
+    $lg render --scene scenes/depth_discontinuity.ron --graph graphs/$v.ron > "$out/dd_$v.txt" 2>&1
+done
+for s in coarse seeds stress; do
+    $lg bench --sweep benches/sweeps/$s.ron --out "$out/$s" > "$out/$s.log" 2>&1
+done
+$lg reload-bench --out "$out/reload_1080p" --width 1920 --height 1080 --lights 3072 --repeats 20 > "$out/reload_1080p.log" 2>&1
+$lg reload-bench --out "$out/reload_160x90" --width 160 --height 90 --lights 1024 --repeats 10 > "$out/reload_160x90.log" 2>&1
+cat "$out"/gpu.txt "$out"/coarse/results.md "$out"/reload_1080p/reload_latency.md
 # The device tool brings back few files: pack everything into one archive.
 tar -czf "$final/results.tar.gz" -C "$final" r && rm -rf "$out"
