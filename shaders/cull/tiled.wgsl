@@ -53,6 +53,22 @@ fn view_ray(pixel: vec2<f32>) -> vec3<f32> {
     return p.xyz / p.w;
 }
 
+// Folds a pixel's view depth into the workgroup's range; returns it, or -1 where the
+// pixel is outside the frame or holds no geometry.
+fn add_depth_sample(pixel: vec2<u32>) -> f32 {
+    if (any(pixel >= frame.size)) {
+        return -1.0;
+    }
+    let d = textureLoad(depth, pixel, 0);
+    if (d >= 1.0) {
+        return -1.0;
+    }
+    let z = view_depth(d);
+    atomicMin(&z_min_bits, bitcast<u32>(z));
+    atomicMax(&z_max_bits, bitcast<u32>(z));
+    return z;
+}
+
 // Depth cell of z in [lo, hi] for the 2.5D mask: 32 equal cells.
 fn cell_of(z: f32, lo: f32, hi: f32) -> u32 {
     let t = (z - lo) / max(hi - lo, 1e-30);
@@ -85,16 +101,7 @@ fn main(
     workgroupBarrier();
 
     // 1. The tile's depth range, over pixels that hold geometry.
-    let pixel = group.xy * TILE + lid.xy;
-    var z = -1.0;
-    if (all(pixel < frame.size)) {
-        let d = textureLoad(depth, pixel, 0);
-        if (d < 1.0) {
-            z = view_depth(d);
-            atomicMin(&z_min_bits, bitcast<u32>(z));
-            atomicMax(&z_max_bits, bitcast<u32>(z));
-        }
-    }
+    let z = add_depth_sample(group.xy * TILE + lid.xy);
     workgroupBarrier();
     let tile_min = bitcast<f32>(atomicLoad(&z_min_bits));
     let tile_max = bitcast<f32>(atomicLoad(&z_max_bits));
@@ -335,15 +342,7 @@ fn coarse(
     let origin = group.xy * span;
     for (var dy = 0u; dy < COARSE; dy++) {
         for (var dx = 0u; dx < COARSE; dx++) {
-            let pixel = origin + lid.xy * COARSE + vec2<u32>(dx, dy);
-            if (all(pixel < frame.size)) {
-                let d = textureLoad(depth, pixel, 0);
-                if (d < 1.0) {
-                    let z = view_depth(d);
-                    atomicMin(&z_min_bits, bitcast<u32>(z));
-                    atomicMax(&z_max_bits, bitcast<u32>(z));
-                }
-            }
+            add_depth_sample(origin + lid.xy * COARSE + vec2<u32>(dx, dy));
         }
     }
     workgroupBarrier();
