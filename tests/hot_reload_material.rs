@@ -1,4 +1,4 @@
-//! Hot reload of materials and graphs on the real adapter, with what each edit rebuilds:
+//! Hot reload of materials, glTF models and graphs on the real adapter, with what each edit rebuilds:
 //! a scene file in a temp dir overrides the harada boxes' material with a material file
 //! beside it (outside any watched folder: the session watches it because the scene uses
 //! it). Editing the albedo scales exactly those pixels; broken saves name file:line and
@@ -268,4 +268,106 @@ fn graph_edits_keep_unchanged_resources_and_pipelines() {
     let r = reload_of(&mut s, &graph);
     assert!(r.rebuilt.is_empty(), "{r:?}");
     assert_eq!(s.prepared().unwrap().graph.checked.desc.name, "brute_force");
+}
+
+/// A scene file naming the Cornell box glTF beside it, with one light and a camera.
+const CORNELL_SCENE: &str = r#"Scene(
+    name: "model_reload",
+    models: [(path: "cornell/scene.gltf")],
+    camera: LookAt(eye: (0, 1, 3.5), target: (0, 1, 0), fov_y_deg: 50, near: 0.05, far: 20),
+    lights: [(name: "key", position: (0, 1.5, 0.2), range: 4, intensity: 2, color: (1, 1, 1))],
+    ambient: (0, 0, 0),
+)
+"#;
+
+#[test]
+fn model_edits_reload_the_scene_and_broken_models_keep_the_frame() {
+    let project = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path().canonicalize().unwrap();
+    std::fs::create_dir(root.join("cornell")).unwrap();
+    for f in ["scene.gltf", "scene.bin"] {
+        std::fs::copy(
+            project.join("scenes/cornell_box").join(f),
+            root.join("cornell").join(f),
+        )
+        .unwrap();
+    }
+    std::fs::copy(
+        project.join("graphs/forward_plus.ron"),
+        root.join("forward_plus.ron"),
+    )
+    .unwrap();
+    std::fs::write(root.join("scene.ron"), CORNELL_SCENE).unwrap();
+    let renderer = Renderer::new(
+        lightgraph::gpu::GpuContext::new_headless().unwrap(),
+        ShaderLibrary::builtin(),
+    );
+    let mut s = ReloadSession::new(
+        renderer,
+        &root.join("forward_plus.ron"),
+        SceneSource::File(root.join("scene.ron")),
+        96,
+        64,
+        &[],
+    )
+    .unwrap();
+    // The model and its buffer are watched because the scene file names the model.
+    let watched = s.watched_files();
+    for f in ["scene.gltf", "scene.bin"] {
+        assert!(
+            watched
+                .iter()
+                .any(|w| w.ends_with(Path::new("cornell").join(f))),
+            "{f} is not watched: {watched:?}"
+        );
+    }
+    let first = image(&s);
+    let red_wall = first
+        .iter()
+        .filter(|p| p[0] > 4.0 * p[1] && p[0] > 0.0)
+        .count();
+    assert!(red_wall > 50, "the red wall is in view ({red_wall} px)");
+
+    // 1. Halve the left wall's red albedo in the glTF. Its pixels' red is diffuse (scales
+    //    with the albedo) plus the dielectric specular (does not), so it drops to between
+    //    half and all of what it was; green, blue and every other pixel stay bit for bit.
+    let gltf = root.join("cornell/scene.gltf");
+    let original = std::fs::read_to_string(&gltf).unwrap();
+    let edited = original.replacen("0.6299999952316284", "0.3149999976158142", 1);
+    assert_ne!(edited, original);
+    std::fs::write(&gltf, &edited).unwrap();
+    reload_of(&mut s, &gltf)
+        .outcome
+        .expect("the edited model loads");
+    let second = image(&s);
+    let mut halved = 0;
+    for (a, b) in second.iter().zip(&first) {
+        assert_eq!((a[1], a[2]), (b[1], b[2]), "green and blue are unchanged");
+        if a[0] != b[0] {
+            assert!(
+                a[0] < b[0] && a[0] >= 0.5 * b[0],
+                "red {} -> {}: the diffuse half goes, the specular stays",
+                b[0],
+                a[0]
+            );
+            halved += 1;
+        }
+    }
+    assert!(halved >= red_wall / 2, "{halved} red pixels halved");
+
+    // 2. A model that no longer parses: the error names the file, the frame stays.
+    std::fs::write(&gltf, "{ \"asset\": ").unwrap();
+    let err = reload_of(&mut s, &gltf)
+        .outcome
+        .expect_err("a truncated glTF must not load");
+    assert!(err.contains("scene.gltf"), "{err}");
+    assert!(image(&s) == second, "the last good frame stays");
+
+    // 3. The fix brings the edited model back, bit for bit.
+    std::fs::write(&gltf, &edited).unwrap();
+    reload_of(&mut s, &gltf)
+        .outcome
+        .expect("the fixed model loads");
+    assert!(image(&s) == second);
 }

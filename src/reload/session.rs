@@ -96,10 +96,13 @@ pub struct ReloadSession {
     pub error: Option<String>,
 }
 
-fn load_scene(source: &SceneSource) -> Result<Scene, String> {
+/// The scene and every file it was read from (models, their buffers and images).
+fn load_scene(source: &SceneSource) -> Result<(Scene, Vec<PathBuf>), String> {
     match source {
-        SceneSource::File(p) => scene::load(p).map(|l| l.scene).map_err(|e| e.to_string()),
-        SceneSource::Fixed(s) => Ok((**s).clone()),
+        SceneSource::File(p) => scene::load(p)
+            .map(|l| (l.scene, l.files))
+            .map_err(|e| e.to_string()),
+        SceneSource::Fixed(s) => Ok(((**s).clone(), Vec::new())),
     }
 }
 
@@ -135,8 +138,8 @@ fn upload_scene(
 struct Candidate {
     /// The stale dependents it loaded.
     resolved: BTreeSet<String>,
-    /// A reloaded scene, its GPU data and its overridden materials' files.
-    scene: Option<(Scene, MaterialFiles)>,
+    /// A reloaded scene, its overridden materials' files and the files it was read from.
+    scene: Option<(Scene, MaterialFiles, Vec<PathBuf>)>,
     /// New GPU data (a reloaded scene, or the live one with some materials replaced).
     gpu: Option<SceneGpu>,
     /// The files of materials reloaded alone.
@@ -159,7 +162,7 @@ impl ReloadSession {
         height: u32,
         extra: &[PathBuf],
     ) -> Result<Self, String> {
-        let scene = load_scene(&source)?;
+        let (scene, scene_files) = load_scene(&source)?;
         let (gpu, materials) = upload_scene(&renderer.ctx.device, &renderer.ctx.queue, &scene)?;
         let watch_err = |e: WatchError| e.to_string();
         let mut watcher = FileWatcher::new(WatchConfig::default()).map_err(watch_err)?;
@@ -185,9 +188,8 @@ impl ReloadSession {
             error: None,
         };
         session.watch_dependency(GRAPH, vec![session.graph_path.clone()])?;
-        if let SceneSource::File(p) = &session.source {
-            let p = p.clone();
-            session.watch_dependency(SCENE, vec![p])?;
+        if !scene_files.is_empty() {
+            session.watch_dependency(SCENE, scene_files)?;
         }
         for (name, files) in materials {
             session.watch_dependency(&material_key(&name), files)?;
@@ -338,10 +340,10 @@ impl ReloadSession {
         let mut gpu = None;
         let mut materials = Vec::new();
         if self.stale.contains(SCENE) {
-            let s = load_scene(&self.source)?;
+            let (s, scene_files) = load_scene(&self.source)?;
             let (g, files) = upload_scene(&device, &queue, &s)?;
             gpu = Some(g);
-            scene = Some((s, files));
+            scene = Some((s, files, scene_files));
         } else {
             // Materials alone: a copy of the live scene's GPU data with those replaced.
             for key in &self.stale {
@@ -368,10 +370,11 @@ impl ReloadSession {
         let graph = match (&self.prepared, graph_unchanged) {
             // A material edit changes neither the graph nor the scene's features.
             (Some(p), true) => p.graph.clone(),
-            _ => self.compile_graph(scene.as_ref().map_or(&self.scene, |(s, _)| s))?,
+            _ => self.compile_graph(scene.as_ref().map_or(&self.scene, |(s, _, _)| s))?,
         };
         t.graph = start.elapsed();
-        let mut c = self.prepare_and_render(graph, scene.as_ref().map(|(s, _)| s), gpu.as_ref())?;
+        let mut c =
+            self.prepare_and_render(graph, scene.as_ref().map(|(s, _, _)| s), gpu.as_ref())?;
         t.prepare = c.prepare_time;
         t.render = c.render_time;
         t.shader_compose = c.prepared.stats().shader_compose;
@@ -439,7 +442,11 @@ impl ReloadSession {
     fn commit(&mut self, c: Candidate) {
         let generation = c.prepared.stats().cache_generation;
         let mut materials = c.materials;
-        if let Some((scene, files)) = c.scene {
+        if let Some((scene, files, scene_files)) = c.scene {
+            // A model the scene file now names is watched from here on.
+            if let Err(e) = self.watch_dependency(SCENE, scene_files) {
+                log::warn!("hot reload: {e}");
+            }
             // A new scene may override other materials, from other files.
             let old: Vec<String> = self
                 .deps

@@ -104,12 +104,14 @@ fn import_slice_inner(
         scene: Scene::default(),
         triangles: 0,
         has_camera: false,
+        files_read: std::cell::RefCell::new(vec![file.to_path_buf()]),
     };
     imp.run(bytes)?;
     Ok((
         Loaded {
             scene: imp.scene,
             warnings: imp.warnings,
+            files: imp.files_read.into_inner(),
         },
         imp.has_camera,
     ))
@@ -131,6 +133,8 @@ struct Importer {
     scene: Scene,
     triangles: u64,
     has_camera: bool,
+    /// The glTF file and every external buffer and image read for it.
+    files_read: std::cell::RefCell<Vec<PathBuf>>,
 }
 
 fn named(kind: &str, index: usize, name: Option<&str>) -> String {
@@ -609,6 +613,8 @@ impl Importer {
             return Err(self.err(element, format!("unsupported URI scheme in \"{uri}\"")));
         }
         let path = self.base_dir.join(percent_decode(uri));
+        // Recorded even if the read fails: fixing the file should trigger a reload.
+        self.files_read.borrow_mut().push(path.clone());
         std::fs::read(&path)
             .map_err(|e| self.err(element, format!("cannot read \"{}\": {e}", path.display())))
     }

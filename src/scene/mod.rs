@@ -23,6 +23,9 @@ use std::path::Path;
 pub struct Loaded {
     pub scene: Scene,
     pub warnings: Vec<String>,
+    /// Every file the scene was read from (scene file, glTF models, their buffers and
+    /// images): what hot reload watches.
+    pub files: Vec<std::path::PathBuf>,
 }
 
 /// Loads a scene file, dispatching on the extension: `.ron` (scene file), `.gltf`, `.glb`.

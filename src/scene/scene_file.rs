@@ -293,6 +293,7 @@ fn transform_scene(scene: &mut Scene, m: Mat4) {
 pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> {
     let dir = file.parent().unwrap_or(Path::new("."));
     let mut warnings = Vec::new();
+    let mut files = vec![file.to_path_buf()];
     let mut scene = Scene::default();
     let mut camera: Option<Camera> = None;
     if let Some(name) = &spec.builtin {
@@ -335,6 +336,7 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
         let (loaded, has_camera) = import_gltf_inner(&path, &ImportLimits::default())?;
         let mut sub = loaded.scene;
         warnings.extend(loaded.warnings);
+        files.extend(loaded.files);
         transform_scene(&mut sub, m);
         let offset = scene.materials.len();
         scene.materials.extend(sub.materials);
@@ -493,5 +495,9 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
         scene.ambient = a;
     }
     scene.source_path = Some(file.to_path_buf());
-    Ok(Loaded { scene, warnings })
+    Ok(Loaded {
+        scene,
+        warnings,
+        files,
+    })
 }
