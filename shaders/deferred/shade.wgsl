@@ -2,7 +2,9 @@
 // each invocation shades the pixel if the G-buffer holds this material there, with the
 // same material code and light loop as forward shading. On GPUs where few SMs run
 // fragment work (GH100) this is where the lighting throughput is.
-// Defines: MATERIAL_INDEX, LIGHT_LISTS.
+// With G_PACKED the G-buffer is one texture: view depth, octahedral normal, material;
+// the position is rebuilt on the pixel's view ray.
+// Defines: MATERIAL_INDEX, LIGHT_LISTS, G_PACKED.
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"
@@ -15,7 +17,11 @@
 @group(0) @binding(4) var<uniform> list_params: ListParams;
 #endif
 @group(0) @binding(5) var g_position: texture_2d<f32>;
+#if G_PACKED
+#include "common/octahedral.wgsl"
+#else
 @group(0) @binding(6) var g_normal: texture_2d<f32>;
+#endif
 @group(0) @binding(7) var hdr: texture_storage_2d<rgba32float, write>;
 
 #include "common/light_lists.wgsl"
@@ -30,6 +36,20 @@ struct ShadingPoint {
 
 #include <material>
 #include "common/light_loop.wgsl"
+
+#if G_PACKED
+// The world point at view depth `view_z` on the ray through framebuffer position `pixel`.
+fn position_on_view_ray(pixel: vec2<f32>, view_z: f32) -> vec3<f32> {
+    let size = vec2<f32>(frame.size);
+    let ndc = vec2<f32>(pixel.x / size.x * 2.0 - 1.0, 1.0 - pixel.y / size.y * 2.0);
+    let far = frame.inv_proj * vec4<f32>(ndc, 1.0, 1.0);
+    let ray = far.xyz / far.w;
+    let view_pos = ray * (view_z / -ray.z);
+    // The view matrix is a rotation and a translation: its inverse is the transpose.
+    let r = mat3x3<f32>(frame.view[0].xyz, frame.view[1].xyz, frame.view[2].xyz);
+    return transpose(r) * (view_pos - frame.view[3].xyz);
+}
+#endif
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -49,8 +69,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     var p: ShadingPoint;
+#if G_PACKED
+    p.position = position_on_view_ray(vec2<f32>(id.xy) + 0.5, g.x);
+    p.normal = oct_decode(g.yz);
+#else
     p.position = g.xyz;
     p.normal = textureLoad(g_normal, id.xy, 0).xyz;
+#endif
     p.view = normalize(frame.camera_pos.xyz - p.position);
     p.tangent = vec4<f32>(0.0);
     p.uv = vec2<f32>(0.0);

@@ -70,10 +70,18 @@ fn shading_point(in: VertexOut, front: bool) -> ShadingPoint {
 #if GBUFFER
 // Deferred shading's G-buffer: world position with the material index in w (-1 where
 // nothing was drawn), and the shading normal (already facing the viewer).
+#if GBUFFER_PACKED
+// Packed: one texture of view depth, octahedral normal and the material index (or -1).
+#include "common/octahedral.wgsl"
+struct GBufferOut {
+    @location(0) packed: vec4<f32>,
+};
+#else
 struct GBufferOut {
     @location(0) position: vec4<f32>,
     @location(1) normal: vec4<f32>,
 };
+#endif
 
 @fragment
 fn fs_gbuffer(in: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
@@ -84,7 +92,14 @@ fn fs_gbuffer(in: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
         discard;
     }
 #endif
+#if GBUFFER_PACKED
+    // Deferred shading rebuilds the position from the pixel's view ray and this depth.
+    let view_z = -(frame.view * vec4<f32>(in.world, 1.0)).z;
+    let n = oct_encode(p.normal);
+    return GBufferOut(vec4<f32>(view_z, n.x, n.y, f32(MATERIAL_INDEX)));
+#else
     return GBufferOut(vec4<f32>(in.world, f32(MATERIAL_INDEX)), vec4<f32>(p.normal, 0.0));
+#endif
 }
 #endif
 

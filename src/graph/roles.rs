@@ -283,13 +283,7 @@ impl RoleCtx<'_> {
                 need(
                     &roles,
                     Slot::GPosition,
-                    "two Rgba32Float textures in writes (positions, normals)",
-                    &mut errors,
-                );
-                need(
-                    &roles,
-                    Slot::GNormal,
-                    "two Rgba32Float textures in writes (positions, normals)",
+                    "one Rgba32Float texture in writes (packed: view depth, octahedral normal, material) or two (positions, normals)",
                     &mut errors,
                 );
                 for slot in [Slot::GPosition, Slot::GNormal] {
@@ -315,7 +309,7 @@ impl RoleCtx<'_> {
                     Slot::LightProperties,
                 ] {
                     if let Some(name) = roles.slot(slot) {
-                        errors.push(self.mismatch(pass, name, "a G-buffer pass uses no lights and writes only depth and its two textures"));
+                        errors.push(self.mismatch(pass, name, "a G-buffer pass uses no lights and writes only depth and its one or two textures"));
                     }
                 }
             }
@@ -323,13 +317,7 @@ impl RoleCtx<'_> {
                 need(
                     &roles,
                     Slot::GPosition,
-                    "the G-buffer's two textures in reads (positions, normals)",
-                    &mut errors,
-                );
-                need(
-                    &roles,
-                    Slot::GNormal,
-                    "the G-buffer's two textures in reads (positions, normals)",
+                    "the G-buffer's texture(s) in reads (packed, or positions and normals)",
                     &mut errors,
                 );
                 need(

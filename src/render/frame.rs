@@ -44,8 +44,9 @@ enum PassExec {
         depth: String,
         /// False after a depth prepass: load its depth and only test against it.
         clear_depth: bool,
+        /// Positions, or the packed texture when there is no normals texture.
         positions: String,
-        normals: String,
+        normals: Option<String>,
         draws: Vec<Draw>,
         bind: wgpu::BindGroup,
     },
@@ -508,6 +509,8 @@ impl Renderer {
                     // After a depth prepass the G-buffer only tests depth: each pixel is
                     // written once instead of once per overlapping surface.
                     let writes_depth = graph.checked.desc.passes[sp.index].writes.contains(&depth);
+                    // One texture: view depth, octahedral normal and material, packed.
+                    let packed = sp.roles.slot(Slot::GNormal).is_none();
                     let layout = forward_layout(false);
                     let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
                         label: Some(&sp.name),
@@ -523,14 +526,17 @@ impl Renderer {
                         &layout,
                         None,
                         1,
-                        DrawMode::GBuffer { writes_depth },
+                        DrawMode::GBuffer {
+                            writes_depth,
+                            packed,
+                        },
                         &sp.name,
                     )?;
                     PassExec::GBuffer {
                         depth,
                         clear_depth: writes_depth,
                         positions: sp.roles.slot(Slot::GPosition).unwrap().to_string(),
-                        normals: sp.roles.slot(Slot::GNormal).unwrap().to_string(),
+                        normals: sp.roles.slot(Slot::GNormal).map(str::to_string),
                         draws,
                         bind,
                     }
@@ -553,7 +559,6 @@ impl Renderer {
                         storage_entry(1, compute, true),
                         storage_entry(2, compute, true),
                         texture(5),
-                        texture(6),
                         wgpu::BindGroupLayoutEntry {
                             binding: 7,
                             visibility: compute,
@@ -580,14 +585,19 @@ impl Renderer {
                             resource: wgpu::BindingResource::TextureView(view_of(Slot::GPosition)?),
                         },
                         wgpu::BindGroupEntry {
-                            binding: 6,
-                            resource: wgpu::BindingResource::TextureView(view_of(Slot::GNormal)?),
-                        },
-                        wgpu::BindGroupEntry {
                             binding: 7,
                             resource: wgpu::BindingResource::TextureView(view_of(Slot::Color)?),
                         },
                     ];
+                    // Without a normals texture the G-buffer is the packed one.
+                    let packed = sp.roles.slot(Slot::GNormal).is_none();
+                    if !packed {
+                        layout_entries.push(texture(6));
+                        entries.push(wgpu::BindGroupEntry {
+                            binding: 6,
+                            resource: wgpu::BindingResource::TextureView(view_of(Slot::GNormal)?),
+                        });
+                    }
                     let lists = if culled {
                         let lists = sp.roles.slot(Slot::LightLists).unwrap();
                         Some(
@@ -626,6 +636,9 @@ impl Renderer {
                             )));
                         }
                         let mut d = vec![("MATERIAL_INDEX", index.to_string())];
+                        if packed {
+                            d.push(("G_PACKED", "1".into()));
+                        }
                         if culled {
                             d.push(("LIGHT_LISTS", "1".into()));
                         }
@@ -830,7 +843,7 @@ impl Renderer {
         let gbuffer = matches!(mode, DrawMode::GBuffer { .. });
         let writes_depth = match mode {
             DrawMode::DepthOnly => true,
-            DrawMode::GBuffer { writes_depth } => writes_depth,
+            DrawMode::GBuffer { writes_depth, .. } => writes_depth,
             DrawMode::Shade => false,
         };
         let device = self.ctx.device.clone();
@@ -848,6 +861,9 @@ impl Renderer {
             let mut d = vec![];
             if depth_only {
                 d.push(("DEPTH_ONLY", "1".to_string()));
+            }
+            if let DrawMode::GBuffer { packed: true, .. } = mode {
+                d.push(("GBUFFER_PACKED", "1".to_string()));
             }
             if gbuffer {
                 d.push(("GBUFFER", "1".to_string()));
@@ -901,7 +917,8 @@ impl Renderer {
                             compilation_options: Default::default(),
                             targets: match mode {
                                 DrawMode::DepthOnly => &[],
-                                DrawMode::GBuffer { .. } => &targets,
+                                DrawMode::GBuffer { packed: false, .. } => &targets,
+                                DrawMode::GBuffer { packed: true, .. } => &targets[..1],
                                 DrawMode::Shade => &targets[..1],
                             },
                         });
@@ -1117,12 +1134,14 @@ impl PreparedFrame {
                             store: wgpu::StoreOp::Store,
                         },
                     };
+                    let mut targets =
+                        vec![Some(clear(self.resources.view(plan, positions).unwrap()))];
+                    if let Some(normals) = normals {
+                        targets.push(Some(clear(self.resources.view(plan, normals).unwrap())));
+                    }
                     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                         label: Some(name),
-                        color_attachments: &[
-                            Some(clear(self.resources.view(plan, positions).unwrap())),
-                            Some(clear(self.resources.view(plan, normals).unwrap())),
-                        ],
+                        color_attachments: &targets,
                         depth_stencil_attachment: Some(depth_attachment(dview, *clear_depth)),
                         timestamp_writes: render_ts,
                         occlusion_query_set: None,
@@ -1394,7 +1413,7 @@ fn draw_meshes(pass: &mut wgpu::RenderPass<'_>, bind: &wgpu::BindGroup, draws: &
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum DrawMode {
     DepthOnly,
-    GBuffer { writes_depth: bool },
+    GBuffer { writes_depth: bool, packed: bool },
     Shade,
 }
 
