@@ -14,16 +14,12 @@ pub mod scene;
 pub mod shader;
 pub mod view;
 
-/// Where the project's shaders/, graphs/ and materials/ are: `LIGHTGRAPH_ROOT` if set,
-/// else the source tree the binary was built from, else the current directory (a
-/// binary copied to another machine next to a checkout).
+/// The folder the user's shaders/, graphs/ and materials/ are looked for in first (see
+/// [`shader::assets`]): the CLI's `--root`, else `LIGHTGRAPH_ROOT`, else the current
+/// directory. Files not there come from the copies built into the binary. Never the
+/// source tree the binary was built from: code that needs that uses `CARGO_MANIFEST_DIR`.
 pub fn project_root() -> std::path::PathBuf {
-    if let Some(root) = std::env::var_os("LIGHTGRAPH_ROOT") {
-        return root.into();
-    }
-    let built = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    if built.join("shaders").is_dir() {
-        return built.to_path_buf();
-    }
-    std::env::current_dir().unwrap_or_else(|_| ".".into())
+    shader::assets::project()
+        .root
+        .unwrap_or_else(|| std::env::current_dir().unwrap_or_else(|_| ".".into()))
 }

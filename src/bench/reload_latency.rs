@@ -13,6 +13,7 @@
 use super::report::{summarize, TimingSummary};
 use crate::reload::{Reload, ReloadSession, SceneSource, WatchConfig};
 use crate::render::Renderer;
+use crate::shader::assets::{Project, RootSource};
 use crate::shader::ShaderLibrary;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -70,7 +71,8 @@ impl std::fmt::Display for EditKind {
 
 #[derive(Clone, Debug)]
 pub struct ReloadBenchConfig {
-    /// Where shaders/, graphs/ and materials/ are (`lightgraph::project_root()`).
+    /// Where shaders/, graphs/ and materials/ are looked for first (the built-in copies
+    /// fill in what is not there).
     pub project: PathBuf,
     /// An empty folder to copy them into and edit there.
     pub work: PathBuf,
@@ -186,20 +188,6 @@ impl Target {
     }
 }
 
-fn copy_dir(from: &Path, to: &Path) -> Result<(), ReloadBenchError> {
-    std::fs::create_dir_all(to).map_err(io(to))?;
-    for e in std::fs::read_dir(from).map_err(io(from))? {
-        let e = e.map_err(io(from))?;
-        let target = to.join(e.file_name());
-        if e.file_type().map_err(io(&e.path()))?.is_dir() {
-            copy_dir(&e.path(), &target)?;
-        } else {
-            std::fs::copy(e.path(), &target).map_err(io(&target))?;
-        }
-    }
-    Ok(())
-}
-
 fn scene_text(lights: u32) -> String {
     format!(
         r#"// Reload benchmark: the harada geometry, its boxes in car paint, random lights.
@@ -227,15 +215,17 @@ pub fn run(
 ) -> Result<Vec<ReloadSample>, ReloadBenchError> {
     let work = &config.work;
     let shaders = work.join("shaders");
-    copy_dir(&config.project.join("shaders"), &shaders)?;
+    let project = Project::at(&config.project, RootSource::Flag);
+    project.extract("shaders", &shaders).map_err(io(&shaders))?;
     let graph = work.join("forward_plus.ron");
     let material = work.join("car_paint.ron");
     let scene = work.join("scene.ron");
-    for (from, to) in [
-        (config.project.join("graphs/forward_plus.ron"), &graph),
-        (config.project.join("materials/car_paint.ron"), &material),
+    for (rel, to) in [
+        ("graphs/forward_plus.ron", &graph),
+        ("materials/car_paint.ron", &material),
     ] {
-        std::fs::copy(&from, to).map_err(io(&from))?;
+        let (from, text) = project.read(rel).map_err(io(&project.locate(rel)))?;
+        std::fs::write(to, text).map_err(io(&from))?;
     }
     std::fs::write(&scene, scene_text(config.lights)).map_err(io(&scene))?;
     let targets = [

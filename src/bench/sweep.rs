@@ -176,7 +176,6 @@ pub fn run(
     renderer: &mut Renderer,
     mut progress: impl FnMut(SweepEvent),
 ) -> Result<Vec<BenchRow>, SweepError> {
-    let graphs_dir = crate::project_root().join("graphs");
     let counts: Vec<Option<u32>> = if sweep.lights.is_empty() {
         vec![None]
     } else {
@@ -214,7 +213,7 @@ pub fn run(
                     let reference = if size.lights <= sweep.brute_force_limit {
                         Some(render_once(
                             renderer,
-                            &graphs_dir.join("brute_force.ron"),
+                            "brute_force.ron",
                             &scene,
                             &gpu,
                             size,
@@ -248,7 +247,7 @@ pub fn run(
                             size,
                             reference: reference.as_deref(),
                         };
-                        measure(sweep, &graphs_dir, g, &point, renderer, &mut row)?;
+                        measure(sweep, g, &point, renderer, &mut row)?;
                         rows.push(row);
                         progress(SweepEvent::Done {
                             done: rows.len(),
@@ -275,7 +274,6 @@ struct Point<'a> {
 /// the reference and fills the row.
 fn measure(
     sweep: &Sweep,
-    graphs_dir: &Path,
     graph_name: &str,
     point: &Point,
     renderer: &mut Renderer,
@@ -284,8 +282,7 @@ fn measure(
     let Point {
         scene, gpu, size, ..
     } = *point;
-    let checked = graph::check_file(&graphs_dir.join(graph_name), &renderer.shaders)
-        .map_err(|e| SweepError::Graph(graph_name.into(), e.to_string()))?;
+    let checked = check_graph(graph_name, renderer)?;
     let compiled = graph::compile(checked, &scene.features(), size);
     let prepared = renderer.prepare(compiled, scene, gpu, size, false)?;
     for _ in 0..sweep.warmup {
@@ -363,14 +360,23 @@ fn measure(
 
 fn render_once(
     renderer: &mut Renderer,
-    graph_path: &Path,
+    graph_name: &str,
     scene: &Scene,
     gpu: &SceneGpu,
     size: FrameSize,
 ) -> Result<Vec<[f32; 4]>, SweepError> {
-    let checked = graph::check_file(graph_path, &renderer.shaders)
-        .map_err(|e| SweepError::Graph(graph_path.display().to_string(), e.to_string()))?;
+    let checked = check_graph(graph_name, renderer)?;
     let compiled = graph::compile(checked, &scene.features(), size);
     let prepared = renderer.prepare(compiled, scene, gpu, size, false)?;
     Ok(prepared.render(renderer)?.image)
+}
+
+/// Graph `name` of the project's graphs/ (the root's own file, else the built-in one),
+/// parsed and validated.
+fn check_graph(name: &str, renderer: &Renderer) -> Result<graph::CheckedGraph, SweepError> {
+    let err = |e: String| SweepError::Graph(name.into(), e);
+    let (path, text) = crate::shader::assets::project()
+        .read(&format!("graphs/{name}"))
+        .map_err(|e| err(e.to_string()))?;
+    graph::check_text(&path, &text, &renderer.shaders).map_err(|e| err(e.to_string()))
 }

@@ -17,6 +17,7 @@ use super::{normalize_path, ChangeBatch, DependencyIndex, FileWatcher, WatchConf
 use crate::graph::{self, CompiledGraph, FrameSize};
 use crate::render::{FrameResult, MaterialProgram, PreparedFrame, Renderer, SceneGpu};
 use crate::scene::{self, Scene};
+use crate::shader::assets;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -96,6 +97,14 @@ pub struct ReloadSession {
     pub error: Option<String>,
 }
 
+/// [`normalize_path`], except for built-in files' names (`<built-in>/...`).
+fn normalize(path: &Path) -> PathBuf {
+    match assets::builtin_rel(path) {
+        Some(_) => path.to_path_buf(),
+        None => normalize_path(path),
+    }
+}
+
 /// The scene and every file it was read from (models, their buffers and images).
 fn load_scene(source: &SceneSource) -> Result<(Scene, Vec<PathBuf>), String> {
     match source {
@@ -151,8 +160,8 @@ struct Candidate {
 }
 
 impl ReloadSession {
-    /// Renders once and starts watching the renderer's shader folder, the graph file,
-    /// the scene file, every material file the scene overrides a material with (wherever
+    /// Renders once and starts watching the renderer's shader folder (if it is on disk),
+    /// the graph file (unless it is built in), the scene file, every material file the scene overrides a material with (wherever
     /// it lies, with its textures) and `extra` paths (material folders).
     pub fn new(
         renderer: Renderer,
@@ -166,13 +175,18 @@ impl ReloadSession {
         let (gpu, materials) = upload_scene(&renderer.ctx.device, &renderer.ctx.queue, &scene)?;
         let watch_err = |e: WatchError| e.to_string();
         let mut watcher = FileWatcher::new(WatchConfig::default()).map_err(watch_err)?;
-        let shader_root = watcher.watch(&renderer.shaders.root).map_err(watch_err)?;
+        // With no shader folder on disk (built-in shaders only) there is none to watch.
+        let shader_root = if renderer.shaders.root.is_dir() {
+            watcher.watch(&renderer.shaders.root).map_err(watch_err)?
+        } else {
+            normalize(&renderer.shaders.root)
+        };
         for p in extra {
             watcher.watch(p).map_err(watch_err)?;
         }
         let mut session = Self {
             renderer,
-            graph_path: normalize_path(graph_path),
+            graph_path: normalize(graph_path),
             source,
             scene,
             gpu,
@@ -244,8 +258,10 @@ impl ReloadSession {
     /// over the live frame's resources where they fit. On error the old graph and frame
     /// stay and the error (with file:line) is returned.
     pub fn set_graph(&mut self, path: &Path) -> Result<(), String> {
-        let path = normalize_path(path);
-        self.watcher.watch(&path).map_err(|e| e.to_string())?;
+        let path = normalize(path);
+        if assets::builtin_rel(&path).is_none() {
+            self.watcher.watch(&path).map_err(|e| e.to_string())?;
+        }
         let old = std::mem::replace(&mut self.graph_path, path.clone());
         let candidate = self
             .compile_graph(&self.scene)
@@ -387,7 +403,7 @@ impl ReloadSession {
     }
 
     fn compile_graph(&self, scene: &Scene) -> Result<CompiledGraph, String> {
-        let checked = graph::check_file(&self.graph_path, &self.renderer.shaders)
+        let checked = assets::check_graph(&self.graph_path, &self.renderer.shaders)
             .map_err(|e| e.to_string())?;
         Ok(graph::compile(
             checked,
@@ -477,7 +493,8 @@ impl ReloadSession {
     }
 
     fn watch_dependency(&mut self, key: &str, files: Vec<PathBuf>) -> Result<(), String> {
-        for f in &files {
+        // Built-in files (`<built-in>/...`) never change: nothing to watch.
+        for f in files.iter().filter(|f| assets::builtin_rel(f).is_none()) {
             self.watcher.watch(f).map_err(|e| e.to_string())?;
         }
         self.deps.set_dependencies(key, files);

@@ -23,11 +23,16 @@ pub enum ShaderError {
     },
 }
 
-/// Where shader files are found; `#include "x.wgsl"` resolves against `root`.
-/// Virtual files (generated code such as materials) are included as `#include <name>`.
+/// Where shader files are found; `#include "x.wgsl"` resolves against `root`, and with
+/// `builtin_fallback` a file not there comes from the shaders built into the binary
+/// (named `<built-in>/shaders/x.wgsl` in errors). Virtual files (generated code such as
+/// materials) are included as `#include <name>`.
 #[derive(Clone, Debug)]
 pub struct ShaderLibrary {
+    /// The shader folder on disk (`<built-in>/shaders` when there is none).
     pub root: PathBuf,
+    /// Whether files missing under `root` are taken from the built-in shaders.
+    pub builtin_fallback: bool,
 }
 
 /// A shader after includes and defines, with a map from each line back to its origin.
@@ -41,13 +46,56 @@ pub struct Composed {
 }
 
 impl ShaderLibrary {
+    /// Shaders from `root` only.
     pub fn new(root: impl Into<PathBuf>) -> Self {
-        Self { root: root.into() }
+        Self {
+            root: root.into(),
+            builtin_fallback: false,
+        }
     }
 
-    /// The project's own shaders/ folder (next to Cargo.toml).
+    /// Shaders from `root` first, file by file, then the built-in ones.
+    pub fn with_builtin(root: impl Into<PathBuf>) -> Self {
+        Self {
+            root: root.into(),
+            builtin_fallback: true,
+        }
+    }
+
+    /// The project's shaders: `shaders/` of the process's root (see
+    /// [`assets`](super::assets): `--root`, `LIGHTGRAPH_ROOT`, the current directory)
+    /// over the built-in ones.
     pub fn builtin() -> Self {
-        Self::new(crate::project_root().join("shaders"))
+        Self::for_project(&super::assets::project())
+    }
+
+    /// `project`'s shaders/ over the built-in ones.
+    pub fn for_project(project: &super::assets::Project) -> Self {
+        Self::with_builtin(project.shader_dir())
+    }
+
+    /// The name shader file `rel` (relative to the root) is read by: `root/rel` when
+    /// that file exists (or there is no fallback), else `<built-in>/shaders/rel` when it
+    /// is built in.
+    pub fn locate(&self, rel: &str) -> PathBuf {
+        let disk = self.root.join(rel);
+        if self.builtin_fallback && !disk.is_file() {
+            let name = format!("shaders/{rel}");
+            if super::assets::builtin(&name).is_some() {
+                return super::assets::builtin_path(&name);
+            }
+        }
+        disk
+    }
+
+    /// The text of shader file `rel` (e.g. `common/fullscreen_vs.wgsl`), found as
+    /// `#include` finds it: on disk under the root first, then built in.
+    pub fn read_source(&self, rel: &str) -> Result<String, ShaderError> {
+        let file = self.locate(rel);
+        super::assets::read_path(&file).map_err(|e| ShaderError::Io {
+            message: e.to_string(),
+            file,
+        })
     }
 
     /// Reads `file` (relative to the root), expands includes and `#if`, and prepends the
@@ -70,27 +118,28 @@ impl ShaderLibrary {
                 0,
             );
         }
-        let path = self.root.join(file);
-        self.include(&path, defines, virtual_files, &mut out)?;
+        self.include(file, defines, virtual_files, &mut out)?;
         Ok(out)
     }
 
+    /// Includes file `rel` (relative to the root) once. `files` records where it is or
+    /// would be on disk, so that a file created there later to override a built-in one
+    /// invalidates what used it; line origins name the file it was read from.
     fn include(
         &self,
-        path: &Path,
+        rel: &str,
         defines: &BTreeMap<String, String>,
         virtual_files: &BTreeMap<String, String>,
         out: &mut Composed,
     ) -> Result<(), ShaderError> {
-        if out.files.iter().any(|f| f == path) {
+        let disk = self.root.join(rel);
+        if out.files.iter().any(|f| f == &disk) {
             return Ok(()); // include once
         }
-        let text = std::fs::read_to_string(path).map_err(|e| ShaderError::Io {
-            file: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
-        out.files.push(path.to_path_buf());
-        self.expand(path, &text, defines, virtual_files, out)
+        let path = self.locate(rel);
+        let text = self.read_source(rel)?;
+        out.files.push(disk);
+        self.expand(&path, &text, defines, virtual_files, out)
     }
 
     fn expand(
@@ -143,7 +192,7 @@ impl ShaderLibrary {
                     self.expand(&vpath, code, defines, virtual_files, out)?;
                 } else if let Some(name) = rest.strip_prefix('"').and_then(|r| r.strip_suffix('"'))
                 {
-                    self.include(&self.root.join(name), defines, virtual_files, out)?;
+                    self.include(name, defines, virtual_files, out)?;
                 } else {
                     return Err(directive_error(n, format!("malformed #include {rest}")));
                 }

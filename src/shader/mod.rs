@@ -1,6 +1,8 @@
 //! WGSL handling without a GPU: composing files (includes, defines), validating with
-//! naga (errors mapped back to the original file and line), reflecting bindings.
+//! naga (errors mapped back to the original file and line), reflecting bindings; and
+//! where the project's files are found ([`assets`]: a root folder, then built-in copies).
 
+pub mod assets;
 mod compose;
 mod reflect;
 

@@ -1,0 +1,148 @@
+//! `bench` (time against error) and `reload-bench` (edit-to-frame latency).
+
+use super::{project_path, ReloadBenchArgs};
+use anyhow::{bail, Context, Result};
+use lightgraph::bench;
+use lightgraph::render::Renderer;
+use std::path::Path;
+
+pub fn run_bench(sweep: Option<&Path>, out: &Path) -> Result<()> {
+    use bench::sweep::SweepEvent;
+    let path = sweep
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| project_path("benches/sweeps/headline.ron"));
+    let sweep = bench::sweep::Sweep::load(&path)?;
+    let mut renderer = Renderer::headless()?;
+    let progress = bench::progress::SweepProgress::new(sweep.point_count());
+    progress.println(&format!("adapter: {}", renderer.ctx.adapter_name()));
+    if !renderer.ctx.has_timestamps {
+        progress.warn(&format!(
+            "{} has no timestamp queries: no GPU times will be reported (time columns stay empty, no time plots)",
+            renderer.ctx.adapter_name()
+        ));
+    }
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let rows = bench::sweep::run(&sweep, dir, &mut renderer, |event| match event {
+        SweepEvent::Start { point, .. } => progress.start(point),
+        SweepEvent::Done { done, total, row } => {
+            progress.finish_point();
+            progress.println(&format!("[{done}/{total}] {}", point_summary(row)));
+            if let Some(warning) = non_finite_warning(row) {
+                progress.warn(&warning);
+            }
+        }
+    });
+    progress.finish();
+    let rows = rows?;
+    std::fs::create_dir_all(out).with_context(|| out.display().to_string())?;
+    let files = bench::write_report(out, &rows)?;
+    if let Some(reason) = &files.plots_skipped {
+        println!("time plots not drawn: no GPU times ({reason})");
+    }
+    println!("wrote {}", files.markdown.display());
+    Ok(())
+}
+
+/// One log line per point: time, error against the reference, NaN / Inf counts.
+fn point_summary(row: &bench::BenchRow) -> String {
+    let time = match row.frame_ms {
+        Some(t) => format!("{:.3} ms (p10 {:.3}, p90 {:.3})", t.median, t.p10, t.p90),
+        None => format!(
+            "no GPU time: {}",
+            row.untimed.as_deref().unwrap_or("not measured")
+        ),
+    };
+    let error = match (row.rmse, row.max_abs, row.max_rel) {
+        (Some(rmse), Some(abs), Some(rel)) => {
+            format!("rmse {rmse:.3e} max abs {abs:.3e} max rel {rel:.3e}")
+        }
+        _ => "no reference".into(),
+    };
+    format!(
+        "{} {} {} lights {}x{}: {time}, {error}, NaN px {}, Inf px {}",
+        row.scene,
+        row.technique,
+        row.light_count,
+        row.width,
+        row.height,
+        row.nan_pixels.unwrap_or(0),
+        row.inf_pixels.unwrap_or(0)
+    )
+}
+
+/// A warning naming the first NaN / Inf pixels of a point, if it has any.
+fn non_finite_warning(row: &bench::BenchRow) -> Option<String> {
+    if row.non_finite_examples.is_empty() {
+        return None;
+    }
+    let listed: Vec<String> = row
+        .non_finite_examples
+        .iter()
+        .take(4)
+        .map(|p| format!("{} at ({}, {})", p.kind(), p.x, p.y))
+        .collect();
+    Some(format!(
+        "{} {}: {} NaN and {} Inf pixels, first {}",
+        row.scene,
+        row.technique,
+        row.nan_pixels.unwrap_or(0),
+        row.inf_pixels.unwrap_or(0),
+        listed.join(", ")
+    ))
+}
+
+pub fn reload_bench(args: &ReloadBenchArgs) -> Result<()> {
+    use lightgraph::bench::reload_latency as rl;
+    if args.width == 0 || args.height == 0 || args.repeats == 0 {
+        bail!("--width, --height and --repeats must be positive");
+    }
+    // A fresh folder of our own to copy the inputs into and edit.
+    let work = std::env::temp_dir().join(format!("lightgraph-reload-bench-{}", std::process::id()));
+    if work.exists() {
+        std::fs::remove_dir_all(&work).with_context(|| work.display().to_string())?;
+    }
+    let config = rl::ReloadBenchConfig {
+        project: lightgraph::project_root(),
+        work: work.clone(),
+        width: args.width,
+        height: args.height,
+        lights: args.lights,
+        repeats: args.repeats,
+    };
+    let gpu = lightgraph::gpu::GpuContext::new_headless()?;
+    let adapter = gpu.adapter_name();
+    println!("adapter: {adapter}");
+    let result = rl::run(&config, gpu, |s| {
+        println!(
+            "{:<8} #{:<3} {:>8.1} ms  (watch {:.1}, compose {:.1}, build {:.1}, render {:.1} [again {:.1}]; {} pipelines built, {} resources reused, {} created)",
+            s.kind.to_string(),
+            s.index,
+            s.total_ms,
+            s.watch_ms,
+            s.shader_compose_ms,
+            s.pipeline_build_ms,
+            s.render_ms,
+            s.rerender_ms,
+            s.pipelines_built,
+            s.resources_reused,
+            s.resources_created
+        );
+    });
+    let _ = std::fs::remove_dir_all(&work);
+    let samples = result?;
+    std::fs::create_dir_all(&args.out).with_context(|| args.out.display().to_string())?;
+    let csv = args.out.join("reload_latency.csv");
+    std::fs::write(&csv, rl::to_csv(&samples)).with_context(|| csv.display().to_string())?;
+    let md = args.out.join("reload_latency.md");
+    let watch = lightgraph::reload::WatchConfig::default();
+    std::fs::write(&md, rl::to_markdown(&samples, &config, &adapter, &watch))
+        .with_context(|| md.display().to_string())?;
+    for k in rl::summarize_kinds(&samples) {
+        println!(
+            "{}: median {:.1} ms, p10 {:.1}, p90 {:.1}",
+            k.kind, k.total.median, k.total.p10, k.total.p90
+        );
+    }
+    println!("wrote {} and {}", csv.display(), md.display());
+    Ok(())
+}

@@ -1,0 +1,215 @@
+//! The lightgraph command line: a thin layer over the library. Arguments here; the
+//! commands in [`render`] (one frame, checks), [`live`] (watch, view) and [`bench`].
+
+pub mod bench;
+pub mod live;
+pub mod render;
+
+use anyhow::{bail, Result};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
+use lightgraph::shader::assets::{self, Project};
+use std::path::PathBuf;
+
+#[derive(Parser)]
+#[command(
+    name = "lightgraph",
+    version,
+    about = "Render graphs for scenes with thousands of lights"
+)]
+pub struct Cli {
+    /// The folder whose shaders/, graphs/ and materials/ are read and watched (over the
+    /// built-in ones, file by file). Default: LIGHTGRAPH_ROOT, else the current directory
+    /// if it has any of them, else built-in files only.
+    #[arg(long, global = true, value_name = "DIR")]
+    pub root: Option<PathBuf>,
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Render a scene through a graph, headless; print per-pass GPU times and light statistics.
+    Render(RenderArgs),
+    /// Validate graph files; every error is printed as file:line:col. Exit 1 if any.
+    Validate { files: Vec<PathBuf> },
+    /// Print the compiled schedule (after culling for the scene) as Graphviz.
+    Graph {
+        graph: PathBuf,
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        #[arg(long)]
+        dot: bool,
+    },
+    /// Hot reload, headless: re-render on every change to shaders/, materials/, the
+    /// graph or the scene; print the reload latency or the error (the last good frame
+    /// stays in --out).
+    Watch {
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        #[arg(long)]
+        graph: Option<PathBuf>,
+        #[arg(long, default_value_t = 640)]
+        width: u32,
+        #[arg(long, default_value_t = 360)]
+        height: u32,
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// A window onto a hot-reloading graph: fly/orbit camera, per-pass GPU times, light
+    /// statistics, reload errors and graph variants in an overlay.
+    View(ViewArgs),
+    /// Check a layered material; with --wgsl print the WGSL generated for it.
+    Material {
+        file: PathBuf,
+        #[arg(long)]
+        wgsl: bool,
+    },
+    /// Compare two EXR images: RMSE, max abs, PSNR, FLIP mean, bad pixels.
+    Compare { a: PathBuf, b: PathBuf },
+    /// Time against error: run a sweep file, write CSV, Markdown and plots to --out.
+    Bench {
+        #[arg(long)]
+        sweep: Option<PathBuf>,
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Hot-reload latency: time real shader, material and graph edits from the file
+    /// write to the new frame; write CSV and Markdown to --out.
+    ReloadBench(ReloadBenchArgs),
+}
+
+#[derive(clap::Args)]
+pub struct ReloadBenchArgs {
+    #[arg(long)]
+    pub out: PathBuf,
+    #[arg(long, default_value_t = 160)]
+    pub width: u32,
+    #[arg(long, default_value_t = 90)]
+    pub height: u32,
+    /// Random lights in the benchmark scene.
+    #[arg(long, default_value_t = 1024)]
+    pub lights: u32,
+    /// Edits of each kind.
+    #[arg(long, default_value_t = 10)]
+    pub repeats: usize,
+}
+
+#[derive(clap::Args, Default)]
+pub struct RenderArgs {
+    /// Scene: .ron, .gltf or .glb (default: the built-in atrium).
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
+    /// Graph file (default: graphs/forward_plus.ron).
+    #[arg(long)]
+    pub graph: Option<PathBuf>,
+    #[arg(long)]
+    pub width: Option<u32>,
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Output image: .png (tonemapped sRGB) or .exr (linear HDR, 32-bit float).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Lights-per-tile heat map (PNG); a histogram CSV is written beside it.
+    #[arg(long)]
+    pub heatmap: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
+pub struct ViewArgs {
+    /// Scene: .ron, .gltf or .glb (default: the built-in atrium). Watched and reloaded.
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
+    /// Graph file (default: graphs/forward_plus.ron of the root, else built in); the other
+    /// graphs in its folder are offered as variants.
+    #[arg(long)]
+    pub graph: Option<PathBuf>,
+    #[arg(long, default_value_t = 1280)]
+    pub width: u32,
+    #[arg(long, default_value_t = 720)]
+    pub height: u32,
+    /// Render size relative to the window (0.5 shades a quarter of the pixels).
+    #[arg(long, default_value_t = 1.0)]
+    pub scale: f32,
+    /// Exposure in stops.
+    #[arg(long, default_value_t = 0.0)]
+    pub exposure: f32,
+    /// Save what the window shows to this PNG after --frames frames, then exit.
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+    #[arg(long, default_value_t = 10)]
+    pub frames: u32,
+}
+
+/// What `--help` says about where files are found, with the root it resolved to.
+fn where_files_are(project: &Project) -> String {
+    format!(
+        "Where files are found:\n  \
+         shaders/, graphs/ and materials/ are read, and watched by `watch` and `view`, in a root\n  \
+         folder; a file the root lacks comes from the copy built into this binary (so the\n  \
+         default scene renders from any folder). The root is the first of:\n    \
+         1. --root DIR\n    \
+         2. the {env} environment variable\n    \
+         3. the current directory, if it has shaders/, graphs/ or materials/\n    \
+         4. none: built-in files only\n  \
+         Root now: {}",
+        project.describe(),
+        env = assets::ROOT_ENV,
+    )
+}
+
+/// `--root DIR` or `--root=DIR` from the raw arguments, so that `--help` can name the
+/// root before clap has parsed (and exited on) `--help`.
+fn root_flag(args: &[std::ffi::OsString]) -> Option<PathBuf> {
+    let mut it = args.iter().skip(1);
+    while let Some(a) = it.next() {
+        let s = a.to_string_lossy();
+        if s == "--" {
+            break;
+        }
+        if s == "--root" {
+            return it.next().map(PathBuf::from);
+        }
+        if let Some(v) = s.strip_prefix("--root=") {
+            return Some(PathBuf::from(v));
+        }
+    }
+    None
+}
+
+/// Parses the arguments, fixes the project root for the library and runs the command.
+pub fn run() -> Result<()> {
+    let args: Vec<std::ffi::OsString> = std::env::args_os().collect();
+    let project = Project::resolve(root_flag(&args).as_deref());
+    let command = Cli::command().after_help(where_files_are(&project));
+    let cli = Cli::from_arg_matches(&command.get_matches_from(&args))?;
+    let project = Project::resolve(cli.root.as_deref());
+    if let Err(e) = project.check() {
+        bail!("{e}");
+    }
+    assets::set_project(project);
+    match cli.command {
+        None => render::render(RenderArgs::default()),
+        Some(Command::Render(args)) => render::render(args),
+        Some(Command::Validate { files }) => render::validate(&files),
+        Some(Command::Graph { graph, scene, dot }) => {
+            render::print_graph(&graph, scene.as_deref(), dot)
+        }
+        Some(Command::Compare { a, b }) => render::compare(&a, &b),
+        Some(Command::Material { file, wgsl }) => render::material(&file, wgsl),
+        Some(Command::Watch {
+            scene,
+            graph,
+            width,
+            height,
+            out,
+        }) => live::watch(scene, graph, width, height, &out),
+        Some(Command::Bench { sweep, out }) => bench::run_bench(sweep.as_deref(), &out),
+        Some(Command::View(args)) => live::view(args),
+        Some(Command::ReloadBench(args)) => bench::reload_bench(&args),
+    }
+}
+
+/// Project file `rel` (`graphs/forward_plus.ron`): the root's own, else the built-in one.
+pub fn project_path(rel: &str) -> PathBuf {
+    assets::project().locate(rel)
+}
