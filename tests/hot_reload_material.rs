@@ -220,7 +220,7 @@ fn graph_edits_keep_unchanged_resources_and_pipelines() {
         stats
             .pipelines_built
             .iter()
-            .all(|p| p.starts_with("cull/tiled.wgsl")),
+            .all(|p| p.starts_with("cull/light_culling.wgsl")),
         "{stats:?}"
     );
     assert!(stats.pipeline_hits >= 4, "{stats:?}");

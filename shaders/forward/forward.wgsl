@@ -1,11 +1,13 @@
-// Depth prepass and forward shading of one material. The material's generated code is
-// included as <material>; defines: LIGHT_LISTS (read culled lists), DEPTH_ONLY
-// (prepass), ALPHA_MASK (prepass discards below the cutoff).
+// Mesh draws of one material (src/render/draws.rs): the depth prepass (DEPTH_ONLY), the
+// G-buffer (GBUFFER, GBUFFER_PACKED) and forward shading (SHADE, with LIGHT_LISTS for
+// culled lists). The material's generated code is included as <material>; ALPHA_MASK
+// discards below the cutoff. Only SHADE binds lights: a pass binds what it declares.
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: Frame;
+#if SHADE
 @group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
 @group(0) @binding(2) var<storage, read> light_properties: array<LightProperties>;
 #if LIGHT_LISTS
@@ -14,6 +16,7 @@
 #endif
 
 #include "common/light_lists.wgsl"
+#endif
 
 struct ShadingPoint {
     position: vec3<f32>,
@@ -24,7 +27,9 @@ struct ShadingPoint {
 };
 
 #include <material>
+#if SHADE
 #include "common/light_loop.wgsl"
+#endif
 
 struct VertexIn {
     @location(0) position: vec3<f32>,
@@ -113,7 +118,9 @@ fn fs_depth(in: VertexOut, @builtin(front_facing) front: bool) {
     }
 #endif
 }
-#else
+#endif
+
+#if SHADE
 @fragment
 fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
     let p = shading_point(in, front);

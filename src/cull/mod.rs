@@ -1,4 +1,4 @@
-//! CPU versions of the culling tests in `shaders/cull/tiled.wgsl`, line for line, for
+//! CPU versions of the culling tests in `shaders/cull/light_culling.wgsl`, line for line, for
 //! property tests (a light that reaches any point of a tile's depth range is never
 //! culled) and for tools that want to reason about lists without a GPU.
 

@@ -82,14 +82,14 @@ pub struct GpuListParams {
 }
 
 impl GpuListParams {
-    pub fn new(layout: &crate::graph::ListLayout, tile: u32, variant: u32) -> Self {
+    pub fn new(layout: &crate::graph::ListLayout) -> Self {
         Self {
             tiles_x: layout.tiles_x,
             tiles_y: layout.tiles_y,
-            tile,
+            tile: layout.tile,
             lists_per_tile: layout.lists_per_tile,
             capacity: layout.capacity,
-            variant,
+            variant: layout.variant.code(),
             pool_offset: layout.pool_offset_words(),
             _pad0: 0,
         }

@@ -1,6 +1,6 @@
 //! A compiled graph: plain data you can print and assert on.
 
-use super::model::PassKind;
+use super::model::{PassKind, ResourceDesc};
 use super::plan::ResourcePlan;
 use super::roles::PassRoles;
 use super::specialise::CullReason;
@@ -14,6 +14,27 @@ pub struct ScheduledPass {
     pub index: usize,
     pub kind: PassKind,
     pub roles: PassRoles,
+    /// Resources this pass writes first in the schedule: its attachments clear them,
+    /// later writers load.
+    pub clears: Vec<String>,
+    /// Sample count of the textures in its slots (validation made them agree).
+    pub samples: u32,
+}
+
+impl ScheduledPass {
+    /// Whether this pass writes `resource` first (clear) or after another pass (load).
+    pub fn clears(&self, resource: &str) -> bool {
+        self.clears.iter().any(|c| c == resource)
+    }
+    /// The resource in a slot the kind's table marks required, which validation filled.
+    pub fn required(&self, slot: &str) -> &str {
+        self.roles.slot(slot).unwrap_or_else(|| {
+            panic!(
+                "pass '{}': slot '{slot}' was checked at validation",
+                self.name
+            )
+        })
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -108,13 +129,38 @@ pub(crate) fn assemble(
     schedule: Vec<usize>,
     plan: ResourcePlan,
 ) -> CompiledGraph {
+    let mut written = std::collections::HashSet::new();
     let passes = schedule
         .iter()
-        .map(|&i| ScheduledPass {
-            name: checked.desc.passes[i].name.clone(),
-            index: i,
-            kind: checked.desc.passes[i].kind.clone(),
-            roles: checked.roles[i].clone(),
+        .map(|&i| {
+            let desc = &checked.desc.passes[i];
+            let roles = checked.roles[i].clone();
+            let clears = desc
+                .writes
+                .iter()
+                .filter(|w| written.insert(w.as_str()))
+                .cloned()
+                .collect();
+            let samples = roles
+                .slots
+                .values()
+                .chain(roles.target.iter())
+                .filter_map(
+                    |name| match checked.desc.resources.iter().find(|r| r.name() == name) {
+                        Some(ResourceDesc::Texture { samples, .. }) => Some(*samples),
+                        _ => None,
+                    },
+                )
+                .max()
+                .unwrap_or(1);
+            ScheduledPass {
+                name: desc.name.clone(),
+                index: i,
+                kind: desc.kind.clone(),
+                roles,
+                clears,
+                samples,
+            }
         })
         .collect();
     let culled = culled

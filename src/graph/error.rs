@@ -14,11 +14,13 @@ pub enum GraphError {
         context: String,
         message: String,
     },
-    #[error("{at}: pass '{pass}': unknown pass kind '{kind}' (known: DepthPrepass, LightCulling, ForwardShading, GBuffer, DeferredShading, Compute, Fullscreen)")]
+    #[error("{at}: pass '{pass}': unknown pass kind '{kind}' (known: {known})")]
     UnknownPassKind {
         at: Location,
         pass: String,
         kind: String,
+        /// The variants of `PassKind`, as serde lists them.
+        known: String,
     },
     #[error("{at}: {what} '{name}' is declared twice")]
     Duplicate {
@@ -32,8 +34,12 @@ pub enum GraphError {
         pass: String,
         resource: String,
     },
-    #[error("{at}: output '{resource}' is not a declared colour texture")]
-    BadOutput { at: Location, resource: String },
+    #[error("{at}: output '{resource}' {problem}")]
+    BadOutput {
+        at: Location,
+        resource: String,
+        problem: String,
+    },
     #[error("{at}: side effect '{pass}' is not a declared pass")]
     UnknownSideEffect { at: Location, pass: String },
     #[error("{at}: pass '{pass}' reads resource '{resource}', which no pass writes")]

@@ -86,8 +86,12 @@ impl SourceText {
             .find("name:")
             .map_or(self.text.len(), |i| start + pass.len() + 2 + i);
         let quoted = format!("\"{word}\"");
-        let offset = self.text[start..end]
+        // `"slot=word"`: point at the slot's entry.
+        let named = format!("={word}\"");
+        let text = &self.text[start..end];
+        let offset = text
             .find(&quoted)
+            .or_else(|| text.find(&named).map(|i| text[..i].rfind('"').unwrap_or(i)))
             .map_or(start, |i| start + i);
         self.at_offset(offset)
     }

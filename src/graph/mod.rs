@@ -5,6 +5,7 @@
 mod compiled;
 mod deps;
 mod error;
+pub mod kinds;
 mod location;
 pub mod model;
 mod order;
@@ -16,10 +17,11 @@ mod validate;
 
 pub use compiled::{CompiledGraph, CulledPass, ScheduledPass};
 pub use error::{GraphError, GraphErrors};
+pub use kinds::{slot, BufferLayout, SlotSpec};
 pub use location::{Location, SourceText};
 pub use model::*;
 pub use plan::{FrameSize, ListLayout, ResourcePlan};
-pub use roles::{PassRoles, Slot};
+pub use roles::{PassRoles, BUILTIN_BINDINGS};
 pub use specialise::CullReason;
 pub use validate::CheckedGraph;
 

@@ -1,5 +1,8 @@
 //! The graph file format: plain serde data, exactly what a RON file says.
 
+pub use super::kinds::deferred_shading::DeferredShading;
+pub use super::kinds::forward_shading::ForwardShading;
+pub use super::kinds::light_culling::LightCulling;
 use serde::{Deserialize, Serialize};
 
 /// A whole graph file (`graphs/*.ron`).
@@ -155,6 +158,34 @@ pub struct PassDesc {
     pub writes: Vec<String>,
     #[serde(default)]
     pub when: Option<SceneFeature>,
+    /// `slot=resource` entries of reads and writes, split off by the parser: (slot,
+    /// resource). Built-in kinds match these by name; the rest by type and order.
+    #[serde(skip)]
+    pub named_slots: Vec<(String, String)>,
+}
+
+impl PassDesc {
+    /// The slot a `slot=resource` entry named for `resource`.
+    pub fn explicit_slot(&self, resource: &str) -> Option<&str> {
+        self.named_slots
+            .iter()
+            .find(|(_, r)| r == resource)
+            .map(|(s, _)| s.as_str())
+    }
+
+    /// Splits `slot=resource` entries of reads and writes into `named_slots`, leaving
+    /// plain resource names in the lists.
+    pub fn split_named_slots(&mut self) {
+        for list in [&mut self.reads, &mut self.writes] {
+            for entry in list.iter_mut() {
+                if let Some((slot, resource)) = entry.split_once('=') {
+                    let (slot, resource) = (slot.trim().to_string(), resource.trim().to_string());
+                    self.named_slots.push((slot, resource.clone()));
+                    *entry = resource;
+                }
+            }
+        }
+    }
 }
 
 /// How a culling pass bounds a tile in depth.
@@ -169,6 +200,18 @@ pub enum CullVariant {
     DepthMask,
     /// A 3D grid: `slices` exponential depth slices per tile, one list per cell.
     Clustered { slices: u32 },
+}
+
+impl CullVariant {
+    /// The `VARIANT` define and `ListParams::variant` of the culling shader.
+    pub fn code(self) -> u32 {
+        match self {
+            CullVariant::Frustum => 0,
+            CullVariant::HalfZ => 1,
+            CullVariant::DepthMask => 2,
+            CullVariant::Clustered { .. } => 3,
+        }
+    }
 }
 
 /// Where light lists come from for forward shading.
@@ -198,37 +241,20 @@ pub enum Dispatch {
     Fixed(u32, u32, u32),
 }
 
+/// A pass's kind and its parameters: one line per kind. Built-in kinds keep their
+/// parameters, slot table and checks in `graph/kinds/<kind>.rs`.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 pub enum PassKind {
     /// Depth only, no colour target; alpha-masked geometry discards.
     DepthPrepass,
     /// Tiled light culling against the prepass depth.
-    LightCulling {
-        tile: u32,
-        #[serde(default)]
-        variant: CullVariant,
-        /// Most lights a tile (or a half, or a cluster) can list.
-        #[serde(default = "default_capacity")]
-        capacity: u32,
-        /// Tiles per side of a coarse tile culled first: fine tiles then test only
-        /// their coarse tile's lights instead of every light. 0 or 1 turns it off.
-        #[serde(default = "default_coarse")]
-        coarse: u32,
-    },
+    LightCulling(LightCulling),
     /// Forward shading of the scene's materials through the light loop.
-    ForwardShading {
-        #[serde(default)]
-        lights: LightSource,
-    },
-    /// Geometry into a G-buffer: a depth texture and two Rgba32Float textures, in this
-    /// order in `writes`: world position (material index in w), shading normal.
+    ForwardShading(ForwardShading),
+    /// Geometry into a G-buffer: a depth texture and one packed or two Rgba32Float textures.
     GBuffer,
-    /// Lighting in a compute shader from the G-buffer (tiled deferred with `Culled`):
-    /// reads the G-buffer's two textures in order, writes an Rgba32Float texture.
-    DeferredShading {
-        #[serde(default)]
-        lights: LightSource,
-    },
+    /// Lighting in a compute shader from the G-buffer (tiled deferred with `Culled`).
+    DeferredShading(DeferredShading),
     /// A compute shader the graph file names; bindings are matched by name.
     Compute {
         shader: String,
@@ -244,12 +270,6 @@ pub enum PassKind {
     },
 }
 
-fn default_capacity() -> u32 {
-    256
-}
-fn default_coarse() -> u32 {
-    4
-}
 fn default_entry() -> String {
     "main".into()
 }
@@ -261,10 +281,10 @@ impl PassKind {
     pub fn label(&self) -> &'static str {
         match self {
             PassKind::DepthPrepass => "DepthPrepass",
-            PassKind::LightCulling { .. } => "LightCulling",
-            PassKind::ForwardShading { .. } => "ForwardShading",
+            PassKind::LightCulling(_) => "LightCulling",
+            PassKind::ForwardShading(_) => "ForwardShading",
             PassKind::GBuffer => "GBuffer",
-            PassKind::DeferredShading { .. } => "DeferredShading",
+            PassKind::DeferredShading(_) => "DeferredShading",
             PassKind::Compute { .. } => "Compute",
             PassKind::Fullscreen { .. } => "Fullscreen",
         }

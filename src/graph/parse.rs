@@ -18,7 +18,10 @@ pub fn load(path: &Path) -> Result<(GraphDesc, SourceText), GraphError> {
 
 /// Parses graph text; `source.file` is only used in messages.
 pub fn parse(source: &SourceText) -> Result<GraphDesc, GraphError> {
-    ron::from_str::<GraphDesc>(&source.text).map_err(|e| {
+    // Kinds wrap their parameter struct: `LightCulling(tile: 16)`, not `LightCulling((tile: 16))`.
+    let options = ron::Options::default()
+        .with_default_extension(ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES);
+    let mut desc = options.from_str::<GraphDesc>(&source.text).map_err(|e| {
         let (line, col) = (e.span.start.line, e.span.start.col);
         let at = source.at(line, col);
         let pass = source.pass_around(source.offset_of(line, col));
@@ -31,6 +34,7 @@ pub fn parse(source: &SourceText) -> Result<GraphDesc, GraphError> {
                     at,
                     pass: pass.unwrap_or_else(|| "?".into()),
                     kind: found.clone(),
+                    known: expected.join(", "),
                 };
             }
         }
@@ -39,5 +43,9 @@ pub fn parse(source: &SourceText) -> Result<GraphDesc, GraphError> {
             context: pass.map(|p| format!("pass '{p}': ")).unwrap_or_default(),
             message: e.code.to_string(),
         }
-    })
+    })?;
+    for pass in &mut desc.passes {
+        pass.split_named_slots();
+    }
+    Ok(desc)
 }

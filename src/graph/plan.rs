@@ -2,9 +2,8 @@
 //! one physical texture or buffer serving several graph resources with the same
 //! descriptor whose lifetimes (first to last use in the schedule) do not overlap.
 
-use super::model::{
-    BufferSize, CullVariant, GraphDesc, PassKind, ResourceDesc, TextureFormat, TextureSize,
-};
+use super::kinds::{self, BufferLayout, Usage};
+use super::model::{BufferSize, CullVariant, GraphDesc, ResourceDesc, TextureFormat, TextureSize};
 use super::roles::PassRoles;
 use crate::shader::BindingKind;
 
@@ -43,6 +42,9 @@ pub struct PlannedResource {
     pub last: usize,
     /// No running pass writes it (its writers were culled): cleared to zero each frame.
     pub absent: bool,
+    /// What the built-in pass declared to write it says about its contents (light-list
+    /// layout), even if that pass was culled.
+    pub layout: Option<BufferLayout>,
 }
 
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -54,6 +56,12 @@ pub struct ResourcePlan {
 impl ResourcePlan {
     pub fn get(&self, name: &str) -> Option<&PlannedResource> {
         self.resources.iter().find(|r| r.name == name)
+    }
+    /// The light-list layout of a planned buffer a culling pass writes.
+    pub fn list_layout(&self, name: &str) -> Option<ListLayout> {
+        match self.get(name)?.layout? {
+            BufferLayout::LightLists(l) => Some(l),
+        }
     }
 }
 
@@ -70,6 +78,9 @@ pub struct FrameSize {
 /// overflows), then (offset, count, z_min, z_max) per list, then the index pool.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ListLayout {
+    /// Pixels per tile side.
+    pub tile: u32,
+    pub variant: CullVariant,
     pub tiles_x: u32,
     pub tiles_y: u32,
     pub lists_per_tile: u32,
@@ -82,6 +93,8 @@ impl ListLayout {
     pub const ENTRY_WORDS: u32 = 4;
     pub fn new(tile: u32, variant: CullVariant, capacity: u32, width: u32, height: u32) -> Self {
         Self {
+            tile,
+            variant,
             tiles_x: width.div_ceil(tile),
             tiles_y: height.div_ceil(tile),
             lists_per_tile: match variant {
@@ -116,7 +129,22 @@ fn texture_extent(size: TextureSize, frame: FrameSize) -> (u32, u32) {
     }
 }
 
-fn buffer_bytes(name: &str, size: BufferSize, desc: &GraphDesc, frame: FrameSize) -> u64 {
+/// The layout the built-in pass declared to write buffer `name` gives it.
+fn buffer_layout(
+    name: &str,
+    desc: &GraphDesc,
+    roles: &[PassRoles],
+    frame: FrameSize,
+) -> Option<BufferLayout> {
+    desc.passes.iter().zip(roles).find_map(|(p, r)| {
+        if !p.writes.iter().any(|w| w == name) {
+            return None;
+        }
+        kinds::buffer_layout(&p.kind, r.slot_of(name)?, frame)
+    })
+}
+
+fn buffer_bytes(size: BufferSize, layout: Option<BufferLayout>, frame: FrameSize) -> u64 {
     let bytes = match size {
         BufferSize::Bytes(b) => b,
         BufferSize::PerTile { tile, bytes } => {
@@ -125,21 +153,7 @@ fn buffer_bytes(name: &str, size: BufferSize, desc: &GraphDesc, frame: FrameSize
         }
         BufferSize::PerPixel(b) => frame.width as u64 * frame.height as u64 * b,
         BufferSize::PerLight(b) => frame.lights.max(1) as u64 * b,
-        BufferSize::Auto => desc
-            .passes
-            .iter()
-            .find_map(|p| match p.kind {
-                PassKind::LightCulling {
-                    tile,
-                    variant,
-                    capacity,
-                    ..
-                } if p.writes.iter().any(|w| w == name) => Some(
-                    ListLayout::new(tile, variant, capacity, frame.width, frame.height).bytes(),
-                ),
-                _ => None,
-            })
-            .unwrap_or(16),
+        BufferSize::Auto => layout.map_or(16, |l| l.bytes()),
     };
     // Storage bindings need a multiple of 4 and at least one element.
     bytes.max(16).next_multiple_of(4)
@@ -189,7 +203,11 @@ pub fn plan(
             .iter()
             .map(|&pos| schedule[pos])
             .collect();
-        let (pdesc, tex_usage, buf_usage) = describe(r, desc, roles, &users, frame);
+        let layout = match r {
+            ResourceDesc::Buffer { .. } => buffer_layout(r.name(), desc, roles, frame),
+            _ => None,
+        };
+        let (pdesc, tex_usage, buf_usage) = describe(r, desc, roles, &users, frame, layout);
         let absent = !users
             .iter()
             .any(|&p| desc.passes[p].writes.iter().any(|w| w == r.name()));
@@ -221,6 +239,7 @@ pub fn plan(
             first,
             last,
             absent,
+            layout,
         });
     }
     plan
@@ -232,6 +251,7 @@ fn describe(
     roles: &[PassRoles],
     users: &[usize],
     frame: FrameSize,
+    layout: Option<BufferLayout>,
 ) -> (PhysicalDesc, wgpu::TextureUsages, wgpu::BufferUsages) {
     use wgpu::{BufferUsages as B, TextureUsages as T};
     match r {
@@ -251,22 +271,21 @@ fn describe(
             }
             for &p in users {
                 let role = &roles[p];
-                let is_slot =
-                    role.slots.values().any(|v| v == name) || role.target.as_deref() == Some(name);
-                if is_slot && matches!(desc.passes[p].kind, PassKind::DeferredShading { .. }) {
-                    // Reads the G-buffer as textures, stores its output as a storage texture.
-                    usage |= if desc.passes[p].writes.iter().any(|w| w == name) {
-                        T::STORAGE_BINDING
-                    } else {
-                        T::TEXTURE_BINDING
+                let slot = role.slot_of(name).and_then(|slot| {
+                    kinds::slots(&desc.passes[p].kind)?
+                        .iter()
+                        .find(|s| s.name == slot)
+                });
+                if let Some(spec) = slot {
+                    usage |= match spec.usage {
+                        Usage::Attachment => T::RENDER_ATTACHMENT,
+                        Usage::Sampled => T::TEXTURE_BINDING,
+                        Usage::Storage => T::STORAGE_BINDING,
+                        Usage::Bound => T::empty(),
                     };
-                } else if is_slot {
+                }
+                if role.target.as_deref() == Some(name) {
                     usage |= T::RENDER_ATTACHMENT;
-                    if format.is_depth()
-                        && matches!(desc.passes[p].kind, PassKind::LightCulling { .. })
-                    {
-                        usage |= T::TEXTURE_BINDING;
-                    }
                 }
                 for (b, n) in &role.bindings {
                     if n == name {
@@ -288,9 +307,9 @@ fn describe(
                 B::empty(),
             )
         }
-        ResourceDesc::Buffer { name, size } => (
+        ResourceDesc::Buffer { size, .. } => (
             PhysicalDesc::Buffer {
-                bytes: buffer_bytes(name, *size, desc, frame),
+                bytes: buffer_bytes(*size, layout, frame),
             },
             T::empty(),
             B::STORAGE | B::COPY_SRC | B::COPY_DST | B::UNIFORM,

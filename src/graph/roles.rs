@@ -1,26 +1,11 @@
-//! What each declared resource is to a pass: the built-in kinds find their slots by the
-//! resource's type, generic kinds by shader binding name. No GPU here.
+//! What each declared resource is to a pass: built-in kinds fill their slot tables
+//! (`kinds/`), generic kinds bind by shader binding name. No GPU here.
 
 use super::error::GraphError;
 use super::location::SourceText;
-use super::model::{LightSource, PassDesc, PassKind, ResourceDesc, SceneResource};
+use super::model::{PassDesc, PassKind, ResourceDesc, SceneResource};
 use crate::shader::{BindingKind, ReflectedBinding};
 use std::collections::BTreeMap;
-
-/// A slot of a built-in pass kind.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum Slot {
-    Depth,
-    Color,
-    LightGeometry,
-    LightProperties,
-    Geometry,
-    LightLists,
-    /// G-buffer world positions (material index in w).
-    GPosition,
-    /// G-buffer shading normals.
-    GNormal,
-}
 
 /// Binding names every generic shader may use without declaring them.
 pub const BUILTIN_BINDINGS: [&str; 3] = ["frame", "linear_sampler", "nearest_sampler"];
@@ -28,8 +13,8 @@ pub const BUILTIN_BINDINGS: [&str; 3] = ["frame", "linear_sampler", "nearest_sam
 /// How a pass uses its resources, resolved and checked.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PassRoles {
-    /// Built-in kinds: slot -> resource name.
-    pub slots: BTreeMap<Slot, String>,
+    /// Built-in kinds: slot name (from the kind's table) -> resource name.
+    pub slots: BTreeMap<&'static str, String>,
     /// Generic kinds: reflected binding -> resource name (or a built-in binding name).
     pub bindings: Vec<(ReflectedBinding, String)>,
     /// Fullscreen: the colour target it renders into.
@@ -37,8 +22,15 @@ pub struct PassRoles {
 }
 
 impl PassRoles {
-    pub fn slot(&self, slot: Slot) -> Option<&str> {
-        self.slots.get(&slot).map(String::as_str)
+    pub fn slot(&self, slot: &str) -> Option<&str> {
+        self.slots.get(slot).map(String::as_str)
+    }
+    /// The slot `resource` fills, if any.
+    pub fn slot_of(&self, resource: &str) -> Option<&'static str> {
+        self.slots
+            .iter()
+            .find(|(_, r)| *r == resource)
+            .map(|(s, _)| *s)
     }
 }
 
@@ -48,7 +40,12 @@ pub(crate) struct RoleCtx<'a> {
 }
 
 impl RoleCtx<'_> {
-    fn mismatch(&self, pass: &PassDesc, resource: &str, problem: impl Into<String>) -> GraphError {
+    pub(crate) fn mismatch(
+        &self,
+        pass: &PassDesc,
+        resource: &str,
+        problem: impl Into<String>,
+    ) -> GraphError {
         GraphError::Mismatch {
             at: self.source.in_pass(&pass.name, resource),
             pass: pass.name.clone(),
@@ -56,7 +53,7 @@ impl RoleCtx<'_> {
             problem: problem.into(),
         }
     }
-    fn bad(&self, pass: &PassDesc, problem: impl Into<String>) -> GraphError {
+    pub(crate) fn bad(&self, pass: &PassDesc, problem: impl Into<String>) -> GraphError {
         GraphError::BadPass {
             at: self.source.of_declaration(&pass.name),
             pass: pass.name.clone(),
@@ -64,20 +61,6 @@ impl RoleCtx<'_> {
         }
     }
 
-    fn import_of(&self, name: &str) -> Option<SceneResource> {
-        match self.resources.get(name) {
-            Some(ResourceDesc::Import { from, .. }) => Some(*from),
-            _ => None,
-        }
-    }
-    fn depth_texture(&self, name: &str) -> Option<u32> {
-        match self.resources.get(name) {
-            Some(ResourceDesc::Texture {
-                format, samples, ..
-            }) if format.is_depth() => Some(*samples),
-            _ => None,
-        }
-    }
     fn color_texture(&self, name: &str) -> Option<u32> {
         match self.resources.get(name) {
             Some(ResourceDesc::Texture {
@@ -86,305 +69,11 @@ impl RoleCtx<'_> {
             _ => None,
         }
     }
-    fn is_rgba32f(&self, name: &str) -> bool {
-        matches!(
-            self.resources.get(name),
-            Some(ResourceDesc::Texture {
-                format: super::model::TextureFormat::Rgba32Float,
-                ..
-            })
-        )
-    }
-    fn is_buffer(&self, name: &str) -> bool {
-        matches!(self.resources.get(name), Some(ResourceDesc::Buffer { .. }))
-    }
 
-    /// Resolves the slots of a built-in pass; every declared resource must fill a slot.
+    /// Resolves the slots of a built-in pass (see [`super::kinds::resolve`]).
     pub fn builtin(&self, pass: &PassDesc) -> Result<PassRoles, Vec<GraphError>> {
-        let mut roles = PassRoles::default();
-        let mut errors = Vec::new();
-        let put = |roles: &mut PassRoles, slot: Slot, name: &str, errors: &mut Vec<GraphError>| {
-            if let Some(prev) = roles.slots.insert(slot, name.to_string()) {
-                errors.push(self.mismatch(
-                    pass,
-                    name,
-                    format!("{:?} slot already filled by '{prev}'", slot),
-                ));
-            }
-        };
-        for name in &pass.reads {
-            match (self.import_of(name), self.depth_texture(name)) {
-                (Some(SceneResource::LightGeometry), _) => {
-                    put(&mut roles, Slot::LightGeometry, name, &mut errors)
-                }
-                (Some(SceneResource::LightProperties), _) => {
-                    put(&mut roles, Slot::LightProperties, name, &mut errors)
-                }
-                (Some(SceneResource::Geometry), _) => {
-                    put(&mut roles, Slot::Geometry, name, &mut errors)
-                }
-                (None, Some(_)) => put(&mut roles, Slot::Depth, name, &mut errors),
-                _ if self.is_buffer(name) => put(&mut roles, Slot::LightLists, name, &mut errors),
-                _ if matches!(pass.kind, PassKind::DeferredShading { .. }) => {
-                    let slot = if roles.slots.contains_key(&Slot::GPosition) {
-                        Slot::GNormal
-                    } else {
-                        Slot::GPosition
-                    };
-                    put(&mut roles, slot, name, &mut errors)
-                }
-                _ => errors.push(self.mismatch(
-                    pass,
-                    name,
-                    format!("a {} pass cannot read a colour texture", pass.kind.label()),
-                )),
-            }
-        }
-        for name in &pass.writes {
-            if self.import_of(name).is_some() {
-                continue; // reported as a write to a read-only import by validation
-            }
-            if self.depth_texture(name).is_some() {
-                put(&mut roles, Slot::Depth, name, &mut errors);
-            } else if self.color_texture(name).is_some() && matches!(pass.kind, PassKind::GBuffer) {
-                let slot = if roles.slots.contains_key(&Slot::GPosition) {
-                    Slot::GNormal
-                } else {
-                    Slot::GPosition
-                };
-                put(&mut roles, slot, name, &mut errors);
-            } else if self.color_texture(name).is_some() {
-                put(&mut roles, Slot::Color, name, &mut errors);
-            } else {
-                put(&mut roles, Slot::LightLists, name, &mut errors);
-            }
-        }
-        let need = |roles: &PassRoles, slot: Slot, what: &str, errors: &mut Vec<GraphError>| {
-            if !roles.slots.contains_key(&slot) {
-                errors.push(self.bad(pass, format!("{} needs {what}", pass.kind.label())));
-            }
-        };
-        match &pass.kind {
-            PassKind::DepthPrepass => {
-                need(
-                    &roles,
-                    Slot::Depth,
-                    "a depth texture in writes",
-                    &mut errors,
-                );
-                for slot in [
-                    Slot::Color,
-                    Slot::LightLists,
-                    Slot::LightGeometry,
-                    Slot::LightProperties,
-                ] {
-                    if let Some(name) = roles.slot(slot) {
-                        errors.push(self.mismatch(
-                            pass,
-                            name,
-                            "a depth prepass has no colour target and uses no lights",
-                        ));
-                    }
-                }
-                if let Some(name) = roles.slot(Slot::Depth) {
-                    if !pass.writes.iter().any(|w| w == name) {
-                        errors.push(self.mismatch(
-                            pass,
-                            name,
-                            "the depth prepass must write its depth texture",
-                        ));
-                    }
-                }
-            }
-            PassKind::LightCulling {
-                tile,
-                variant,
-                capacity,
-                coarse,
-            } => {
-                need(&roles, Slot::Depth, "a depth texture in reads", &mut errors);
-                need(
-                    &roles,
-                    Slot::LightGeometry,
-                    "an Import of LightGeometry in reads",
-                    &mut errors,
-                );
-                need(
-                    &roles,
-                    Slot::LightLists,
-                    "a buffer in writes for the light lists",
-                    &mut errors,
-                );
-                if let Some(name) = roles.slot(Slot::LightLists) {
-                    if !pass.writes.iter().any(|w| w == name) {
-                        errors.push(self.mismatch(pass, name, "light lists must be in writes"));
-                    }
-                }
-                if let Some(name) = roles.slot(Slot::Depth) {
-                    if self.depth_texture(name).unwrap_or(1) > 1 {
-                        errors.push(self.mismatch(
-                            pass,
-                            name,
-                            "culling reads a single-sample depth texture; this one is multisampled",
-                        ));
-                    }
-                    if pass.writes.iter().any(|w| w == name) {
-                        errors.push(self.mismatch(pass, name, "culling only reads depth"));
-                    }
-                }
-                if !matches!(tile, 8 | 16) {
-                    errors.push(self.bad(pass, format!("tile size {tile} is not supported (8 or 16: one workgroup of tile×tile invocations)")));
-                }
-                if *capacity == 0 || *capacity > 4096 {
-                    errors.push(self.bad(pass, format!("capacity {capacity} must be in 1..=4096")));
-                }
-                if *coarse > 16 {
-                    errors.push(self.bad(pass, format!("coarse {coarse} must be in 0..=16 tiles per side (0 or 1: no coarse stage)")));
-                }
-                if let super::model::CullVariant::Clustered { slices } = variant {
-                    if *slices == 0 || *slices > 64 {
-                        errors.push(
-                            self.bad(pass, format!("clustered slices {slices} must be in 1..=64")),
-                        );
-                    }
-                }
-            }
-            PassKind::ForwardShading { lights } => {
-                need(
-                    &roles,
-                    Slot::Color,
-                    "a colour texture in writes",
-                    &mut errors,
-                );
-                need(
-                    &roles,
-                    Slot::Depth,
-                    "a depth texture in reads or writes",
-                    &mut errors,
-                );
-                self.check_light_inputs(pass, *lights, &roles, &mut errors);
-                if let (Some(c), Some(d)) = (roles.slot(Slot::Color), roles.slot(Slot::Depth)) {
-                    let (cs, ds) = (
-                        self.color_texture(c).unwrap_or(1),
-                        self.depth_texture(d).unwrap_or(1),
-                    );
-                    if cs != ds {
-                        errors.push(self.mismatch(pass, c, format!("colour target has {cs} sample(s) but depth '{d}' has {ds}: MSAA needs both multisampled")));
-                    }
-                }
-            }
-            PassKind::GBuffer => {
-                need(
-                    &roles,
-                    Slot::Depth,
-                    "a depth texture (in writes, or in reads after a depth prepass)",
-                    &mut errors,
-                );
-                need(
-                    &roles,
-                    Slot::GPosition,
-                    "one Rgba32Float texture in writes (packed: view depth, octahedral normal, material) or two (positions, normals)",
-                    &mut errors,
-                );
-                for slot in [Slot::GPosition, Slot::GNormal] {
-                    if let Some(name) = roles.slot(slot) {
-                        if !self.is_rgba32f(name) || self.color_texture(name) != Some(1) {
-                            errors.push(self.mismatch(
-                                pass,
-                                name,
-                                "G-buffer textures are single-sample Rgba32Float",
-                            ));
-                        }
-                    }
-                }
-                if let Some(name) = roles.slot(Slot::Depth) {
-                    if self.depth_texture(name) != Some(1) {
-                        errors.push(self.mismatch(pass, name, "the G-buffer is single-sample"));
-                    }
-                }
-                for slot in [
-                    Slot::Color,
-                    Slot::LightLists,
-                    Slot::LightGeometry,
-                    Slot::LightProperties,
-                ] {
-                    if let Some(name) = roles.slot(slot) {
-                        errors.push(self.mismatch(pass, name, "a G-buffer pass uses no lights and writes only depth and its one or two textures"));
-                    }
-                }
-            }
-            PassKind::DeferredShading { lights } => {
-                need(
-                    &roles,
-                    Slot::GPosition,
-                    "the G-buffer's texture(s) in reads (packed, or positions and normals)",
-                    &mut errors,
-                );
-                need(
-                    &roles,
-                    Slot::Color,
-                    "an Rgba32Float texture in writes",
-                    &mut errors,
-                );
-                self.check_light_inputs(pass, *lights, &roles, &mut errors);
-                if let Some(name) = roles.slot(Slot::Color) {
-                    if !self.is_rgba32f(name) || self.color_texture(name) != Some(1) {
-                        errors.push(self.mismatch(
-                            pass,
-                            name,
-                            "deferred shading stores into a single-sample Rgba32Float texture",
-                        ));
-                    }
-                }
-                if let Some(name) = roles.slot(Slot::Depth) {
-                    errors.push(self.mismatch(
-                        pass,
-                        name,
-                        "deferred shading reads positions from the G-buffer, not depth",
-                    ));
-                }
-            }
-            PassKind::Compute { .. } | PassKind::Fullscreen { .. } => {
-                unreachable!("generic kinds are matched by binding")
-            }
-        }
-        if errors.is_empty() {
-            Ok(roles)
-        } else {
-            Err(errors)
-        }
-    }
-
-    /// What every shading pass (forward or deferred) needs to read its lights.
-    fn check_light_inputs(
-        &self,
-        pass: &PassDesc,
-        lights: LightSource,
-        roles: &PassRoles,
-        errors: &mut Vec<GraphError>,
-    ) {
-        let kind = pass.kind.label();
-        for (slot, what) in [
-            (Slot::LightGeometry, "an Import of LightGeometry in reads"),
-            (
-                Slot::LightProperties,
-                "an Import of LightProperties in reads",
-            ),
-        ] {
-            if !roles.slots.contains_key(&slot) {
-                errors.push(self.bad(pass, format!("{kind} needs {what}")));
-            }
-        }
-        match (lights, roles.slot(Slot::LightLists)) {
-            (LightSource::Culled, None) => errors.push(self.bad(
-                pass,
-                "lights: Culled needs the culling pass's light-list buffer in reads",
-            )),
-            (LightSource::AllLights, Some(name)) => {
-                errors.push(self.mismatch(pass, name, "lights: AllLights reads no light lists"))
-            }
-            _ => {}
-        }
+        let specs = super::kinds::slots(&pass.kind).expect("a built-in kind");
+        super::kinds::resolve(self, pass, specs)
     }
 
     /// Matches a generic pass's reflected shader bindings against its declaration.

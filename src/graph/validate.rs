@@ -3,7 +3,7 @@
 use super::deps::{self, DepGraph};
 use super::error::{GraphError, GraphErrors};
 use super::location::SourceText;
-use super::model::{GraphDesc, PassKind, ResourceDesc};
+use super::model::{GraphDesc, PassKind, ResourceDesc, TextureFormat};
 use super::roles::{PassRoles, RoleCtx};
 use crate::shader::{reflect_bindings, Composed, ShaderLibrary};
 use std::collections::{BTreeMap, BTreeSet};
@@ -133,12 +133,24 @@ fn check_references(
         let i = source.text.find("output").unwrap_or(0);
         source.at_offset(i)
     };
-    match resources.get(desc.output.as_str()) {
-        Some(ResourceDesc::Texture { format, .. }) if !format.is_depth() => {}
-        _ => errors.push(GraphError::BadOutput {
+    // The frame is read back and presented as linear HDR.
+    let problem = match resources.get(desc.output.as_str()) {
+        Some(ResourceDesc::Texture {
+            format: TextureFormat::Rgba32Float,
+            samples: 1,
+            ..
+        }) => None,
+        Some(ResourceDesc::Texture { format, samples, .. }) if !format.is_depth() => Some(format!(
+            "must be a single-sample Rgba32Float texture to be read back; it is {format:?} with {samples} sample(s)"
+        )),
+        _ => Some("is not a declared colour texture".to_string()),
+    };
+    if let Some(problem) = problem {
+        errors.push(GraphError::BadOutput {
             at: output_at(),
             resource: desc.output.clone(),
-        }),
+            problem,
+        });
     }
     for s in &desc.side_effects {
         if !desc.passes.iter().any(|p| &p.name == s) {

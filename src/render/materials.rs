@@ -2,10 +2,10 @@
 //! `<material>` include of `shaders/forward/forward.wgsl`), its textures uploaded into
 //! bind group 2, and what the pipelines need to know.
 
+use super::bind::{BindingSet, Bound};
 use crate::material::{Material, MaterialError, TextureSource};
 use crate::scene::{AlphaMode, Scene, SurfaceMaterial};
 use std::path::PathBuf;
-use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
 #[derive(Clone)]
@@ -15,8 +15,8 @@ pub struct MaterialProgram {
     pub wgsl: String,
     pub alpha_mode: AlphaMode,
     pub double_sided: bool,
-    /// Group 2 (sampler + textures); None for a material without textures.
-    pub bind_group: Option<(Arc<wgpu::BindGroupLayout>, wgpu::BindGroup)>,
+    /// Group 2's sampler and textures by binding name; None without textures.
+    pub(super) textures: Option<BindingSet>,
 }
 
 impl MaterialProgram {
@@ -29,17 +29,24 @@ impl MaterialProgram {
     ) -> Result<Self, MaterialError> {
         let wgsl = material.wgsl()?;
         let slots = material.texture_slots();
-        let bind_group = if slots.is_empty() {
+        // Offered by the names the generated WGSL declares (`material_sampler`,
+        // `material_tex{i}`); the layout comes from reflecting the composed shader.
+        let textures = if slots.is_empty() {
             None
         } else {
-            let mut entries = vec![wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                count: None,
-            }];
-            let mut views = Vec::new();
-            for slot in slots {
+            let mut set = BindingSet::default();
+            set.offer(
+                "material_sampler",
+                Bound::Sampler(device.create_sampler(&wgpu::SamplerDescriptor {
+                    label: Some("material_sampler"),
+                    address_mode_u: wgpu::AddressMode::Repeat,
+                    address_mode_v: wgpu::AddressMode::Repeat,
+                    mag_filter: wgpu::FilterMode::Linear,
+                    min_filter: wgpu::FilterMode::Linear,
+                    ..Default::default()
+                })),
+            );
+            for (i, slot) in slots.iter().enumerate() {
                 let image = slot.source.load()?;
                 let format = if image.srgb {
                     wgpu::TextureFormat::Rgba8UnormSrgb
@@ -65,55 +72,19 @@ impl MaterialProgram {
                     wgpu::util::TextureDataOrder::LayerMajor,
                     &image.rgba8,
                 );
-                entries.push(wgpu::BindGroupLayoutEntry {
-                    binding: slot.binding,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                });
-                views.push((slot.binding, texture.create_view(&Default::default())));
+                set.offer(
+                    &format!("material_tex{i}"),
+                    Bound::View(texture.create_view(&Default::default())),
+                );
             }
-            let layout = Arc::new(device.create_bind_group_layout(
-                &wgpu::BindGroupLayoutDescriptor {
-                    label: Some(material.name()),
-                    entries: &entries,
-                },
-            ));
-            let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-                label: Some("material_sampler"),
-                address_mode_u: wgpu::AddressMode::Repeat,
-                address_mode_v: wgpu::AddressMode::Repeat,
-                mag_filter: wgpu::FilterMode::Linear,
-                min_filter: wgpu::FilterMode::Linear,
-                ..Default::default()
-            });
-            let mut bind_entries = vec![wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Sampler(&sampler),
-            }];
-            for (binding, view) in &views {
-                bind_entries.push(wgpu::BindGroupEntry {
-                    binding: *binding,
-                    resource: wgpu::BindingResource::TextureView(view),
-                });
-            }
-            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(material.name()),
-                layout: &layout,
-                entries: &bind_entries,
-            });
-            Some((layout, group))
+            Some(set)
         };
         Ok(Self {
             name: material.name().to_string(),
             wgsl,
             alpha_mode,
             double_sided,
-            bind_group,
+            textures,
         })
     }
 

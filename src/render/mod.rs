@@ -1,18 +1,24 @@
 //! Running a compiled graph on wgpu: physical resources from the plan, pipelines from
 //! the cache, one wgpu pass per graph pass with GPU timestamps around it, readback.
 
+mod bind;
+mod draws;
 mod frame;
-mod generic;
+mod light_stats;
 pub mod materials;
+mod passes;
 mod pipelines;
 mod prepare_stats;
+mod report;
 mod resources;
 mod scene_gpu;
 
-pub use frame::{CullingReport, FrameResult, LightStats, PreparedFrame};
+pub use bind::LayoutCache;
+pub use frame::PreparedFrame;
 pub use materials::MaterialProgram;
 pub use pipelines::{CacheCounters, Pipeline, PipelineCache, PipelineKey};
 pub use prepare_stats::PrepareStats;
+pub use report::{CullingReport, FrameResult, LightStats};
 pub use resources::FrameResources;
 pub use scene_gpu::{GpuMesh, SceneGpu};
 
@@ -41,6 +47,8 @@ pub struct Renderer {
     pub ctx: GpuContext,
     pub shaders: ShaderLibrary,
     pub pipelines: PipelineCache,
+    /// Bind-group layouts by their reflected entries, shared by the pipelines made from them.
+    pub layouts: std::sync::Arc<LayoutCache>,
 }
 
 impl Renderer {
@@ -49,6 +57,7 @@ impl Renderer {
             ctx,
             shaders,
             pipelines: PipelineCache::default(),
+            layouts: Default::default(),
         }
     }
 

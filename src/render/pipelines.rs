@@ -3,7 +3,7 @@
 //! hits, misses and builds and times composing and building, so hot reload can show
 //! (and tests can check) exactly what an edit rebuilt.
 
-use crate::shader::{Composed, ShaderError, ShaderLibrary};
+use crate::shader::{reflect_bindings, Composed, ReflectedBinding, ShaderError, ShaderLibrary};
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -106,6 +106,8 @@ impl std::ops::Sub for CacheCounters {
 
 struct Entry {
     pipeline: Pipeline,
+    /// The composed shader's bindings, as naga reflects them.
+    bindings: Arc<[ReflectedBinding]>,
     /// Every shader file that went into it (includes too).
     files: Vec<PathBuf>,
     /// The generation that last asked for it (see [`PipelineCache::next_generation`]).
@@ -135,23 +137,37 @@ impl PipelineCache {
         build: impl FnOnce(&Composed, wgpu::ShaderModule) -> Pipeline,
         device: &wgpu::Device,
     ) -> Result<Pipeline, ShaderError> {
+        self.get_or_build_reflected(shaders, key, |c, m, _| build(c, m), device)
+            .map(|(p, _)| p)
+    }
+
+    /// Like [`get_or_build`](Self::get_or_build), handing `build` the shader's reflected
+    /// bindings (to make its layout from) and returning them with the pipeline.
+    pub fn get_or_build_reflected(
+        &mut self,
+        shaders: &ShaderLibrary,
+        key: PipelineKey,
+        build: impl FnOnce(&Composed, wgpu::ShaderModule, &[ReflectedBinding]) -> Pipeline,
+        device: &wgpu::Device,
+    ) -> Result<(Pipeline, Arc<[ReflectedBinding]>), ShaderError> {
         if let Some(e) = self.pipelines.get_mut(&key) {
             e.last_used = self.generation;
             self.hits += 1;
-            return Ok(e.pipeline.clone());
+            return Ok((e.pipeline.clone(), e.bindings.clone()));
         }
         self.misses += 1;
         let start = Instant::now();
         let composed = shaders.compose(&key.shader, &key.defines, &key.virtual_code);
-        let composed = composed.and_then(|c| c.validate().map(|_| c));
+        let composed = composed.and_then(|c| c.validate().map(|m| (c, m)));
         self.compose_time += start.elapsed();
-        let composed = composed?;
+        let (composed, naga_module) = composed?;
+        let bindings: Arc<[ReflectedBinding]> = reflect_bindings(&naga_module).into();
         let start = Instant::now();
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(&key.shader),
             source: wgpu::ShaderSource::Wgsl(composed.text.clone().into()),
         });
-        let pipeline = build(&composed, module);
+        let pipeline = build(&composed, module, &bindings);
         self.build_time += start.elapsed();
         self.builds += 1;
         self.built.push(key.clone());
@@ -159,11 +175,12 @@ impl PipelineCache {
             key,
             Entry {
                 pipeline: pipeline.clone(),
+                bindings: bindings.clone(),
                 files: composed.files.clone(),
                 last_used: self.generation,
             },
         );
-        Ok(pipeline)
+        Ok((pipeline, bindings))
     }
 
     pub fn len(&self) -> usize {

@@ -1,0 +1,105 @@
+//! `DeferredShading`: lighting in a compute shader from the G-buffer (tiled deferred
+//! with `lights: Culled`), one dispatch per material. Runs `shaders/deferred/deferred_shading.wgsl`.
+
+use super::g_buffer::{G_NORMAL, G_POSITION};
+use super::{check_light_source, slot, Access, KindCtx, SlotSpec, SlotType, Usage};
+use crate::graph::error::GraphError;
+use crate::graph::model::{LightSource, SceneResource};
+use serde::{Deserialize, Serialize};
+
+/// `DeferredShading(lights: Culled)`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
+#[serde(deny_unknown_fields)]
+pub struct DeferredShading {
+    #[serde(default)]
+    pub lights: LightSource,
+}
+
+/// The texture it stores into (the shader's binding name).
+pub const HDR: &str = "hdr";
+
+pub const SLOTS: &[SlotSpec] = &[
+    SlotSpec::new(
+        G_POSITION,
+        SlotType::ColorTexture,
+        Access::Read,
+        Usage::Sampled,
+    ),
+    SlotSpec::new(
+        G_NORMAL,
+        SlotType::ColorTexture,
+        Access::Read,
+        Usage::Sampled,
+    )
+    .optional(),
+    SlotSpec::new(
+        slot::LIGHT_GEOMETRY,
+        SlotType::Import(SceneResource::LightGeometry),
+        Access::Read,
+        Usage::Bound,
+    ),
+    SlotSpec::new(
+        slot::LIGHT_PROPERTIES,
+        SlotType::Import(SceneResource::LightProperties),
+        Access::Read,
+        Usage::Bound,
+    ),
+    SlotSpec::new(
+        slot::LIGHT_LISTS,
+        SlotType::Buffer,
+        Access::Read,
+        Usage::Bound,
+    )
+    .optional(),
+    SlotSpec::new(HDR, SlotType::ColorTexture, Access::Write, Usage::Storage),
+];
+
+pub fn check(p: &DeferredShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+    check_light_source(ctx, p.lights, errors);
+    if let Some(name) = ctx.slot(HDR) {
+        if !ctx.is_single_rgba32f(name) {
+            errors.push(ctx.mismatch(
+                name,
+                "deferred shading stores into a single-sample Rgba32Float texture",
+            ));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::graph::kinds::test_support::{errors, validate};
+
+    const GBUF: &str =
+        r#"Pass(name: "g", kind: GBuffer, reads: ["geometry"], writes: ["depth", "pos", "nrm"]),"#;
+
+    #[test]
+    fn reads_the_g_buffer_not_depth() {
+        validate(
+            &format!(r#"{GBUF} Pass(name: "d", kind: DeferredShading(), reads: ["pos", "nrm", "lg", "lp"], writes: ["hdr"])"#),
+            "hdr",
+        )
+        .unwrap();
+        let e = errors(
+            &format!(
+                r#"{GBUF} Pass(name: "d", kind: DeferredShading(), reads: ["pos", "nrm", "depth", "lg", "lp"], writes: ["hdr"])"#
+            ),
+            "hdr",
+        );
+        assert!(
+            e.contains("DeferredShading has no free slot for a depth texture in reads"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn stores_into_single_sample_rgba32f() {
+        let e = errors(
+            &format!(
+                r#"{GBUF} Pass(name: "d", kind: DeferredShading(), reads: ["pos", "nrm", "lg", "lp"], writes: ["small"])"#
+            ),
+            "hdr",
+        );
+        assert!(e.contains("single-sample Rgba32Float"), "{e}");
+    }
+}

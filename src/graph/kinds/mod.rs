@@ -1,0 +1,380 @@
+//! Built-in pass kinds, one file each: its parameters, its slot table and its checks.
+//! This file holds the one match from a kind to them, and the slot matching every
+//! built-in kind shares. Generic kinds (Compute, Fullscreen) bind by reflected shader
+//! binding names instead (see `roles.rs`).
+
+pub mod deferred_shading;
+pub mod depth_prepass;
+pub mod forward_shading;
+pub mod g_buffer;
+pub mod light_culling;
+
+use super::error::GraphError;
+use super::model::{PassDesc, PassKind, ResourceDesc, SceneResource};
+use super::plan::{FrameSize, ListLayout};
+use super::roles::{PassRoles, RoleCtx};
+
+/// Slot names shared by several kinds; each is also the WGSL binding name the kind's
+/// shader uses for it (attachments are not bindings).
+pub mod slot {
+    pub const GEOMETRY: &str = "geometry";
+    pub const DEPTH: &str = "depth";
+    pub const COLOR: &str = "color";
+    pub const LIGHT_GEOMETRY: &str = "light_geometry";
+    pub const LIGHT_PROPERTIES: &str = "light_properties";
+    pub const LIGHT_LISTS: &str = "light_lists";
+}
+
+/// What a slot takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SlotType {
+    DepthTexture,
+    /// Any texture that is not depth (the kind's checks narrow the format).
+    ColorTexture,
+    Buffer,
+    Import(SceneResource),
+}
+
+impl SlotType {
+    fn describe(self) -> String {
+        match self {
+            SlotType::DepthTexture => "a depth texture".into(),
+            SlotType::ColorTexture => "a colour texture".into(),
+            SlotType::Buffer => "a buffer".into(),
+            SlotType::Import(from) => format!("an Import of {from:?}"),
+        }
+    }
+}
+
+/// Which of the pass's lists a slot's resource belongs in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Access {
+    Read,
+    Write,
+    /// Reads or writes: a depth attachment that is tested against, or written first.
+    ReadOrWrite,
+}
+
+impl Access {
+    fn allows(self, write: bool) -> bool {
+        match self {
+            Access::Read => !write,
+            Access::Write => write,
+            Access::ReadOrWrite => true,
+        }
+    }
+    fn describe(self) -> &'static str {
+        match self {
+            Access::Read => "in reads",
+            Access::Write => "in writes",
+            Access::ReadOrWrite => "in reads or writes",
+        }
+    }
+}
+
+/// How the pass's GPU work uses a texture slot (for the plan's texture usages).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Usage {
+    /// A render-pass attachment.
+    Attachment,
+    /// Sampled or loaded in a shader.
+    Sampled,
+    /// A storage texture.
+    Storage,
+    /// Buffers and imports: bound as storage or uniform.
+    Bound,
+}
+
+/// One row of a kind's slot table.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SlotSpec {
+    pub name: &'static str,
+    pub ty: SlotType,
+    pub access: Access,
+    pub optional: bool,
+    pub usage: Usage,
+}
+
+impl SlotSpec {
+    pub const fn new(name: &'static str, ty: SlotType, access: Access, usage: Usage) -> Self {
+        Self {
+            name,
+            ty,
+            access,
+            optional: false,
+            usage,
+        }
+    }
+    pub const fn optional(self) -> Self {
+        Self {
+            optional: true,
+            ..self
+        }
+    }
+}
+
+/// What a buffer slot's writer says about its contents, published on the planned
+/// buffer so readers never search for the producer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BufferLayout {
+    LightLists(ListLayout),
+}
+
+impl BufferLayout {
+    pub fn bytes(&self) -> u64 {
+        match self {
+            BufferLayout::LightLists(l) => l.bytes(),
+        }
+    }
+}
+
+/// The slot table of a built-in kind; `None` for generic kinds.
+pub fn slots(kind: &PassKind) -> Option<&'static [SlotSpec]> {
+    Some(match kind {
+        PassKind::DepthPrepass => depth_prepass::SLOTS,
+        PassKind::LightCulling(_) => light_culling::SLOTS,
+        PassKind::ForwardShading(_) => forward_shading::SLOTS,
+        PassKind::GBuffer => g_buffer::SLOTS,
+        PassKind::DeferredShading(_) => deferred_shading::SLOTS,
+        PassKind::Compute { .. } | PassKind::Fullscreen { .. } => return None,
+    })
+}
+
+/// The kind's own checks, after its slots were matched.
+fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+    match &ctx.pass.kind {
+        PassKind::DepthPrepass => depth_prepass::check(ctx, errors),
+        PassKind::LightCulling(p) => light_culling::check(p, ctx, errors),
+        PassKind::ForwardShading(p) => forward_shading::check(p, ctx, errors),
+        PassKind::GBuffer => g_buffer::check(ctx, errors),
+        PassKind::DeferredShading(p) => deferred_shading::check(p, ctx, errors),
+        PassKind::Compute { .. } | PassKind::Fullscreen { .. } => {}
+    }
+}
+
+/// The layout a built-in pass gives a buffer it writes into `slot`.
+pub fn buffer_layout(kind: &PassKind, slot: &str, frame: FrameSize) -> Option<BufferLayout> {
+    match kind {
+        PassKind::LightCulling(p) if slot == slot::LIGHT_LISTS => Some(BufferLayout::LightLists(
+            p.list_layout(frame.width, frame.height),
+        )),
+        _ => None,
+    }
+}
+
+/// A matched pass, for its kind's checks.
+pub struct KindCtx<'a> {
+    pub roles: &'a PassRoles,
+    pub pass: &'a PassDesc,
+    pub(crate) graph: &'a RoleCtx<'a>,
+}
+
+impl KindCtx<'_> {
+    pub fn slot(&self, name: &str) -> Option<&str> {
+        self.roles.slot(name)
+    }
+    pub fn mismatch(&self, resource: &str, problem: impl Into<String>) -> GraphError {
+        self.graph.mismatch(self.pass, resource, problem)
+    }
+    pub fn bad(&self, problem: impl Into<String>) -> GraphError {
+        self.graph.bad(self.pass, problem)
+    }
+    /// Sample count of a texture (1 for anything else).
+    pub fn samples(&self, name: &str) -> u32 {
+        match self.graph.resources.get(name) {
+            Some(ResourceDesc::Texture { samples, .. }) => *samples,
+            _ => 1,
+        }
+    }
+    pub fn is_single_rgba32f(&self, name: &str) -> bool {
+        matches!(
+            self.graph.resources.get(name),
+            Some(ResourceDesc::Texture {
+                format: super::model::TextureFormat::Rgba32Float,
+                samples: 1,
+                ..
+            })
+        )
+    }
+    pub fn writes(&self, name: &str) -> bool {
+        self.pass.writes.iter().any(|w| w == name)
+    }
+}
+
+fn slot_type_of(ctx: &RoleCtx, name: &str) -> Option<SlotType> {
+    Some(match ctx.resources.get(name)? {
+        ResourceDesc::Texture { format, .. } if format.is_depth() => SlotType::DepthTexture,
+        ResourceDesc::Texture { .. } => SlotType::ColorTexture,
+        ResourceDesc::Buffer { .. } => SlotType::Buffer,
+        ResourceDesc::Import { from, .. } => SlotType::Import(*from),
+    })
+}
+
+/// Matches a built-in pass's declared resources to its kind's slots: by name where the
+/// declaration says `slot=resource`, else to the first free slot of the resource's type
+/// that takes it from that list (reads or writes), in the table's order. Every resource
+/// must fill a slot and every required slot must be filled; then the kind checks.
+pub(crate) fn resolve(
+    ctx: &RoleCtx,
+    pass: &PassDesc,
+    specs: &[SlotSpec],
+) -> Result<PassRoles, Vec<GraphError>> {
+    let mut roles = PassRoles::default();
+    let mut errors = Vec::new();
+    let kind = pass.kind.label();
+    let names = || specs.iter().map(|s| s.name).collect::<Vec<_>>().join(", ");
+    for (write, list) in [(false, &pass.reads), (true, &pass.writes)] {
+        for name in list {
+            let Some(ty) = slot_type_of(ctx, name) else {
+                continue; // unknown resources are reported by validation
+            };
+            if write && matches!(ty, SlotType::Import(_)) {
+                continue; // a write to a read-only import, reported by validation
+            }
+            if roles.slots.values().any(|v| v == name) {
+                continue; // in reads and writes: one slot
+            }
+            let spec = match pass.explicit_slot(name) {
+                Some(wanted) => match specs.iter().find(|s| s.name == wanted) {
+                    None => {
+                        errors.push(ctx.mismatch(
+                            pass,
+                            name,
+                            format!("{kind} has no slot '{wanted}' (its slots: {})", names()),
+                        ));
+                        continue;
+                    }
+                    Some(s) if s.ty != ty || !s.access.allows(write) => {
+                        errors.push(ctx.mismatch(
+                            pass,
+                            name,
+                            format!(
+                                "slot '{wanted}' takes {} {}",
+                                s.ty.describe(),
+                                s.access.describe()
+                            ),
+                        ));
+                        continue;
+                    }
+                    Some(s) => s,
+                },
+                None => match specs.iter().find(|s| {
+                    s.ty == ty && s.access.allows(write) && !roles.slots.contains_key(s.name)
+                }) {
+                    Some(s) => s,
+                    None => {
+                        let list = if write { "writes" } else { "reads" };
+                        errors.push(ctx.mismatch(
+                            pass,
+                            name,
+                            format!(
+                                "{kind} has no free slot for {} in {list} (its slots: {})",
+                                ty.describe(),
+                                names()
+                            ),
+                        ));
+                        continue;
+                    }
+                },
+            };
+            if let Some(prev) = roles.slots.insert(spec.name, name.clone()) {
+                errors.push(ctx.mismatch(
+                    pass,
+                    name,
+                    format!("slot '{}' already filled by '{prev}'", spec.name),
+                ));
+            }
+        }
+    }
+    for s in specs.iter().filter(|s| !s.optional) {
+        if !roles.slots.contains_key(s.name) {
+            errors.push(ctx.bad(
+                pass,
+                format!(
+                    "{kind} needs {} {} (slot '{}')",
+                    s.ty.describe(),
+                    s.access.describe(),
+                    s.name
+                ),
+            ));
+        }
+    }
+    if errors.is_empty() {
+        check(
+            &KindCtx {
+                roles: &roles,
+                pass,
+                graph: ctx,
+            },
+            &mut errors,
+        );
+    }
+    if errors.is_empty() {
+        Ok(roles)
+    } else {
+        Err(errors)
+    }
+}
+
+/// What every shading pass (forward or deferred) needs to read its lights.
+pub fn check_light_source(
+    ctx: &KindCtx,
+    lights: super::model::LightSource,
+    errors: &mut Vec<GraphError>,
+) {
+    use super::model::LightSource;
+    match (lights, ctx.slot(slot::LIGHT_LISTS)) {
+        (LightSource::Culled, None) => errors
+            .push(ctx.bad("lights: Culled needs the culling pass's light-list buffer in reads")),
+        (LightSource::AllLights, Some(name)) => {
+            errors.push(ctx.mismatch(name, "lights: AllLights reads no light lists"))
+        }
+        _ => {}
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod test_support {
+    //! Validates a one-pass graph around a pass declaration, for the kinds' unit tests.
+    use crate::graph::{check_text, GraphErrors};
+    use crate::shader::ShaderLibrary;
+
+    /// A graph with the usual resources and `passes` (RON text), validated.
+    pub fn validate(passes: &str, output: &str) -> Result<(), GraphErrors> {
+        let text = format!(
+            r#"Graph(
+    name: "t",
+    resources: [
+        Texture(name: "depth", format: Depth32Float),
+        Texture(name: "depth4", format: Depth32Float, samples: 4),
+        Texture(name: "hdr", format: Rgba32Float),
+        Texture(name: "hdr4", format: Rgba32Float, samples: 4),
+        Texture(name: "pos", format: Rgba32Float),
+        Texture(name: "nrm", format: Rgba32Float),
+        Texture(name: "small", format: Rgba8Unorm),
+        Buffer(name: "lists"),
+        Import(name: "geometry", from: Geometry),
+        Import(name: "lg", from: LightGeometry),
+        Import(name: "lp", from: LightProperties),
+    ],
+    passes: [{passes}],
+    output: "{output}",
+    side_effects: [],
+)"#
+        );
+        check_text(
+            std::path::Path::new("t.ron"),
+            &text,
+            &ShaderLibrary::builtin(),
+        )
+        .map(|_| ())
+    }
+
+    /// The messages of a failed validation, joined.
+    pub fn errors(passes: &str, output: &str) -> String {
+        match validate(passes, output) {
+            Ok(()) => panic!("expected errors for {passes}"),
+            Err(e) => e.to_string(),
+        }
+    }
+}

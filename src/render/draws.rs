@@ -1,0 +1,360 @@
+//! Drawing the scene's meshes, one pipeline per material, for every pass that draws
+//! them: depth only, G-buffer, shading (optionally blended), at any sample count. The
+//! group-0 layout comes from the shader's reflected bindings and the bind group from
+//! what the pass offers, by name.
+
+use super::bind::{layout_entries, BindingSet};
+use super::passes::pass_error;
+use super::pipelines::{Pipeline, PipelineKey};
+use super::scene_gpu::SceneGpu;
+use super::{RenderError, Renderer};
+use crate::gpu::structs::GpuVertex;
+use crate::scene::AlphaMode;
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// What a mesh draw writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum DrawMode {
+    DepthOnly,
+    GBuffer { writes_depth: bool, packed: bool },
+    Shade { culled: bool, blend: bool },
+}
+
+impl DrawMode {
+    fn writes_depth(self) -> bool {
+        match self {
+            DrawMode::DepthOnly => true,
+            DrawMode::GBuffer { writes_depth, .. } => writes_depth,
+            DrawMode::Shade { .. } => false,
+        }
+    }
+}
+
+/// One mesh drawn with its material's pipeline.
+struct Draw {
+    pipeline: Arc<wgpu::RenderPipeline>,
+    /// The material's textures (group 2), if it has any.
+    material: Option<wgpu::BindGroup>,
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    index_count: u32,
+}
+
+/// Every opaque mesh of a pass, sorted by material, and the pass's group-0 bind group.
+pub(super) struct MeshDraws {
+    bind: Option<wgpu::BindGroup>,
+    draws: Vec<Draw>,
+}
+
+const SHADER: &str = "forward/forward.wgsl";
+/// The bind group the generated material code declares its textures in.
+const MATERIAL_GROUP: u32 = 2;
+
+/// The material's texture layout, from the composed shader's reflection (None when the
+/// material declares no textures).
+fn material_layout(
+    layouts: &super::bind::LayoutCache,
+    device: &wgpu::Device,
+    bindings: &[crate::shader::ReflectedBinding],
+) -> Option<Arc<wgpu::BindGroupLayout>> {
+    let entries = super::bind::layout_entries_filtering(
+        bindings,
+        MATERIAL_GROUP,
+        wgpu::ShaderStages::FRAGMENT,
+        true,
+    );
+    (!entries.is_empty()).then(|| layouts.get(device, entries))
+}
+
+impl Renderer {
+    /// One pipeline per material (draws sorted by material) for `mode` at `samples`.
+    pub(super) fn mesh_draws(
+        &mut self,
+        gpu: &SceneGpu,
+        mode: DrawMode,
+        samples: u32,
+        pass: &str,
+        offered: &BindingSet,
+    ) -> Result<MeshDraws, RenderError> {
+        let device = self.ctx.device.clone();
+        let layouts = self.layouts.clone();
+        let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let mut draws = Vec::new();
+        // One texture group per material, shared by its meshes.
+        let mut material_groups: std::collections::HashMap<usize, wgpu::BindGroup> =
+            Default::default();
+        let mut group0: Option<(
+            Vec<wgpu::BindGroupLayoutEntry>,
+            Arc<[crate::shader::ReflectedBinding]>,
+        )> = None;
+        for mesh in gpu.opaque_draws() {
+            let material_index = gpu.meshes[mesh].material;
+            let m = &gpu.materials[material_index];
+            let masked = matches!(m.alpha_mode, AlphaMode::Mask(_));
+            let mut d: Vec<(&str, String)> = vec![];
+            match mode {
+                DrawMode::DepthOnly => d.push(("DEPTH_ONLY", "1".into())),
+                DrawMode::GBuffer { packed, .. } => {
+                    d.push(("GBUFFER", "1".into()));
+                    d.push(("MATERIAL_INDEX", material_index.to_string()));
+                    if packed {
+                        d.push(("GBUFFER_PACKED", "1".into()));
+                    }
+                }
+                DrawMode::Shade { culled, .. } => {
+                    d.push(("SHADE", "1".into()));
+                    if culled {
+                        d.push(("LIGHT_LISTS", "1".into()));
+                    }
+                }
+            }
+            if let AlphaMode::Mask(cutoff) = m.alpha_mode {
+                d.push(("ALPHA_MASK", "1".into()));
+                d.push(("ALPHA_CUTOFF", format!("{cutoff:?}")));
+            }
+            // A prepass or G-buffer draw of an opaque, untextured material never calls the
+            // material code: key it with a neutral material, so editing the material
+            // rebuilds only the pipelines that shade with it.
+            let shading = matches!(mode, DrawMode::Shade { .. });
+            let material_unused = !masked && !shading && m.textures.is_none();
+            let code = match neutral_material_wgsl() {
+                Some(neutral) if material_unused => neutral.to_string(),
+                _ => m.wgsl.clone(),
+            };
+            let key = PipelineKey {
+                shader: SHADER.into(),
+                defines: super::passes::defines(&d),
+                virtual_code: BTreeMap::from([("material".to_string(), code)]),
+                state: format!(
+                    "samples={samples} double_sided={} mode={mode:?}",
+                    m.double_sided
+                ),
+            };
+            let cull_mode = (!m.double_sided).then_some(wgpu::Face::Back);
+            let (pipeline, bindings) = self
+                .pipelines
+                .get_or_build_reflected(
+                    &self.shaders,
+                    key,
+                    |_, module, bindings| {
+                        let bgl = layouts.get(&device, layout_entries(bindings, 0, vf));
+                        let material = material_layout(&layouts, &device, bindings);
+                        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                            label: Some(pass),
+                            bind_group_layouts: &[Some(&bgl), None, material.as_deref()],
+                            immediate_size: 0,
+                        });
+                        build_pipeline(
+                            &device, pass, &pl, &module, mode, masked, samples, cull_mode,
+                        )
+                    },
+                    &device,
+                )
+                .map_err(|source| RenderError::Shader {
+                    pass: format!("{pass} (material '{}')", m.name),
+                    source,
+                })?;
+            let Pipeline::Render(pipeline) = pipeline else {
+                return Err(pass_error(pass, "expected a render pipeline".into()));
+            };
+            let entries = layout_entries(&bindings, 0, vf);
+            match &group0 {
+                None => group0 = Some((entries, bindings)),
+                Some((first, _)) if *first != entries => {
+                    return Err(pass_error(
+                        pass,
+                        format!(
+                            "material '{}' changes the shader's group-0 bindings",
+                            m.name
+                        ),
+                    ))
+                }
+                Some(_) => {}
+            }
+            let material = match (&m.textures, material_layout(&layouts, &device, &bindings)) {
+                (Some(textures), Some(layout)) => match material_groups.get(&material_index) {
+                    Some(group) => Some(group),
+                    None => {
+                        let group = textures
+                            .bind(&device, &m.name, &layout, &bindings, MATERIAL_GROUP)
+                            .map_err(|e| pass_error(pass, format!("material '{}': {e}", m.name)))?;
+                        Some(material_groups.entry(material_index).or_insert(group))
+                    }
+                }
+                .cloned(),
+                _ => None,
+            };
+            let gm = &gpu.meshes[mesh];
+            draws.push(Draw {
+                material,
+                pipeline,
+                vertices: gm.vertices.clone(),
+                indices: gm.indices.clone(),
+                index_count: gm.index_count,
+            });
+        }
+        let bind = match group0 {
+            Some((entries, bindings)) => {
+                let bgl = layouts.get(&device, entries);
+                Some(
+                    offered
+                        .bind(&device, pass, &bgl, &bindings, 0)
+                        .map_err(|m| pass_error(pass, m))?,
+                )
+            }
+            None => None,
+        };
+        Ok(MeshDraws { bind, draws })
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn build_pipeline(
+    device: &wgpu::Device,
+    pass: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    mode: DrawMode,
+    masked: bool,
+    samples: u32,
+    cull_mode: Option<wgpu::Face>,
+) -> Pipeline {
+    let writes_depth = mode.writes_depth();
+    let (entry, colour_targets) = match mode {
+        DrawMode::DepthOnly => ("fs_depth", 0),
+        DrawMode::GBuffer { packed: false, .. } => ("fs_gbuffer", 2),
+        DrawMode::GBuffer { packed: true, .. } => ("fs_gbuffer", 1),
+        DrawMode::Shade { .. } => ("fs_main", 1),
+    };
+    let blend = match mode {
+        DrawMode::Shade { blend: true, .. } => Some(wgpu::BlendState::ALPHA_BLENDING),
+        _ => None,
+    };
+    let target = Some(wgpu::ColorTargetState {
+        format: wgpu::TextureFormat::Rgba32Float,
+        blend,
+        write_mask: wgpu::ColorWrites::ALL,
+    });
+    let targets = vec![target; colour_targets];
+    // A depth-only draw needs a fragment stage only to discard masked fragments.
+    let fragment = (mode != DrawMode::DepthOnly || masked).then(|| wgpu::FragmentState {
+        module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        targets: &targets,
+    });
+    Pipeline::Render(Arc::new(device.create_render_pipeline(
+        &wgpu::RenderPipelineDescriptor {
+            label: Some(pass),
+            layout: Some(layout),
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(GpuVertex::layout())],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: wgpu::TextureFormat::Depth32Float,
+                depth_write_enabled: Some(writes_depth),
+                depth_compare: Some(if writes_depth {
+                    wgpu::CompareFunction::Less
+                } else {
+                    wgpu::CompareFunction::LessEqual
+                }),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: wgpu::MultisampleState {
+                count: samples,
+                ..Default::default()
+            },
+            fragment,
+            multiview_mask: None,
+            cache: None,
+        },
+    )))
+}
+
+/// Material code for pipelines that include the material but never call it (`None`
+/// only if generating it failed, then each material keys with its own code).
+fn neutral_material_wgsl() -> Option<&'static str> {
+    static CODE: std::sync::OnceLock<Option<String>> = std::sync::OnceLock::new();
+    CODE.get_or_init(|| {
+        let neutral = crate::scene::SurfaceMaterial {
+            name: "neutral".into(),
+            ..Default::default()
+        };
+        crate::material::Material::from_surface(&neutral)
+            .wgsl()
+            .ok()
+    })
+    .as_deref()
+}
+
+impl MeshDraws {
+    /// Draws every mesh into `pass`.
+    pub fn record(&self, pass: &mut wgpu::RenderPass<'_>) {
+        if let Some(bind) = &self.bind {
+            pass.set_bind_group(0, bind, &[]);
+        }
+        let mut current: Option<*const wgpu::RenderPipeline> = None;
+        for d in &self.draws {
+            // Draws are sorted by material: switch pipelines only when it changes.
+            let ptr = Arc::as_ptr(&d.pipeline);
+            if current != Some(ptr) {
+                pass.set_pipeline(&d.pipeline);
+                current = Some(ptr);
+                if let Some(group) = &d.material {
+                    pass.set_bind_group(MATERIAL_GROUP, group, &[]);
+                }
+            }
+            pass.set_vertex_buffer(0, d.vertices.slice(..));
+            pass.set_index_buffer(d.indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..d.index_count, 0, 0..1);
+        }
+    }
+}
+
+/// A depth attachment that clears (first writer) or loads.
+pub(super) fn depth_attachment(
+    view: &wgpu::TextureView,
+    clear: bool,
+) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+    wgpu::RenderPassDepthStencilAttachment {
+        view,
+        depth_ops: Some(wgpu::Operations {
+            load: if clear {
+                wgpu::LoadOp::Clear(1.0)
+            } else {
+                wgpu::LoadOp::Load
+            },
+            store: wgpu::StoreOp::Store,
+        }),
+        stencil_ops: None,
+    }
+}
+
+/// A colour attachment that clears to `clear` or loads, resolving into `resolve` (MSAA).
+pub(super) fn color_attachment<'a>(
+    view: &'a wgpu::TextureView,
+    clear: Option<wgpu::Color>,
+    resolve: Option<&'a wgpu::TextureView>,
+) -> wgpu::RenderPassColorAttachment<'a> {
+    wgpu::RenderPassColorAttachment {
+        view,
+        depth_slice: None,
+        resolve_target: resolve,
+        ops: wgpu::Operations {
+            load: match clear {
+                Some(c) => wgpu::LoadOp::Clear(c),
+                None => wgpu::LoadOp::Load,
+            },
+            store: wgpu::StoreOp::Store,
+        },
+    }
+}

@@ -1,0 +1,146 @@
+//! The opt-in light-statistics pass: per pixel, lights listed against lights that reach
+//! it, over the depth and lists of the graph's last forward shading pass.
+
+use super::bind::BindingSet;
+use super::passes::{dispatch, pass_error, Timestamps};
+use super::pipelines::{Pipeline, PipelineKey};
+use super::report::LightStats;
+use super::scene_gpu::SceneGpu;
+use super::{RenderError, Renderer};
+use crate::gpu::readback::read_buffer;
+use crate::gpu::structs::{GpuFrame, GpuListParams};
+use crate::graph::{slot, CompiledGraph, FrameSize, PassKind};
+use std::collections::BTreeMap;
+use std::sync::Arc;
+use wgpu::util::DeviceExt;
+
+const PASS: &str = "light statistics";
+
+pub(super) struct LightStatsPass {
+    pipeline: Arc<wgpu::ComputePipeline>,
+    bind: wgpu::BindGroup,
+    counts: wgpu::Buffer,
+    groups: [u32; 3],
+}
+
+impl LightStatsPass {
+    pub fn prepare(
+        r: &mut Renderer,
+        graph: &CompiledGraph,
+        resources: &super::resources::FrameResources,
+        frame_uniform: &wgpu::Buffer,
+        gpu: &SceneGpu,
+        gpu_frame: &GpuFrame,
+        size: FrameSize,
+    ) -> Result<Self, RenderError> {
+        let device = r.ctx.device.clone();
+        let shading = graph
+            .passes
+            .iter()
+            .rev()
+            .find(|p| matches!(p.kind, PassKind::ForwardShading(_)))
+            .ok_or_else(|| {
+                pass_error(
+                    PASS,
+                    "the graph has no ForwardShading pass to take statistics of".into(),
+                )
+            })?;
+        let lists = shading.roles.slot(slot::LIGHT_LISTS);
+        let mut d = BTreeMap::new();
+        if lists.is_some() {
+            d.insert("LIGHT_LISTS".to_string(), "1".to_string());
+        }
+        let key = PipelineKey {
+            shader: "stats/light_stats.wgsl".into(),
+            defines: d,
+            virtual_code: BTreeMap::new(),
+            state: String::new(),
+        };
+        let (pipeline, bindings) = r
+            .pipelines
+            .get_or_build_reflected(
+                &r.shaders,
+                key,
+                |_, module, _| Pipeline::compute(&device, PASS, None, &module, "main"),
+                &device,
+            )
+            .map_err(|source| RenderError::Shader {
+                pass: PASS.into(),
+                source,
+            })?;
+        let Pipeline::Compute(pipeline) = pipeline else {
+            return Err(pass_error(PASS, "expected a compute pipeline".into()));
+        };
+        let counts = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("light counts"),
+            size: 8 * size.width as u64 * size.height as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let view_proj = glam::Mat4::from_cols_array_2d(&gpu_frame.view_proj);
+        let inv = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("inverse view-projection"),
+            contents: bytemuck::cast_slice(&view_proj.inverse().to_cols_array()),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let plan = &graph.plan;
+        let missing = |name: &str| pass_error(PASS, format!("'{name}' is not planned"));
+        let depth = shading.required(slot::DEPTH);
+        let mut set = BindingSet::default();
+        set.buffer("frame", frame_uniform);
+        set.buffer("light_geometry", &gpu.light_geometry);
+        set.buffer("light_properties", &gpu.light_properties);
+        set.offer(
+            "depth",
+            super::bind::Bound::View(
+                resources
+                    .view(plan, depth)
+                    .ok_or_else(|| missing(depth))?
+                    .clone(),
+            ),
+        );
+        set.buffer("counts", &counts);
+        set.buffer("inv_view_proj", &inv);
+        if let Some(lists) = lists {
+            let layout = plan.list_layout(lists).ok_or_else(|| missing(lists))?;
+            set.buffer(
+                "light_lists",
+                resources
+                    .buffer(plan, lists)
+                    .ok_or_else(|| missing(lists))?,
+            );
+            set.buffer("list_params", &GpuListParams::new(&layout).buffer(&device));
+        }
+        let bind = set
+            .bind(
+                &device,
+                PASS,
+                &pipeline.get_bind_group_layout(0),
+                &bindings,
+                0,
+            )
+            .map_err(|m| pass_error(PASS, m))?;
+        Ok(Self {
+            pipeline,
+            bind,
+            counts,
+            groups: [size.width.div_ceil(8), size.height.div_ceil(8), 1],
+        })
+    }
+
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder) {
+        dispatch(
+            encoder,
+            PASS,
+            Timestamps(None),
+            &self.pipeline,
+            &self.bind,
+            self.groups,
+        );
+    }
+
+    pub fn read(&self, r: &Renderer) -> Result<LightStats, RenderError> {
+        let bytes = read_buffer(&r.ctx.device, &r.ctx.queue, &self.counts)?;
+        Ok(LightStats::from_counts(bytemuck::cast_slice(&bytes)))
+    }
+}

@@ -1,0 +1,118 @@
+//! `Compute`: a shader the graph names, dispatched per pixel, tile, light or a fixed
+//! grid; bound by reflected binding names (auto layout).
+
+use super::{dispatch, pass_error, PrepareCtx, PreparedPass, Timestamps};
+use crate::graph::{Dispatch, ScheduledPass};
+use crate::render::bind::Bound;
+use crate::render::pipelines::{Pipeline, PipelineKey};
+use crate::render::RenderError;
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+pub(super) struct ComputePass {
+    name: String,
+    pipeline: Arc<wgpu::ComputePipeline>,
+    bind: wgpu::BindGroup,
+    groups: [u32; 3],
+}
+
+pub(super) fn prepare(
+    cx: &mut PrepareCtx,
+    sp: &ScheduledPass,
+    shader: &str,
+    entry: &str,
+    d: Dispatch,
+) -> Result<ComputePass, RenderError> {
+    let device = cx.device();
+    let key = PipelineKey {
+        shader: shader.to_string(),
+        defines: BTreeMap::new(),
+        virtual_code: BTreeMap::new(),
+        state: format!("compute entry={entry}"),
+    };
+    let (pipeline, bindings) = cx
+        .renderer
+        .pipelines
+        .get_or_build_reflected(
+            &cx.renderer.shaders,
+            key,
+            |_, module, _| Pipeline::compute(&device, &sp.name, None, &module, entry),
+            &device,
+        )
+        .map_err(|source| RenderError::Shader {
+            pass: sp.name.clone(),
+            source,
+        })?;
+    let Pipeline::Compute(pipeline) = pipeline else {
+        return Err(pass_error(&sp.name, "expected a compute pipeline".into()));
+    };
+    let offered = generic_bindings(cx, sp)?;
+    let bind = offered
+        .bind(
+            &device,
+            &sp.name,
+            &pipeline.get_bind_group_layout(0),
+            &bindings,
+            0,
+        )
+        .map_err(|m| pass_error(&sp.name, m))?;
+    let size = cx.size;
+    let groups = match d {
+        Dispatch::PerPixel { workgroup: (x, y) } => [
+            size.width.div_ceil(x.max(1)),
+            size.height.div_ceil(y.max(1)),
+            1,
+        ],
+        Dispatch::PerTile { tile } => [
+            size.width.div_ceil(tile.max(1)),
+            size.height.div_ceil(tile.max(1)),
+            1,
+        ],
+        Dispatch::PerLight { workgroup } => {
+            [cx.gpu.light_count.div_ceil(workgroup.max(1)).max(1), 1, 1]
+        }
+        Dispatch::Fixed(x, y, z) => [x, y, z],
+    };
+    Ok(ComputePass {
+        name: sp.name.clone(),
+        pipeline,
+        bind,
+        groups,
+    })
+}
+
+/// A generic pass's declared resources plus the samplers every generic shader may use.
+pub(super) fn generic_bindings(
+    cx: &PrepareCtx,
+    sp: &ScheduledPass,
+) -> Result<crate::render::bind::BindingSet, RenderError> {
+    let device = &cx.renderer.ctx.device;
+    let mut set = cx.declared(sp)?;
+    set.offer(
+        "linear_sampler",
+        Bound::Sampler(device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("linear_sampler"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        })),
+    );
+    set.offer(
+        "nearest_sampler",
+        Bound::Sampler(device.create_sampler(&Default::default())),
+    );
+    Ok(set)
+}
+
+impl PreparedPass for ComputePass {
+    fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
+        dispatch(
+            encoder,
+            &self.name,
+            ts,
+            &self.pipeline,
+            &self.bind,
+            self.groups,
+        );
+    }
+}

@@ -1,0 +1,83 @@
+//! `DeferredShading`: one compute dispatch per material over the frame, reading the
+//! G-buffer and storing lit colour.
+
+use super::{defines, pass_error, PrepareCtx, PreparedPass, Timestamps};
+use crate::graph::kinds::g_buffer::G_NORMAL;
+use crate::graph::{slot, DeferredShading, LightSource, ScheduledPass};
+use crate::render::pipelines::PipelineKey;
+use crate::render::RenderError;
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+pub(super) struct DeferredShadingPass {
+    name: String,
+    pipelines: Vec<Arc<wgpu::ComputePipeline>>,
+    bind: Option<wgpu::BindGroup>,
+    groups: [u32; 3],
+}
+
+pub(super) fn prepare(
+    cx: &mut PrepareCtx,
+    sp: &ScheduledPass,
+    p: &DeferredShading,
+) -> Result<DeferredShadingPass, RenderError> {
+    let culled = p.lights == LightSource::Culled;
+    // Without a normals texture the G-buffer is the packed one.
+    let packed = sp.roles.slot(G_NORMAL).is_none();
+    let mut offered = cx.declared(sp)?;
+    if culled {
+        let params = cx.list_params(&sp.name, sp.required(slot::LIGHT_LISTS))?;
+        offered.buffer("list_params", &params);
+    }
+    let mut pipelines = Vec::new();
+    let mut bind = None;
+    for (index, m) in cx.gpu.materials.iter().enumerate() {
+        if m.textures.is_some() {
+            return Err(pass_error(
+                &sp.name,
+                format!("material '{}' has textures; deferred shading supports untextured materials only (the G-buffer holds no UVs or tangents yet)", m.name),
+            ));
+        }
+        let mut d = vec![("MATERIAL_INDEX", index.to_string())];
+        if packed {
+            d.push(("G_PACKED", "1".into()));
+        }
+        if culled {
+            d.push(("LIGHT_LISTS", "1".into()));
+        }
+        let key = PipelineKey {
+            shader: "deferred/deferred_shading.wgsl".into(),
+            defines: defines(&d),
+            virtual_code: BTreeMap::from([("material".to_string(), m.wgsl.clone())]),
+            state: String::new(),
+        };
+        let label = format!("{} (material '{}')", sp.name, m.name);
+        let (pipeline, b) = cx.compute_pipeline(&label, key, "main", &offered)?;
+        pipelines.push(pipeline);
+        // Every material's shader declares the same bindings: one group serves all.
+        bind.get_or_insert(b);
+    }
+    Ok(DeferredShadingPass {
+        name: sp.name.clone(),
+        pipelines,
+        bind,
+        groups: [cx.size.width.div_ceil(8), cx.size.height.div_ceil(8), 1],
+    })
+}
+
+impl PreparedPass for DeferredShadingPass {
+    fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(&self.name),
+            timestamp_writes: ts.compute(),
+        });
+        if let Some(bind) = &self.bind {
+            pass.set_bind_group(0, bind, &[]);
+        }
+        let [x, y, z] = self.groups;
+        for p in &self.pipelines {
+            pass.set_pipeline(p);
+            pass.dispatch_workgroups(x, y, z);
+        }
+    }
+}

@@ -1,0 +1,59 @@
+//! `ForwardShading`: every opaque mesh through its material and the light loop, over
+//! the prepass depth (tested, not written).
+
+use super::{PrepareCtx, PreparedPass, Timestamps};
+use crate::graph::{slot, ForwardShading, LightSource, ScheduledPass};
+use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws};
+use crate::render::RenderError;
+
+pub(super) struct ForwardShadingPass {
+    name: String,
+    color: wgpu::TextureView,
+    depth: wgpu::TextureView,
+    clear: bool,
+    draws: MeshDraws,
+}
+
+pub(super) fn prepare(
+    cx: &mut PrepareCtx,
+    sp: &ScheduledPass,
+    p: &ForwardShading,
+) -> Result<ForwardShadingPass, RenderError> {
+    let color = sp.required(slot::COLOR);
+    let depth = sp.required(slot::DEPTH);
+    let mut offered = cx.declared(sp)?;
+    let culled = p.lights == LightSource::Culled;
+    if culled {
+        let params = cx.list_params(&sp.name, sp.required(slot::LIGHT_LISTS))?;
+        offered.buffer("list_params", &params);
+    }
+    let mode = DrawMode::Shade {
+        culled,
+        blend: false,
+    };
+    let draws = cx
+        .renderer
+        .mesh_draws(cx.gpu, mode, sp.samples, &sp.name, &offered)?;
+    Ok(ForwardShadingPass {
+        name: sp.name.clone(),
+        color: cx.view(&sp.name, color)?,
+        depth: cx.view(&sp.name, depth)?,
+        clear: sp.clears(color),
+        draws,
+    })
+}
+
+impl PreparedPass for ForwardShadingPass {
+    fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
+        let clear = self.clear.then_some(wgpu::Color::TRANSPARENT);
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(&self.name),
+            color_attachments: &[Some(color_attachment(&self.color, clear, None))],
+            depth_stencil_attachment: Some(depth_attachment(&self.depth, false)),
+            timestamp_writes: ts.render(),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        self.draws.record(&mut pass);
+    }
+}

@@ -1,0 +1,73 @@
+//! `GBuffer`: every opaque mesh into one packed or two Rgba32Float textures. After a
+//! depth prepass it loads that depth and only tests against it, so each pixel is
+//! written once instead of once per overlapping surface.
+
+use super::{PrepareCtx, PreparedPass, Timestamps};
+use crate::graph::kinds::g_buffer::{self as kind, G_NORMAL, G_POSITION};
+use crate::graph::{slot, ScheduledPass};
+use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws};
+use crate::render::RenderError;
+
+pub(super) struct GBuffer {
+    name: String,
+    depth: wgpu::TextureView,
+    /// False after a depth prepass.
+    clear_depth: bool,
+    /// Positions, or the packed texture; then normals.
+    targets: Vec<wgpu::TextureView>,
+    draws: MeshDraws,
+}
+
+pub(super) fn prepare(cx: &mut PrepareCtx, sp: &ScheduledPass) -> Result<GBuffer, RenderError> {
+    let depth = sp.required(slot::DEPTH);
+    let writes_depth = cx.graph.checked.desc.passes[sp.index]
+        .writes
+        .iter()
+        .any(|w| w == depth);
+    let packed = kind::packed(&sp.roles);
+    let offered = cx.declared(sp)?;
+    let mode = DrawMode::GBuffer {
+        writes_depth,
+        packed,
+    };
+    let draws = cx
+        .renderer
+        .mesh_draws(cx.gpu, mode, 1, &sp.name, &offered)?;
+    let mut targets = vec![cx.view(&sp.name, sp.required(G_POSITION))?];
+    if let Some(normals) = sp.roles.slot(G_NORMAL) {
+        targets.push(cx.view(&sp.name, normals)?);
+    }
+    Ok(GBuffer {
+        name: sp.name.clone(),
+        depth: cx.view(&sp.name, depth)?,
+        clear_depth: sp.clears(depth),
+        targets,
+        draws,
+    })
+}
+
+impl PreparedPass for GBuffer {
+    fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
+        // w = -1 marks pixels where nothing was drawn.
+        let empty = wgpu::Color {
+            r: 0.0,
+            g: 0.0,
+            b: 0.0,
+            a: -1.0,
+        };
+        let targets: Vec<_> = self
+            .targets
+            .iter()
+            .map(|v| Some(color_attachment(v, Some(empty), None)))
+            .collect();
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(&self.name),
+            color_attachments: &targets,
+            depth_stencil_attachment: Some(depth_attachment(&self.depth, self.clear_depth)),
+            timestamp_writes: ts.render(),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        self.draws.record(&mut pass);
+    }
+}

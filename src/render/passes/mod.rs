@@ -1,0 +1,238 @@
+//! Built-in and generic passes, one file per kind (named as in `graph/kinds/`): each
+//! prepares its pipelines and bind groups from a scheduled pass and records itself.
+//! This file holds the one match from a compiled pass to its prepared form.
+
+mod compute;
+mod deferred_shading;
+mod depth_prepass;
+mod forward_shading;
+mod fullscreen;
+mod g_buffer;
+pub(super) mod light_culling;
+
+use super::bind::{BindingSet, Bound};
+use super::pipelines::{Pipeline, PipelineKey};
+use super::report::CullingReport;
+use super::resources::FrameResources;
+use super::scene_gpu::SceneGpu;
+use super::{RenderError, Renderer};
+use crate::gpu::structs::GpuListParams;
+use crate::graph::{
+    CompiledGraph, FrameSize, PassKind, ResourceDesc, SceneResource, ScheduledPass,
+};
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// A pass ready to record, as often as frames run.
+pub(super) trait PreparedPass {
+    fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>);
+    /// What the pass counted on the GPU, for passes that count (read after a frame).
+    fn report(&self, _r: &Renderer) -> Result<Option<CullingReport>, RenderError> {
+        Ok(None)
+    }
+}
+
+/// Prepares one scheduled pass.
+pub(super) fn prepare(
+    cx: &mut PrepareCtx<'_>,
+    sp: &ScheduledPass,
+) -> Result<Box<dyn PreparedPass>, RenderError> {
+    Ok(match &sp.kind {
+        PassKind::DepthPrepass => Box::new(depth_prepass::prepare(cx, sp)?),
+        PassKind::LightCulling(p) => Box::new(light_culling::prepare(cx, sp, p)?),
+        PassKind::ForwardShading(p) => Box::new(forward_shading::prepare(cx, sp, p)?),
+        PassKind::GBuffer => Box::new(g_buffer::prepare(cx, sp)?),
+        PassKind::DeferredShading(p) => Box::new(deferred_shading::prepare(cx, sp, p)?),
+        PassKind::Compute {
+            shader,
+            entry,
+            dispatch,
+        } => Box::new(compute::prepare(cx, sp, shader, entry, *dispatch)?),
+        PassKind::Fullscreen { shader, entry } => {
+            Box::new(fullscreen::prepare(cx, sp, shader, entry)?)
+        }
+    })
+}
+
+/// The timestamp query pair around one pass, when the adapter has timestamps.
+#[derive(Clone, Copy)]
+pub(super) struct Timestamps<'a>(pub Option<(&'a wgpu::QuerySet, u32)>);
+
+impl<'a> Timestamps<'a> {
+    pub fn compute(self) -> Option<wgpu::ComputePassTimestampWrites<'a>> {
+        self.0.map(|(q, i)| wgpu::ComputePassTimestampWrites {
+            query_set: q,
+            beginning_of_pass_write_index: Some(2 * i),
+            end_of_pass_write_index: Some(2 * i + 1),
+        })
+    }
+    pub fn render(self) -> Option<wgpu::RenderPassTimestampWrites<'a>> {
+        self.0.map(|(q, i)| wgpu::RenderPassTimestampWrites {
+            query_set: q,
+            beginning_of_pass_write_index: Some(2 * i),
+            end_of_pass_write_index: Some(2 * i + 1),
+        })
+    }
+}
+
+/// What preparing a pass needs: the renderer (pipeline cache), the compiled graph, the
+/// scene's buffers and the frame's physical resources.
+pub(super) struct PrepareCtx<'a> {
+    pub renderer: &'a mut Renderer,
+    pub graph: &'a CompiledGraph,
+    pub gpu: &'a SceneGpu,
+    pub resources: &'a FrameResources,
+    pub frame_uniform: &'a wgpu::Buffer,
+    pub size: FrameSize,
+}
+
+impl PrepareCtx<'_> {
+    pub fn device(&self) -> wgpu::Device {
+        self.renderer.ctx.device.clone()
+    }
+
+    pub fn view(&self, pass: &str, name: &str) -> Result<wgpu::TextureView, RenderError> {
+        self.resources
+            .view(&self.graph.plan, name)
+            .cloned()
+            .ok_or_else(|| pass_error(pass, format!("texture '{name}' is not planned")))
+    }
+
+    pub fn buffer(&self, pass: &str, name: &str) -> Result<wgpu::Buffer, RenderError> {
+        self.resources
+            .buffer(&self.graph.plan, name)
+            .cloned()
+            .ok_or_else(|| pass_error(pass, format!("buffer '{name}' is not planned")))
+    }
+
+    /// A declared resource as something to bind: scene imports, planned buffers and
+    /// textures. `None` for scene geometry (drawn, never bound).
+    fn bound(&self, pass: &str, name: &str) -> Result<Option<Bound>, RenderError> {
+        let desc = self
+            .graph
+            .checked
+            .desc
+            .resources
+            .iter()
+            .find(|r| r.name() == name);
+        Ok(Some(match desc {
+            Some(ResourceDesc::Import { from, .. }) => match from {
+                SceneResource::LightGeometry => Bound::Buffer(self.gpu.light_geometry.clone()),
+                SceneResource::LightProperties => Bound::Buffer(self.gpu.light_properties.clone()),
+                SceneResource::Geometry => return Ok(None),
+            },
+            Some(ResourceDesc::Buffer { .. }) => Bound::Buffer(self.buffer(pass, name)?),
+            Some(ResourceDesc::Texture { .. }) => Bound::View(self.view(pass, name)?),
+            None => return Err(pass_error(pass, format!("'{name}' is not declared"))),
+        }))
+    }
+
+    /// What a pass may bind: the frame uniform and, under their slot names (built-in
+    /// kinds) or their own names (generic kinds), exactly the resources it declared.
+    pub fn declared(&self, sp: &ScheduledPass) -> Result<BindingSet, RenderError> {
+        let mut set = BindingSet::default();
+        set.buffer("frame", self.frame_uniform);
+        for (slot, name) in &sp.roles.slots {
+            if let Some(b) = self.bound(&sp.name, name)? {
+                set.offer(slot, b);
+            }
+        }
+        for (_, name) in &sp.roles.bindings {
+            if crate::graph::BUILTIN_BINDINGS.contains(&name.as_str()) {
+                continue;
+            }
+            if let Some(b) = self.bound(&sp.name, name)? {
+                set.offer(name, b);
+            }
+        }
+        Ok(set)
+    }
+
+    /// The uniform describing the light lists in `lists` (their layout is published on
+    /// the planned buffer by the culling pass declared to write it).
+    pub fn list_params(&self, pass: &str, lists: &str) -> Result<wgpu::Buffer, RenderError> {
+        let layout = self.graph.plan.list_layout(lists).ok_or_else(|| {
+            pass_error(
+                pass,
+                format!("no LightCulling pass is declared to write '{lists}'"),
+            )
+        })?;
+        Ok(GpuListParams::new(&layout).buffer(&self.renderer.ctx.device))
+    }
+
+    /// A compute pipeline whose group-0 layout is made from its own reflected bindings,
+    /// with the bind group from `offered`.
+    pub fn compute_pipeline(
+        &mut self,
+        pass: &str,
+        key: PipelineKey,
+        entry: &str,
+        offered: &BindingSet,
+    ) -> Result<(Arc<wgpu::ComputePipeline>, wgpu::BindGroup), RenderError> {
+        let device = self.device();
+        let layouts = self.renderer.layouts.clone();
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let (pipeline, bindings) = self
+            .renderer
+            .pipelines
+            .get_or_build_reflected(
+                &self.renderer.shaders,
+                key,
+                |_, module, bindings| {
+                    let bgl =
+                        layouts.get(&device, super::bind::layout_entries(bindings, 0, compute));
+                    let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                        label: Some(pass),
+                        bind_group_layouts: &[Some(&bgl)],
+                        immediate_size: 0,
+                    });
+                    Pipeline::compute(&device, pass, Some(&pl), &module, entry)
+                },
+                &device,
+            )
+            .map_err(|source| RenderError::Shader {
+                pass: pass.to_string(),
+                source,
+            })?;
+        let Pipeline::Compute(pipeline) = pipeline else {
+            return Err(pass_error(pass, "expected a compute pipeline".into()));
+        };
+        let bgl = layouts.get(&device, super::bind::layout_entries(&bindings, 0, compute));
+        let bind = offered
+            .bind(&device, pass, &bgl, &bindings, 0)
+            .map_err(|m| pass_error(pass, m))?;
+        Ok((pipeline, bind))
+    }
+}
+
+pub(super) fn pass_error(pass: &str, message: String) -> RenderError {
+    RenderError::Pass {
+        pass: pass.to_string(),
+        message,
+    }
+}
+
+pub(super) fn defines(pairs: &[(&str, String)]) -> BTreeMap<String, String> {
+    pairs
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.clone()))
+        .collect()
+}
+
+/// One compute pass with one dispatch.
+pub(super) fn dispatch(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    ts: Timestamps<'_>,
+    pipeline: &wgpu::ComputePipeline,
+    bind: &wgpu::BindGroup,
+    groups: [u32; 3],
+) {
+    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(label),
+        timestamp_writes: ts.compute(),
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, bind, &[]);
+    pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
+}

@@ -1,0 +1,75 @@
+//! What a frame returns: the image, per-pass GPU times, culling reports, statistics.
+
+use crate::graph::ListLayout;
+
+/// Per culling pass: what its lists held this frame.
+#[derive(Clone, Debug)]
+pub struct CullingReport {
+    pub pass: String,
+    pub layout: ListLayout,
+    /// Lists (tiles, halves or clusters) that wanted more lights than the capacity.
+    pub overflowed_lists: u32,
+    /// The longest list wanted (before clamping to the capacity).
+    pub longest_list: u32,
+    /// Kept count of every list, `lists_per_tile` consecutive entries per tile.
+    pub counts: Vec<u32>,
+}
+
+impl CullingReport {
+    /// Lights listed per tile (all its lists together), row-major.
+    pub fn per_tile(&self) -> Vec<u32> {
+        self.counts
+            .chunks(self.layout.lists_per_tile as usize)
+            .map(|c| c.iter().sum())
+            .collect()
+    }
+}
+
+/// Per-pixel light statistics over pixels that hold geometry.
+#[derive(Clone, Debug, Default)]
+pub struct LightStats {
+    pub pixels: u64,
+    pub listed_total: u64,
+    pub exact_total: u64,
+    pub max_listed: u32,
+    pub max_exact: u32,
+}
+
+impl LightStats {
+    pub fn avg_listed(&self) -> f64 {
+        self.listed_total as f64 / self.pixels.max(1) as f64
+    }
+    pub fn avg_exact(&self) -> f64 {
+        self.exact_total as f64 / self.pixels.max(1) as f64
+    }
+    /// Listed over exact: 1 means no false positives.
+    pub fn false_positive_ratio(&self) -> f64 {
+        self.listed_total as f64 / self.exact_total.max(1) as f64
+    }
+    /// Sums the (listed, exact) counts of every pixel that holds either.
+    pub fn from_counts(counts: &[[u32; 2]]) -> Self {
+        let mut s = LightStats::default();
+        for &[listed, exact] in counts {
+            if listed == 0 && exact == 0 {
+                continue;
+            }
+            s.pixels += 1;
+            s.listed_total += listed as u64;
+            s.exact_total += exact as u64;
+            s.max_listed = s.max_listed.max(listed);
+            s.max_exact = s.max_exact.max(exact);
+        }
+        s
+    }
+}
+
+pub struct FrameResult {
+    pub width: u32,
+    pub height: u32,
+    /// Linear HDR RGBA, row-major.
+    pub image: Vec<[f32; 4]>,
+    /// GPU milliseconds per pass, when the adapter has timestamp queries.
+    pub pass_ms: Option<Vec<(String, f64)>>,
+    pub culling: Vec<CullingReport>,
+    pub light_stats: Option<LightStats>,
+}
