@@ -12,6 +12,7 @@ pub mod reload;
 pub mod render;
 pub mod scene;
 pub mod shader;
+pub mod shadow;
 pub mod view;
 
 /// The folder the user's shaders/, graphs/ and materials/ are looked for in first (see

@@ -4,6 +4,7 @@
 //! [`builtin`] has the procedural scenes; [`lights`] the procedural light sets.
 
 pub mod builtin;
+pub mod builtin_chairs;
 mod error;
 pub mod geometry;
 pub mod gltf_import;

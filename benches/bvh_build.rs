@@ -1,0 +1,29 @@
+//! Building the shadow BVH over the built-in `chairs` scene (≥ 250,000 triangles) on one
+//! core. obvhs is built without its `parallel` feature (Cargo.toml), so the build is
+//! single-threaded whatever divan's thread count; divan runs this bench on one thread.
+//! Aim: ≤ 50 ms.
+
+use lightgraph::scene::builtin;
+use lightgraph::shadow::bvh::{BuildOptions, BuildQuality, ShadowBvh};
+
+fn main() {
+    divan::main();
+}
+
+const QUALITIES: [BuildQuality; 4] = [
+    BuildQuality::Fastest,
+    BuildQuality::VeryFast,
+    BuildQuality::Fast,
+    BuildQuality::Medium,
+];
+
+#[divan::bench(args = QUALITIES, threads = 1, sample_count = 20)]
+fn chairs(bencher: divan::Bencher, quality: BuildQuality) {
+    let scene = builtin::by_name("chairs").expect("chairs scene");
+    assert!(scene.triangle_count() >= 250_000);
+    let options = BuildOptions {
+        quality,
+        ..Default::default()
+    };
+    bencher.bench(|| ShadowBvh::build_with(divan::black_box(&scene), &options).unwrap());
+}

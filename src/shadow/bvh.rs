@@ -1,0 +1,636 @@
+//! A BVH over every scene triangle for any-hit shadow rays, built with `obvhs` (PLOC,
+//! single-threaded: the crate's `parallel` feature is off) and flattened into two
+//! GPU-ready arrays:
+//!
+//! * [`BvhNode`], 32 bytes, in depth-first pre-order. The left child of an inner node is
+//!   the next node; `a` is the right child; `b` is the first node after the subtree (the
+//!   "skip" link the stackless fallback follows). A leaf has `b = LEAF_BIT | count` and its
+//!   triangles are `triangles[a .. a + count]`.
+//! * [`BvhTriangle`], 48 bytes: `v0`, `e1 = v1 - v0`, `e2 = v2 - v0` (Möller–Trumbore
+//!   form) and the triangle's index in the scene.
+//!
+//! [`ShadowBvh::occluded`] is a line-by-line twin of `bvh_occluded` in
+//! `shaders/shadow/bvh.wgsl`: the same f32 slab and triangle tests, the same 32-entry
+//! stack and the same exact fallback when that stack would overflow.
+
+use crate::scene::Scene;
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use std::time::{Duration, Instant};
+use thiserror::Error;
+
+/// Set in [`BvhNode::b`] of a leaf; the low bits are its triangle count.
+pub const LEAF_BIT: u32 = 0x8000_0000;
+/// Entries in the traversal stack (`BVH_STACK_SIZE` in the WGSL).
+pub const STACK_SIZE: usize = 32;
+/// Direction components smaller than this are replaced by ±this before the reciprocal,
+/// so the slab test never computes `0 * inf`.
+pub const MIN_DIR: f32 = 1e-20;
+/// `t_far` of a slab test is scaled by this, so rounding never culls a box the ray
+/// touches (1 + 2γ₃, Ize, "Robust BVH Ray Traversal").
+pub const SLAB_SLACK: f32 = 1.000_000_4;
+/// Below this |det| a ray counts as parallel to a triangle (miss).
+pub const MIN_DET: f32 = 1e-30;
+
+/// A BVH node as the GPU reads it (`BvhNode` in `shaders/shadow/bvh.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct BvhNode {
+    pub min: [f32; 3],
+    /// Inner: index of the right child (the left child is the next node). Leaf: first
+    /// triangle.
+    pub a: u32,
+    pub max: [f32; 3],
+    /// Inner: index of the first node after this subtree. Leaf: `LEAF_BIT | count`.
+    pub b: u32,
+}
+
+impl BvhNode {
+    pub fn is_leaf(&self) -> bool {
+        self.b & LEAF_BIT != 0
+    }
+    /// Triangles in a leaf (0 for inner nodes).
+    pub fn count(&self) -> u32 {
+        if self.is_leaf() {
+            self.b & !LEAF_BIT
+        } else {
+            0
+        }
+    }
+}
+
+/// A triangle as the GPU reads it (`BvhTriangle` in `shaders/shadow/bvh.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct BvhTriangle {
+    pub v0: [f32; 3],
+    /// Index of the triangle in the scene: meshes in order, triangles in index order,
+    /// skipped triangles counted too (so it maps back to mesh and triangle).
+    pub id: u32,
+    pub e1: [f32; 3],
+    pub _pad0: u32,
+    pub e2: [f32; 3],
+    pub _pad1: u32,
+}
+
+#[derive(Debug, Error, Clone, PartialEq, Eq)]
+pub enum ShadowError {
+    #[error("{count} shadow-casting triangles do not fit the 31-bit GPU indices")]
+    TooManyTriangles { count: usize },
+    #[error("the shadow BVH has {count} nodes, more than 31-bit GPU indices address")]
+    TooManyNodes { count: usize },
+}
+
+/// How hard the PLOC builder works (after obvhs's presets of the same names).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BuildQuality {
+    /// PLOC search distance 1, no reinsertion.
+    Fastest,
+    /// PLOC search distance 1, reinsertion of 1 % of the nodes.
+    #[default]
+    VeryFast,
+    /// PLOC search distance 6 (1 below depth 2), reinsertion of 2 %.
+    Fast,
+    /// PLOC search distance 14 (1 below depth 3), reinsertion of 5 %.
+    Medium,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BuildOptions {
+    pub quality: BuildQuality,
+    /// Most triangles in a leaf (1..=255). Subtrees up to this size become leaves where
+    /// the surface area heuristic says a leaf is cheaper.
+    pub max_leaf_triangles: u32,
+    /// Cost of visiting an inner node relative to testing one triangle, for that
+    /// leaf-collapse decision.
+    pub traversal_cost: f32,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        Self {
+            quality: BuildQuality::default(),
+            max_leaf_triangles: 4,
+            traversal_cost: 2.0,
+        }
+    }
+}
+
+impl BuildOptions {
+    /// (PLOC search distance, depth below which it drops to 1, reinsertion batch ratio).
+    fn ploc(&self) -> (obvhs::ploc::PlocSearchDistance, usize, f32) {
+        use obvhs::ploc::PlocSearchDistance::*;
+        match self.quality {
+            BuildQuality::Fastest => (Minimum, 0, 0.0),
+            BuildQuality::VeryFast => (Minimum, 0, 0.01),
+            BuildQuality::Fast => (Low, 2, 0.02),
+            BuildQuality::Medium => (Medium, 3, 0.05),
+        }
+    }
+}
+
+/// What a build did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BuildStats {
+    /// Triangles in the BVH.
+    pub triangles: usize,
+    /// Triangles the scene's index lists name (whole triples).
+    pub input_triangles: usize,
+    /// Skipped: zero area (collinear or repeated vertices).
+    pub skipped_degenerate: usize,
+    /// Skipped: a NaN or infinite coordinate.
+    pub skipped_non_finite: usize,
+    /// Skipped: an index past the mesh's vertices (plus trailing indices that make no
+    /// whole triangle).
+    pub skipped_bad_index: usize,
+    pub nodes: usize,
+    pub leaves: usize,
+    /// Longest root-to-leaf path, in nodes (a lone root leaf is depth 1).
+    pub max_depth: usize,
+    /// Everything: gathering triangles, the obvhs build, flattening.
+    pub build_time: Duration,
+    /// The obvhs PLOC build, reinsertion and leaf collapse alone.
+    pub core_build_time: Duration,
+}
+
+/// What one traversal did (CPU twin only).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TraversalStats {
+    pub nodes_visited: u32,
+    pub triangles_tested: u32,
+    /// The stack would have overflowed, so the ray was re-cast stackless from the root.
+    pub fell_back: bool,
+}
+
+/// The flattened BVH: what the GPU uploads, and its CPU twin traversal.
+#[derive(Clone, Debug, Default)]
+pub struct ShadowBvh {
+    /// Never empty: an empty scene has one empty leaf.
+    pub nodes: Vec<BvhNode>,
+    /// Never empty (storage bindings may not be): an empty scene has one zeroed
+    /// triangle no leaf names. [`BuildStats::triangles`] is the real count.
+    pub triangles: Vec<BvhTriangle>,
+    pub stats: BuildStats,
+}
+
+struct Gathered {
+    tris: Vec<[Vec3; 3]>,
+    ids: Vec<u32>,
+    stats: BuildStats,
+}
+
+/// Every drawable triangle of the scene, in world space exactly as the renderer draws
+/// it (`Mesh::positions` are already world space; no transforms), with the skips counted.
+fn gather<'a>(meshes: impl Iterator<Item = (&'a [Vec3], &'a [u32])>) -> Gathered {
+    let mut g = Gathered {
+        tris: Vec::new(),
+        ids: Vec::new(),
+        stats: BuildStats::default(),
+    };
+    let mut id: u64 = 0;
+    for (positions, indices) in meshes {
+        g.stats.skipped_bad_index += usize::from(indices.len() % 3 != 0);
+        for t in indices.chunks_exact(3) {
+            g.stats.input_triangles += 1;
+            let this = id;
+            id += 1;
+            let fetch = |i: u32| positions.get(i as usize).copied();
+            let (Some(p0), Some(p1), Some(p2)) = (fetch(t[0]), fetch(t[1]), fetch(t[2])) else {
+                g.stats.skipped_bad_index += 1;
+                continue;
+            };
+            if !(p0.is_finite() && p1.is_finite() && p2.is_finite()) {
+                g.stats.skipped_non_finite += 1;
+                continue;
+            }
+            // Area in f64 from the f32 inputs (products of f32 are exact in f64), so only
+            // truly flat triangles count as degenerate.
+            let (d0, d1, d2) = (p0.as_dvec3(), p1.as_dvec3(), p2.as_dvec3());
+            if (d1 - d0).cross(d2 - d0).length_squared() == 0.0 {
+                g.stats.skipped_degenerate += 1;
+                continue;
+            }
+            g.tris.push([p0, p1, p2]);
+            g.ids.push(this.min(u32::MAX as u64) as u32);
+        }
+    }
+    g
+}
+
+/// An empty leaf no ray enters (what an empty scene's BVH is).
+const EMPTY_LEAF: BvhNode = BvhNode {
+    min: [f32::MAX; 3],
+    a: 0,
+    max: [f32::MIN; 3],
+    b: LEAF_BIT,
+};
+
+fn to_obvhs(v: Vec3) -> glam_obvhs::Vec3A {
+    glam_obvhs::Vec3A::new(v.x, v.y, v.z)
+}
+
+impl ShadowBvh {
+    /// Builds over every triangle of every mesh in the scene with [`BuildOptions::default`].
+    pub fn build(scene: &Scene) -> Result<Self, ShadowError> {
+        Self::build_with(scene, &BuildOptions::default())
+    }
+
+    pub fn build_with(scene: &Scene, options: &BuildOptions) -> Result<Self, ShadowError> {
+        let start = Instant::now();
+        let g = gather(
+            scene
+                .meshes
+                .iter()
+                .map(|m| (m.positions.as_slice(), m.indices.as_slice())),
+        );
+        Self::finish(g, options, start)
+    }
+
+    /// Builds over a triangle soup (ids are the positions in `tris`).
+    pub fn from_triangles(tris: &[[Vec3; 3]], options: &BuildOptions) -> Result<Self, ShadowError> {
+        let start = Instant::now();
+        let positions: Vec<Vec3> = tris.iter().flatten().copied().collect();
+        let indices: Vec<u32> = (0..positions.len() as u32).collect();
+        let g = gather(std::iter::once((positions.as_slice(), indices.as_slice())));
+        Self::finish(g, options, start)
+    }
+
+    fn finish(g: Gathered, options: &BuildOptions, start: Instant) -> Result<Self, ShadowError> {
+        let Gathered {
+            tris,
+            ids,
+            mut stats,
+        } = g;
+        if tris.len() >= LEAF_BIT as usize {
+            return Err(ShadowError::TooManyTriangles { count: tris.len() });
+        }
+        stats.triangles = tris.len();
+        let mut out = ShadowBvh {
+            nodes: Vec::new(),
+            triangles: Vec::with_capacity(tris.len().max(1)),
+            stats,
+        };
+        if tris.is_empty() {
+            out.nodes.push(EMPTY_LEAF);
+            out.triangles.push(BvhTriangle::zeroed());
+            out.stats.nodes = 1;
+            out.stats.leaves = 1;
+            out.stats.max_depth = 1;
+            out.stats.build_time = start.elapsed();
+            return Ok(out);
+        }
+        let aabbs: Vec<obvhs::aabb::Aabb> = tris
+            .iter()
+            .map(|t| {
+                obvhs::aabb::Aabb::from_points(&[to_obvhs(t[0]), to_obvhs(t[1]), to_obvhs(t[2])])
+            })
+            .collect();
+        let core = Instant::now();
+        let (distance, depth_threshold, reinsertion) = options.ploc();
+        let mut bvh = obvhs::ploc::PlocBuilder::with_capacity(aabbs.len()).build(
+            distance,
+            &aabbs,
+            (0..aabbs.len() as u32).collect(),
+            obvhs::ploc::SortPrecision::U64,
+            depth_threshold,
+        );
+        if reinsertion > 0.0 {
+            obvhs::bvh2::reinsertion::ReinsertionOptimizer::default().run(
+                &mut bvh,
+                reinsertion,
+                None,
+            );
+        }
+        out.stats.core_build_time = core.elapsed();
+        if bvh.nodes.len() >= LEAF_BIT as usize {
+            return Err(ShadowError::TooManyNodes {
+                count: bvh.nodes.len(),
+            });
+        }
+        out.flatten(&bvh, &tris, &ids, options);
+        out.stats.nodes = out.nodes.len();
+        out.stats.build_time = start.elapsed();
+        Ok(out)
+    }
+
+    /// Pre-order flattening with an SAH leaf collapse (obvhs's own collapse pass costs
+    /// more than this, so leaves come out of PLOC with one triangle each and are merged
+    /// here).
+    fn flatten(
+        &mut self,
+        bvh: &obvhs::bvh2::Bvh2,
+        tris: &[[Vec3; 3]],
+        ids: &[u32],
+        options: &BuildOptions,
+    ) {
+        let src = &bvh.nodes;
+        let half_area = |i: u32| src.get(i as usize).map_or(0.0, |n| n.aabb().half_area());
+        // Source pre-order; reversed, children come before parents.
+        let mut order = Vec::with_capacity(src.len());
+        let mut stack = vec![0u32];
+        while let Some(i) = stack.pop() {
+            let Some(n) = src.get(i as usize) else {
+                continue;
+            };
+            order.push(i);
+            if !n.is_leaf() {
+                stack.push(n.first_index + 1);
+                stack.push(n.first_index);
+            }
+        }
+        // Bottom up: triangles under each node, its best area-weighted cost, and whether
+        // it becomes a leaf.
+        let max_leaf = options.max_leaf_triangles.clamp(1, 255);
+        let mut count = vec![0u32; src.len()];
+        let mut cost = vec![0f32; src.len()];
+        let mut leaf = vec![false; src.len()];
+        for &i in order.iter().rev() {
+            let n = &src[i as usize];
+            let area = half_area(i);
+            let k = i as usize;
+            if n.is_leaf() {
+                count[k] = n.prim_count;
+                cost[k] = area * n.prim_count as f32;
+                leaf[k] = true;
+                continue;
+            }
+            let (l, r) = (n.first_index as usize, n.first_index as usize + 1);
+            let get = |v: &[u32], j: usize| v.get(j).copied().unwrap_or(0);
+            let c = get(&count, l) + get(&count, r);
+            let inner = area * options.traversal_cost
+                + cost.get(l).copied().unwrap_or(0.0)
+                + cost.get(r).copied().unwrap_or(0.0);
+            let as_leaf = area * c as f32;
+            count[k] = c;
+            if c <= max_leaf && as_leaf <= inner {
+                leaf[k] = true;
+                cost[k] = as_leaf;
+            } else {
+                cost[k] = inner;
+            }
+        }
+
+        // Emit. `Visit` writes a node (patching its parent's right-child link when it is a
+        // right child); `Close` writes an inner node's skip link.
+        enum Task {
+            Visit {
+                src: u32,
+                depth: usize,
+                right_of: Option<usize>,
+            },
+            Close(usize),
+        }
+        let mut tasks = vec![Task::Visit {
+            src: 0,
+            depth: 1,
+            right_of: None,
+        }];
+        let mut under = Vec::new();
+        while let Some(task) = tasks.pop() {
+            let (i, depth, right_of) = match task {
+                Task::Close(at) => {
+                    self.nodes[at].b = self.nodes.len() as u32;
+                    continue;
+                }
+                Task::Visit {
+                    src,
+                    depth,
+                    right_of,
+                } => (src, depth, right_of),
+            };
+            let at = self.nodes.len();
+            if let Some(parent) = right_of {
+                self.nodes[parent].a = at as u32;
+            }
+            self.stats.max_depth = self.stats.max_depth.max(depth);
+            let Some(n) = src.get(i as usize) else {
+                // Not expected from obvhs; keep the tree well formed regardless.
+                self.nodes.push(EMPTY_LEAF);
+                continue;
+            };
+            let aabb = n.aabb();
+            let mut node = BvhNode {
+                min: aabb.min.to_array(),
+                a: 0,
+                max: aabb.max.to_array(),
+                b: 0,
+            };
+            if !leaf[i as usize] {
+                self.nodes.push(node);
+                tasks.push(Task::Close(at));
+                tasks.push(Task::Visit {
+                    src: n.first_index + 1,
+                    depth: depth + 1,
+                    right_of: Some(at),
+                });
+                tasks.push(Task::Visit {
+                    src: n.first_index,
+                    depth: depth + 1,
+                    right_of: None,
+                });
+                continue;
+            }
+            // A leaf: every triangle of the source subtree.
+            node.a = self.triangles.len() as u32;
+            under.clear();
+            under.push(i);
+            while let Some(j) = under.pop() {
+                let Some(m) = src.get(j as usize) else {
+                    continue;
+                };
+                if !m.is_leaf() {
+                    under.push(m.first_index + 1);
+                    under.push(m.first_index);
+                    continue;
+                }
+                let first = m.first_index as usize;
+                let prims = bvh
+                    .primitive_indices
+                    .get(first..first + m.prim_count as usize)
+                    .unwrap_or(&[]);
+                for &p in prims {
+                    let [p0, p1, p2] = tris[p as usize];
+                    self.triangles.push(BvhTriangle {
+                        v0: p0.to_array(),
+                        id: ids[p as usize],
+                        e1: (p1 - p0).to_array(),
+                        _pad0: 0,
+                        e2: (p2 - p0).to_array(),
+                        _pad1: 0,
+                    });
+                }
+            }
+            node.b = LEAF_BIT | (self.triangles.len() as u32 - node.a);
+            self.stats.leaves += 1;
+            self.nodes.push(node);
+        }
+    }
+
+    /// Whether anything blocks `origin + t * dir` for `0 < t < t_max` (the CPU twin of
+    /// `bvh_occluded` in `shaders/shadow/bvh.wgsl`).
+    pub fn occluded(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+        self.traverse::<STACK_SIZE>(origin, dir, t_max).0
+    }
+
+    /// [`Self::occluded`] with a stack of `N` entries (the fallback path is exercised with
+    /// small `N`), and what the traversal did.
+    pub fn traverse<const N: usize>(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+    ) -> (bool, TraversalStats) {
+        let mut stats = TraversalStats::default();
+        if !(origin.is_finite() && dir.is_finite() && t_max > 0.0) || self.nodes.is_empty() {
+            return (false, stats);
+        }
+        let inv_dir = safe_inverse(dir);
+        let ray = Ray {
+            origin,
+            dir,
+            inv_dir,
+            t_max,
+        };
+        let nodes = &self.nodes;
+        let node_at = |i: u32| nodes.get(i as usize).copied().unwrap_or_default();
+
+        // Stack pass: test both children at their parent, go to the nearer, push the other.
+        let mut stack = [0u32; N];
+        let mut sp = 0usize;
+        let mut overflow = false;
+        let mut current = 0u32;
+        let mut alive = slab(&node_at(0), &ray).is_some();
+        while alive {
+            stats.nodes_visited += 1;
+            let node = node_at(current);
+            let mut next = None;
+            if node.is_leaf() {
+                if self.leaf_hit(&node, &ray, &mut stats) {
+                    return (true, stats);
+                }
+            } else {
+                let left = current + 1;
+                let right = node.a;
+                let tl = slab(&node_at(left), &ray);
+                let tr = slab(&node_at(right), &ray);
+                match (tl, tr) {
+                    (Some(l), Some(r)) => {
+                        let (near, far) = if l <= r { (left, right) } else { (right, left) };
+                        if sp == N {
+                            overflow = true;
+                            break;
+                        }
+                        stack[sp] = far;
+                        sp += 1;
+                        next = Some(near);
+                    }
+                    (Some(_), None) => next = Some(left),
+                    (None, Some(_)) => next = Some(right),
+                    (None, None) => {}
+                }
+            }
+            match next {
+                Some(n) => current = n,
+                None if sp > 0 => {
+                    sp -= 1;
+                    current = stack[sp];
+                }
+                None => alive = false,
+            }
+        }
+        if !overflow {
+            return (false, stats);
+        }
+
+        // Fallback: stackless pre-order walk from the root along the skip links. It
+        // re-tests what the stack pass already tested (none of which hit), so the answer
+        // is exact.
+        stats.fell_back = true;
+        let mut i = 0u32;
+        let end = nodes.len() as u32;
+        while i < end {
+            stats.nodes_visited += 1;
+            let node = node_at(i);
+            let skip = if node.is_leaf() { i + 1 } else { node.b };
+            if slab(&node, &ray).is_none() {
+                i = skip.max(i + 1);
+                continue;
+            }
+            if node.is_leaf() && self.leaf_hit(&node, &ray, &mut stats) {
+                return (true, stats);
+            }
+            i += 1;
+        }
+        (false, stats)
+    }
+
+    fn leaf_hit(&self, node: &BvhNode, ray: &Ray, stats: &mut TraversalStats) -> bool {
+        let first = node.a as usize;
+        let count = node.count() as usize;
+        let tris = self.triangles.get(first..first + count).unwrap_or(&[]);
+        tris.iter().any(|t| {
+            stats.triangles_tested += 1;
+            triangle_hit(t, ray)
+        })
+    }
+
+    /// The bytes to upload into `bvh_nodes` and `bvh_triangles`.
+    pub fn gpu_bytes(&self) -> (&[u8], &[u8]) {
+        (
+            bytemuck::cast_slice(&self.nodes),
+            bytemuck::cast_slice(&self.triangles),
+        )
+    }
+}
+
+struct Ray {
+    origin: Vec3,
+    dir: Vec3,
+    inv_dir: Vec3,
+    t_max: f32,
+}
+
+fn safe_inverse(d: Vec3) -> Vec3 {
+    let fix = |c: f32| {
+        if c.abs() < MIN_DIR {
+            if c < 0.0 {
+                -MIN_DIR
+            } else {
+                MIN_DIR
+            }
+        } else {
+            c
+        }
+    };
+    Vec3::ONE / Vec3::new(fix(d.x), fix(d.y), fix(d.z))
+}
+
+/// Entry distance if the ray's `[0, t_max]` overlaps the box.
+fn slab(node: &BvhNode, ray: &Ray) -> Option<f32> {
+    let t0 = (Vec3::from(node.min) - ray.origin) * ray.inv_dir;
+    let t1 = (Vec3::from(node.max) - ray.origin) * ray.inv_dir;
+    let near = t0.min(t1).max_element().max(0.0);
+    let far = t0.max(t1).min_element().min(ray.t_max) * SLAB_SLACK;
+    (near <= far).then_some(near)
+}
+
+/// Möller–Trumbore in f32, two-sided, hit for `0 < t < t_max`.
+fn triangle_hit(tri: &BvhTriangle, ray: &Ray) -> bool {
+    let (v0, e1, e2) = (Vec3::from(tri.v0), Vec3::from(tri.e1), Vec3::from(tri.e2));
+    let p = ray.dir.cross(e2);
+    let det = e1.dot(p);
+    if det.abs() < MIN_DET {
+        return false;
+    }
+    let inv_det = 1.0 / det;
+    let s = ray.origin - v0;
+    let u = s.dot(p) * inv_det;
+    if !(0.0..=1.0).contains(&u) {
+        return false;
+    }
+    let q = s.cross(e1);
+    let v = ray.dir.dot(q) * inv_det;
+    let t = e2.dot(q) * inv_det;
+    // Every comparison is false for NaN, so NaN misses.
+    v >= 0.0 && u + v <= 1.0 && t > 0.0 && t < ray.t_max
+}
