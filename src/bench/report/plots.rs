@@ -1,0 +1,236 @@
+//! PNG plots of frame time against light count and against error, drawn with plotters.
+
+use super::{BenchRow, ReportError};
+use plotters::prelude::*;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+static FONT: &[u8] = include_bytes!("../fonts/DejaVuSansMono.ttf");
+
+fn register_fonts() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        for family in ["sans-serif", "serif", "monospace"] {
+            plotters::style::register_font(family, plotters::style::FontStyle::Normal, FONT)
+                .unwrap_or_else(|_| panic!("bundled font is a valid TrueType font"));
+        }
+    });
+}
+
+/// Size of the plot PNGs.
+pub const PLOT_SIZE: (u32, u32) = (1024, 640);
+
+/// A point: (x, median, p10, p90).
+type Point = (f64, f64, f64, f64);
+/// Labelled series of points, each sorted by x, in legend order.
+type Series = Vec<(String, Vec<Point>)>;
+
+/// Axis label: integers as integers, otherwise up to 4 significant digits, scientific notation
+/// outside `[1e-3, 1e5)`.
+fn axis_label(x: f64) -> String {
+    if x == 0.0 {
+        return "0".into();
+    }
+    if x.abs() < 1e-3 || x.abs() >= 1e5 {
+        return format!("{x:.1e}");
+    }
+    if x.fract() == 0.0 {
+        return format!("{x:.0}");
+    }
+    let digits = (3 - x.abs().log10().floor() as i32).clamp(0, 6) as usize;
+    let s = format!("{x:.digits$}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+fn render_plot(
+    path: &Path,
+    title: &str,
+    x_desc: &str,
+    log_x: bool,
+    series: &Series,
+) -> Result<(), ReportError> {
+    register_fonts();
+    let (w, h) = PLOT_SIZE;
+    let mut buf = vec![0u8; (w * h * 3) as usize];
+    let plot_err = |e: &dyn std::fmt::Display| ReportError::Plot {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| plot_err(&e))?;
+        let pts = series.iter().flat_map(|(_, p)| p);
+        let (mut x0, mut x1, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
+        for &(x, _, _, yh) in pts {
+            x0 = x0.min(x);
+            x1 = x1.max(x);
+            y1 = y1.max(yh);
+        }
+        if !x0.is_finite() {
+            (x0, x1) = (1.0, 10.0);
+        }
+        if log_x {
+            x0 = x0.max(1e-12);
+            x1 = x1.max(x0 * 10.0);
+            (x0, x1) = (x0 / 1.5, x1 * 1.5);
+        } else {
+            let pad = ((x1 - x0) * 0.05).max(x1.abs() * 0.05).max(1e-9);
+            // Errors are non-negative: start the axis at 0 so "exact" sits on the axis.
+            (x0, x1) = (if x0 >= 0.0 { 0.0 } else { x0 - pad }, x1 + pad);
+        }
+        let y1 = if y1 > 0.0 { y1 * 1.1 } else { 1.0 };
+        let mut builder = ChartBuilder::on(&root);
+        builder
+            .caption(title, ("sans-serif", 24))
+            .margin(16)
+            .x_label_area_size(48)
+            .y_label_area_size(72);
+        macro_rules! draw {
+            ($chart:expr) => {{
+                let mut chart = $chart;
+                chart
+                    .configure_mesh()
+                    .x_desc(x_desc)
+                    .x_label_formatter(&|x: &f64| axis_label(*x))
+                    .y_label_formatter(&|y: &f64| axis_label(*y))
+                    .y_desc("frame time, median (ms); bars p10-p90")
+                    .draw()
+                    .map_err(|e| plot_err(&e))?;
+                for (i, (name, points)) in series.iter().enumerate() {
+                    let color = Palette99::pick(i).to_rgba();
+                    chart
+                        .draw_series(LineSeries::new(
+                            points.iter().map(|p| (p.0, p.1)),
+                            color.stroke_width(2),
+                        ))
+                        .map_err(|e| plot_err(&e))?
+                        .label(name.as_str())
+                        .legend(move |(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                        });
+                    chart
+                        .draw_series(
+                            points
+                                .iter()
+                                .map(|p| Circle::new((p.0, p.1), 4, color.filled())),
+                        )
+                        .map_err(|e| plot_err(&e))?;
+                    chart
+                        .draw_series(points.iter().map(|p| {
+                            PathElement::new(vec![(p.0, p.2), (p.0, p.3)], color.stroke_width(1))
+                        }))
+                        .map_err(|e| plot_err(&e))?;
+                }
+                chart
+                    .configure_series_labels()
+                    .position(SeriesLabelPosition::UpperLeft)
+                    .background_style(&WHITE.mix(0.85))
+                    .border_style(&BLACK)
+                    .draw()
+                    .map_err(|e| plot_err(&e))?;
+            }};
+        }
+        if log_x {
+            draw!(builder
+                .build_cartesian_2d((x0..x1).log_scale(), 0.0..y1)
+                .map_err(|e| plot_err(&e))?);
+        } else {
+            draw!(builder
+                .build_cartesian_2d(x0..x1, 0.0..y1)
+                .map_err(|e| plot_err(&e))?);
+        }
+        root.present().map_err(|e| plot_err(&e))?;
+    }
+    crate::bench::image_io::write_png_rgb8(path, buf, w, h)?;
+    Ok(())
+}
+
+/// Plot median frame time (p10–p90 bars) against light count (log x), one line per technique.
+pub fn plot_time_vs_lights(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(), ReportError> {
+    let mut series: BTreeMap<String, Vec<Point>> = BTreeMap::new();
+    for r in rows.iter().filter(|r| r.light_count > 0) {
+        if let Some(t) = r.frame_ms {
+            series.entry(r.technique.clone()).or_default().push((
+                r.light_count as f64,
+                t.median,
+                t.p10,
+                t.p90,
+            ));
+        }
+    }
+    let series: Series = series
+        .into_iter()
+        .map(|(name, mut points)| {
+            points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            (name, points)
+        })
+        .collect();
+    render_plot(
+        path.as_ref(),
+        "Frame time vs light count",
+        "lights (log)",
+        true,
+        &series,
+    )
+}
+
+/// Plot median frame time (p10–p90 bars) against RMSE (linear x from 0; rows without RMSE are
+/// left out), one series per technique, points joined in order of RMSE (a parameter sweep then
+/// draws its time/error trade-off curve). If the rows hold several light counts, each
+/// (technique, light count) pair is its own series, labelled `technique @ N lights`, so points
+/// of different scene sizes are never joined.
+pub fn plot_time_vs_error(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(), ReportError> {
+    let with_error = || {
+        rows.iter()
+            .filter(|r| r.rmse.is_some_and(f64::is_finite) && r.frame_ms.is_some())
+    };
+    let first_count = with_error().next().map(|r| r.light_count);
+    let several_counts = with_error().any(|r| Some(r.light_count) != first_count);
+    let mut series: BTreeMap<(String, u32), Vec<Point>> = BTreeMap::new();
+    for r in with_error() {
+        if let (Some(e), Some(t)) = (r.rmse, r.frame_ms) {
+            let key = (
+                r.technique.clone(),
+                if several_counts { r.light_count } else { 0 },
+            );
+            series
+                .entry(key)
+                .or_default()
+                .push((e, t.median, t.p10, t.p90));
+        }
+    }
+    let series: Series = series
+        .into_iter()
+        .map(|((technique, lights), mut points)| {
+            points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let name = if several_counts {
+                format!("{technique} @ {lights} lights")
+            } else {
+                technique
+            };
+            (name, points)
+        })
+        .collect();
+    render_plot(
+        path.as_ref(),
+        "Frame time vs error",
+        "RMSE vs reference (linear)",
+        false,
+        &series,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::axis_label;
+
+    #[test]
+    fn axis_labels_are_short() {
+        assert_eq!(axis_label(0.0), "0");
+        assert_eq!(axis_label(1000.0), "1000");
+        assert_eq!(axis_label(0.15000000000000002), "0.15");
+        assert_eq!(axis_label(0.39999999), "0.4");
+        assert_eq!(axis_label(12.5), "12.5");
+        assert_eq!(axis_label(2e-5), "2.0e-5");
+    }
+}

@@ -1,0 +1,109 @@
+//! One benchmark measurement ([`BenchRow`]) and timing summaries (median, p10, p90).
+
+use crate::bench::metrics::{ImageMetrics, NonFinitePixel};
+use serde::{Deserialize, Serialize};
+
+/// One benchmark measurement. Optional fields are `None` where they do not apply (the reference
+/// has no error against itself to speak of; brute force has no tiles).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct BenchRow {
+    /// Scene name or file.
+    pub scene: String,
+    /// Graph / technique name (e.g. `forward_plus`); plots group series by this.
+    pub technique: String,
+    /// Free-form parameters, e.g. `tile=16 depth_bins=32`.
+    pub params: String,
+    /// Number of lights in the scene.
+    pub light_count: u32,
+    /// Render width.
+    pub width: u32,
+    /// Render height.
+    pub height: u32,
+    /// `wgpu::AdapterInfo::name`.
+    pub adapter: String,
+    /// GPU frame time (the sum of the per-pass timestamps) over the timed frames, ms; `None`
+    /// when nothing was timed (the adapter has no timestamp queries).
+    pub frame_ms: Option<TimingSummary>,
+    /// Why `frame_ms` is `None` (e.g. "the adapter has no timestamp queries").
+    pub untimed: Option<String>,
+    /// GPU time of each pass over the timed frames, ms, in schedule order (empty when untimed).
+    pub pass_ms: Vec<(String, TimingSummary)>,
+    /// RMSE against the reference (linear).
+    pub rmse: Option<f64>,
+    /// Largest absolute channel error against the reference.
+    pub max_abs: Option<f64>,
+    /// Largest relative channel error against the reference (floor: see
+    /// [`crate::bench::metrics::REL_ERROR_FLOOR`]).
+    pub max_rel: Option<f64>,
+    /// PSNR against the reference, dB (`inf` when identical).
+    pub psnr: Option<f64>,
+    /// Mean FLIP against the reference.
+    pub flip_mean: Option<f64>,
+    /// Lights listed per tile (or cluster) over lights that really touch it; 1 is exact culling.
+    pub listed_exact_ratio: Option<f64>,
+    /// Largest per-tile light count.
+    pub max_lights_per_tile: Option<u32>,
+    /// Tiles whose list overflowed.
+    pub overflow_tiles: Option<u32>,
+    /// Pixels of the output with a NaN channel.
+    pub nan_pixels: Option<u64>,
+    /// Pixels of the output with an infinite channel and no NaN.
+    pub inf_pixels: Option<u64>,
+    /// The first NaN / infinite pixels of the output, row-major (all of them are counted above).
+    pub non_finite_examples: Vec<NonFinitePixel>,
+    /// Pixels of the output with some non-zero channel: 0 means the point shows no light at all.
+    pub lit_pixels: Option<u64>,
+}
+
+impl BenchRow {
+    /// Fill the error fields (RMSE, max abs, max rel, PSNR, FLIP mean, NaN and Inf pixels of the
+    /// test image) from a comparison against the reference.
+    pub fn set_metrics(&mut self, m: &ImageMetrics) {
+        self.rmse = Some(m.rmse);
+        self.max_abs = Some(m.max_abs);
+        self.max_rel = Some(m.max_rel);
+        self.psnr = Some(m.psnr);
+        self.flip_mean = m.flip_mean;
+        self.nan_pixels = Some(m.test_non_finite.nan_pixels as u64);
+        self.inf_pixels = Some(m.test_non_finite.inf_pixels as u64);
+    }
+
+    /// Sum of the per-pass median times, if any pass was timed.
+    pub fn passes_ms_total(&self) -> Option<f64> {
+        (!self.pass_ms.is_empty()).then(|| self.pass_ms.iter().map(|(_, t)| t.median).sum())
+    }
+}
+
+/// Median and 10th / 90th percentiles of a set of timings.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct TimingSummary {
+    /// Median.
+    pub median: f64,
+    /// 10th percentile.
+    pub p10: f64,
+    /// 90th percentile.
+    pub p90: f64,
+}
+
+/// Percentile of sorted samples with linear interpolation between closest ranks.
+fn percentile_sorted(sorted: &[f64], p: f64) -> f64 {
+    let pos = p * (sorted.len() - 1) as f64;
+    let lo = pos.floor() as usize;
+    let hi = pos.ceil() as usize;
+    sorted[lo] + (sorted[hi] - sorted[lo]) * (pos - lo as f64)
+}
+
+/// Median, p10 and p90 (linear interpolation between closest ranks) of the finite samples;
+/// `None` if there are none.
+pub fn summarize(samples: &[f64]) -> Option<TimingSummary> {
+    let mut s: Vec<f64> = samples.iter().copied().filter(|x| x.is_finite()).collect();
+    if s.is_empty() {
+        return None;
+    }
+    s.sort_by(f64::total_cmp);
+    Some(TimingSummary {
+        median: percentile_sorted(&s, 0.5),
+        p10: percentile_sorted(&s, 0.1),
+        p90: percentile_sorted(&s, 0.9),
+    })
+}

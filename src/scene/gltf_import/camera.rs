@@ -1,0 +1,60 @@
+//! The perspective camera: a node's world matrix and lens checked into a scene [`Camera`].
+
+use super::Importer;
+use crate::scene::error::SceneError;
+use crate::scene::types::Camera;
+use glam::{Mat4, Vec3};
+
+/// (element name, world matrix, (yfov, znear, zfar)).
+pub(super) type FoundCamera = (String, Mat4, (f32, f32, Option<f32>));
+
+impl Importer {
+    pub(super) fn make_camera(
+        &mut self,
+        element: &str,
+        world: Mat4,
+        lens: (f32, f32, Option<f32>),
+        bounds: Option<(Vec3, Vec3)>,
+    ) -> Result<Camera, SceneError> {
+        let eye = world.transform_point3(Vec3::ZERO);
+        let fwd = world.transform_vector3(-Vec3::Z).normalize_or_zero();
+        let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
+        let (yfov, znear, zfar) = lens;
+        if !eye.is_finite() || fwd == Vec3::ZERO || up == Vec3::ZERO || !fwd.is_finite() {
+            return Err(self.err(element, "camera node transform is degenerate"));
+        }
+        if !(yfov.is_finite() && yfov > 0.0 && yfov < std::f32::consts::PI) {
+            return Err(self.err(element, format!("yfov {yfov} must lie in (0, pi)")));
+        }
+        if !(znear.is_finite() && znear > 0.0) {
+            return Err(self.err(element, format!("znear {znear} must be > 0")));
+        }
+        let far = match zfar {
+            Some(f) if f.is_finite() && f > znear => f,
+            Some(f) => {
+                return Err(self.err(
+                    element,
+                    format!("zfar {f} must be finite and > znear {znear}"),
+                ))
+            }
+            None => {
+                // Infinite projection: reach past the farthest corner of the scene.
+                let far = bounds
+                    .map(|(lo, hi)| {
+                        let c = (lo + hi) * 0.5;
+                        (eye - c).length() + (hi - lo).length()
+                    })
+                    .unwrap_or(1000.0);
+                far.max(znear * 10.0)
+            }
+        };
+        Ok(Camera {
+            eye,
+            target: eye + fwd,
+            up,
+            fov_y: yfov,
+            near: znear,
+            far,
+        })
+    }
+}

@@ -1,0 +1,224 @@
+//! Mesh primitives: triangles (strips and fans unrolled) with normals, UVs and tangents,
+//! transformed to world space.
+
+use super::{named, Importer};
+use crate::scene::error::SceneError;
+use crate::scene::geometry::{compute_normals, compute_tangents};
+use crate::scene::types::Mesh;
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
+use gltf::accessor::DataType;
+
+impl Importer {
+    pub(super) fn import_mesh(
+        &mut self,
+        mesh: &gltf::Mesh,
+        world: &Mat4,
+    ) -> Result<(), SceneError> {
+        let mesh_el = named("mesh", mesh.index(), mesh.name());
+        let prim_count = mesh.primitives().len();
+        for prim in mesh.primitives() {
+            let pel = format!("{mesh_el} primitive {}", prim.index());
+            use gltf::mesh::Mode;
+            let mode = prim.mode();
+            if !matches!(
+                mode,
+                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+            ) {
+                self.warn(format!(
+                    "{pel}: {mode:?} primitives are not triangles; skipped"
+                ));
+                continue;
+            }
+            let Some(pos_acc) = prim.get(&gltf::Semantic::Positions) else {
+                self.warn(format!("{pel}: no POSITION attribute; skipped"));
+                continue;
+            };
+            let el =
+                |sem: &str, acc: &gltf::Accessor| format!("{pel} {sem} accessor {}", acc.index());
+            let pe = el("POSITION", &pos_acc);
+            let local: Vec<[f32; 3]> = self.read_f32(&pos_acc, &pe, &[DataType::F32])?;
+            let n = local.len();
+            if let Some(i) = local.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+                return Err(self.err(
+                    pe,
+                    format!(
+                        "vertex {i} position {:?} is not finite (NaN or Inf)",
+                        local[i]
+                    ),
+                ));
+            }
+            let mut indices = match prim.indices() {
+                Some(acc) => {
+                    let ie = el("indices", &acc);
+                    let idx = self.read_indices(&acc, &ie)?;
+                    if let Some(k) = idx.iter().position(|&i| i as usize >= n) {
+                        return Err(self.err(
+                            ie,
+                            format!("index {k} is {}, past the vertex count {n}", idx[k]),
+                        ));
+                    }
+                    idx
+                }
+                None => (0..n as u32).collect(),
+            };
+            indices = match mode {
+                Mode::TriangleStrip => (2..indices.len())
+                    .flat_map(|i| {
+                        let (a, b, c) = (indices[i - 2], indices[i - 1], indices[i]);
+                        if i % 2 == 0 {
+                            [a, b, c]
+                        } else {
+                            [a, c, b]
+                        }
+                    })
+                    .collect(),
+                Mode::TriangleFan => (2..indices.len())
+                    .flat_map(|i| [indices[i - 1], indices[i], indices[0]])
+                    .collect(),
+                _ => indices,
+            };
+            if indices.len() % 3 != 0 {
+                self.warn(format!(
+                    "{pel}: {} indices is not a multiple of 3; the last {} ignored",
+                    indices.len(),
+                    indices.len() % 3
+                ));
+                indices.truncate(indices.len() / 3 * 3);
+            }
+            self.triangles += indices.len() as u64 / 3;
+            self.limit(
+                &pel,
+                "scene triangle count",
+                self.triangles,
+                self.limits.max_triangles,
+            )?;
+
+            let read_attr = |this: &Self,
+                             sem: gltf::Semantic,
+                             name: &str|
+             -> Result<Option<(gltf::Accessor, String)>, SceneError> {
+                match prim.get(&sem) {
+                    Some(acc) => {
+                        let e = el(name, &acc);
+                        if acc.count() != n {
+                            return Err(this.err(
+                                e,
+                                format!("has {} elements but POSITION has {n}", acc.count()),
+                            ));
+                        }
+                        Ok(Some((acc, e)))
+                    }
+                    None => Ok(None),
+                }
+            };
+            let normals_local: Option<Vec<[f32; 3]>> =
+                match read_attr(self, gltf::Semantic::Normals, "NORMAL")? {
+                    Some((acc, e)) => {
+                        let v = self.read_f32(&acc, &e, &[DataType::F32])?;
+                        if v.iter().any(|p| !p.iter().all(|c| c.is_finite())) {
+                            self.warn(format!("{e}: non-finite normals; normals regenerated"));
+                            None
+                        } else {
+                            Some(v)
+                        }
+                    }
+                    None => None,
+                };
+            let uvs: Vec<Vec2> = match read_attr(self, gltf::Semantic::TexCoords(0), "TEXCOORD_0")?
+            {
+                Some((acc, e)) => self
+                    .read_f32::<2>(&acc, &e, &[DataType::F32, DataType::U8, DataType::U16])?
+                    .into_iter()
+                    .map(|[u, v]| {
+                        if u.is_finite() && v.is_finite() {
+                            Vec2::new(u, v)
+                        } else {
+                            Vec2::ZERO
+                        }
+                    })
+                    .collect(),
+                None => Vec::new(),
+            };
+            let tangents_local: Option<Vec<[f32; 4]>> =
+                match read_attr(self, gltf::Semantic::Tangents, "TANGENT")? {
+                    Some((acc, e)) => {
+                        let v = self.read_f32(&acc, &e, &[DataType::F32])?;
+                        if v.iter().any(|p| !p.iter().all(|c| c.is_finite())) {
+                            self.warn(format!("{e}: non-finite tangents; tangents regenerated"));
+                            None
+                        } else {
+                            Some(v)
+                        }
+                    }
+                    None => None,
+                };
+
+            // To world space.
+            let m3 = Mat3::from_mat4(*world);
+            let det = m3.determinant();
+            let normal_m = if det.abs() > 1e-30 {
+                m3.inverse().transpose()
+            } else {
+                m3
+            };
+            let positions: Vec<Vec3> = local
+                .iter()
+                .map(|p| world.transform_point3(Vec3::from(*p)))
+                .collect();
+            if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+                return Err(self.err(
+                    pe,
+                    format!("vertex {i} is not finite after the node transforms"),
+                ));
+            }
+            if det < 0.0 {
+                // Mirroring transform: keep counter-clockwise front faces.
+                for t in indices.chunks_exact_mut(3) {
+                    t.swap(1, 2);
+                }
+            }
+            let normals = match &normals_local {
+                Some(v) => v
+                    .iter()
+                    .map(|n| {
+                        (normal_m * Vec3::from(*n))
+                            .try_normalize()
+                            .unwrap_or(Vec3::Y)
+                    })
+                    .collect(),
+                None => compute_normals(&positions, &indices),
+            };
+            let tangents = match &tangents_local {
+                Some(v) if normals_local.is_some() => v
+                    .iter()
+                    .zip(&normals)
+                    .map(|(t, n)| {
+                        let t3 = (m3 * Vec3::new(t[0], t[1], t[2]))
+                            .try_normalize()
+                            .unwrap_or_else(|| crate::scene::geometry::any_perpendicular(*n));
+                        let w = if t[3] < 0.0 { -1.0 } else { 1.0 } * det.signum();
+                        t3.extend(w)
+                    })
+                    .collect::<Vec<Vec4>>(),
+                _ => compute_tangents(&positions, &normals, &uvs, &indices),
+            };
+            let material = self.material(prim.material())?;
+            let name = match (mesh.name(), prim_count) {
+                (Some(nm), 1) => nm.to_string(),
+                (Some(nm), _) => format!("{nm}/{}", prim.index()),
+                (None, 1) => format!("mesh{}", mesh.index()),
+                (None, _) => format!("mesh{}/{}", mesh.index(), prim.index()),
+            };
+            self.scene.meshes.push(Mesh {
+                name,
+                positions,
+                normals,
+                uvs,
+                tangents,
+                indices,
+                material,
+            });
+        }
+        Ok(())
+    }
+}

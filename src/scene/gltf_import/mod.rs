@@ -1,0 +1,183 @@
+//! glTF 2.0 import (.gltf with external or embedded buffers, .glb) into a world-space
+//! [`Scene`].
+//!
+//! Buffers, accessors and images are read here (not through `gltf::import`) so that every
+//! failure is an error naming the file and the element, bounds are checked before anything is
+//! sliced, and a missing texture only costs a warning.
+//!
+//! One job per module: `document` parses, validates and walks the node graph; `buffers`
+//! and `accessors` read the binary data; `mesh`, `materials`, `images`, `lights` and
+//! `camera` turn glTF elements into scene ones; `encoding` holds the URI / base64 codecs.
+
+mod accessors;
+mod buffers;
+mod camera;
+mod document;
+mod encoding;
+mod images;
+mod lights;
+mod materials;
+mod mesh;
+
+pub use encoding::{base64_decode, base64_encode};
+pub use lights::INFINITE_RANGE_CUTOFF;
+
+use super::error::SceneError;
+use super::types::{Scene, TextureImage};
+use super::Loaded;
+use images::ImageSource;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Extensions this importer understands; any other in `extensionsRequired` is refused.
+pub const SUPPORTED_EXTENSIONS: &[&str] =
+    &["KHR_lights_punctual", "KHR_materials_emissive_strength"];
+
+/// Safety limits: inputs past them are refused with a [`SceneError::Limit`].
+#[derive(Clone, Copy, Debug)]
+pub struct ImportLimits {
+    /// Elements in one accessor.
+    pub max_accessor_count: u64,
+    /// Triangles in the whole scene.
+    pub max_triangles: u64,
+    /// Declared `byteLength` of one buffer.
+    pub max_buffer_bytes: u64,
+    pub max_nodes: u64,
+    pub max_lights: u64,
+    /// Pixels in one decoded image.
+    pub max_image_pixels: u64,
+}
+
+impl Default for ImportLimits {
+    fn default() -> Self {
+        ImportLimits {
+            max_accessor_count: 1 << 27,
+            max_triangles: 1 << 26,
+            max_buffer_bytes: 1 << 32,
+            max_nodes: 1 << 20,
+            max_lights: 1 << 20,
+            max_image_pixels: 1 << 26,
+        }
+    }
+}
+
+/// Imports a .gltf or .glb file with default limits.
+pub fn import_gltf(path: &Path) -> Result<Loaded, SceneError> {
+    import_gltf_with(path, &ImportLimits::default())
+}
+
+/// Imports a .gltf or .glb file. Relative URIs resolve against the file's folder.
+pub fn import_gltf_with(path: &Path, limits: &ImportLimits) -> Result<Loaded, SceneError> {
+    import_gltf_inner(path, limits).map(|(l, _)| l)
+}
+
+/// Imports and tells whether the file had a perspective camera (else one was fitted).
+pub(crate) fn import_gltf_inner(
+    path: &Path,
+    limits: &ImportLimits,
+) -> Result<(Loaded, bool), SceneError> {
+    let bytes = std::fs::read(path).map_err(|e| SceneError::io(path, e))?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    import_slice_inner(&bytes, base, path, limits)
+}
+
+/// Imports glTF bytes; `base_dir` resolves relative URIs, `file` names the source in messages.
+pub fn import_gltf_slice(
+    bytes: &[u8],
+    base_dir: &Path,
+    file: &Path,
+    limits: &ImportLimits,
+) -> Result<Loaded, SceneError> {
+    import_slice_inner(bytes, base_dir, file, limits).map(|(l, _)| l)
+}
+
+fn import_slice_inner(
+    bytes: &[u8],
+    base_dir: &Path,
+    file: &Path,
+    limits: &ImportLimits,
+) -> Result<(Loaded, bool), SceneError> {
+    let mut imp = Importer {
+        file: file.to_path_buf(),
+        base_dir: base_dir.to_path_buf(),
+        limits: *limits,
+        warnings: Vec::new(),
+        buffers: Vec::new(),
+        images: HashMap::new(),
+        textures: HashMap::new(),
+        materials: HashMap::new(),
+        image_sources: Vec::new(),
+        image_names: Vec::new(),
+        scene: Scene::default(),
+        triangles: 0,
+        has_camera: false,
+        files_read: std::cell::RefCell::new(vec![file.to_path_buf()]),
+    };
+    imp.run(bytes)?;
+    Ok((
+        Loaded {
+            scene: imp.scene,
+            warnings: imp.warnings,
+            files: imp.files_read.into_inner(),
+        },
+        imp.has_camera,
+    ))
+}
+
+struct Importer {
+    file: PathBuf,
+    base_dir: PathBuf,
+    limits: ImportLimits,
+    warnings: Vec<String>,
+    buffers: Vec<Vec<u8>>,
+    /// Decoded RGBA8 per glTF image index (`None`: failed, already warned).
+    images: HashMap<usize, Option<Arc<image::RgbaImage>>>,
+    textures: HashMap<(usize, bool), Option<Arc<TextureImage>>>,
+    /// glTF material index (`None`: default material) to scene material index.
+    materials: HashMap<Option<usize>, usize>,
+    image_sources: Vec<ImageSource>,
+    image_names: Vec<String>,
+    scene: Scene,
+    triangles: u64,
+    has_camera: bool,
+    /// The glTF file and every external buffer and image read for it.
+    files_read: std::cell::RefCell<Vec<PathBuf>>,
+}
+
+fn named(kind: &str, index: usize, name: Option<&str>) -> String {
+    match name {
+        Some(n) => format!("{kind} {index} (\"{n}\")"),
+        None => format!("{kind} {index}"),
+    }
+}
+
+impl Importer {
+    fn err(&self, element: impl std::fmt::Display, message: impl std::fmt::Display) -> SceneError {
+        SceneError::invalid(&self.file, element, message)
+    }
+
+    fn limit(
+        &self,
+        element: impl std::fmt::Display,
+        what: &'static str,
+        count: u64,
+        limit: u64,
+    ) -> Result<(), SceneError> {
+        if count > limit {
+            return Err(SceneError::Limit {
+                file: self.file.clone(),
+                element: element.to_string(),
+                what,
+                count,
+                limit,
+            });
+        }
+        Ok(())
+    }
+
+    fn warn(&mut self, msg: impl std::fmt::Display) {
+        self.warnings
+            .push(format!("{}: {msg}", self.file.display()));
+    }
+}
