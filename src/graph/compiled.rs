@@ -129,7 +129,17 @@ pub(crate) fn assemble(
     schedule: Vec<usize>,
     plan: ResourcePlan,
 ) -> CompiledGraph {
-    let mut written = std::collections::HashSet::new();
+    use super::fxmap::{FxHashMap, FxHashSet};
+    let mut written = FxHashSet::default();
+    // Sample count of each texture by name (the first declaration of a name).
+    let mut texture_samples: FxHashMap<&str, Option<u32>> =
+        FxHashMap::with_capacity_and_hasher(checked.desc.resources.len(), Default::default());
+    for r in &checked.desc.resources {
+        texture_samples.entry(r.name()).or_insert(match r {
+            ResourceDesc::Texture { samples, .. } => Some(*samples),
+            _ => None,
+        });
+    }
     let passes = schedule
         .iter()
         .map(|&i| {
@@ -145,12 +155,7 @@ pub(crate) fn assemble(
                 .slots
                 .values()
                 .chain(roles.target.iter())
-                .filter_map(
-                    |name| match checked.desc.resources.iter().find(|r| r.name() == name) {
-                        Some(ResourceDesc::Texture { samples, .. }) => Some(*samples),
-                        _ => None,
-                    },
-                )
+                .filter_map(|name| texture_samples.get(name.as_str()).copied().flatten())
                 .max()
                 .unwrap_or(1);
             ScheduledPass {

@@ -1,16 +1,17 @@
 //! The dependency graph between passes (petgraph): an edge W -> R for every resource
 //! that R reads and another pass W writes.
 
+use super::fxmap::FxHashMap;
 use super::model::GraphDesc;
 use petgraph::graph::{DiGraph, NodeIndex};
 
 /// Node weights are pass indices into `GraphDesc::passes`; edge weights resource names.
 pub type DepGraph = DiGraph<usize, String>;
 
-pub fn build(desc: &GraphDesc) -> DepGraph {
-    let mut g = DepGraph::new();
+/// `writers` is [`writers_by_resource`] of `desc`.
+pub fn build(desc: &GraphDesc, writers: &Writers) -> DepGraph {
+    let mut g = DepGraph::with_capacity(desc.passes.len(), 0);
     let nodes: Vec<NodeIndex> = (0..desc.passes.len()).map(|i| g.add_node(i)).collect();
-    let writers = writers_by_resource(desc);
     for (r, reader) in desc.passes.iter().enumerate() {
         for res in &reader.reads {
             for &w in writers.get(res.as_str()).into_iter().flatten() {
@@ -24,8 +25,11 @@ pub fn build(desc: &GraphDesc) -> DepGraph {
 }
 
 /// Resource name -> indices of the passes that write it, in declaration order.
-pub fn writers_by_resource(desc: &GraphDesc) -> std::collections::HashMap<&str, Vec<usize>> {
-    let mut writers: std::collections::HashMap<&str, Vec<usize>> = std::collections::HashMap::new();
+pub type Writers<'a> = FxHashMap<&'a str, Vec<usize>>;
+
+/// Resource name -> indices of the passes that write it, in declaration order.
+pub fn writers_by_resource(desc: &GraphDesc) -> Writers<'_> {
+    let mut writers = Writers::default();
     for (i, p) in desc.passes.iter().enumerate() {
         for w in &p.writes {
             writers.entry(w.as_str()).or_default().push(i);

@@ -5,6 +5,7 @@
 mod compiled;
 mod deps;
 mod error;
+mod fxmap;
 pub mod kinds;
 mod location;
 pub mod model;

@@ -2,6 +2,7 @@
 //! one physical texture or buffer serving several graph resources with the same
 //! descriptor whose lifetimes (first to last use in the schedule) do not overlap.
 
+use super::fxmap::FxHashMap;
 use super::kinds::{self, BufferLayout, Usage};
 use super::model::{BufferSize, CullVariant, GraphDesc, ResourceDesc, TextureFormat, TextureSize};
 use super::roles::PassRoles;
@@ -129,19 +130,28 @@ fn texture_extent(size: TextureSize, frame: FrameSize) -> (u32, u32) {
     }
 }
 
-/// The layout the built-in pass declared to write buffer `name` gives it.
-fn buffer_layout(
-    name: &str,
+/// Per written resource, the layout the built-in pass declared to write it gives it:
+/// the first pass in declaration order that writes it into a slot whose kind gives one.
+fn buffer_layouts<'a>(
     desc: &GraphDesc,
-    roles: &[PassRoles],
+    roles: &'a [PassRoles],
     frame: FrameSize,
-) -> Option<BufferLayout> {
-    desc.passes.iter().zip(roles).find_map(|(p, r)| {
-        if !p.writes.iter().any(|w| w == name) {
-            return None;
+) -> FxHashMap<&'a str, BufferLayout> {
+    let mut layouts = FxHashMap::default();
+    for (p, r) in desc.passes.iter().zip(roles) {
+        for name in r.slots.values() {
+            if layouts.contains_key(name.as_str()) || !p.writes.iter().any(|w| w == name) {
+                continue;
+            }
+            let Some(slot) = r.slot_of(name) else {
+                continue;
+            };
+            if let Some(layout) = kinds::buffer_layout(&p.kind, slot, frame) {
+                layouts.insert(name.as_str(), layout);
+            }
         }
-        kinds::buffer_layout(&p.kind, r.slot_of(name)?, frame)
-    })
+    }
+    layouts
 }
 
 fn buffer_bytes(size: BufferSize, layout: Option<BufferLayout>, frame: FrameSize) -> u64 {
@@ -167,27 +177,53 @@ pub fn plan(
     frame: FrameSize,
 ) -> ResourcePlan {
     let mut plan = ResourcePlan::default();
-    // Schedule positions that use each resource, from one walk over the schedule.
-    let mut positions: std::collections::HashMap<&str, Vec<usize>> =
-        std::collections::HashMap::new();
+    // Each name's first declaration stands for the name.
+    let mut index: FxHashMap<&str, usize> =
+        FxHashMap::with_capacity_and_hasher(desc.resources.len(), Default::default());
+    for (i, r) in desc.resources.iter().enumerate() {
+        index.entry(r.name()).or_insert(i);
+    }
+    // Schedule positions that use each resource, from one walk over the schedule, as
+    // one array: `positions[start[i]..start[i + 1]]` are resource i's, ascending.
+    let mut uses_at: Vec<(usize, usize)> = Vec::new();
+    let mut last_pos = vec![usize::MAX; desc.resources.len()];
+    let mut start = vec![0usize; desc.resources.len() + 1];
     for (pos, &p) in schedule.iter().enumerate() {
         let pass = &desc.passes[p];
         for n in pass.reads.iter().chain(&pass.writes) {
-            let v = positions.entry(n.as_str()).or_default();
-            if v.last() != Some(&pos) {
-                v.push(pos);
+            let Some(&i) = index.get(n.as_str()) else {
+                continue; // not declared: nothing to plan
+            };
+            if last_pos[i] != pos {
+                last_pos[i] = pos;
+                uses_at.push((i, pos));
+                start[i + 1] += 1;
             }
         }
     }
+    for i in 0..desc.resources.len() {
+        start[i + 1] += start[i];
+    }
+    let mut positions = vec![0usize; uses_at.len()];
+    let mut fill = start.clone();
+    for &(i, pos) in &uses_at {
+        positions[fill[i]] = pos;
+        fill[i] += 1;
+    }
+    let used_at = |r: &ResourceDesc| -> &[usize] {
+        let i = index[r.name()];
+        &positions[start[i]..start[i + 1]]
+    };
     // Transients in order of first use.
     let mut uses: Vec<(usize, usize, &ResourceDesc)> = Vec::new();
     for r in &desc.resources {
         if matches!(r, ResourceDesc::Import { .. }) {
             continue;
         }
-        let Some(used_at) = positions.get(r.name()) else {
+        let used_at = used_at(r);
+        if used_at.is_empty() {
             continue;
-        };
+        }
         let (first, last) = (used_at[0], *used_at.last().unwrap());
         // The output lives to the end of the frame (it is read back).
         let last = if r.name() == desc.output {
@@ -198,26 +234,30 @@ pub fn plan(
         uses.push((first, last, r));
     }
     uses.sort_by_key(|u| u.0);
+    let layouts = buffer_layouts(desc, roles, frame);
+    // Physical resources by descriptor, in index order: reuse takes the first free one.
+    let mut by_desc: FxHashMap<PhysicalDesc, Vec<usize>> = FxHashMap::default();
+    let mut users: Vec<usize> = Vec::new();
     for (first, last, r) in uses {
-        let users: Vec<usize> = positions[r.name()]
-            .iter()
-            .map(|&pos| schedule[pos])
-            .collect();
+        users.clear();
+        users.extend(used_at(r).iter().map(|&pos| schedule[pos]));
         let layout = match r {
-            ResourceDesc::Buffer { .. } => buffer_layout(r.name(), desc, roles, frame),
+            ResourceDesc::Buffer { .. } => layouts.get(r.name()).copied(),
             _ => None,
         };
         let (pdesc, tex_usage, buf_usage) = describe(r, desc, roles, &users, frame, layout);
         let absent = !users
             .iter()
             .any(|&p| desc.passes[p].writes.iter().any(|w| w == r.name()));
-        let reuse = plan
-            .physical
+        let same = by_desc.entry(pdesc.clone()).or_default();
+        let reuse = same
             .iter()
-            .position(|ph| ph.desc == pdesc && ph.last_use < first);
+            .copied()
+            .find(|&i| plan.physical[i].last_use < first);
         let physical = match reuse {
             Some(i) => i,
             None => {
+                same.push(plan.physical.len());
                 plan.physical.push(PhysicalResource {
                     desc: pdesc,
                     texture_usage: wgpu::TextureUsages::empty(),

@@ -2,6 +2,7 @@
 //! (`kinds/`), generic kinds bind by shader binding name. No GPU here.
 
 use super::error::GraphError;
+use super::fxmap::FxHashMap;
 use super::location::SourceText;
 use super::model::{PassDesc, PassKind, ResourceDesc, SceneResource};
 use crate::shader::{BindingKind, ReflectedBinding};
@@ -36,7 +37,7 @@ impl PassRoles {
 
 pub(crate) struct RoleCtx<'a> {
     pub source: &'a SourceText,
-    pub resources: &'a BTreeMap<&'a str, &'a ResourceDesc>,
+    pub resources: &'a FxHashMap<&'a str, &'a ResourceDesc>,
 }
 
 impl RoleCtx<'_> {

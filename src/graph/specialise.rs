@@ -26,11 +26,13 @@ pub fn specialise(graph: &CheckedGraph, features: &SceneFeatures) -> Vec<Option<
             _ => None,
         })
         .collect();
+    let side_effects: super::fxmap::FxHashSet<&str> =
+        desc.side_effects.iter().map(String::as_str).collect();
     let roots: Vec<usize> = (0..desc.passes.len())
         .filter(|&i| {
             culled[i].is_none()
                 && (desc.passes[i].writes.contains(&desc.output)
-                    || desc.side_effects.contains(&desc.passes[i].name))
+                    || side_effects.contains(desc.passes[i].name.as_str()))
         })
         .collect();
     let mut reached = vec![false; desc.passes.len()];

@@ -1,12 +1,13 @@
 //! Step 2: everything that can be wrong with a graph, found before anything reaches the GPU.
 
-use super::deps::{self, DepGraph};
+use super::deps::{self, DepGraph, Writers};
 use super::error::{GraphError, GraphErrors};
+use super::fxmap::{FxHashMap, FxHashSet};
 use super::location::SourceText;
 use super::model::{GraphDesc, PassKind, ResourceDesc, TextureFormat};
 use super::roles::{PassRoles, RoleCtx};
 use crate::shader::{reflect_bindings, Composed, ShaderLibrary};
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeSet;
 
 /// A graph that passed validation: its roles resolved and its shaders composed.
 #[derive(Clone, Debug)]
@@ -26,15 +27,16 @@ pub fn validate(
     shaders: &ShaderLibrary,
 ) -> Result<CheckedGraph, GraphErrors> {
     let mut errors = Vec::new();
-    let resources = names_and_duplicates(&desc, &source, &mut errors);
-    check_references(&desc, &source, &resources, &mut errors);
+    let (resources, passes) = names_and_duplicates(&desc, &source, &mut errors);
+    check_references(&desc, &source, &resources, &passes, &mut errors);
     if !errors.is_empty() {
         // Role and order checks assume every name resolves.
         return Err(GraphErrors(errors));
     }
-    check_writes(&desc, &source, &resources, &mut errors);
+    let writers = deps::writers_by_resource(&desc);
+    check_writes(&desc, &source, &resources, &writers, &mut errors);
 
-    let deps = deps::build(&desc);
+    let deps = deps::build(&desc, &writers);
     for cycle in deps::cycles(&desc, &deps) {
         errors.push(GraphError::Cycle {
             at: source.of_declaration(&cycle[0]),
@@ -42,15 +44,15 @@ pub fn validate(
         });
     }
     if errors.is_empty() {
-        check_writer_order(&desc, &source, &deps, &mut errors);
+        check_writer_order(&desc, &source, &deps, &writers, &mut errors);
     }
 
     let ctx = RoleCtx {
         source: &source,
         resources: &resources,
     };
-    let mut roles = Vec::new();
-    let mut composed = Vec::new();
+    let mut roles = Vec::with_capacity(desc.passes.len());
+    let mut composed = Vec::with_capacity(desc.passes.len());
     for pass in &desc.passes {
         let (r, c) = match pass.kind.shader_file() {
             None => (ctx.builtin(pass), None),
@@ -84,12 +86,16 @@ pub fn validate(
     }
 }
 
+/// Resource name -> declaration, and the set of pass names.
+type Names<'a> = (FxHashMap<&'a str, &'a ResourceDesc>, FxHashSet<&'a str>);
+
 fn names_and_duplicates<'a>(
     desc: &'a GraphDesc,
     source: &SourceText,
     errors: &mut Vec<GraphError>,
-) -> BTreeMap<&'a str, &'a ResourceDesc> {
-    let mut resources = BTreeMap::new();
+) -> Names<'a> {
+    let mut resources =
+        FxHashMap::with_capacity_and_hasher(desc.resources.len(), Default::default());
     for r in &desc.resources {
         if resources.insert(r.name(), r).is_some() {
             errors.push(GraphError::Duplicate {
@@ -99,7 +105,7 @@ fn names_and_duplicates<'a>(
             });
         }
     }
-    let mut passes = BTreeSet::new();
+    let mut passes = FxHashSet::with_capacity_and_hasher(desc.passes.len(), Default::default());
     for p in &desc.passes {
         if !passes.insert(p.name.as_str()) || resources.contains_key(p.name.as_str()) {
             errors.push(GraphError::Duplicate {
@@ -109,13 +115,14 @@ fn names_and_duplicates<'a>(
             });
         }
     }
-    resources
+    (resources, passes)
 }
 
 fn check_references(
     desc: &GraphDesc,
     source: &SourceText,
-    resources: &BTreeMap<&str, &ResourceDesc>,
+    resources: &FxHashMap<&str, &ResourceDesc>,
+    passes: &FxHashSet<&str>,
     errors: &mut Vec<GraphError>,
 ) {
     for pass in &desc.passes {
@@ -153,7 +160,7 @@ fn check_references(
         });
     }
     for s in &desc.side_effects {
-        if !desc.passes.iter().any(|p| &p.name == s) {
+        if !passes.contains(s.as_str()) {
             let at = source.at_offset(source.text.find(&format!("\"{s}\"")).unwrap_or(0));
             errors.push(GraphError::UnknownSideEffect {
                 at,
@@ -166,10 +173,10 @@ fn check_references(
 fn check_writes(
     desc: &GraphDesc,
     source: &SourceText,
-    resources: &BTreeMap<&str, &ResourceDesc>,
+    resources: &FxHashMap<&str, &ResourceDesc>,
+    writers: &Writers,
     errors: &mut Vec<GraphError>,
 ) {
-    let writers = deps::writers_by_resource(desc);
     for (index, pass) in desc.passes.iter().enumerate() {
         for name in &pass.writes {
             if let Some(ResourceDesc::Import { from, .. }) = resources.get(name.as_str()) {
@@ -205,12 +212,12 @@ fn check_writer_order(
     desc: &GraphDesc,
     source: &SourceText,
     deps: &DepGraph,
+    by_resource: &Writers,
     errors: &mut Vec<GraphError>,
 ) {
     use petgraph::algo::has_path_connecting;
     use petgraph::graph::NodeIndex;
     let mut reported = BTreeSet::new();
-    let by_resource = deps::writers_by_resource(desc);
     for r in &desc.resources {
         let Some(writers) = by_resource.get(r.name()) else {
             continue;
