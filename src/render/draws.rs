@@ -160,7 +160,7 @@ impl Renderer {
             };
             let entries = layout_entries(&bindings, 0, vf);
             match &group0 {
-                None => group0 = Some((entries, bindings)),
+                None => group0 = Some((entries, bindings.clone())),
                 Some((first, _)) if *first != entries => {
                     return Err(pass_error(
                         pass,
@@ -173,16 +173,20 @@ impl Renderer {
                 Some(_) => {}
             }
             let material = match (&m.textures, material_layout(&layouts, &device, &bindings)) {
-                (Some(textures), Some(layout)) => match material_groups.get(&material_index) {
-                    Some(group) => Some(group),
-                    None => {
-                        let group = textures
-                            .bind(&device, &m.name, &layout, &bindings, MATERIAL_GROUP)
-                            .map_err(|e| pass_error(pass, format!("material '{}': {e}", m.name)))?;
-                        Some(material_groups.entry(material_index).or_insert(group))
+                (Some(textures), Some(layout)) => {
+                    if let std::collections::hash_map::Entry::Vacant(e) =
+                        material_groups.entry(material_index)
+                    {
+                        e.insert(
+                            textures
+                                .bind(&device, &m.name, &layout, &bindings, MATERIAL_GROUP)
+                                .map_err(|e| {
+                                    pass_error(pass, format!("material '{}': {e}", m.name))
+                                })?,
+                        );
                     }
+                    material_groups.get(&material_index).cloned()
                 }
-                .cloned(),
                 _ => None,
             };
             let gm = &gpu.meshes[mesh];
