@@ -487,6 +487,38 @@ fn stack_overflow_fallback_is_exact() {
     assert!(occluded > 100 && occluded < rays.len() - 100);
 }
 
+/// A malformed tree (a node that is its own right child) must not hang the traversal:
+/// the step cap hands it to the stackless fallback, which still answers.
+#[test]
+fn malformed_tree_terminates() {
+    use lightgraph::shadow::bvh::{BvhNode, BvhTriangle};
+    let good = ShadowBvh::from_triangles(
+        &[[
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        ]],
+        &BuildOptions::default(),
+    )
+    .unwrap();
+    let tri: BvhTriangle = good.triangles[0];
+    let bounds = |b: u32, a: u32| BvhNode {
+        min: [-1.0, -1.0, -0.5],
+        a,
+        max: [1.0, 1.0, 0.5],
+        b,
+    };
+    let bad = ShadowBvh {
+        nodes: vec![bounds(2, 0), bounds(LEAF_BIT | 1, 0)],
+        triangles: vec![tri],
+        stats: Default::default(),
+    };
+    assert!(bad.occluded(Vec3::new(0.0, 0.0, -1.0), Vec3::Z, 2.0));
+    // A miss would cycle root → leaf → root... for ever.
+    let (hit, s) = bad.traverse::<STACK_SIZE>(Vec3::new(0.9, 0.9, -1.0), Vec3::Z, 2.0);
+    assert!(!hit && s.fell_back, "{s:?}");
+}
+
 /// Structure: pre-order, left child next, skip links, leaves cover every triangle once.
 #[test]
 fn flattened_layout_is_consistent() {

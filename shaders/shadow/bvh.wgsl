@@ -112,7 +112,16 @@ fn bvh_occluded(origin: vec3<f32>, dir: vec3<f32>, t_max: f32) -> bool {
     var overflow = false;
     var current = 0u;
     var alive = bvh_slab(bvh_nodes[0], origin, inv_dir, t_max) >= 0.0;
+    // A well-formed tree visits each node at most once; more means a malformed one, and
+    // the fallback (which always terminates) takes over.
+    let node_count = arrayLength(&bvh_nodes);
+    var steps = 0u;
     while (alive) {
+        steps += 1u;
+        if (steps > node_count) {
+            overflow = true;
+            break;
+        }
         let node = bvh_nodes[current];
         var has_next = false;
         var next = 0u;
@@ -156,8 +165,7 @@ fn bvh_occluded(origin: vec3<f32>, dir: vec3<f32>, t_max: f32) -> bool {
         return false;
     }
     var i = 0u;
-    let end = arrayLength(&bvh_nodes);
-    while (i < end) {
+    while (i < node_count) {
         let node = bvh_nodes[i];
         let leaf = bvh_is_leaf(node);
         let skip = select(node.b, i + 1u, leaf);

@@ -500,7 +500,15 @@ impl ShadowBvh {
         let mut overflow = false;
         let mut current = 0u32;
         let mut alive = slab(&node_at(0), &ray).is_some();
+        // A well-formed tree visits each node at most once; more means a malformed one,
+        // and the fallback (which always terminates) takes over.
+        let mut steps = 0usize;
         while alive {
+            steps += 1;
+            if steps > nodes.len() {
+                overflow = true;
+                break;
+            }
             stats.nodes_visited += 1;
             let node = node_at(current);
             let mut next = None;
