@@ -5,9 +5,26 @@
 fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f32) -> vec3<f32> {
     var color = material_emission(m) + frame.ambient.rgb * material_eval(m, p.normal);
     let range = light_range(pixel, view_z);
+#if SHADOWS
+    // Casters are numbered before the material mask is applied, as job creation does.
+    var caster = 0u;
+    let pixel_index = u32(pixel.y) * frame.size.x + u32(pixel.x);
+#endif
     for (var k = 0u; k < range.count; k++) {
         let i = light_at(range, k);
         let props = light_properties[i];
+#if SHADOWS
+        let g = light_geometry[i];
+        let inc = incident_light(g, props, p.position);
+        var lit = any(inc.radiance > vec3<f32>(0.0));
+        if (lit && (props.flags & LIGHT_CASTS_SHADOW) != 0u) {
+            lit = shadow_visible(pixel_index, caster, g.position, p.position);
+            caster += 1u;
+        }
+        if (lit && (props.material_mask & MATERIAL_TYPE_BIT) != 0u) {
+            color += inc.radiance * material_eval(m, inc.dir);
+        }
+#else
         if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
             continue;
         }
@@ -15,6 +32,7 @@ fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f
         if (any(inc.radiance > vec3<f32>(0.0))) {
             color += inc.radiance * material_eval(m, inc.dir);
         }
+#endif
     }
     return color;
 }

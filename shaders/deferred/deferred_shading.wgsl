@@ -4,7 +4,8 @@
 // fragment work (GH100) this is where the lighting throughput is.
 // With G_PACKED the G-buffer is one texture: view depth, octahedral normal, material;
 // the position is rebuilt on the pixel's view ray.
-// Defines: MATERIAL_INDEX, LIGHT_LISTS, G_PACKED.
+// Defines: MATERIAL_INDEX, LIGHT_LISTS, G_PACKED, SHADOWS with SHADOW_MASK (ray-cast
+// shadows from shadow/shadow_ray_cast.wgsl).
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"
@@ -25,6 +26,12 @@
 @group(0) @binding(7) var hdr: texture_storage_2d<rgba32float, write>;
 
 #include "common/light_lists.wgsl"
+#if SHADOW_MASK
+@group(0) @binding(8) var<storage, read> shadow_mask: array<u32>;
+#endif
+#if SHADOWS
+#include "common/shadows.wgsl"
+#endif
 
 struct ShadingPoint {
     position: vec3<f32>,

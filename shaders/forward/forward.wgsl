@@ -16,6 +16,17 @@
 #endif
 
 #include "common/light_lists.wgsl"
+#if SHADOW_MASK
+@group(0) @binding(5) var<storage, read> shadow_mask: array<u32>;
+#endif
+#if SHADOW_TRACE
+@group(0) @binding(6) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(0) @binding(7) var<storage, read> bvh_triangles: array<BvhTriangle>;
+#include "shadow/bvh.wgsl"
+#endif
+#if SHADOWS
+#include "common/shadows.wgsl"
+#endif
 #endif
 
 struct ShadingPoint {
@@ -58,6 +69,13 @@ fn vs_main(v: VertexIn) -> VertexOut {
     return out;
 }
 
+// The fragment's triangle normal, facing the eye (exact within a triangle: the world
+// position is linear across it). Call in uniform control flow.
+fn face_normal(world: vec3<f32>) -> vec3<f32> {
+    let n = normalize(cross(dpdx(world), dpdy(world)));
+    return select(n, -n, dot(n, frame.camera_pos.xyz - world) < 0.0);
+}
+
 fn shading_point(in: VertexOut, front: bool) -> ShadingPoint {
     var p: ShadingPoint;
     p.position = in.world;
@@ -82,14 +100,29 @@ struct GBufferOut {
     @location(0) packed: vec4<f32>,
 };
 #else
+#if GBUFFER_NORMALS
 struct GBufferOut {
     @location(0) position: vec4<f32>,
     @location(1) normal: vec4<f32>,
+#if GBUFFER_GEOMETRIC
+    // Ray-cast shadows: the triangle's normal, facing the eye.
+    @location(2) geometric: vec4<f32>,
+#endif
 };
+#else
+// Positions and geometric normals only (ray-cast shadows for forward shading).
+struct GBufferOut {
+    @location(0) position: vec4<f32>,
+    @location(1) geometric: vec4<f32>,
+};
+#endif
 #endif
 
 @fragment
 fn fs_gbuffer(in: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
+#if GBUFFER_GEOMETRIC
+    let ng = face_normal(in.world);
+#endif
     let p = shading_point(in, front);
 #if ALPHA_MASK
     let m = material_setup(p);
@@ -103,7 +136,16 @@ fn fs_gbuffer(in: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
     let n = oct_encode(p.normal);
     return GBufferOut(vec4<f32>(view_z, n.x, n.y, f32(MATERIAL_INDEX)));
 #else
-    return GBufferOut(vec4<f32>(in.world, f32(MATERIAL_INDEX)), vec4<f32>(p.normal, 0.0));
+    let position = vec4<f32>(in.world, f32(MATERIAL_INDEX));
+#if GBUFFER_NORMALS
+#if GBUFFER_GEOMETRIC
+    return GBufferOut(position, vec4<f32>(p.normal, 0.0), vec4<f32>(ng, 0.0));
+#else
+    return GBufferOut(position, vec4<f32>(p.normal, 0.0));
+#endif
+#else
+    return GBufferOut(position, vec4<f32>(ng, 0.0));
+#endif
 #endif
 }
 #endif
@@ -123,6 +165,9 @@ fn fs_depth(in: VertexOut, @builtin(front_facing) front: bool) {
 #if SHADE
 @fragment
 fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+#if SHADOW_TRACE
+    shadow_ng = face_normal(in.world);
+#endif
     let p = shading_point(in, front);
     let m = material_setup(p);
 #if ALPHA_MASK

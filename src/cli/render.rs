@@ -129,6 +129,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
     prepared.execute(&renderer)?;
     let result = prepared.render(&renderer)?;
     report(&renderer, &scene, &graph_path, &result);
+    shadow_report(&scene, &gpu, &result);
     if let Some(out) = &args.out {
         write_image(out, &result)?;
         println!("wrote {}", out.display());
@@ -152,6 +153,58 @@ pub fn render(args: RenderArgs) -> Result<()> {
         println!("wrote {} and {}", path.display(), csv.display());
     }
     Ok(())
+}
+
+/// What ray-cast shadows cast this frame: casters, rays, drops, memory, the BVH.
+fn shadow_report(scene: &Scene, gpu: &SceneGpu, result: &FrameResult) {
+    let casters = scene
+        .lights
+        .iter()
+        .filter(|l| l.flags & lightgraph::scene::light_flags::CASTS_SHADOW != 0)
+        .count();
+    if casters == 0 && result.shadows.is_empty() {
+        return;
+    }
+    println!(
+        "  shadow-casting lights: {casters} of {}",
+        scene.lights.len()
+    );
+    if let Some(b) = &gpu.bvh {
+        let s = &b.stats;
+        println!(
+            "  shadow BVH: {} triangles ({} degenerate, {} non-finite, {} bad indices skipped), {} nodes, built in {:.1} ms, {:.1} MiB",
+            s.triangles,
+            s.skipped_degenerate,
+            s.skipped_non_finite,
+            s.skipped_bad_index,
+            s.nodes,
+            s.build_time.as_secs_f64() * 1e3,
+            b.bytes() as f64 / (1 << 20) as f64
+        );
+    }
+    for s in &result.shadows {
+        println!(
+            "  {}: {} rays traced ({:.2} a pixel), job buffer {:.1} MiB for {} jobs, mask {:.1} MiB",
+            s.pass,
+            s.rays(),
+            s.rays() as f64 / s.pixels.max(1) as f64,
+            s.job_bytes as f64 / (1 << 20) as f64,
+            s.capacity,
+            s.mask_bytes as f64 / (1 << 20) as f64
+        );
+        if s.jobs_dropped > 0 {
+            println!(
+                "  WARNING: {} of {} shadow jobs did not fit the job buffer (raise jobs_per_pixel): those lights were lit unshadowed",
+                s.jobs_dropped, s.jobs_wanted
+            );
+        }
+        if s.overflow_pixels > 0 {
+            println!(
+                "  WARNING: {} pixels have more than 128 shadow-casting lights: the rest were lit unshadowed",
+                s.overflow_pixels
+            );
+        }
+    }
 }
 
 fn report(r: &Renderer, scene: &Scene, graph: &Path, result: &FrameResult) {

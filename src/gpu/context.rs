@@ -63,6 +63,10 @@ impl GpuContext {
                 .max_storage_buffers_per_shader_stage
                 .min(16),
             max_compute_workgroup_storage_size: adapter_limits.max_compute_workgroup_storage_size,
+            // A G-buffer with geometric normals for ray-cast shadows has three Rgba32Float
+            // targets (48 bytes a sample; the default allows 32).
+            max_color_attachment_bytes_per_sample: adapter_limits
+                .max_color_attachment_bytes_per_sample,
             ..wgpu::Limits::default()
         };
         let (device, queue) = adapter

@@ -21,6 +21,27 @@ pub fn read_buffer(
     map_and_copy(device, &staging, size as usize)
 }
 
+/// Reads `len` bytes from `offset` of a buffer (COPY_SRC; both multiples of 4).
+pub fn read_buffer_range(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    buffer: &wgpu::Buffer,
+    offset: u64,
+    len: u64,
+) -> Result<Vec<u8>, GpuError> {
+    let len = len.min(buffer.size().saturating_sub(offset));
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback staging"),
+        size: len.max(4),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    encoder.copy_buffer_to_buffer(buffer, offset, &staging, 0, len);
+    queue.submit([encoder.finish()]);
+    map_and_copy(device, &staging, len as usize)
+}
+
 fn map_and_copy(
     device: &wgpu::Device,
     staging: &wgpu::Buffer,

@@ -3,6 +3,8 @@
 pub use super::kinds::deferred_shading::DeferredShading;
 pub use super::kinds::forward_shading::ForwardShading;
 pub use super::kinds::light_culling::LightCulling;
+pub use super::kinds::shadow_ray_cast::ShadowRayCast;
+pub use super::kinds::shadow_ray_jobs::ShadowRayJobs;
 use serde::{Deserialize, Serialize};
 
 /// A whole graph file (`graphs/*.ron`).
@@ -119,6 +121,11 @@ pub enum SceneResource {
     LightProperties,
     /// Vertex and index buffers of every mesh.
     Geometry,
+    /// The shadow BVH's nodes over every scene triangle (`src/shadow/bvh.rs`), built
+    /// when the scene has shadow-casting lights.
+    BvhNodes,
+    /// The shadow BVH's triangles, in the order its leaves name them.
+    BvhTriangles,
 }
 
 /// A scene feature a pass can be conditional on (`when:`).
@@ -255,6 +262,10 @@ pub enum PassKind {
     GBuffer,
     /// Lighting in a compute shader from the G-buffer (tiled deferred with `Culled`).
     DeferredShading(DeferredShading),
+    /// Ray-cast shadow jobs from the light lists (one per shadow-casting light a pixel sees).
+    ShadowRayJobs(ShadowRayJobs),
+    /// One any-hit ray a job against the scene BVH, into the per-pixel hit mask.
+    ShadowRayCast(ShadowRayCast),
     /// A compute shader the graph file names; bindings are matched by name.
     Compute {
         shader: String,
@@ -285,6 +296,8 @@ impl PassKind {
             PassKind::ForwardShading(_) => "ForwardShading",
             PassKind::GBuffer => "GBuffer",
             PassKind::DeferredShading(_) => "DeferredShading",
+            PassKind::ShadowRayJobs(_) => "ShadowRayJobs",
+            PassKind::ShadowRayCast(_) => "ShadowRayCast",
             PassKind::Compute { .. } => "Compute",
             PassKind::Fullscreen { .. } => "Fullscreen",
         }

@@ -62,6 +62,7 @@ impl ResourcePlan {
     pub fn list_layout(&self, name: &str) -> Option<ListLayout> {
         match self.get(name)?.layout? {
             BufferLayout::LightLists(l) => Some(l),
+            _ => None,
         }
     }
 }
@@ -352,7 +353,8 @@ fn describe(
                 bytes: buffer_bytes(*size, layout, frame),
             },
             T::empty(),
-            B::STORAGE | B::COPY_SRC | B::COPY_DST | B::UNIFORM,
+            // INDIRECT: ray-cast shadow jobs carry their casting pass's dispatch.
+            B::STORAGE | B::COPY_SRC | B::COPY_DST | B::UNIFORM | B::INDIRECT,
         ),
         ResourceDesc::Import { .. } => unreachable!("imports are not planned"),
     }

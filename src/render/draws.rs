@@ -9,6 +9,7 @@ use super::pipelines::{Pipeline, PipelineKey};
 use super::scene_gpu::SceneGpu;
 use super::{RenderError, Renderer};
 use crate::gpu::structs::GpuVertex;
+use crate::graph::kinds::forward_shading::Shadows;
 use crate::scene::AlphaMode;
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -17,8 +18,20 @@ use std::sync::Arc;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum DrawMode {
     DepthOnly,
-    GBuffer { writes_depth: bool, packed: bool },
-    Shade { culled: bool, blend: bool },
+    GBuffer {
+        writes_depth: bool,
+        /// One target: view depth, octahedral normal, material.
+        packed: bool,
+        /// Unpacked: a target of shading normals after the positions.
+        normals: bool,
+        /// Unpacked: a target of geometric normals last (ray-cast shadows).
+        geometric: bool,
+    },
+    Shade {
+        culled: bool,
+        blend: bool,
+        shadows: Shadows,
+    },
 }
 
 impl DrawMode {
@@ -48,6 +61,27 @@ pub(super) struct MeshDraws {
 }
 
 const SHADER: &str = "forward/forward.wgsl";
+
+/// The light loop's shadow defines (see `shaders/common/shadows.wgsl`).
+pub(super) fn shadow_defines(shadows: Shadows) -> Vec<(&'static str, String)> {
+    let offset = format!(
+        "{:?}",
+        crate::graph::kinds::shadow_ray_cast::DEFAULT_NORMAL_OFFSET
+    );
+    match shadows {
+        Shadows::None => vec![],
+        Shadows::Mask => vec![
+            ("SHADOWS", "1".into()),
+            ("SHADOW_MASK", "1".into()),
+            ("SHADOW_NORMAL_OFFSET", offset),
+        ],
+        Shadows::Trace => vec![
+            ("SHADOWS", "1".into()),
+            ("SHADOW_TRACE", "1".into()),
+            ("SHADOW_NORMAL_OFFSET", offset),
+        ],
+    }
+}
 /// The bind group the generated material code declares its textures in.
 const MATERIAL_GROUP: u32 = 2;
 
@@ -95,18 +129,32 @@ impl Renderer {
             let mut d: Vec<(&str, String)> = vec![];
             match mode {
                 DrawMode::DepthOnly => d.push(("DEPTH_ONLY", "1".into())),
-                DrawMode::GBuffer { packed, .. } => {
+                DrawMode::GBuffer {
+                    packed,
+                    normals,
+                    geometric,
+                    ..
+                } => {
                     d.push(("GBUFFER", "1".into()));
                     d.push(("MATERIAL_INDEX", material_index.to_string()));
                     if packed {
                         d.push(("GBUFFER_PACKED", "1".into()));
                     }
+                    if normals {
+                        d.push(("GBUFFER_NORMALS", "1".into()));
+                    }
+                    if geometric {
+                        d.push(("GBUFFER_GEOMETRIC", "1".into()));
+                    }
                 }
-                DrawMode::Shade { culled, .. } => {
+                DrawMode::Shade {
+                    culled, shadows, ..
+                } => {
                     d.push(("SHADE", "1".into()));
                     if culled {
                         d.push(("LIGHT_LISTS", "1".into()));
                     }
+                    d.extend(shadow_defines(shadows));
                 }
             }
             if let AlphaMode::Mask(cutoff) = m.alpha_mode {
@@ -227,8 +275,12 @@ fn build_pipeline(
     let writes_depth = mode.writes_depth();
     let (entry, colour_targets) = match mode {
         DrawMode::DepthOnly => ("fs_depth", 0),
-        DrawMode::GBuffer { packed: false, .. } => ("fs_gbuffer", 2),
-        DrawMode::GBuffer { packed: true, .. } => ("fs_gbuffer", 1),
+        DrawMode::GBuffer {
+            normals, geometric, ..
+        } => (
+            "fs_gbuffer",
+            1 + usize::from(normals) + usize::from(geometric),
+        ),
         DrawMode::Shade { .. } => ("fs_main", 1),
     };
     let blend = match mode {

@@ -6,7 +6,7 @@
 use super::light_stats::LightStatsPass;
 use super::passes::{self, PrepareCtx, PreparedPass, Timestamps};
 use super::prepare_stats::PrepareStats;
-use super::report::{CullingReport, FrameResult, LightStats};
+use super::report::{CullingReport, FrameResult, LightStats, PassReport, ShadowReport};
 use super::resources::FrameResources;
 use super::scene_gpu::SceneGpu;
 use super::{RenderError, Renderer};
@@ -238,12 +238,14 @@ impl PreparedFrame {
         let pass_ms = self.execute(r)?;
         let image = read_rgba32f(&r.ctx.device, &r.ctx.queue, self.output_texture())?;
         let (culling, light_stats) = self.read_reports(r)?;
+        let shadows = self.read_shadow_reports(r)?;
         Ok(FrameResult {
             width: self.size.width,
             height: self.size.height,
             image,
             pass_ms,
             culling,
+            shadows,
             light_stats,
         })
     }
@@ -263,7 +265,7 @@ impl PreparedFrame {
     ) -> Result<(Vec<CullingReport>, Option<LightStats>), RenderError> {
         let mut culling = Vec::new();
         for (_, pass) in &self.passes {
-            if let Some(report) = pass.report(r)? {
+            if let Some(PassReport::Culling(report)) = pass.report(r)? {
                 culling.push(report);
             }
         }
@@ -272,6 +274,41 @@ impl PreparedFrame {
             None => None,
         };
         Ok((culling, light_stats))
+    }
+
+    /// What the last executed frame's ray-cast shadow job passes counted.
+    pub fn read_shadow_reports(&self, r: &Renderer) -> Result<Vec<ShadowReport>, RenderError> {
+        let mut out = Vec::new();
+        for (_, pass) in &self.passes {
+            if let Some(PassReport::Shadow(report)) = pass.report(r)? {
+                out.push(report);
+            }
+        }
+        Ok(out)
+    }
+
+    /// Reads back a planned buffer of the last executed frame (tests, inspection).
+    pub fn read_buffer(&self, r: &Renderer, name: &str) -> Result<Vec<u8>, RenderError> {
+        let buffer = self
+            .resources
+            .buffer(&self.graph.plan, name)
+            .ok_or_else(|| RenderError::Pass {
+                pass: "readback".into(),
+                message: format!("'{name}' is not a planned buffer"),
+            })?;
+        Ok(read_buffer(&r.ctx.device, &r.ctx.queue, buffer)?)
+    }
+
+    /// Reads back a planned Rgba32Float texture of the last executed frame.
+    pub fn read_texture(&self, r: &Renderer, name: &str) -> Result<Vec<[f32; 4]>, RenderError> {
+        let texture = self
+            .resources
+            .texture(&self.graph.plan, name)
+            .ok_or_else(|| RenderError::Pass {
+                pass: "readback".into(),
+                message: format!("'{name}' is not a planned texture"),
+            })?;
+        Ok(read_rgba32f(&r.ctx.device, &r.ctx.queue, texture)?)
     }
 
     /// Moves the camera without re-preparing (benchmarks, the viewer).

@@ -18,9 +18,9 @@ pub use frame::PreparedFrame;
 pub use materials::MaterialProgram;
 pub use pipelines::{CacheCounters, Pipeline, PipelineCache, PipelineKey};
 pub use prepare_stats::PrepareStats;
-pub use report::{CullingReport, FrameResult, LightStats};
+pub use report::{CullingReport, FrameResult, LightStats, PassReport, ShadowReport};
 pub use resources::FrameResources;
-pub use scene_gpu::{GpuMesh, SceneGpu};
+pub use scene_gpu::{GpuBvh, GpuMesh, SceneGpu};
 
 use crate::gpu::{GpuContext, GpuError};
 use crate::shader::{ShaderError, ShaderLibrary};

@@ -63,6 +63,36 @@ impl LightStats {
     }
 }
 
+/// Per ray-cast shadow job pass: what this frame asked of it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ShadowReport {
+    pub pass: String,
+    /// Jobs the pixels asked for: one ray each, unless dropped.
+    pub jobs_wanted: u64,
+    /// Jobs past the buffer's capacity: those lights are lit unshadowed.
+    pub jobs_dropped: u64,
+    /// Pixels with more than 128 shadow-casting lights (the rest lit unshadowed).
+    pub overflow_pixels: u64,
+    pub capacity: u64,
+    pub job_bytes: u64,
+    pub mask_bytes: u64,
+    pub pixels: u64,
+}
+
+impl ShadowReport {
+    /// Rays traced this frame.
+    pub fn rays(&self) -> u64 {
+        self.jobs_wanted.min(self.capacity)
+    }
+}
+
+/// What a pass counted on the GPU.
+#[derive(Clone, Debug)]
+pub enum PassReport {
+    Culling(CullingReport),
+    Shadow(ShadowReport),
+}
+
 pub struct FrameResult {
     pub width: u32,
     pub height: u32,
@@ -71,5 +101,6 @@ pub struct FrameResult {
     /// GPU milliseconds per pass, when the adapter has timestamp queries.
     pub pass_ms: Option<Vec<(String, f64)>>,
     pub culling: Vec<CullingReport>,
+    pub shadows: Vec<ShadowReport>,
     pub light_stats: Option<LightStats>,
 }

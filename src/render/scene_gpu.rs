@@ -23,6 +23,50 @@ pub struct SceneGpu {
     pub light_geometry: wgpu::Buffer,
     pub light_properties: wgpu::Buffer,
     pub light_count: u32,
+    /// The shadow BVH, when the scene has shadow-casting lights.
+    pub bvh: Option<GpuBvh>,
+}
+
+/// The shadow BVH's two storage buffers and what building it found.
+#[derive(Clone)]
+pub struct GpuBvh {
+    pub nodes: wgpu::Buffer,
+    pub triangles: wgpu::Buffer,
+    pub stats: crate::shadow::BuildStats,
+}
+
+impl GpuBvh {
+    /// Builds the BVH over every triangle of `scene` (or an empty one when `full` is
+    /// false) and uploads it.
+    pub fn build(
+        device: &wgpu::Device,
+        scene: &Scene,
+        full: bool,
+    ) -> Result<Self, crate::shadow::ShadowError> {
+        let bvh = if full {
+            crate::shadow::ShadowBvh::build(scene)?
+        } else {
+            crate::shadow::ShadowBvh::from_triangles(&[], &Default::default())?
+        };
+        let (nodes, triangles) = bvh.gpu_bytes();
+        let upload = |label: &str, contents: &[u8]| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
+        Ok(Self {
+            nodes: upload("bvh_nodes", nodes),
+            triangles: upload("bvh_triangles", triangles),
+            stats: bvh.stats.clone(),
+        })
+    }
+
+    /// Bytes on the GPU (nodes and triangles).
+    pub fn bytes(&self) -> u64 {
+        self.nodes.size() + self.triangles.size()
+    }
 }
 
 impl SceneGpu {
@@ -34,6 +78,13 @@ impl SceneGpu {
     ) -> Result<Self, crate::material::MaterialError> {
         let materials = MaterialProgram::for_scene(device, queue, scene)?;
         Ok(Self::upload_with(device, scene, materials))
+    }
+
+    /// The scene's BVH buffers, or why there are none.
+    pub fn bvh(&self) -> Result<&GpuBvh, String> {
+        self.bvh
+            .as_ref()
+            .ok_or_else(|| "the scene's shadow BVH could not be built (see the log)".to_string())
     }
 
     pub fn upload_with(
@@ -92,6 +143,15 @@ impl SceneGpu {
             light_geometry: storage("light geometry", bytemuck::cast_slice(&geometry)),
             light_properties: storage("light properties", bytemuck::cast_slice(&properties)),
             light_count: scene.lights.len() as u32,
+            // Rebuilt with every upload, so hot reload of geometry rebuilds it. Without
+            // shadow-casting lights no ray is cast: an empty BVH keeps bindings valid.
+            bvh: match GpuBvh::build(device, scene, scene.features().has_shadow_casters) {
+                Ok(b) => Some(b),
+                Err(e) => {
+                    log::error!("shadow BVH: {e}");
+                    None
+                }
+            },
         }
     }
 

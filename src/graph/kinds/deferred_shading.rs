@@ -2,6 +2,7 @@
 //! with `lights: Culled`), one dispatch per material. Runs `shaders/deferred/deferred_shading.wgsl`.
 
 use super::g_buffer::{G_NORMAL, G_POSITION};
+use super::shadow_ray_jobs::SHADOW_MASK;
 use super::{check_light_source, slot, Access, KindCtx, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 use crate::graph::model::{LightSource, SceneResource};
@@ -52,10 +53,18 @@ pub const SLOTS: &[SlotSpec] = &[
     )
     .optional(),
     SlotSpec::new(HDR, SlotType::ColorTexture, Access::Write, Usage::Storage),
+    // Ray-cast shadows: the hit mask of a ShadowRayCast pass.
+    SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound).optional(),
 ];
 
 pub fn check(p: &DeferredShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     check_light_source(ctx, p.lights, errors);
+    if let (Some(mask), None) = (ctx.slot(SHADOW_MASK), ctx.slot(slot::LIGHT_LISTS)) {
+        errors.push(ctx.mismatch(
+            mask,
+            "the shadow mask numbers the lights of the culled lists it was made from: read them too (lights: Culled)",
+        ));
+    }
     if let Some(name) = ctx.slot(HDR) {
         if !ctx.is_single_rgba32f(name) {
             errors.push(ctx.mismatch(

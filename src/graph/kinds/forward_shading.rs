@@ -1,6 +1,8 @@
 //! `ForwardShading`: the scene's materials through the light loop, into a colour target
 //! over the prepass depth. Runs `shaders/forward/forward.wgsl` with `SHADE`.
 
+use super::shadow_ray_cast::{BVH_NODES, BVH_TRIANGLES};
+use super::shadow_ray_jobs::SHADOW_MASK;
 use super::{check_light_source, slot, Access, KindCtx, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 use crate::graph::model::{LightSource, SceneResource};
@@ -53,10 +55,63 @@ pub const SLOTS: &[SlotSpec] = &[
         Access::Write,
         Usage::Attachment,
     ),
+    // Ray-cast shadows: the hit mask of a ShadowRayCast pass, or the BVH to trace in the
+    // light loop (the naive variant).
+    SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound).optional(),
+    SlotSpec::new(
+        BVH_NODES,
+        SlotType::Import(SceneResource::BvhNodes),
+        Access::Read,
+        Usage::Bound,
+    )
+    .optional(),
+    SlotSpec::new(
+        BVH_TRIANGLES,
+        SlotType::Import(SceneResource::BvhTriangles),
+        Access::Read,
+        Usage::Bound,
+    )
+    .optional(),
 ];
+
+/// How a shading pass shadows its lights, from the slots it filled.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Shadows {
+    None,
+    /// Reads the per-pixel hit mask.
+    Mask,
+    /// Casts a ray per light in the light loop.
+    Trace,
+}
+
+pub fn shadows(roles: &crate::graph::PassRoles) -> Shadows {
+    if roles.slot(SHADOW_MASK).is_some() {
+        Shadows::Mask
+    } else if roles.slot(BVH_NODES).is_some() {
+        Shadows::Trace
+    } else {
+        Shadows::None
+    }
+}
 
 pub fn check(p: &ForwardShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     check_light_source(ctx, p.lights, errors);
+    match (ctx.slot(BVH_NODES), ctx.slot(BVH_TRIANGLES)) {
+        (Some(_), None) | (None, Some(_)) => errors.push(
+            ctx.bad("tracing shadows in the light loop needs both bvh_nodes and bvh_triangles"),
+        ),
+        (Some(n), Some(_)) if ctx.slot(SHADOW_MASK).is_some() => errors.push(ctx.mismatch(
+            n,
+            "a pass reads the shadow mask or traces the BVH, not both",
+        )),
+        _ => {}
+    }
+    if let (Some(mask), None) = (ctx.slot(SHADOW_MASK), ctx.slot(slot::LIGHT_LISTS)) {
+        errors.push(ctx.mismatch(
+            mask,
+            "the shadow mask numbers the lights of the culled lists it was made from: read them too (lights: Culled)",
+        ));
+    }
     if let (Some(c), Some(d)) = (ctx.slot(slot::COLOR), ctx.slot(slot::DEPTH)) {
         let (cs, ds) = (ctx.samples(c), ctx.samples(d));
         if cs != ds {

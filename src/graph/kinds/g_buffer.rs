@@ -9,6 +9,8 @@ use crate::graph::model::SceneResource;
 
 pub const G_POSITION: &str = "g_position";
 pub const G_NORMAL: &str = "g_normal";
+/// Geometric (face) normals facing the viewer, for ray-cast shadows' origin offset.
+pub const G_GEOMETRIC: &str = "g_geometric";
 
 pub const SLOTS: &[SlotSpec] = &[
     SlotSpec::new(
@@ -38,10 +40,17 @@ pub const SLOTS: &[SlotSpec] = &[
         Usage::Attachment,
     )
     .optional(),
+    SlotSpec::new(
+        G_GEOMETRIC,
+        SlotType::ColorTexture,
+        Access::Write,
+        Usage::Attachment,
+    )
+    .optional(),
 ];
 
 pub fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
-    for s in [G_POSITION, G_NORMAL] {
+    for s in [G_POSITION, G_NORMAL, G_GEOMETRIC] {
         if let Some(name) = ctx.slot(s) {
             if !ctx.is_single_rgba32f(name) {
                 errors.push(ctx.mismatch(name, "G-buffer textures are single-sample Rgba32Float"));
@@ -55,9 +64,9 @@ pub fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     }
 }
 
-/// Whether the pass writes the packed layout (one texture).
+/// Whether the pass writes the packed layout (one texture: no normals of either kind).
 pub fn packed(roles: &crate::graph::PassRoles) -> bool {
-    roles.slot(G_NORMAL).is_none()
+    roles.slot(G_NORMAL).is_none() && roles.slot(G_GEOMETRIC).is_none()
 }
 
 #[cfg(test)]

@@ -8,6 +8,8 @@ pub mod depth_prepass;
 pub mod forward_shading;
 pub mod g_buffer;
 pub mod light_culling;
+pub mod shadow_ray_cast;
+pub mod shadow_ray_jobs;
 
 use super::error::GraphError;
 use super::model::{PassDesc, PassKind, ResourceDesc, SceneResource};
@@ -118,12 +120,22 @@ impl SlotSpec {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BufferLayout {
     LightLists(ListLayout),
+    /// Ray-cast shadow jobs: a header and room for `capacity` jobs.
+    ShadowJobs {
+        capacity: u64,
+    },
+    /// A 128-bit hit mask per pixel.
+    ShadowMask {
+        pixels: u64,
+    },
 }
 
 impl BufferLayout {
     pub fn bytes(&self) -> u64 {
         match self {
             BufferLayout::LightLists(l) => l.bytes(),
+            BufferLayout::ShadowJobs { capacity } => shadow_ray_jobs::job_buffer_bytes(*capacity),
+            BufferLayout::ShadowMask { pixels } => 4 * shadow_ray_jobs::MASK_WORDS * pixels,
         }
     }
 }
@@ -136,6 +148,8 @@ pub fn slots(kind: &PassKind) -> Option<&'static [SlotSpec]> {
         PassKind::ForwardShading(_) => forward_shading::SLOTS,
         PassKind::GBuffer => g_buffer::SLOTS,
         PassKind::DeferredShading(_) => deferred_shading::SLOTS,
+        PassKind::ShadowRayJobs(_) => shadow_ray_jobs::SLOTS,
+        PassKind::ShadowRayCast(_) => shadow_ray_cast::SLOTS,
         PassKind::Compute { .. } | PassKind::Fullscreen { .. } => return None,
     })
 }
@@ -148,6 +162,8 @@ fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         PassKind::ForwardShading(p) => forward_shading::check(p, ctx, errors),
         PassKind::GBuffer => g_buffer::check(ctx, errors),
         PassKind::DeferredShading(p) => deferred_shading::check(p, ctx, errors),
+        PassKind::ShadowRayJobs(p) => shadow_ray_jobs::check(p, ctx, errors),
+        PassKind::ShadowRayCast(p) => shadow_ray_cast::check(p, ctx, errors),
         PassKind::Compute { .. } | PassKind::Fullscreen { .. } => {}
     }
 }
@@ -158,6 +174,16 @@ pub fn buffer_layout(kind: &PassKind, slot: &str, frame: FrameSize) -> Option<Bu
         PassKind::LightCulling(p) if slot == slot::LIGHT_LISTS => Some(BufferLayout::LightLists(
             p.list_layout(frame.width, frame.height),
         )),
+        PassKind::ShadowRayJobs(p) if slot == shadow_ray_jobs::SHADOW_JOBS => {
+            Some(BufferLayout::ShadowJobs {
+                capacity: p.capacity(frame.width, frame.height),
+            })
+        }
+        PassKind::ShadowRayJobs(_) if slot == shadow_ray_jobs::SHADOW_MASK => {
+            Some(BufferLayout::ShadowMask {
+                pixels: frame.width as u64 * frame.height as u64,
+            })
+        }
         _ => None,
     }
 }
@@ -352,6 +378,12 @@ pub(crate) mod test_support {
         Texture(name: "pos", format: Rgba32Float),
         Texture(name: "nrm", format: Rgba32Float),
         Texture(name: "small", format: Rgba8Unorm),
+        Texture(name: "geo", format: Rgba32Float),
+        Buffer(name: "jobs"),
+        Buffer(name: "mask"),
+        Buffer(name: "small_buf", size: Bytes(16)),
+        Import(name: "bn", from: BvhNodes),
+        Import(name: "bt", from: BvhTriangles),
         Buffer(name: "lists"),
         Import(name: "geometry", from: Geometry),
         Import(name: "lg", from: LightGeometry),

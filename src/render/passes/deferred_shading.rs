@@ -2,7 +2,9 @@
 //! G-buffer and storing lit colour.
 
 use super::{defines, pass_error, PrepareCtx, PreparedPass, Timestamps};
+use crate::graph::kinds::forward_shading::Shadows;
 use crate::graph::kinds::g_buffer::G_NORMAL;
+use crate::graph::kinds::shadow_ray_jobs::SHADOW_MASK;
 use crate::graph::{slot, DeferredShading, LightSource, ScheduledPass};
 use crate::render::pipelines::PipelineKey;
 use crate::render::RenderError;
@@ -29,6 +31,10 @@ pub(super) fn prepare(
         let params = cx.list_params(&sp.name, sp.required(slot::LIGHT_LISTS))?;
         offered.buffer("list_params", &params);
     }
+    let shadows = match sp.roles.slot(SHADOW_MASK) {
+        Some(_) => Shadows::Mask,
+        None => Shadows::None,
+    };
     let mut pipelines = Vec::new();
     let mut bind = None;
     for (index, m) in cx.gpu.materials.iter().enumerate() {
@@ -45,6 +51,7 @@ pub(super) fn prepare(
         if culled {
             d.push(("LIGHT_LISTS", "1".into()));
         }
+        d.extend(crate::render::draws::shadow_defines(shadows));
         let key = PipelineKey {
             shader: "deferred/deferred_shading.wgsl".into(),
             defines: defines(&d),

@@ -30,6 +30,7 @@ pub(super) fn prepare(
     let mode = DrawMode::Shade {
         culled,
         blend: false,
+        shadows: crate::graph::kinds::forward_shading::shadows(&sp.roles),
     };
     let draws = cx
         .renderer

@@ -3,7 +3,7 @@
 //! written once instead of once per overlapping surface.
 
 use super::{PrepareCtx, PreparedPass, Timestamps};
-use crate::graph::kinds::g_buffer::{self as kind, G_NORMAL, G_POSITION};
+use crate::graph::kinds::g_buffer::{self as kind, G_GEOMETRIC, G_NORMAL, G_POSITION};
 use crate::graph::{slot, ScheduledPass};
 use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws};
 use crate::render::RenderError;
@@ -13,7 +13,7 @@ pub(super) struct GBuffer {
     depth: wgpu::TextureView,
     /// False after a depth prepass.
     clear_depth: bool,
-    /// Positions, or the packed texture; then normals.
+    /// Positions, or the packed texture; then normals and geometric normals, if any.
     targets: Vec<wgpu::TextureView>,
     draws: MeshDraws,
 }
@@ -26,16 +26,21 @@ pub(super) fn prepare(cx: &mut PrepareCtx, sp: &ScheduledPass) -> Result<GBuffer
         .any(|w| w == depth);
     let packed = kind::packed(&sp.roles);
     let offered = cx.declared(sp)?;
+    let geometric = sp.roles.slot(G_GEOMETRIC).is_some();
     let mode = DrawMode::GBuffer {
         writes_depth,
         packed,
+        normals: sp.roles.slot(G_NORMAL).is_some(),
+        geometric,
     };
     let draws = cx
         .renderer
         .mesh_draws(cx.gpu, mode, 1, &sp.name, &offered)?;
     let mut targets = vec![cx.view(&sp.name, sp.required(G_POSITION))?];
-    if let Some(normals) = sp.roles.slot(G_NORMAL) {
-        targets.push(cx.view(&sp.name, normals)?);
+    for slot in [G_NORMAL, G_GEOMETRIC] {
+        if let Some(name) = sp.roles.slot(slot) {
+            targets.push(cx.view(&sp.name, name)?);
+        }
     }
     Ok(GBuffer {
         name: sp.name.clone(),

@@ -5,7 +5,7 @@ use super::{defines, PrepareCtx, PreparedPass, Timestamps};
 use crate::gpu::readback::read_buffer;
 use crate::graph::{slot, LightCulling, ListLayout, ScheduledPass};
 use crate::render::pipelines::PipelineKey;
-use crate::render::report::CullingReport;
+use crate::render::report::{CullingReport, PassReport};
 use crate::render::{RenderError, Renderer};
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -106,7 +106,7 @@ impl PreparedPass for LightCullingPass {
         pass.dispatch_workgroups(x, y, z);
     }
 
-    fn report(&self, r: &Renderer) -> Result<Option<CullingReport>, RenderError> {
+    fn report(&self, r: &Renderer) -> Result<Option<PassReport>, RenderError> {
         let words = read_buffer(&r.ctx.device, &r.ctx.queue, &self.lists)?;
         let words: &[u32] = bytemuck::cast_slice(&words);
         let counts = (0..self.layout.lists() as usize)
@@ -114,12 +114,12 @@ impl PreparedPass for LightCullingPass {
                 words[(ListLayout::HEADER_WORDS + ListLayout::ENTRY_WORDS * l as u32 + 1) as usize]
             })
             .collect();
-        Ok(Some(CullingReport {
+        Ok(Some(PassReport::Culling(CullingReport {
             pass: self.name.clone(),
             layout: self.layout,
             overflowed_lists: words[1],
             longest_list: words[2],
             counts,
-        }))
+        })))
     }
 }

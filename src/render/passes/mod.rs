@@ -9,10 +9,12 @@ mod forward_shading;
 mod fullscreen;
 mod g_buffer;
 pub(super) mod light_culling;
+mod shadow_ray_cast;
+mod shadow_ray_jobs;
 
 use super::bind::{BindingSet, Bound};
 use super::pipelines::{Pipeline, PipelineKey};
-use super::report::CullingReport;
+use super::report::PassReport;
 use super::resources::FrameResources;
 use super::scene_gpu::SceneGpu;
 use super::{RenderError, Renderer};
@@ -27,7 +29,7 @@ use std::sync::Arc;
 pub(super) trait PreparedPass {
     fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>);
     /// What the pass counted on the GPU, for passes that count (read after a frame).
-    fn report(&self, _r: &Renderer) -> Result<Option<CullingReport>, RenderError> {
+    fn report(&self, _r: &Renderer) -> Result<Option<PassReport>, RenderError> {
         Ok(None)
     }
 }
@@ -43,6 +45,8 @@ pub(super) fn prepare(
         PassKind::ForwardShading(p) => Box::new(forward_shading::prepare(cx, sp, p)?),
         PassKind::GBuffer => Box::new(g_buffer::prepare(cx, sp)?),
         PassKind::DeferredShading(p) => Box::new(deferred_shading::prepare(cx, sp, p)?),
+        PassKind::ShadowRayJobs(p) => Box::new(shadow_ray_jobs::prepare(cx, sp, p)?),
+        PassKind::ShadowRayCast(p) => Box::new(shadow_ray_cast::prepare(cx, sp, p)?),
         PassKind::Compute {
             shader,
             entry,
@@ -120,6 +124,20 @@ impl PrepareCtx<'_> {
                 SceneResource::LightGeometry => Bound::Buffer(self.gpu.light_geometry.clone()),
                 SceneResource::LightProperties => Bound::Buffer(self.gpu.light_properties.clone()),
                 SceneResource::Geometry => return Ok(None),
+                SceneResource::BvhNodes => Bound::Buffer(
+                    self.gpu
+                        .bvh()
+                        .map_err(|m| pass_error(pass, m))?
+                        .nodes
+                        .clone(),
+                ),
+                SceneResource::BvhTriangles => Bound::Buffer(
+                    self.gpu
+                        .bvh()
+                        .map_err(|m| pass_error(pass, m))?
+                        .triangles
+                        .clone(),
+                ),
             },
             Some(ResourceDesc::Buffer { .. }) => Bound::Buffer(self.buffer(pass, name)?),
             Some(ResourceDesc::Texture { .. }) => Bound::View(self.view(pass, name)?),

@@ -1,0 +1,44 @@
+// Ray-cast shadows: one invocation per job (pixel, light, caster number), an any-hit
+// ray from the pixel's offset position towards the light against the scene BVH; a hit
+// sets the caster's bit in the pixel's mask. Dispatched indirectly from the job count.
+// Defines: JOB_CAPACITY, SHADOW_NORMAL_OFFSET.
+
+#include "common/types.wgsl"
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
+@group(0) @binding(2) var<storage, read> shadow_jobs: array<u32>;
+@group(0) @binding(3) var g_position: texture_2d<f32>;
+@group(0) @binding(4) var g_geometric: texture_2d<f32>;
+@group(0) @binding(5) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(0) @binding(6) var<storage, read> bvh_triangles: array<BvhTriangle>;
+@group(0) @binding(7) var<storage, read_write> shadow_mask: array<atomic<u32>>;
+
+#include "shadow/bvh.wgsl"
+#include "common/shadows.wgsl"
+
+const JOB_HEADER_WORDS: u32 = 8u;
+
+@compute @workgroup_size(64, 1, 1)
+fn main(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    let job = (group.y * groups.x + group.x) * 64u + local;
+    if (job >= min(shadow_jobs[0], JOB_CAPACITY)) {
+        return;
+    }
+    let pixel = shadow_jobs[JOB_HEADER_WORDS + 2u * job];
+    let packed = shadow_jobs[JOB_HEADER_WORDS + 2u * job + 1u];
+    let light = packed & 0xffffffu;
+    let caster = packed >> 24u;
+    let xy = vec2<u32>(pixel % frame.size.x, pixel / frame.size.x);
+    let p = textureLoad(g_position, xy, 0).xyz;
+    let ng = textureLoad(g_geometric, xy, 0).xyz;
+    let origin = shadow_origin(p, ng);
+    let to_light = light_geometry[light].position - origin;
+    if (bvh_occluded(origin, to_light, 1.0)) {
+        atomicOr(&shadow_mask[pixel * SHADOW_MASK_WORDS + caster / 32u], 1u << (caster % 32u));
+    }
+}

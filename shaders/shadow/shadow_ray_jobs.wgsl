@@ -1,0 +1,159 @@
+// Ray-cast shadow jobs (Leo demo, tiled ray-cast shadows): one invocation per pixel walks
+// its light list and, for every shadow-casting light that reaches and faces it, emits a
+// job (pixel, light, caster number). Jobs are compacted per workgroup: a prefix sum over
+// the workgroup's counts and one atomic add per workgroup reserve its range of the job
+// buffer. Casters behind the surface are hidden without a ray: their mask bit is set
+// here, which also clears every pixel's mask for the frame. `finalize` then writes the
+// casting pass's indirect dispatch.
+//
+// Job buffer (src/graph/kinds/shadow_ray_jobs.rs, ShadowJobLayout): words 0..4 jobs wanted,
+// jobs dropped (buffer full), pixels with more than 128 casters, unused; 4..8 the
+// indirect dispatch (x, y, z, unused); then two words a job.
+// Defines: TILE-free; JOB_CAPACITY, LIGHT_LISTS, SHADOW_NORMAL_OFFSET.
+
+#include "common/types.wgsl"
+#include "common/lighting.wgsl"
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
+@group(0) @binding(2) var<storage, read> light_properties: array<LightProperties>;
+@group(0) @binding(3) var<storage, read> light_lists: array<u32>;
+@group(0) @binding(4) var<uniform> list_params: ListParams;
+@group(0) @binding(5) var g_position: texture_2d<f32>;
+@group(0) @binding(6) var g_geometric: texture_2d<f32>;
+@group(0) @binding(7) var<storage, read_write> shadow_jobs: array<atomic<u32>>;
+@group(0) @binding(8) var<storage, read_write> shadow_mask: array<u32>;
+
+#include "common/light_lists.wgsl"
+#include "common/shadows.wgsl"
+
+const JOB_HEADER_WORDS: u32 = 8u;
+const GROUP_SIZE: u32 = 256u;
+// Workgroups a dispatch dimension may have (WebGPU's limit).
+const MAX_GROUPS_X: u32 = 65535u;
+const CAST_GROUP_SIZE: u32 = 64u;
+
+var<workgroup> scan: array<u32, 256>;
+var<workgroup> group_base: u32;
+
+struct Pixel {
+    valid: bool,
+    index: u32,
+    position: vec3<f32>,
+    ng: vec3<f32>,
+    range: LightRange,
+};
+
+fn load_pixel(xy: vec2<u32>) -> Pixel {
+    var px: Pixel;
+    px.valid = all(xy < frame.size);
+    if (!px.valid) {
+        return px;
+    }
+    let g = textureLoad(g_position, xy, 0);
+    px.valid = g.w >= 0.0;
+    px.index = xy.y * frame.size.x + xy.x;
+    px.position = g.xyz;
+    px.ng = textureLoad(g_geometric, xy, 0).xyz;
+    let view_z = -(frame.view * vec4<f32>(g.xyz, 1.0)).z;
+    px.range = light_range(vec2<f32>(xy) + 0.5, view_z);
+    return px;
+}
+
+// Walks the pixel's casters. With `emit`, writes its jobs from `first` on (those past
+// JOB_CAPACITY are dropped, counted by the caller); returns how many jobs it has.
+fn walk(px: Pixel, emit: bool, first: u32) -> u32 {
+    var caster = 0u;
+    var jobs = 0u;
+    var hidden = array<u32, 4>(0u, 0u, 0u, 0u);
+    for (var k = 0u; k < px.range.count; k++) {
+        let i = light_at(px.range, k);
+        let props = light_properties[i];
+        if ((props.flags & LIGHT_CASTS_SHADOW) == 0u) {
+            continue;
+        }
+        let g = light_geometry[i];
+        let inc = incident_light(g, props, px.position);
+        if (!any(inc.radiance > vec3<f32>(0.0))) {
+            continue;
+        }
+        if (caster < SHADOW_MAX_CASTERS) {
+            if (shadow_faces(px.position, px.ng, g.position)) {
+                if (emit) {
+                    let slot = first + jobs;
+                    if (slot < JOB_CAPACITY) {
+                        atomicStore(&shadow_jobs[JOB_HEADER_WORDS + 2u * slot], px.index);
+                        atomicStore(&shadow_jobs[JOB_HEADER_WORDS + 2u * slot + 1u], i | (caster << 24u));
+                    }
+                }
+                jobs += 1u;
+            } else {
+                hidden[caster / 32u] |= 1u << (caster % 32u);
+            }
+        }
+        caster += 1u;
+    }
+    if (emit) {
+        for (var w = 0u; w < SHADOW_MASK_WORDS; w++) {
+            shadow_mask[px.index * SHADOW_MASK_WORDS + w] = hidden[w];
+        }
+        if (caster > SHADOW_MAX_CASTERS) {
+            atomicAdd(&shadow_jobs[2], 1u);
+        }
+    }
+    return jobs;
+}
+
+@compute @workgroup_size(16, 16, 1)
+fn main(
+    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    let px = load_pixel(id.xy);
+    var count = 0u;
+    if (px.valid) {
+        count = walk(px, false, 0u);
+    } else if (all(id.xy < frame.size)) {
+        let base = (id.y * frame.size.x + id.x) * SHADOW_MASK_WORDS;
+        for (var w = 0u; w < SHADOW_MASK_WORDS; w++) {
+            shadow_mask[base + w] = 0u;
+        }
+    }
+    // Inclusive prefix sum of the counts over the workgroup (Hillis-Steele).
+    scan[local] = count;
+    workgroupBarrier();
+    for (var step = 1u; step < GROUP_SIZE; step *= 2u) {
+        var add = 0u;
+        if (local >= step) {
+            add = scan[local - step];
+        }
+        workgroupBarrier();
+        scan[local] += add;
+        workgroupBarrier();
+    }
+    if (local == GROUP_SIZE - 1u) {
+        let total = scan[local];
+        let base = atomicAdd(&shadow_jobs[0], total);
+        group_base = base;
+        let end = base + total;
+        if (end > JOB_CAPACITY) {
+            atomicAdd(&shadow_jobs[1], end - max(base, JOB_CAPACITY));
+        }
+    }
+    workgroupBarrier();
+    if (px.valid) {
+        walk(px, true, group_base + scan[local] - count);
+    }
+}
+
+// The casting pass's indirect dispatch: 64 jobs a workgroup, in rows of MAX_GROUPS_X.
+@compute @workgroup_size(1, 1, 1)
+fn finalize() {
+    let jobs = min(atomicLoad(&shadow_jobs[0]), JOB_CAPACITY);
+    let groups = (jobs + CAST_GROUP_SIZE - 1u) / CAST_GROUP_SIZE;
+    let x = min(groups, MAX_GROUPS_X);
+    let y = select(0u, (groups + MAX_GROUPS_X - 1u) / MAX_GROUPS_X, groups > 0u);
+    atomicStore(&shadow_jobs[4], x);
+    atomicStore(&shadow_jobs[5], y);
+    atomicStore(&shadow_jobs[6], 1u);
+}

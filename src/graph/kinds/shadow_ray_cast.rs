@@ -1,0 +1,92 @@
+//! `ShadowRayCast`: one invocation per job, dispatched indirectly from the job count: an
+//! any-hit ray against the scene BVH from the pixel's position offset along its geometric
+//! normal; a hit sets the light's bit in the pixel's mask. Runs
+//! `shaders/shadow/shadow_ray_cast.wgsl`.
+
+use super::g_buffer::{G_GEOMETRIC, G_POSITION};
+use super::shadow_ray_jobs::{SHADOW_JOBS, SHADOW_MASK};
+use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
+use crate::graph::error::GraphError;
+use crate::graph::model::SceneResource;
+use serde::{Deserialize, Serialize};
+
+/// `ShadowRayCast(normal_offset: 1e-4)`.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ShadowRayCast {
+    /// Origin offset along the geometric normal, relative to the position's largest
+    /// coordinate (at least 1): what keeps a surface from shadowing itself.
+    #[serde(default = "default_normal_offset")]
+    pub normal_offset: f32,
+}
+
+/// The default origin offset (also what naive tracing in the light loop uses).
+pub const DEFAULT_NORMAL_OFFSET: f32 = 1e-4;
+
+fn default_normal_offset() -> f32 {
+    DEFAULT_NORMAL_OFFSET
+}
+
+pub const BVH_NODES: &str = "bvh_nodes";
+pub const BVH_TRIANGLES: &str = "bvh_triangles";
+
+pub const SLOTS: &[SlotSpec] = &[
+    SlotSpec::new(SHADOW_JOBS, SlotType::Buffer, Access::Read, Usage::Bound),
+    SlotSpec::new(
+        G_POSITION,
+        SlotType::ColorTexture,
+        Access::Read,
+        Usage::Sampled,
+    ),
+    SlotSpec::new(
+        G_GEOMETRIC,
+        SlotType::ColorTexture,
+        Access::Read,
+        Usage::Sampled,
+    ),
+    SlotSpec::new(
+        slot::LIGHT_GEOMETRY,
+        SlotType::Import(SceneResource::LightGeometry),
+        Access::Read,
+        Usage::Bound,
+    ),
+    SlotSpec::new(
+        BVH_NODES,
+        SlotType::Import(SceneResource::BvhNodes),
+        Access::Read,
+        Usage::Bound,
+    ),
+    SlotSpec::new(
+        BVH_TRIANGLES,
+        SlotType::Import(SceneResource::BvhTriangles),
+        Access::Read,
+        Usage::Bound,
+    ),
+    SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Write, Usage::Bound),
+];
+
+pub fn check(p: &ShadowRayCast, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+    if !(p.normal_offset.is_finite() && (0.0..=0.1).contains(&p.normal_offset)) {
+        errors.push(ctx.bad(format!(
+            "normal_offset {} must be in [0, 0.1]",
+            p.normal_offset
+        )));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::graph::kinds::test_support::errors;
+
+    #[test]
+    fn checks_offset() {
+        let e = errors(
+            r#"Pass(name: "r", kind: ShadowRayCast(normal_offset: -1.0), reads: ["lists", "pos", "nrm", "lg", "bn", "bt"], writes: ["small_buf"])"#,
+            "pos",
+        );
+        assert!(
+            e.contains("normal_offset -1 must be in [0, 0.1]") || e.contains("reads resource"),
+            "{e}"
+        );
+    }
+}
