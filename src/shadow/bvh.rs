@@ -414,6 +414,7 @@ impl ShadowBvh {
             right_of: None,
         }];
         let mut under = Vec::new();
+        let mut perm: Vec<u32> = Vec::with_capacity(tris.len());
         while let Some(task) = tasks.pop() {
             let (i, depth, right_of) = match task {
                 Task::Close(at) => {
@@ -458,8 +459,9 @@ impl ShadowBvh {
                 });
                 continue;
             }
-            // A leaf: every triangle of the source subtree.
-            node.a = self.triangles.len() as u32;
+            // A leaf: every triangle of the source subtree (indices now, the triangles
+            // themselves in one tight gather loop below, which overlaps the cache misses).
+            node.a = perm.len() as u32;
             under.clear();
             under.push(i);
             while let Some(j) = under.pop() {
@@ -476,22 +478,26 @@ impl ShadowBvh {
                     .primitive_indices
                     .get(first..first + m.prim_count as usize)
                     .unwrap_or(&[]);
-                for &p in prims {
-                    let [p0, p1, p2] = tris[p as usize];
-                    self.triangles.push(BvhTriangle {
-                        v0: p0.to_array(),
-                        id: ids[p as usize],
-                        e1: (p1 - p0).to_array(),
-                        _pad0: 0,
-                        e2: (p2 - p0).to_array(),
-                        _pad1: 0,
-                    });
-                }
+                perm.extend(prims.iter().filter(|&&p| (p as usize) < tris.len()));
             }
-            node.b = LEAF_BIT | (self.triangles.len() as u32 - node.a);
+            node.b = LEAF_BIT | (perm.len() as u32 - node.a);
             self.stats.leaves += 1;
             self.nodes.push(node);
         }
+        self.triangles = perm
+            .iter()
+            .map(|&p| {
+                let [p0, p1, p2] = tris[p as usize];
+                BvhTriangle {
+                    v0: p0.to_array(),
+                    id: ids[p as usize],
+                    e1: (p1 - p0).to_array(),
+                    _pad0: 0,
+                    e2: (p2 - p0).to_array(),
+                    _pad1: 0,
+                }
+            })
+            .collect();
     }
 
     /// Whether anything blocks `origin + t * dir` for `0 < t < t_max` (the CPU twin of
