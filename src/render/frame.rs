@@ -287,8 +287,26 @@ impl PreparedFrame {
         Ok(out)
     }
 
+    /// Errs when `name` shares its physical resource with one used after it: what a
+    /// readback would see is the later resource.
+    fn check_not_reused(&self, name: &str) -> Result<(), RenderError> {
+        let plan = &self.graph.plan;
+        let later = plan
+            .get(name)
+            .and_then(|r| plan.physical[r.physical].serves.last())
+            .filter(|last| *last != name);
+        match later {
+            Some(last) => Err(RenderError::Pass {
+                pass: "readback".into(),
+                message: format!("'{name}' shares its physical resource with '{last}', used after it in the frame: it no longer holds '{name}' (make '{name}' the output, or keep its readers last)"),
+            }),
+            None => Ok(()),
+        }
+    }
+
     /// Reads back a planned buffer of the last executed frame (tests, inspection).
     pub fn read_buffer(&self, r: &Renderer, name: &str) -> Result<Vec<u8>, RenderError> {
+        self.check_not_reused(name)?;
         let buffer = self
             .resources
             .buffer(&self.graph.plan, name)
@@ -301,6 +319,7 @@ impl PreparedFrame {
 
     /// Reads back a planned Rgba32Float texture of the last executed frame.
     pub fn read_texture(&self, r: &Renderer, name: &str) -> Result<Vec<[f32; 4]>, RenderError> {
+        self.check_not_reused(name)?;
         let texture = self
             .resources
             .texture(&self.graph.plan, name)
