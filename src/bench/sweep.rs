@@ -1,15 +1,16 @@
 //! Benchmark sweeps: scenes × light counts × resolutions × graphs, each point timed on
 //! the GPU (warm-up, then N frames, median and spread per pass) and compared with the
-//! brute-force image of the same scene.
+//! reference image of the same scene (brute force unless the sweep names another graph).
 
 use super::cases::SceneCase;
 use super::metrics::non_finite_pixels;
 use super::report::{summarize, BenchRow, TimingSummary};
 use super::{compare, CompareOptions};
-use crate::graph::{self, FrameSize};
-use crate::render::{RenderError, Renderer, SceneGpu};
+use crate::graph::{self, FrameSize, PassKind, ResourceDesc, SceneResource};
+use crate::render::{RenderError, Renderer, SceneGpu, ShadowReport};
 use crate::scene::{self, lights::RandomLights, Scene};
 use serde::Deserialize;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -36,9 +37,18 @@ pub struct Sweep {
     pub warmup: u32,
     #[serde(default = "default_frames")]
     pub frames: u32,
-    /// Above this many lights the brute-force reference is not run (no error columns).
+    /// Above this many lights the reference is not run (no error columns).
     #[serde(default = "default_brute_force_limit")]
     pub brute_force_limit: u32,
+    /// The graph whose image the error columns compare against, like `graphs` (default
+    /// `brute_force.ron`). Brute force does not trace shadows: name a shadow-tracing graph to
+    /// compare ray-cast shadows with something shadowed.
+    #[serde(default = "default_reference")]
+    pub reference: String,
+    /// Per-graph exceptions to `reference`: graph → its reference graph, e.g.
+    /// `{"raycast_shadows.ron": "raycast_shadows_naive.ron"}`. Keys must be in `graphs`.
+    #[serde(default)]
+    pub references: BTreeMap<String, String>,
     /// Render an extra frame per point for the light statistics (the listed/exact column);
     /// it costs as much as a brute-force frame.
     #[serde(default = "yes")]
@@ -56,6 +66,9 @@ fn default_frames() -> u32 {
 }
 fn default_brute_force_limit() -> u32 {
     16384
+}
+fn default_reference() -> String {
+    "brute_force.ron".into()
 }
 
 #[derive(Debug, Error)]
@@ -114,7 +127,18 @@ impl Sweep {
                 )));
             }
         }
+        if let Some(g) = sweep.references.keys().find(|g| !sweep.graphs.contains(g)) {
+            let line = line_of("references");
+            return Err(error(format!(
+                "{line}references names graph \"{g}\", which is not in graphs"
+            )));
+        }
         Ok(sweep)
+    }
+
+    /// The reference graph the error columns of `graph` compare against.
+    pub fn reference_for(&self, graph: &str) -> &str {
+        self.references.get(graph).unwrap_or(&self.reference)
     }
 
     /// Number of points the sweep runs.
@@ -210,17 +234,17 @@ pub fn run(
                         height,
                         lights: scene.lights.len() as u32,
                     };
-                    let reference = if size.lights <= sweep.brute_force_limit {
-                        Some(render_once(
-                            renderer,
-                            "brute_force.ron",
-                            &scene,
-                            &gpu,
-                            size,
-                        )?)
-                    } else {
-                        None
-                    };
+                    // Each reference graph the point's graphs name, rendered once.
+                    let mut references: Vec<(&str, Vec<[f32; 4]>)> = Vec::new();
+                    if size.lights <= sweep.brute_force_limit {
+                        for g in &sweep.graphs {
+                            let name = sweep.reference_for(g);
+                            if references.iter().all(|r| r.0 != name) {
+                                let image = render_once(renderer, name, &scene, &gpu, size)?;
+                                references.push((name, image));
+                            }
+                        }
+                    }
                     for g in &sweep.graphs {
                         let technique = g.trim_end_matches(".ron");
                         let point = format!(
@@ -241,11 +265,14 @@ pub fn run(
                             adapter: renderer.ctx.adapter_name(),
                             ..Default::default()
                         };
+                        let reference_name = sweep.reference_for(g);
+                        let reference = references.iter().find(|r| r.0 == reference_name);
+                        row.reference = reference.map(|r| r.0.trim_end_matches(".ron").to_string());
                         let point = Point {
                             scene: &scene,
                             gpu: &gpu,
                             size,
-                            reference: reference.as_deref(),
+                            reference: reference.map(|r| r.1.as_slice()),
                         };
                         measure(sweep, g, &point, renderer, &mut row)?;
                         rows.push(row);
@@ -355,7 +382,73 @@ fn measure(
     if let Some(s) = &light_stats {
         row.listed_exact_ratio = Some(s.false_positive_ratio());
     }
+    set_shadow_columns(row, &prepared.graph, gpu, &result.shadows);
     Ok(())
+}
+
+const MIB: f64 = (1u64 << 20) as f64;
+
+/// The ray-cast shadow columns: rays, rays a second of the `ShadowRayCast` passes, drops and
+/// buffer memory when a `ShadowRayJobs` pass ran; the BVH's size and build time when a pass
+/// that runs reads it (the naive graph traces it in the light loop).
+fn set_shadow_columns(
+    row: &mut BenchRow,
+    graph: &graph::CompiledGraph,
+    gpu: &SceneGpu,
+    shadows: &[ShadowReport],
+) {
+    let runs = |kind: fn(&PassKind) -> bool| graph.passes.iter().filter(move |p| kind(&p.kind));
+    if runs(|k| matches!(k, PassKind::ShadowRayJobs(_)))
+        .next()
+        .is_some()
+    {
+        let rays: u64 = shadows.iter().map(ShadowReport::rays).sum();
+        row.shadow_rays = Some(rays);
+        row.shadow_jobs_dropped = Some(shadows.iter().map(|s| s.jobs_dropped).sum());
+        row.shadow_overflow_pixels = Some(shadows.iter().map(|s| s.overflow_pixels).sum());
+        row.shadow_buffers_mib = Some(
+            shadows
+                .iter()
+                .map(|s| (s.job_bytes + s.mask_bytes) as f64)
+                .sum::<f64>()
+                / MIB,
+        );
+        // Every ShadowRayCast pass's median, found by kind; `None` if any is untimed.
+        let cast_ms: Option<Vec<f64>> = runs(|k| matches!(k, PassKind::ShadowRayCast(_)))
+            .map(|p| {
+                row.pass_ms
+                    .iter()
+                    .find(|(n, _)| *n == p.name)
+                    .map(|(_, t)| t.median)
+            })
+            .collect();
+        row.shadow_rays_per_s = cast_ms
+            .map(|v| v.iter().sum::<f64>())
+            .filter(|&ms| ms > 0.0)
+            .map(|ms| rays as f64 / (ms * 1e-3));
+    }
+    let desc = &graph.checked.desc;
+    let bvh_imports: Vec<&str> = desc
+        .resources
+        .iter()
+        .filter_map(|r| match r {
+            ResourceDesc::Import {
+                name,
+                from: SceneResource::BvhNodes,
+            } => Some(name.as_str()),
+            _ => None,
+        })
+        .collect();
+    let reads_bvh = graph.passes.iter().any(|p| {
+        desc.passes[p.index]
+            .reads
+            .iter()
+            .any(|r| bvh_imports.contains(&r.as_str()))
+    });
+    if let (true, Some(bvh)) = (reads_bvh, &gpu.bvh) {
+        row.bvh_mib = Some(bvh.bytes() as f64 / MIB);
+        row.bvh_build_ms = Some(bvh.stats.build_time.as_secs_f64() * 1e3);
+    }
 }
 
 fn render_once(
@@ -379,4 +472,42 @@ fn check_graph(name: &str, renderer: &Renderer) -> Result<graph::CheckedGraph, S
         .read(&format!("graphs/{name}"))
         .map_err(|e| err(e.to_string()))?;
     graph::check_text(&path, &text, &renderer.shaders).map_err(|e| err(e.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SWEEP: &str = r#"Sweep(
+        scenes: ["builtin:chairs"],
+        graphs: ["forward_plus.ron", "raycast_shadows.ron"],
+        resolutions: [(16, 9)],
+        references: {"raycast_shadows.ron": "raycast_shadows_naive.ron"},
+    )"#;
+
+    #[test]
+    fn references_name_a_graph_per_graph() {
+        let s = Sweep::parse(SWEEP, "s.ron".as_ref()).unwrap();
+        assert_eq!(s.reference_for("forward_plus.ron"), "brute_force.ron");
+        assert_eq!(
+            s.reference_for("raycast_shadows.ron"),
+            "raycast_shadows_naive.ron"
+        );
+        let typo = SWEEP.replace("\"raycast_shadows.ron\":", "\"raycast_shadow.ron\":");
+        let e = Sweep::parse(&typo, "s.ron".as_ref())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("5: references names graph \"raycast_shadow.ron\""),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn the_shadow_sweep_parses() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/sweeps/raycast_shadows.ron");
+        let s = Sweep::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(s.point_count(), 8);
+        assert_eq!(s.reference_for("forward_plus.ron"), "brute_force.ron");
+    }
 }

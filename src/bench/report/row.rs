@@ -53,6 +53,25 @@ pub struct BenchRow {
     pub non_finite_examples: Vec<NonFinitePixel>,
     /// Pixels of the output with some non-zero channel: 0 means the point shows no light at all.
     pub lit_pixels: Option<u64>,
+    /// The graph whose image the error columns compare against (e.g. `brute_force`); `None`
+    /// when no reference was rendered.
+    pub reference: Option<String>,
+    /// Ray-cast shadow rays traced this frame (every `ShadowRayJobs` pass together).
+    pub shadow_rays: Option<u64>,
+    /// Rays traced over the `ShadowRayCast` passes' median GPU time, rays a second (`None`
+    /// when untimed).
+    pub shadow_rays_per_s: Option<f64>,
+    /// Shadow jobs past the job buffer's capacity (those lights are lit unshadowed).
+    pub shadow_jobs_dropped: Option<u64>,
+    /// Pixels with more than 128 shadow-casting lights (the rest are lit unshadowed).
+    pub shadow_overflow_pixels: Option<u64>,
+    /// Job and mask buffers of the shadow passes, MiB.
+    pub shadow_buffers_mib: Option<f64>,
+    /// The scene's shadow BVH on the GPU (nodes and triangles), MiB, when a pass that runs
+    /// reads it.
+    pub bvh_mib: Option<f64>,
+    /// How long building that BVH took on the CPU, ms.
+    pub bvh_build_ms: Option<f64>,
 }
 
 impl BenchRow {

@@ -35,8 +35,9 @@ fn opt<T: ToString>(v: Option<T>) -> String {
 
 /// The fixed CSV columns, in order; per-pass columns follow, three per pass name seen in any
 /// row (first-seen order): `pass_ms:<name>` (median), `pass_ms_p10:<name>`, `pass_ms_p90:<name>`,
-/// empty where a row lacks that pass. Time columns are empty, not 0, for untimed rows.
-pub const CSV_COLUMNS: [&str; 23] = [
+/// empty where a row lacks that pass. Time columns are empty, not 0, for untimed rows; the
+/// ray-cast shadow columns (`shadow_*`, `bvh_*`) are empty for graphs without those passes.
+pub const CSV_COLUMNS: [&str; 31] = [
     "scene",
     "technique",
     "params",
@@ -60,6 +61,14 @@ pub const CSV_COLUMNS: [&str; 23] = [
     "lit_pixels",
     "pass_count",
     "passes_ms_total",
+    "reference",
+    "shadow_rays",
+    "shadow_rays_per_s",
+    "shadow_jobs_dropped",
+    "shadow_overflow_pixels",
+    "shadow_buffers_mib",
+    "bvh_mib",
+    "bvh_build_ms",
 ];
 
 /// The rows as CSV (RFC 4180 quoting; floats in Rust's shortest round-trip form, `inf` for an
@@ -101,6 +110,14 @@ pub fn to_csv(rows: &[BenchRow]) -> String {
             opt(r.lit_pixels),
             r.pass_ms.len().to_string(),
             opt(r.passes_ms_total()),
+            csv_field(r.reference.as_deref().unwrap_or_default()),
+            opt(r.shadow_rays),
+            opt(r.shadow_rays_per_s),
+            opt(r.shadow_jobs_dropped),
+            opt(r.shadow_overflow_pixels),
+            opt(r.shadow_buffers_mib),
+            opt(r.bvh_mib),
+            opt(r.bvh_build_ms),
         ];
         for p in &passes {
             let t = pass_ms(r, p);
@@ -176,15 +193,15 @@ fn md_num(v: Option<f64>, digits: usize) -> String {
 /// a per-pass table (median, p10–p90 per pass name) if any row has timed passes.
 pub fn to_markdown(rows: &[BenchRow]) -> String {
     let mut out = String::new();
-    out.push_str("| scene | technique | params | lights | size | adapter | median ms | p10 | p90 | RMSE | max abs | max rel | PSNR dB | FLIP | listed/exact | max/tile | overflow | NaN px | Inf px | lit px |\n");
+    out.push_str("| scene | technique | params | lights | size | adapter | median ms | p10 | p90 | RMSE | max abs | max rel | PSNR dB | FLIP | listed/exact | max/tile | overflow | NaN px | Inf px | lit px | reference |\n");
     out.push_str(
-        "|---|---|---|--:|--:|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n",
+        "|---|---|---|--:|--:|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|---|\n",
     );
     for r in rows {
         let t = r.frame_ms;
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {} | {}x{} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {}x{} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             md_cell(&r.scene),
             md_cell(&r.technique),
             md_cell(&r.params),
@@ -206,8 +223,10 @@ pub fn to_markdown(rows: &[BenchRow]) -> String {
             opt(r.nan_pixels),
             opt(r.inf_pixels),
             opt(r.lit_pixels),
+            md_cell(r.reference.as_deref().unwrap_or("–")),
         );
     }
+    shadow_markdown(&mut out, rows);
     if let Some(reason) = untimed_reason(rows).filter(|_| !rows.is_empty()) {
         let _ = writeln!(
             out,
@@ -254,6 +273,45 @@ pub fn to_markdown(rows: &[BenchRow]) -> String {
     out
 }
 
+fn has_shadow_columns(r: &BenchRow) -> bool {
+    r.shadow_rays.is_some() || r.bvh_mib.is_some()
+}
+
+/// The ray-cast shadow table, if some row traced shadow rays or read a BVH.
+fn shadow_markdown(out: &mut String, rows: &[BenchRow]) {
+    if !rows.iter().any(has_shadow_columns) {
+        return;
+    }
+    out.push_str(
+        "\nRay-cast shadows (rays per second over the ShadowRayCast passes' median time; \
+         dropped jobs and pixels over 128 casters are lit unshadowed):\n\n\
+         | scene | technique | params | lights | size | rays | rays/px | Mrays/s | dropped jobs | px > 128 casters | jobs+mask MiB | BVH MiB | BVH build ms |\n\
+         |---|---|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n",
+    );
+    for r in rows.iter().filter(|r| has_shadow_columns(r)) {
+        let pixels = (r.width as u64 * r.height as u64).max(1) as f64;
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} | {}x{} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            md_cell(&r.scene),
+            md_cell(&r.technique),
+            md_cell(&r.params),
+            r.light_count,
+            r.width,
+            r.height,
+            r.shadow_rays.map_or("–".into(), |n| n.to_string()),
+            md_num(r.shadow_rays.map(|n| n as f64 / pixels), 2),
+            md_num(r.shadow_rays_per_s.map(|x| x / 1e6), 1),
+            r.shadow_jobs_dropped.map_or("–".into(), |n| n.to_string()),
+            r.shadow_overflow_pixels
+                .map_or("–".into(), |n| n.to_string()),
+            md_num(r.shadow_buffers_mib, 1),
+            md_num(r.bvh_mib, 1),
+            md_num(r.bvh_build_ms, 1),
+        );
+    }
+}
+
 /// Write [`to_csv`] to `path` (creating the parent directory).
 pub fn write_csv(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(), ReportError> {
     write_file(path.as_ref(), &to_csv(rows))
@@ -262,4 +320,51 @@ pub fn write_csv(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(), Report
 /// Write [`to_markdown`] to `path` (creating the parent directory).
 pub fn write_markdown(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(), ReportError> {
     write_file(path.as_ref(), &to_markdown(rows))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shadow_columns_and_table() {
+        let plain = BenchRow {
+            scene: "chairs".into(),
+            technique: "forward_plus".into(),
+            width: 4,
+            height: 2,
+            reference: Some("brute_force".into()),
+            ..Default::default()
+        };
+        let shadowed = BenchRow {
+            technique: "raycast_shadows".into(),
+            reference: Some("raycast_shadows_naive".into()),
+            shadow_rays: Some(16),
+            shadow_rays_per_s: Some(2.5e9),
+            shadow_jobs_dropped: Some(0),
+            shadow_overflow_pixels: Some(1),
+            shadow_buffers_mib: Some(1.5),
+            bvh_mib: Some(20.4),
+            bvh_build_ms: Some(180.0),
+            ..plain.clone()
+        };
+        let csv = to_csv(&[plain.clone(), shadowed.clone()]);
+        let lines: Vec<&str> = csv.lines().collect();
+        assert!(lines[0].ends_with(
+            ",passes_ms_total,reference,shadow_rays,shadow_rays_per_s,shadow_jobs_dropped,shadow_overflow_pixels,shadow_buffers_mib,bvh_mib,bvh_build_ms"
+        ));
+        assert!(lines[1].ends_with(",0,,brute_force,,,,,,,"), "{}", lines[1]);
+        assert!(
+            lines[2].ends_with(",raycast_shadows_naive,16,2500000000,0,1,1.5,20.4,180"),
+            "{}",
+            lines[2]
+        );
+        assert!(!to_markdown(std::slice::from_ref(&plain)).contains("Ray-cast shadows"));
+        let md = to_markdown(&[plain, shadowed]);
+        assert!(md.contains("| brute_force |\n"), "{md}");
+        assert!(
+            md.contains("| chairs | raycast_shadows |  | 0 | 4x2 | 16 | 2.00 | 2500.0 | 0 | 1 | 1.5 | 20.4 | 180.0 |"),
+            "{md}"
+        );
+    }
 }

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Ray-cast shadow benchmarks on the GPU machine (see ../shared/gpu/README.md), after
+# scripts/gpu_bench.sh: the raycast_shadows sweep (chairs at 1280x720 and 1920x1080:
+# Forward+ and tiled deferred with jobs + casting passes, the naive light-loop tracer,
+# Forward+ unshadowed), single renders of the chairs scene with each shadow graph (PNG and
+# EXR, and `render`'s casters / rays / memory / BVH lines), and the default atrium through
+# raycast_shadows, which has no casters and must equal forward_plus. Results are packed
+# into $OUT/results.tar.gz (or results/). Usage from the project root after
+# ../shared/gpu/prepare.sh target/release/lightgraph:
+#   scripts/gpu_bench_shadows.sh
+set -u
+for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig
+final="${OUT:-results}"
+out="$final/r"
+mkdir -p "$out"
+export XDG_RUNTIME_DIR=/tmp
+lg=./.gpu/lightgraph
+nvidia-smi --query-gpu=name,driver_version --format=csv > "$out/gpu.txt" 2>&1
+for g in raycast_shadows tiled_deferred_raycast_shadows raycast_shadows_naive; do
+    $lg render --scene scenes/chairs.ron --graph graphs/$g.ron --width 1280 --height 720 \
+        --out "$out/chairs_$g.png" > "$out/render_chairs_$g.txt" 2>&1
+    $lg render --scene scenes/chairs.ron --graph graphs/$g.ron --width 1280 --height 720 \
+        --out "$out/chairs_$g.exr" > /dev/null 2>&1
+done
+for g in raycast_shadows tiled_deferred_raycast_shadows; do
+    $lg compare "$out/chairs_$g.exr" "$out/chairs_raycast_shadows_naive.exr" \
+        > "$out/compare_chairs_${g}_vs_naive.txt" 2>&1
+done
+for g in forward_plus raycast_shadows; do
+    $lg render --graph graphs/$g.ron --out "$out/atrium_$g.exr" > "$out/render_atrium_$g.txt" 2>&1
+done
+$lg render --graph graphs/raycast_shadows.ron --out "$out/atrium_raycast_shadows.png" > /dev/null 2>&1
+$lg compare "$out/atrium_raycast_shadows.exr" "$out/atrium_forward_plus.exr" \
+    > "$out/compare_atrium_raycast_shadows_vs_forward_plus.txt" 2>&1
+$lg bench --sweep benches/sweeps/raycast_shadows.ron --out "$out/raycast_shadows" \
+    > "$out/raycast_shadows.log" 2>&1
+cat "$out"/gpu.txt "$out"/render_chairs_*.txt "$out"/compare_*.txt "$out"/raycast_shadows/results.md
+# The device tool brings back few files: pack everything into one archive.
+tar -czf "$final/results.tar.gz" -C "$final" r && rm -rf "$out"
