@@ -180,7 +180,8 @@ fn ron_with_gltf_model_transform_and_light_sets() {
         &d,
         r#"Scene(
             models: [
-                (path: "models/floor.gltf", transform: (translation: (10, 0, 0), scale: (2, 2, 2))),
+                (path: "models/floor.gltf", transform: (translation: (10, 0, 0), scale: (2, 2, 2)),
+                 lights_cast_shadows: true),
                 (path: "models/floor.gltf", transform: (rotation_deg: (0, 0, 180))),
             ],
             lights: [(position: (0, 1, 0), range: 2, intensity: 1)],
@@ -207,6 +208,9 @@ fn ron_with_gltf_model_transform_and_light_sets() {
     assert_eq!(s.lights.len(), 103);
     assert_eq!(s.lights[0].position, Vec3::new(10.0, 2.0, 0.0));
     assert!((s.lights[1].position - Vec3::new(0.0, -1.0, 0.0)).length() < 1e-6);
+    // lights_cast_shadows makes the first model's light cast, not the second's.
+    assert_ne!(s.lights[0].flags & light_flags::CASTS_SHADOW, 0);
+    assert_eq!(s.lights[1].flags & light_flags::CASTS_SHADOW, 0);
     let spots = s.lights[3..]
         .iter()
         .filter(|l| matches!(l.shape, LightShape::Spot { .. }))

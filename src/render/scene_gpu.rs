@@ -59,7 +59,7 @@ impl GpuBvh {
         Ok(Self {
             nodes: upload("bvh_nodes", nodes),
             triangles: upload("bvh_triangles", triangles),
-            stats: bvh.stats.clone(),
+            stats: bvh.stats,
         })
     }
 

@@ -6,7 +6,8 @@
 //!     name: "cornell_many_lights",
 //!     models: [
 //!         (path: "../assets/cornell_box/scene.gltf",          // relative to this file
-//!          transform: (translation: (0, 0, 0), rotation_deg: (0, 90, 0), scale: (1, 1, 1))),
+//!          transform: (translation: (0, 0, 0), rotation_deg: (0, 90, 0), scale: (1, 1, 1)),
+//!          lights_cast_shadows: true),                         // its lights cast shadows
 //!     ],
 //!     // builtin: "atrium",                                     // or/and a built-in scene
 //!     camera: LookAt(eye: (0, 1, 6), target: (0, 1, 0), fov_y_deg: 50, near: 0.05, far: 100),
@@ -82,6 +83,10 @@ pub struct Model {
     pub path: PathBuf,
     #[serde(default)]
     pub transform: Transform,
+    /// Every light of this model (KHR_lights_punctual, kept with `keep_model_lights`)
+    /// casts ray-cast shadows.
+    #[serde(default)]
+    pub lights_cast_shadows: bool,
 }
 
 /// Scale, then rotation (Euler XYZ, degrees), then translation.
@@ -345,7 +350,12 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
             mesh
         }));
         if spec.keep_model_lights {
-            scene.lights.extend(sub.lights);
+            scene.lights.extend(sub.lights.into_iter().map(|mut l| {
+                if model.lights_cast_shadows {
+                    l.flags |= light_flags::CASTS_SHADOW;
+                }
+                l
+            }));
         }
         if camera.is_none() && has_camera {
             camera = Some(sub.camera);
