@@ -26,6 +26,8 @@ for g in raycast_shadows tiled_deferred_raycast_shadows; do
     $lg compare "$out/chairs_$g.exr" "$out/chairs_raycast_shadows_naive.exr" \
         > "$out/compare_chairs_${g}_vs_naive.txt" 2>&1
 done
+$lg render --scene scenes/atrium_shadows.ron --graph graphs/raycast_shadows.ron --width 1280 --height 720 \
+    --out "$out/atrium_shadows.png" > "$out/render_atrium_shadows.txt" 2>&1
 for g in forward_plus raycast_shadows; do
     $lg render --graph graphs/$g.ron --out "$out/atrium_$g.exr" > "$out/render_atrium_$g.txt" 2>&1
 done
@@ -34,6 +36,10 @@ $lg compare "$out/atrium_raycast_shadows.exr" "$out/atrium_forward_plus.exr" \
     > "$out/compare_atrium_raycast_shadows_vs_forward_plus.txt" 2>&1
 $lg bench --sweep benches/sweeps/raycast_shadows.ron --out "$out/raycast_shadows" \
     > "$out/raycast_shadows.log" 2>&1
-cat "$out"/gpu.txt "$out"/render_chairs_*.txt "$out"/compare_*.txt "$out"/raycast_shadows/results.md
-# The device tool brings back few files: pack everything into one archive.
+# The pass-kinds refactor must not slow the headline frame (1.74 ms packed, 2026-11-28).
+$lg bench --sweep benches/sweeps/packed_3072.ron --out "$out/packed_3072" > "$out/packed_3072.log" 2>&1
+cat "$out"/gpu.txt "$out"/packed_3072/results.md "$out"/render_chairs_*.txt "$out"/compare_*.txt "$out"/raycast_shadows/results.md
+# The device tool brings back few files of at most 16 MiB: pack everything but the
+# EXRs (already compared above) into one archive.
+rm -f "$out"/*.exr
 tar -czf "$final/results.tar.gz" -C "$final" r && rm -rf "$out"
