@@ -502,9 +502,8 @@ fn a_full_job_buffer_and_pixels_over_128_casters_are_counted() {
             )
         })
         .collect();
-    let big = graph_text("raycast_shadows.ron")
-        .replace("capacity: 256", "capacity: 256")
-        .replace("jobs_per_pixel: 16.0", "jobs_per_pixel: 128.0");
+    let big =
+        graph_text("raycast_shadows.ron").replace("jobs_per_pixel: 16.0", "jobs_per_pixel: 128.0");
     let (_, result) = run(&mut r, &big, &crowd);
     let s = &result.shadows[0];
     assert!(s.overflow_pixels > (W * H / 4) as u64, "{s:?}");

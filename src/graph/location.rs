@@ -112,7 +112,12 @@ impl SourceText {
         let mut offset = 0;
         for (i, l) in self.text.split_inclusive('\n').enumerate() {
             if i + 1 == line {
-                return offset + (col.saturating_sub(1)).min(l.len());
+                // `col` counts characters (ron's columns), not bytes.
+                let within = l
+                    .char_indices()
+                    .nth(col.saturating_sub(1))
+                    .map_or(l.len(), |(b, _)| b);
+                return offset + within;
             }
             offset += l.len();
         }
@@ -123,6 +128,17 @@ impl SourceText {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn columns_count_characters_not_bytes() {
+        let t = SourceText::new(Path::new("g.ron"), "Pass(name: \"é\", kind: ??)");
+        // Column 15 is the comma; counted as bytes it would be the quote before it (é is
+        // two bytes), and a column inside é would not be a char boundary.
+        let off = t.offset_of(1, 15);
+        assert!(t.text.is_char_boundary(off));
+        assert_eq!(&t.text[off..off + 1], ",");
+        assert!(t.pass_around(off).is_some());
+    }
 
     const TEXT: &str = "Graph(\n  passes: [\n    Pass(name: \"a\", reads: [\"x\"]),\n    Pass(\n      name: \"b\",\n      reads: [\"x\", \"y\"],\n    ),\n  ],\n)\n";
 

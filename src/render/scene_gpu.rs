@@ -44,7 +44,11 @@ impl GpuBvh {
         full: bool,
     ) -> Result<Self, crate::shadow::ShadowError> {
         let bvh = if full {
-            crate::shadow::ShadowBvh::build(scene)?
+            let options = crate::shadow::BuildOptions {
+                quality: scene.shadow_bvh,
+                ..Default::default()
+            };
+            crate::shadow::ShadowBvh::build_with(scene, &options)?
         } else {
             crate::shadow::ShadowBvh::from_triangles(&[], &Default::default())?
         };

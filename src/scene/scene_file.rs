@@ -24,6 +24,7 @@
 //!     material_overrides: { "floor": "materials/polished_marble.ron" },
 //!     output_size: (1280, 720),
 //!     ambient: (0, 0, 0),
+//!     shadow_bvh: Fast,                                      // ray-cast shadow BVH quality
 //! )
 //! ```
 //!
@@ -69,6 +70,9 @@ pub struct SceneFile {
     pub output_size: Option<(u32, u32)>,
     #[serde(default)]
     pub ambient: Option<Vec3>,
+    /// The ray-cast shadow BVH's build quality: Fastest, VeryFast, Fast (default), Medium.
+    #[serde(default)]
+    pub shadow_bvh: Option<crate::shadow::bvh::BuildQuality>,
 }
 
 fn yes() -> bool {
@@ -503,6 +507,9 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
             ));
         }
         scene.ambient = a;
+    }
+    if let Some(q) = spec.shadow_bvh {
+        scene.shadow_bvh = q;
     }
     scene.source_path = Some(file.to_path_buf());
     Ok(Loaded {

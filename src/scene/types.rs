@@ -211,6 +211,8 @@ pub struct Scene {
     pub material_overrides: Vec<(String, std::path::PathBuf)>,
     /// The file this scene was loaded from (`None` for built-in scenes).
     pub source_path: Option<std::path::PathBuf>,
+    /// How the ray-cast shadow BVH is built (scene files: `shadow_bvh: Medium`).
+    pub shadow_bvh: crate::shadow::bvh::BuildQuality,
 }
 
 impl Scene {
