@@ -36,9 +36,10 @@ $lg compare "$out/atrium_raycast_shadows.exr" "$out/atrium_forward_plus.exr" \
     > "$out/compare_atrium_raycast_shadows_vs_forward_plus.txt" 2>&1
 $lg bench --sweep benches/sweeps/raycast_shadows.ron --out "$out/raycast_shadows" \
     > "$out/raycast_shadows.log" 2>&1
+$lg bench --sweep benches/sweeps/bvh_quality.ron --out "$out/bvh_quality" > "$out/bvh_quality.log" 2>&1
 # The pass-kinds refactor must not slow the headline frame (1.74 ms packed, 2026-11-28).
 $lg bench --sweep benches/sweeps/packed_3072.ron --out "$out/packed_3072" > "$out/packed_3072.log" 2>&1
-cat "$out"/gpu.txt "$out"/packed_3072/results.md "$out"/render_chairs_*.txt "$out"/compare_*.txt "$out"/raycast_shadows/results.md
+cat "$out"/gpu.txt "$out"/bvh_quality/results.md "$out"/packed_3072/results.md "$out"/render_chairs_*.txt "$out"/compare_*.txt "$out"/raycast_shadows/results.md
 # The device tool brings back few files of at most 16 MiB: pack everything but the
 # EXRs (already compared above) into one archive.
 rm -f "$out"/*.exr
