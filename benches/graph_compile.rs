@@ -96,3 +96,20 @@ fn parse_ron_only(bencher: divan::Bencher, passes: usize) {
     let source = graph::SourceText::new("generated.ron", generated(passes));
     bencher.bench(|| graph::GraphDesc::parse_ron_only(divan::black_box(&source)).expect("valid"));
 }
+
+/// Step 2 alone: validation of an already parsed graph.
+#[divan::bench(args = [100, 500])]
+fn validate_only(bencher: divan::Bencher, passes: usize) {
+    let source = graph::SourceText::new("generated.ron", generated(passes));
+    let desc = graph::parse(&source).expect("valid");
+    let shaders = ShaderLibrary::builtin();
+    bencher
+        .with_inputs(|| (desc.clone(), source.clone()))
+        .bench_values(|(d, s)| graph::validate(d, s, &shaders).expect("valid"));
+}
+
+/// What `compile` above pays per call outside the graph: the built-in shader library.
+#[divan::bench]
+fn shader_library_builtin() -> ShaderLibrary {
+    ShaderLibrary::builtin()
+}

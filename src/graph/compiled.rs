@@ -122,25 +122,19 @@ impl CompiledGraph {
     }
 }
 
-/// Assembles the compiled graph from the steps' results.
-pub(crate) fn assemble(
-    checked: CheckedGraph,
-    culled: Vec<Option<CullReason>>,
-    schedule: Vec<usize>,
-    plan: ResourcePlan,
-) -> CompiledGraph {
-    use super::fxmap::{FxHashMap, FxHashSet};
-    let mut written = FxHashSet::default();
-    // Sample count of each texture by name (the first declaration of a name).
-    let mut texture_samples: FxHashMap<&str, Option<u32>> =
-        FxHashMap::with_capacity_and_hasher(checked.desc.resources.len(), Default::default());
-    for r in &checked.desc.resources {
-        texture_samples.entry(r.name()).or_insert(match r {
-            ResourceDesc::Texture { samples, .. } => Some(*samples),
-            _ => None,
-        });
-    }
-    let passes = schedule
+/// The scheduled passes, in order; `index` is [`super::plan::first_declarations`].
+pub(crate) fn scheduled_passes(
+    checked: &CheckedGraph,
+    schedule: &[usize],
+    index: &super::fxmap::FxHashMap<&str, usize>,
+) -> Vec<ScheduledPass> {
+    let mut written = super::fxmap::FxHashSet::default();
+    // Sample count of a texture by name (the first declaration of a name).
+    let texture_samples = |name: &str| match checked.desc.resources.get(*index.get(name)?)? {
+        ResourceDesc::Texture { samples, .. } => Some(*samples),
+        _ => None,
+    };
+    schedule
         .iter()
         .map(|&i| {
             let desc = &checked.desc.passes[i];
@@ -155,7 +149,7 @@ pub(crate) fn assemble(
                 .slots
                 .values()
                 .chain(roles.target.iter())
-                .filter_map(|name| texture_samples.get(name.as_str()).copied().flatten())
+                .filter_map(|name| texture_samples(name.as_str()))
                 .max()
                 .unwrap_or(1);
             ScheduledPass {
@@ -167,7 +161,16 @@ pub(crate) fn assemble(
                 samples,
             }
         })
-        .collect();
+        .collect()
+}
+
+/// Assembles the compiled graph from the steps' results.
+pub(crate) fn assemble(
+    checked: CheckedGraph,
+    culled: Vec<Option<CullReason>>,
+    passes: Vec<ScheduledPass>,
+    plan: ResourcePlan,
+) -> CompiledGraph {
     let culled = culled
         .into_iter()
         .enumerate()

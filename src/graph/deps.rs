@@ -1,20 +1,37 @@
 //! The dependency graph between passes (petgraph): an edge W -> R for every resource
 //! that R reads and another pass W writes.
 
-use super::fxmap::FxHashMap;
 use super::model::GraphDesc;
 use petgraph::graph::{DiGraph, NodeIndex};
 
 /// Node weights are pass indices into `GraphDesc::passes`; edge weights resource names.
 pub type DepGraph = DiGraph<usize, String>;
 
-/// `writers` is [`writers_by_resource`] of `desc`.
-pub fn build(desc: &GraphDesc, writers: &Writers) -> DepGraph {
+/// Declared-resource indices of every pass's reads and writes, flat, in declaration
+/// order: pass `p`'s reads are `reads[read_start[p]..read_start[p + 1]]`.
+pub struct PassIds {
+    pub reads: Vec<usize>,
+    pub read_start: Vec<usize>,
+    pub writes: Vec<usize>,
+    pub write_start: Vec<usize>,
+}
+
+impl PassIds {
+    pub fn reads(&self, pass: usize) -> &[usize] {
+        &self.reads[self.read_start[pass]..self.read_start[pass + 1]]
+    }
+    pub fn writes(&self, pass: usize) -> &[usize] {
+        &self.writes[self.write_start[pass]..self.write_start[pass + 1]]
+    }
+}
+
+/// `writers` is [`writers_by_resource`] of `ids`.
+pub fn build(desc: &GraphDesc, ids: &PassIds, writers: &Writers) -> DepGraph {
     let mut g = DepGraph::with_capacity(desc.passes.len(), 0);
     let nodes: Vec<NodeIndex> = (0..desc.passes.len()).map(|i| g.add_node(i)).collect();
     for (r, reader) in desc.passes.iter().enumerate() {
-        for res in &reader.reads {
-            for &w in writers.get(res.as_str()).into_iter().flatten() {
+        for (res, &id) in reader.reads.iter().zip(ids.reads(r)) {
+            for &w in writers.of(id) {
                 if w != r {
                     g.update_edge(nodes[w], nodes[r], res.clone());
                 }
@@ -24,18 +41,37 @@ pub fn build(desc: &GraphDesc, writers: &Writers) -> DepGraph {
     g
 }
 
-/// Resource name -> indices of the passes that write it, in declaration order.
-pub type Writers<'a> = FxHashMap<&'a str, Vec<usize>>;
+/// Resource index -> indices of the passes that write it, in declaration order.
+pub struct Writers {
+    start: Vec<usize>,
+    passes: Vec<usize>,
+}
 
-/// Resource name -> indices of the passes that write it, in declaration order.
-pub fn writers_by_resource(desc: &GraphDesc) -> Writers<'_> {
-    let mut writers = Writers::default();
-    for (i, p) in desc.passes.iter().enumerate() {
-        for w in &p.writes {
-            writers.entry(w.as_str()).or_default().push(i);
+impl Writers {
+    pub fn of(&self, resource: usize) -> &[usize] {
+        &self.passes[self.start[resource]..self.start[resource + 1]]
+    }
+}
+
+/// Resource index -> indices of the passes that write it, in declaration order, for
+/// `resources` declared resources.
+pub fn writers_by_resource(ids: &PassIds, resources: usize) -> Writers {
+    let mut start = vec![0usize; resources + 1];
+    for &w in &ids.writes {
+        start[w + 1] += 1;
+    }
+    for i in 0..resources {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start.clone();
+    let mut passes = vec![0usize; ids.writes.len()];
+    for p in 0..ids.write_start.len() - 1 {
+        for &w in ids.writes(p) {
+            passes[fill[w]] = p;
+            fill[w] += 1;
         }
     }
-    writers
+    Writers { start, passes }
 }
 
 /// The passes on each cycle, in declaration order of their first pass.

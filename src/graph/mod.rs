@@ -55,6 +55,9 @@ pub fn compile(checked: CheckedGraph, features: &SceneFeatures, frame: FrameSize
     let culled = specialise::specialise(&checked, features);
     let keep: Vec<bool> = culled.iter().map(Option::is_none).collect();
     let schedule = order::order(&checked, &keep);
-    let plan = plan::plan(&checked.desc, &checked.roles, &schedule, frame);
-    compiled::assemble(checked, culled, schedule, plan)
+    let index = plan::first_declarations(&checked.desc);
+    let plan = plan::plan_indexed(&checked.desc, &checked.roles, &schedule, frame, &index);
+    let passes = compiled::scheduled_passes(&checked, &schedule, &index);
+    drop(index);
+    compiled::assemble(checked, culled, passes, plan)
 }

@@ -177,13 +177,28 @@ pub fn plan(
     schedule: &[usize],
     frame: FrameSize,
 ) -> ResourcePlan {
-    let mut plan = ResourcePlan::default();
-    // Each name's first declaration stands for the name.
+    plan_indexed(desc, roles, schedule, frame, &first_declarations(desc))
+}
+
+/// Resource name -> index of its first declaration (which stands for the name).
+pub(crate) fn first_declarations(desc: &GraphDesc) -> FxHashMap<&str, usize> {
     let mut index: FxHashMap<&str, usize> =
         FxHashMap::with_capacity_and_hasher(desc.resources.len(), Default::default());
     for (i, r) in desc.resources.iter().enumerate() {
         index.entry(r.name()).or_insert(i);
     }
+    index
+}
+
+/// [`plan`] with `index` = [`first_declarations`] of `desc`.
+pub(crate) fn plan_indexed(
+    desc: &GraphDesc,
+    roles: &[PassRoles],
+    schedule: &[usize],
+    frame: FrameSize,
+    index: &FxHashMap<&str, usize>,
+) -> ResourcePlan {
+    let mut plan = ResourcePlan::default();
     // Schedule positions that use each resource, from one walk over the schedule, as
     // one array: `positions[start[i]..start[i + 1]]` are resource i's, ascending.
     let mut uses_at: Vec<(usize, usize)> = Vec::new();

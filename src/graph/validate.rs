@@ -1,6 +1,6 @@
 //! Step 2: everything that can be wrong with a graph, found before anything reaches the GPU.
 
-use super::deps::{self, DepGraph, Writers};
+use super::deps::{self, DepGraph, PassIds, Writers};
 use super::error::{GraphError, GraphErrors};
 use super::fxmap::{FxHashMap, FxHashSet};
 use super::location::SourceText;
@@ -33,10 +33,12 @@ pub fn validate(
         // Role and order checks assume every name resolves.
         return Err(GraphErrors(errors));
     }
-    let writers = deps::writers_by_resource(&desc);
-    check_writes(&desc, &source, &resources, &writers, &mut errors);
+    // Every name resolves and is declared once: from here on, resources by index.
+    let ids = pass_ids(&desc, &resources);
+    let writers = deps::writers_by_resource(&ids, desc.resources.len());
+    check_writes(&desc, &source, &ids, &writers, &mut errors);
 
-    let deps = deps::build(&desc, &writers);
+    let deps = deps::build(&desc, &ids, &writers);
     for cycle in deps::cycles(&desc, &deps) {
         errors.push(GraphError::Cycle {
             at: source.of_declaration(&cycle[0]),
@@ -84,6 +86,31 @@ pub fn validate(
     } else {
         Err(GraphErrors(errors))
     }
+}
+
+/// The declared-resource index of every read and write; every name must resolve.
+fn pass_ids(desc: &GraphDesc, resources: &FxHashMap<&str, &ResourceDesc>) -> PassIds {
+    // The map holds references into `desc.resources`: their index is their offset.
+    let base = desc.resources.as_ptr() as usize;
+    let size = std::mem::size_of::<ResourceDesc>();
+    let index_of =
+        |name: &String| (resources[name.as_str()] as *const ResourceDesc as usize - base) / size;
+    let n = desc.passes.len();
+    let mut ids = PassIds {
+        reads: Vec::with_capacity(n * 4),
+        read_start: Vec::with_capacity(n + 1),
+        writes: Vec::with_capacity(n * 2),
+        write_start: Vec::with_capacity(n + 1),
+    };
+    ids.read_start.push(0);
+    ids.write_start.push(0);
+    for p in &desc.passes {
+        ids.reads.extend(p.reads.iter().map(index_of));
+        ids.read_start.push(ids.reads.len());
+        ids.writes.extend(p.writes.iter().map(index_of));
+        ids.write_start.push(ids.writes.len());
+    }
+    ids
 }
 
 /// Resource name -> declaration, and the set of pass names.
@@ -173,13 +200,13 @@ fn check_references(
 fn check_writes(
     desc: &GraphDesc,
     source: &SourceText,
-    resources: &FxHashMap<&str, &ResourceDesc>,
+    ids: &PassIds,
     writers: &Writers,
     errors: &mut Vec<GraphError>,
 ) {
     for (index, pass) in desc.passes.iter().enumerate() {
-        for name in &pass.writes {
-            if let Some(ResourceDesc::Import { from, .. }) = resources.get(name.as_str()) {
+        for (name, &id) in pass.writes.iter().zip(ids.writes(index)) {
+            if let ResourceDesc::Import { from, .. } = &desc.resources[id] {
                 errors.push(GraphError::Mismatch {
                     at: source.in_pass(&pass.name, name),
                     pass: pass.name.clone(),
@@ -188,14 +215,9 @@ fn check_writes(
                 });
             }
         }
-        for name in &pass.reads {
-            let is_import = matches!(
-                resources.get(name.as_str()),
-                Some(ResourceDesc::Import { .. })
-            );
-            let written_elsewhere = writers
-                .get(name.as_str())
-                .is_some_and(|w| w.iter().any(|&i| i != index));
+        for (name, &id) in pass.reads.iter().zip(ids.reads(index)) {
+            let is_import = matches!(desc.resources[id], ResourceDesc::Import { .. });
+            let written_elsewhere = writers.of(id).iter().any(|&i| i != index);
             if !is_import && !written_elsewhere {
                 errors.push(GraphError::ReadNeverWritten {
                     at: source.in_pass(&pass.name, name),
@@ -218,10 +240,8 @@ fn check_writer_order(
     use petgraph::algo::has_path_connecting;
     use petgraph::graph::NodeIndex;
     let mut reported = BTreeSet::new();
-    for r in &desc.resources {
-        let Some(writers) = by_resource.get(r.name()) else {
-            continue;
-        };
+    for (ri, r) in desc.resources.iter().enumerate() {
+        let writers = by_resource.of(ri);
         for (k, &a) in writers.iter().enumerate() {
             for &b in &writers[k + 1..] {
                 let (na, nb) = (NodeIndex::new(a), NodeIndex::new(b));
