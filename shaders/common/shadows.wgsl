@@ -14,6 +14,8 @@
 const LIGHT_CASTS_SHADOW: u32 = 1u;
 const SHADOW_MAX_CASTERS: u32 = 128u;
 const SHADOW_MASK_WORDS: u32 = 4u;
+// Jobs a workgroup of the casting pass (its dispatch is written by job creation).
+const SHADOW_CAST_GROUP: u32 = 64u;
 
 // The shadow ray's origin: off the surface along its geometric normal, by an amount that
 // scales with the position's magnitude (float positions are that much less precise).

@@ -19,13 +19,13 @@
 
 const JOB_HEADER_WORDS: u32 = 8u;
 
-@compute @workgroup_size(64, 1, 1)
+@compute @workgroup_size(SHADOW_CAST_GROUP, 1, 1)
 fn main(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
 ) {
-    let job = (group.y * groups.x + group.x) * 64u + local;
+    let job = (group.y * groups.x + group.x) * SHADOW_CAST_GROUP + local;
     if (job >= min(shadow_jobs[0], JOB_CAPACITY)) {
         return;
     }

@@ -1,10 +1,13 @@
 // Ray-cast shadow jobs (Leo demo, tiled ray-cast shadows): one invocation per pixel walks
 // its light list and, for every shadow-casting light that reaches and faces it, emits a
-// job (pixel, light, caster number). Jobs are compacted per workgroup: a prefix sum over
-// the workgroup's counts and one atomic add per workgroup reserve its range of the job
-// buffer. Casters behind the surface are hidden without a ray: their mask bit is set
-// here, which also clears every pixel's mask for the frame. `finalize` then writes the
-// casting pass's indirect dispatch.
+// job (pixel, light, caster number). Jobs are compacted per workgroup: a prefix sum and
+// one atomic add per workgroup reserve its range of the job buffer. Within that range the
+// jobs are sorted by their light's position in the list (a counting sort through
+// workgroup atomics), so the casting pass's neighbouring threads trace rays from
+// neighbouring pixels to the same light: coherent rays. (Their order within one light is
+// the atomics' order; the mask, ORed, does not depend on it.) Casters behind the surface
+// are hidden without a ray: their mask bit is set here, which also clears every pixel's
+// mask for the frame. `finalize` then writes the casting pass's indirect dispatch.
 //
 // Job buffer (src/graph/kinds/shadow_ray_jobs.rs, ShadowJobLayout): words 0..4 jobs wanted,
 // jobs dropped (buffer full), pixels with more than 128 casters, unused; 4..8 the
@@ -31,10 +34,14 @@ const JOB_HEADER_WORDS: u32 = 8u;
 const GROUP_SIZE: u32 = 256u;
 // Workgroups a dispatch dimension may have (WebGPU's limit).
 const MAX_GROUPS_X: u32 = 65535u;
-const CAST_GROUP_SIZE: u32 = 64u;
 
 var<workgroup> scan: array<u32, 256>;
 var<workgroup> group_base: u32;
+// Jobs per list position (positions past the last share the last bucket), then the next
+// free slot of each within the workgroup's range.
+const BUCKETS: u32 = 256u;
+var<workgroup> bucket_count: array<atomic<u32>, 256>;
+var<workgroup> bucket_next: array<atomic<u32>, 256>;
 
 struct Pixel {
     valid: bool,
@@ -60,11 +67,11 @@ fn load_pixel(xy: vec2<u32>) -> Pixel {
     return px;
 }
 
-// Walks the pixel's casters. With `emit`, writes its jobs from `first` on (those past
-// JOB_CAPACITY are dropped, counted by the caller); returns how many jobs it has.
-fn walk(px: Pixel, emit: bool, first: u32) -> u32 {
+// Walks the pixel's casters. Without `emit`, counts its jobs into their buckets; with it,
+// writes each job at its bucket's next slot (those past JOB_CAPACITY are dropped, counted
+// by the caller) and the pixel's mask.
+fn walk(px: Pixel, emit: bool) {
     var caster = 0u;
-    var jobs = 0u;
     var hidden = array<u32, 4>(0u, 0u, 0u, 0u);
     for (var k = 0u; k < px.range.count; k++) {
         let i = light_at(px.range, k);
@@ -79,14 +86,16 @@ fn walk(px: Pixel, emit: bool, first: u32) -> u32 {
         }
         if (caster < SHADOW_MAX_CASTERS) {
             if (shadow_faces(px.position, px.ng, g.position)) {
+                let bucket = min(k, BUCKETS - 1u);
                 if (emit) {
-                    let slot = first + jobs;
+                    let slot = group_base + atomicAdd(&bucket_next[bucket], 1u);
                     if (slot < JOB_CAPACITY) {
                         atomicStore(&shadow_jobs[JOB_HEADER_WORDS + 2u * slot], px.index);
                         atomicStore(&shadow_jobs[JOB_HEADER_WORDS + 2u * slot + 1u], i | (caster << 24u));
                     }
+                } else {
+                    atomicAdd(&bucket_count[bucket], 1u);
                 }
-                jobs += 1u;
             } else {
                 hidden[caster / 32u] |= 1u << (caster % 32u);
             }
@@ -101,7 +110,6 @@ fn walk(px: Pixel, emit: bool, first: u32) -> u32 {
             atomicAdd(&shadow_jobs[2], 1u);
         }
     }
-    return jobs;
 }
 
 @compute @workgroup_size(16, 16, 1)
@@ -109,17 +117,20 @@ fn main(
     @builtin(global_invocation_id) id: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
 ) {
+    atomicStore(&bucket_count[local], 0u);
+    workgroupBarrier();
     let px = load_pixel(id.xy);
-    var count = 0u;
     if (px.valid) {
-        count = walk(px, false, 0u);
+        walk(px, false);
     } else if (all(id.xy < frame.size)) {
         let base = (id.y * frame.size.x + id.x) * SHADOW_MASK_WORDS;
         for (var w = 0u; w < SHADOW_MASK_WORDS; w++) {
             shadow_mask[base + w] = 0u;
         }
     }
-    // Inclusive prefix sum of the counts over the workgroup (Hillis-Steele).
+    workgroupBarrier();
+    // Inclusive prefix sum of the bucket counts (Hillis-Steele), one bucket a thread.
+    let count = atomicLoad(&bucket_count[local]);
     scan[local] = count;
     workgroupBarrier();
     for (var step = 1u; step < GROUP_SIZE; step *= 2u) {
@@ -131,6 +142,7 @@ fn main(
         scan[local] += add;
         workgroupBarrier();
     }
+    atomicStore(&bucket_next[local], scan[local] - count);
     if (local == GROUP_SIZE - 1u) {
         let total = scan[local];
         let base = atomicAdd(&shadow_jobs[0], total);
@@ -142,15 +154,15 @@ fn main(
     }
     workgroupBarrier();
     if (px.valid) {
-        walk(px, true, group_base + scan[local] - count);
+        walk(px, true);
     }
 }
 
-// The casting pass's indirect dispatch: 64 jobs a workgroup, in rows of MAX_GROUPS_X.
+// The casting pass's indirect dispatch: SHADOW_CAST_GROUP jobs a workgroup, in rows of MAX_GROUPS_X.
 @compute @workgroup_size(1, 1, 1)
 fn finalize() {
     let jobs = min(atomicLoad(&shadow_jobs[0]), JOB_CAPACITY);
-    let groups = (jobs + CAST_GROUP_SIZE - 1u) / CAST_GROUP_SIZE;
+    let groups = (jobs + SHADOW_CAST_GROUP - 1u) / SHADOW_CAST_GROUP;
     let x = min(groups, MAX_GROUPS_X);
     let y = select(0u, (groups + MAX_GROUPS_X - 1u) / MAX_GROUPS_X, groups > 0u);
     atomicStore(&shadow_jobs[4], x);
