@@ -76,8 +76,20 @@ fn is_ident_start(b: u8) -> bool {
 }
 
 fn is_ident_continue(b: u8) -> bool {
-    b.is_ascii_alphanumeric() || b == b'_'
+    IDENT_CONTINUE[b as usize]
 }
+
+/// `[A-Za-z0-9_]` by byte, for the identifier loop.
+static IDENT_CONTINUE: [bool; 256] = {
+    let mut t = [false; 256];
+    let mut i = 0;
+    while i < 256 {
+        let b = i as u8;
+        t[i] = b.is_ascii_alphanumeric() || b == b'_';
+        i += 1;
+    }
+    t
+};
 
 impl<'de> Deserializer<'de> {
     fn peek(&self) -> Option<u8> {
@@ -162,10 +174,13 @@ impl<'de> Deserializer<'de> {
         if !self.at_ident() {
             return Err(Fail);
         }
-        let mut end = start + 1;
-        while self.bytes.get(end).copied().is_some_and(is_ident_continue) {
-            end += 1;
-        }
+        let rest = &self.bytes[start + 1..];
+        let end = start
+            + 1
+            + rest
+                .iter()
+                .position(|&b| !is_ident_continue(b))
+                .unwrap_or(rest.len());
         // A non-ASCII byte could continue the identifier for ron (unicode XID); `.+-`
         // make a raw-identifier suggestion; `"#'` make raw/byte strings or raw
         // identifiers. None of these may follow an identifier in the subset anyway.
