@@ -14,6 +14,7 @@
 
 pub mod bvh;
 pub mod reference;
+mod traverse;
 
 pub use bvh::{
     BuildOptions, BuildStats, BvhNode, BvhTriangle, ShadowBvh, ShadowError, LEAF_BIT, STACK_SIZE,
