@@ -116,7 +116,7 @@ impl Default for BuildOptions {
     fn default() -> Self {
         Self {
             quality: BuildQuality::default(),
-            max_leaf_triangles: 4,
+            max_leaf_triangles: 8,
             traversal_cost: 2.0,
         }
     }
