@@ -102,31 +102,7 @@ pub fn atrium() -> Scene {
 
     let mut walls = MeshBuilder::new("atrium/walls", 3);
     // Inward-facing walls.
-    walls
-        .quad(
-            Vec3::new(-hx, 0.0, -hz),
-            Vec3::X * 2.0 * hx,
-            Vec3::Y * h,
-            Vec2::new(8.0, 4.0),
-        )
-        .quad(
-            Vec3::new(hx, 0.0, hz),
-            -Vec3::X * 2.0 * hx,
-            Vec3::Y * h,
-            Vec2::new(8.0, 4.0),
-        )
-        .quad(
-            Vec3::new(-hx, 0.0, hz),
-            Vec3::Z * -2.0 * hz,
-            Vec3::Y * h,
-            Vec2::new(6.0, 4.0),
-        )
-        .quad(
-            Vec3::new(hx, 0.0, -hz),
-            Vec3::Z * 2.0 * hz,
-            Vec3::Y * h,
-            Vec2::new(6.0, 4.0),
-        );
+    walls.inward_walls(hx, hz, h, Vec2::new(8.0, 4.0), Vec2::new(6.0, 4.0));
 
     let mut stone = MeshBuilder::new("atrium/colonnade", 1);
     let (col_h, gallery_y, upper_h) = (6.0f32, 8.4f32, 4.0f32);

@@ -95,30 +95,7 @@ fn room(floor: &mut MeshBuilder, walls: &mut MeshBuilder) {
     }
     let (hx, hz, h) = (HALF_X, HALF_Z, HEIGHT);
     walls
-        .quad(
-            Vec3::new(-hx, 0.0, -hz),
-            Vec3::X * 2.0 * hx,
-            Vec3::Y * h,
-            Vec2::new(6.0, 1.0),
-        )
-        .quad(
-            Vec3::new(hx, 0.0, hz),
-            -Vec3::X * 2.0 * hx,
-            Vec3::Y * h,
-            Vec2::new(6.0, 1.0),
-        )
-        .quad(
-            Vec3::new(-hx, 0.0, hz),
-            Vec3::Z * -2.0 * hz,
-            Vec3::Y * h,
-            Vec2::new(4.0, 1.0),
-        )
-        .quad(
-            Vec3::new(hx, 0.0, -hz),
-            Vec3::Z * 2.0 * hz,
-            Vec3::Y * h,
-            Vec2::new(4.0, 1.0),
-        )
+        .inward_walls(hx, hz, h, Vec2::new(6.0, 1.0), Vec2::new(4.0, 1.0))
         // Ceiling, facing down.
         .quad(
             Vec3::new(-hx, h, -hz),

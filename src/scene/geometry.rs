@@ -97,6 +97,35 @@ impl MeshBuilder {
         (m.positions.len() - 1) as u32
     }
 
+    /// The four inward-facing walls of a room centred on the origin, `2hx` × `2hz` and `h`
+    /// high from y = 0; `uv_x` tiles the walls along x, `uv_z` those along z.
+    pub fn inward_walls(&mut self, hx: f32, hz: f32, h: f32, uv_x: Vec2, uv_z: Vec2) -> &mut Self {
+        self.quad(
+            Vec3::new(-hx, 0.0, -hz),
+            Vec3::X * 2.0 * hx,
+            Vec3::Y * h,
+            uv_x,
+        )
+        .quad(
+            Vec3::new(hx, 0.0, hz),
+            -Vec3::X * 2.0 * hx,
+            Vec3::Y * h,
+            uv_x,
+        )
+        .quad(
+            Vec3::new(-hx, 0.0, hz),
+            Vec3::Z * -2.0 * hz,
+            Vec3::Y * h,
+            uv_z,
+        )
+        .quad(
+            Vec3::new(hx, 0.0, -hz),
+            Vec3::Z * 2.0 * hz,
+            Vec3::Y * h,
+            uv_z,
+        )
+    }
+
     /// A quad `o, o+u, o+u+v, o+v`, counter-clockwise seen from `u × v`.
     pub fn quad(&mut self, o: Vec3, u: Vec3, v: Vec3, uv_scale: Vec2) -> &mut Self {
         let n = u.cross(v).normalize_or_zero();
