@@ -5,7 +5,7 @@ use super::g_buffer::{G_NORMAL, G_POSITION};
 use super::shadow_ray_jobs::SHADOW_MASK;
 use super::{check_light_source, slot, Access, KindCtx, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
-use crate::graph::model::{LightSource, SceneResource};
+use crate::graph::model::LightSource;
 use serde::{Deserialize, Serialize};
 
 /// `DeferredShading(lights: Culled)`.
@@ -33,18 +33,8 @@ pub const SLOTS: &[SlotSpec] = &[
         Usage::Sampled,
     )
     .optional(),
-    SlotSpec::new(
-        slot::LIGHT_GEOMETRY,
-        SlotType::Import(SceneResource::LightGeometry),
-        Access::Read,
-        Usage::Bound,
-    ),
-    SlotSpec::new(
-        slot::LIGHT_PROPERTIES,
-        SlotType::Import(SceneResource::LightProperties),
-        Access::Read,
-        Usage::Bound,
-    ),
+    super::LIGHT_GEOMETRY_READ,
+    super::LIGHT_PROPERTIES_READ,
     SlotSpec::new(
         slot::LIGHT_LISTS,
         SlotType::Buffer,
@@ -59,12 +49,7 @@ pub const SLOTS: &[SlotSpec] = &[
 
 pub fn check(p: &DeferredShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     check_light_source(ctx, p.lights, errors);
-    if let (Some(mask), None) = (ctx.slot(SHADOW_MASK), ctx.slot(slot::LIGHT_LISTS)) {
-        errors.push(ctx.mismatch(
-            mask,
-            "the shadow mask numbers the lights of the culled lists it was made from: read them too (lights: Culled)",
-        ));
-    }
+    super::check_shadow_mask(ctx, errors);
     if let Some(name) = ctx.slot(HDR) {
         if !ctx.is_single_rgba32f(name) {
             errors.push(ctx.mismatch(

@@ -3,16 +3,9 @@
 
 use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
-use crate::graph::model::SceneResource;
 
 pub const SLOTS: &[SlotSpec] = &[
-    SlotSpec::new(
-        slot::GEOMETRY,
-        SlotType::Import(SceneResource::Geometry),
-        Access::Read,
-        Usage::Bound,
-    )
-    .optional(),
+    super::GEOMETRY_READ,
     SlotSpec::new(
         slot::DEPTH,
         SlotType::DepthTexture,

@@ -17,25 +17,9 @@ pub struct ForwardShading {
 }
 
 pub const SLOTS: &[SlotSpec] = &[
-    SlotSpec::new(
-        slot::GEOMETRY,
-        SlotType::Import(SceneResource::Geometry),
-        Access::Read,
-        Usage::Bound,
-    )
-    .optional(),
-    SlotSpec::new(
-        slot::LIGHT_GEOMETRY,
-        SlotType::Import(SceneResource::LightGeometry),
-        Access::Read,
-        Usage::Bound,
-    ),
-    SlotSpec::new(
-        slot::LIGHT_PROPERTIES,
-        SlotType::Import(SceneResource::LightProperties),
-        Access::Read,
-        Usage::Bound,
-    ),
+    super::GEOMETRY_READ,
+    super::LIGHT_GEOMETRY_READ,
+    super::LIGHT_PROPERTIES_READ,
     SlotSpec::new(
         slot::LIGHT_LISTS,
         SlotType::Buffer,
@@ -106,12 +90,7 @@ pub fn check(p: &ForwardShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         )),
         _ => {}
     }
-    if let (Some(mask), None) = (ctx.slot(SHADOW_MASK), ctx.slot(slot::LIGHT_LISTS)) {
-        errors.push(ctx.mismatch(
-            mask,
-            "the shadow mask numbers the lights of the culled lists it was made from: read them too (lights: Culled)",
-        ));
-    }
+    super::check_shadow_mask(ctx, errors);
     if let (Some(c), Some(d)) = (ctx.slot(slot::COLOR), ctx.slot(slot::DEPTH)) {
         let (cs, ds) = (ctx.samples(c), ctx.samples(d));
         if cs != ds {

@@ -5,7 +5,6 @@
 
 use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
-use crate::graph::model::SceneResource;
 
 pub const G_POSITION: &str = "g_position";
 pub const G_NORMAL: &str = "g_normal";
@@ -13,13 +12,7 @@ pub const G_NORMAL: &str = "g_normal";
 pub const G_GEOMETRIC: &str = "g_geometric";
 
 pub const SLOTS: &[SlotSpec] = &[
-    SlotSpec::new(
-        slot::GEOMETRY,
-        SlotType::Import(SceneResource::Geometry),
-        Access::Read,
-        Usage::Bound,
-    )
-    .optional(),
+    super::GEOMETRY_READ,
     SlotSpec::new(
         slot::DEPTH,
         SlotType::DepthTexture,

@@ -3,7 +3,7 @@
 
 use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
-use crate::graph::model::{CullVariant, SceneResource};
+use crate::graph::model::CullVariant;
 use crate::graph::plan::ListLayout;
 use serde::{Deserialize, Serialize};
 
@@ -44,12 +44,7 @@ pub const SLOTS: &[SlotSpec] = &[
         Access::Read,
         Usage::Sampled,
     ),
-    SlotSpec::new(
-        slot::LIGHT_GEOMETRY,
-        SlotType::Import(SceneResource::LightGeometry),
-        Access::Read,
-        Usage::Bound,
-    ),
+    super::LIGHT_GEOMETRY_READ,
     SlotSpec::new(
         slot::LIGHT_LISTS,
         SlotType::Buffer,

@@ -140,6 +140,28 @@ impl BufferLayout {
     }
 }
 
+/// Rows several kinds share: the scene's geometry (optional; drawn, never bound) and the
+/// two light arrays, read.
+pub const GEOMETRY_READ: SlotSpec = SlotSpec::new(
+    slot::GEOMETRY,
+    SlotType::Import(SceneResource::Geometry),
+    Access::Read,
+    Usage::Bound,
+)
+.optional();
+pub const LIGHT_GEOMETRY_READ: SlotSpec = SlotSpec::new(
+    slot::LIGHT_GEOMETRY,
+    SlotType::Import(SceneResource::LightGeometry),
+    Access::Read,
+    Usage::Bound,
+);
+pub const LIGHT_PROPERTIES_READ: SlotSpec = SlotSpec::new(
+    slot::LIGHT_PROPERTIES,
+    SlotType::Import(SceneResource::LightProperties),
+    Access::Read,
+    Usage::Bound,
+);
+
 /// The slot table of a built-in kind; `None` for generic kinds.
 pub fn slots(kind: &PassKind) -> Option<&'static [SlotSpec]> {
     Some(match kind {
@@ -339,6 +361,19 @@ pub(crate) fn resolve(
         Ok(roles)
     } else {
         Err(errors)
+    }
+}
+
+/// A shading pass that reads a shadow mask must read the culled lists it numbers.
+pub fn check_shadow_mask(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+    if let (Some(mask), None) = (
+        ctx.slot(shadow_ray_jobs::SHADOW_MASK),
+        ctx.slot(slot::LIGHT_LISTS),
+    ) {
+        errors.push(ctx.mismatch(
+            mask,
+            "the shadow mask numbers the lights of the culled lists it was made from: read them too (lights: Culled)",
+        ));
     }
 }
 

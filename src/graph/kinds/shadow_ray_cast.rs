@@ -5,7 +5,7 @@
 
 use super::g_buffer::{G_GEOMETRIC, G_POSITION};
 use super::shadow_ray_jobs::{SHADOW_JOBS, SHADOW_MASK};
-use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
+use super::{Access, KindCtx, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 use crate::graph::model::SceneResource;
 use serde::{Deserialize, Serialize};
@@ -44,12 +44,7 @@ pub const SLOTS: &[SlotSpec] = &[
         Access::Read,
         Usage::Sampled,
     ),
-    SlotSpec::new(
-        slot::LIGHT_GEOMETRY,
-        SlotType::Import(SceneResource::LightGeometry),
-        Access::Read,
-        Usage::Bound,
-    ),
+    super::LIGHT_GEOMETRY_READ,
     SlotSpec::new(
         BVH_NODES,
         SlotType::Import(SceneResource::BvhNodes),

@@ -6,7 +6,6 @@
 use super::g_buffer::{G_GEOMETRIC, G_POSITION};
 use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
-use crate::graph::model::SceneResource;
 use serde::{Deserialize, Serialize};
 
 /// `ShadowRayJobs(jobs_per_pixel: 16.0)`.
@@ -59,18 +58,8 @@ pub const SLOTS: &[SlotSpec] = &[
         Access::Read,
         Usage::Sampled,
     ),
-    SlotSpec::new(
-        slot::LIGHT_GEOMETRY,
-        SlotType::Import(SceneResource::LightGeometry),
-        Access::Read,
-        Usage::Bound,
-    ),
-    SlotSpec::new(
-        slot::LIGHT_PROPERTIES,
-        SlotType::Import(SceneResource::LightProperties),
-        Access::Read,
-        Usage::Bound,
-    ),
+    super::LIGHT_GEOMETRY_READ,
+    super::LIGHT_PROPERTIES_READ,
     SlotSpec::new(
         slot::LIGHT_LISTS,
         SlotType::Buffer,
