@@ -1,9 +1,9 @@
 //! `ShadowRayCast`: one invocation per job, dispatched indirectly from the dispatch the
 //! job pass wrote into the job buffer's header.
 
-use super::{defines, PrepareCtx, PreparedPass, Timestamps};
-use crate::graph::kinds::shadow_ray_jobs::{JOB_HEADER_WORDS, SHADOW_JOBS};
-use crate::graph::{PassKind, ScheduledPass, ShadowRayCast};
+use super::{defines, pass_error, PrepareCtx, PreparedPass, Timestamps};
+use crate::graph::kinds::shadow_ray_jobs::SHADOW_JOBS;
+use crate::graph::{BufferLayout, ScheduledPass, ShadowRayCast};
 use crate::render::pipelines::PipelineKey;
 use crate::render::RenderError;
 use std::collections::BTreeMap;
@@ -26,20 +26,16 @@ pub(super) fn prepare(
 ) -> Result<ShadowRayCastPass, RenderError> {
     let jobs_name = sp.required(SHADOW_JOBS);
     let jobs = cx.buffer(&sp.name, jobs_name)?;
-    // The job pass that writes this buffer decides its capacity.
-    let capacity = cx
-        .graph
-        .checked
-        .desc
-        .passes
-        .iter()
-        .find_map(|d| match &d.kind {
-            PassKind::ShadowRayJobs(j) if d.writes.iter().any(|w| w == jobs_name) => {
-                Some(j.capacity(cx.size.width, cx.size.height))
-            }
-            _ => None,
-        })
-        .unwrap_or_else(|| (jobs.size() / 4).saturating_sub(JOB_HEADER_WORDS) / 2);
+    // The job pass declared to write this buffer published its capacity on it.
+    let capacity = match cx.graph.plan.get(jobs_name).and_then(|r| r.layout) {
+        Some(BufferLayout::ShadowJobs { capacity }) => capacity,
+        _ => {
+            return Err(pass_error(
+                &sp.name,
+                format!("no ShadowRayJobs pass is declared to write '{jobs_name}'"),
+            ))
+        }
+    };
     let offered = cx.declared(sp)?;
     let key = PipelineKey {
         shader: "shadow/shadow_ray_cast.wgsl".into(),
