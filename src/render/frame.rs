@@ -237,8 +237,14 @@ impl PreparedFrame {
     pub fn render(&self, r: &Renderer) -> Result<FrameResult, RenderError> {
         let pass_ms = self.execute(r)?;
         let image = read_rgba32f(&r.ctx.device, &r.ctx.queue, self.output_texture())?;
-        let (culling, light_stats) = self.read_reports(r)?;
-        let shadows = self.read_shadow_reports(r)?;
+        let (mut culling, mut shadows) = (Vec::new(), Vec::new());
+        for report in self.pass_reports(r)? {
+            match report {
+                PassReport::Culling(c) => culling.push(c),
+                PassReport::Shadow(s) => shadows.push(s),
+            }
+        }
+        let light_stats = self.read_light_stats(r)?;
         Ok(FrameResult {
             width: self.size.width,
             height: self.size.height,
@@ -269,22 +275,35 @@ impl PreparedFrame {
                 culling.push(report);
             }
         }
-        let light_stats = match &self.stats {
-            Some(stats) => Some(stats.read(r)?),
-            None => None,
-        };
-        Ok((culling, light_stats))
+        Ok((culling, self.read_light_stats(r)?))
+    }
+
+    /// What every pass that counts something counted in the last executed frame.
+    fn pass_reports(&self, r: &Renderer) -> Result<Vec<PassReport>, RenderError> {
+        let mut out = Vec::new();
+        for (_, pass) in &self.passes {
+            out.extend(pass.report(r)?);
+        }
+        Ok(out)
+    }
+
+    fn read_light_stats(&self, r: &Renderer) -> Result<Option<LightStats>, RenderError> {
+        match &self.stats {
+            Some(stats) => Ok(Some(stats.read(r)?)),
+            None => Ok(None),
+        }
     }
 
     /// What the last executed frame's ray-cast shadow job passes counted.
     pub fn read_shadow_reports(&self, r: &Renderer) -> Result<Vec<ShadowReport>, RenderError> {
-        let mut out = Vec::new();
-        for (_, pass) in &self.passes {
-            if let Some(PassReport::Shadow(report)) = pass.report(r)? {
-                out.push(report);
-            }
-        }
-        Ok(out)
+        Ok(self
+            .pass_reports(r)?
+            .into_iter()
+            .filter_map(|report| match report {
+                PassReport::Shadow(s) => Some(s),
+                PassReport::Culling(_) => None,
+            })
+            .collect())
     }
 
     /// Errs when `name` shares its physical resource with one used after it: what a
