@@ -1,7 +1,7 @@
 //! Ray-cast shadows on the real adapter (lavapipe on CI), against references:
 //! - every job's mask bit equals an f64 brute-force ray over every triangle from the same
 //!   origin, except rays within 1e-4 of a triangle edge (counted);
-//! - each pixel gets exactly the jobs its reaching, facing casters ask for;
+//! - each pixel gets exactly the jobs its reaching, facing casters ask for (point and spot);
 //! - a quad over a floor: every floor pixel's shadow equals the quad projected from the light;
 //! - no self-shadowing at grazing light on flat and curved surfaces, and acne without the
 //!   normal offset (so the test can fail);
@@ -16,7 +16,7 @@ use glam::{DVec3, Vec3};
 use lightgraph::graph::{self, FrameSize};
 use lightgraph::render::{FrameResult, PreparedFrame, Renderer, SceneGpu};
 use lightgraph::scene::geometry::MeshBuilder;
-use lightgraph::scene::{light_flags, Camera, Light, Scene};
+use lightgraph::scene::{light_flags, Camera, Light, LightShape, Scene};
 use lightgraph::shader::ShaderLibrary;
 use lightgraph::shadow::reference::near_edge;
 use lightgraph::shadow::{scene_triangles_f64, Triangle64};
@@ -100,10 +100,21 @@ fn shadow_scene(lights: usize, seed: u64) -> Scene {
     let mut cyl = MeshBuilder::new("column", 1);
     cyl.cylinder(Vec3::new(2.5, 0.0, -2.0), 0.6, 3.0, 24, 4);
     meshes.push(cyl.build());
+    // Every third light a spot pointing down and about, so the reach test covers cones.
     let lights = (0..lights)
-        .map(|_| {
+        .map(|i| {
             let p = rng.vec3(Vec3::new(-6.0, 0.5, -10.0), Vec3::new(6.0, 5.0, 2.0));
-            caster(p, rng.range(4.0, 12.0), rng.range(2.0, 10.0))
+            let mut l = caster(p, rng.range(4.0, 12.0), rng.range(2.0, 10.0));
+            if i % 3 == 2 {
+                let direction =
+                    (rng.vec3(Vec3::splat(-0.6), Vec3::splat(0.6)) - Vec3::Y).normalize();
+                l.shape = LightShape::Spot {
+                    direction,
+                    inner_angle: 0.3,
+                    outer_angle: rng.range(0.5, 0.9),
+                };
+            }
+            l
         })
         .collect();
     Scene {
@@ -223,7 +234,7 @@ fn masks_equal_the_f64_reference_and_jobs_are_complete() {
     assert_eq!(report.jobs_wanted as usize, f.jobs.len());
     assert_eq!((report.jobs_dropped, report.overflow_pixels), (0, 0));
 
-    // Each pixel's jobs are exactly its facing casters in reach (point lights here).
+    // Each pixel's jobs are exactly its facing casters in reach (in range and cone).
     let mut jobs_at = vec![Vec::new(); (W * H) as usize];
     for &(p, l, c) in &f.jobs {
         jobs_at[p as usize].push((l, c));
@@ -238,23 +249,46 @@ fn masks_equal_the_f64_reference_and_jobs_are_complete() {
         let p = Vec3::new(g[0], g[1], g[2]);
         let n = f.geometric[pixel];
         let ng = Vec3::new(n[0], n[1], n[2]);
-        // Reach is decided in f32 by the shader; skip pixels on a light's range boundary.
-        if scene
-            .lights
-            .iter()
-            .any(|l| (l.position.distance(p) - l.range).abs() < 1e-3 * l.range)
-        {
+        // Reach is decided in f32 by the shader; skip pixels on a light's range or cone
+        // boundary.
+        let cone = |l: &Light| match l.shape {
+            LightShape::Point => None,
+            LightShape::Spot {
+                direction,
+                outer_angle,
+                ..
+            } => Some(direction.dot((p - l.position).normalize()) - outer_angle.cos()),
+        };
+        if scene.lights.iter().any(|l| {
+            (l.position.distance(p) - l.range).abs() < 1e-3 * l.range
+                || cone(l).is_some_and(|c| c.abs() < 1e-3)
+        }) {
             continue;
         }
         let mut want: Vec<u32> = (0..scene.lights.len() as u32)
             .filter(|&i| {
                 let l = &scene.lights[i as usize];
-                l.position.distance(p) < l.range && ng.dot(l.position - p) > 0.0
+                l.position.distance(p) < l.range
+                    && cone(l).is_none_or(|c| c > 0.0)
+                    && ng.dot(l.position - p) > 0.0
             })
             .collect();
         let mut got: Vec<u32> = jobs.iter().map(|j| j.0).collect();
         want.sort();
         got.sort();
+        if got != want {
+            for &i in want.iter().filter(|i| !got.contains(i)) {
+                let l = &scene.lights[i as usize];
+                eprintln!(
+                    "missing light {i}: {:?} dist {} range {} cone {:?} facing {}",
+                    l.shape,
+                    l.position.distance(p),
+                    l.range,
+                    cone(l),
+                    ng.dot(l.position - p)
+                );
+            }
+        }
         assert_eq!(got, want, "pixel {pixel}");
         // Caster numbers are distinct and below 128.
         let mut cs: Vec<u32> = jobs.iter().map(|j| j.1).collect();
