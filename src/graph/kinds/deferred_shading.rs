@@ -50,14 +50,11 @@ pub const SLOTS: &[SlotSpec] = &[
 pub fn check(p: &DeferredShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     check_light_source(ctx, p.lights, errors);
     super::check_shadow_mask(ctx, errors);
-    if let Some(name) = ctx.slot(HDR) {
-        if !ctx.is_single_rgba32f(name) {
-            errors.push(ctx.mismatch(
-                name,
-                "deferred shading stores into a single-sample Rgba32Float texture",
-            ));
-        }
-    }
+    ctx.require_single_rgba32f(
+        &[HDR],
+        "deferred shading stores into a single-sample Rgba32Float texture",
+        errors,
+    );
 }
 
 #[cfg(test)]

@@ -43,19 +43,31 @@ pub const SLOTS: &[SlotSpec] = &[
 ];
 
 pub fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
-    for s in [G_POSITION, G_NORMAL, G_GEOMETRIC] {
-        if let Some(name) = ctx.slot(s) {
-            if !ctx.is_single_rgba32f(name) {
-                errors.push(ctx.mismatch(name, "G-buffer textures are single-sample Rgba32Float"));
-            }
-        }
-    }
+    ctx.require_single_rgba32f(
+        &[G_POSITION, G_NORMAL, G_GEOMETRIC],
+        "G-buffer textures are single-sample Rgba32Float",
+        errors,
+    );
     if let Some(depth) = ctx.slot(slot::DEPTH) {
         if ctx.samples(depth) != 1 {
             errors.push(ctx.mismatch(depth, "the G-buffer is single-sample"));
         }
     }
 }
+
+/// Ray-cast shadows' reads of the unpacked G-buffer: world positions, geometric normals.
+pub const G_POSITION_READ: SlotSpec = SlotSpec::new(
+    G_POSITION,
+    SlotType::ColorTexture,
+    Access::Read,
+    Usage::Sampled,
+);
+pub const G_GEOMETRIC_READ: SlotSpec = SlotSpec::new(
+    G_GEOMETRIC,
+    SlotType::ColorTexture,
+    Access::Read,
+    Usage::Sampled,
+);
 
 /// Whether the pass writes the packed layout (one texture: no normals of either kind).
 pub fn packed(roles: &crate::graph::PassRoles) -> bool {

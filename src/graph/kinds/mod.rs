@@ -234,6 +234,22 @@ impl KindCtx<'_> {
             _ => 1,
         }
     }
+    /// Reports each filled slot of `slots` whose texture is not single-sample
+    /// Rgba32Float, with `problem`.
+    pub fn require_single_rgba32f(
+        &self,
+        slots: &[&str],
+        problem: &str,
+        errors: &mut Vec<GraphError>,
+    ) {
+        for s in slots {
+            if let Some(name) = self.slot(s) {
+                if !self.is_single_rgba32f(name) {
+                    errors.push(self.mismatch(name, problem));
+                }
+            }
+        }
+    }
     pub fn is_single_rgba32f(&self, name: &str) -> bool {
         matches!(
             self.graph.resources.get(name),

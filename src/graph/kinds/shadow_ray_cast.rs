@@ -3,7 +3,7 @@
 //! normal; a hit sets the light's bit in the pixel's mask. Runs
 //! `shaders/shadow/shadow_ray_cast.wgsl`.
 
-use super::g_buffer::{G_GEOMETRIC, G_POSITION};
+use super::g_buffer::{G_GEOMETRIC_READ, G_POSITION_READ};
 use super::shadow_ray_jobs::{SHADOW_JOBS, SHADOW_MASK};
 use super::{Access, KindCtx, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
@@ -32,18 +32,8 @@ pub const BVH_TRIANGLES: &str = "bvh_triangles";
 
 pub const SLOTS: &[SlotSpec] = &[
     SlotSpec::new(SHADOW_JOBS, SlotType::Buffer, Access::Read, Usage::Bound),
-    SlotSpec::new(
-        G_POSITION,
-        SlotType::ColorTexture,
-        Access::Read,
-        Usage::Sampled,
-    ),
-    SlotSpec::new(
-        G_GEOMETRIC,
-        SlotType::ColorTexture,
-        Access::Read,
-        Usage::Sampled,
-    ),
+    G_POSITION_READ,
+    G_GEOMETRIC_READ,
     super::LIGHT_GEOMETRY_READ,
     SlotSpec::new(
         BVH_NODES,

@@ -3,7 +3,7 @@
 //! casting pass's indirect dispatch and clears each pixel's hit mask. Runs
 //! `shaders/shadow/shadow_ray_jobs.wgsl`.
 
-use super::g_buffer::{G_GEOMETRIC, G_POSITION};
+use super::g_buffer::{G_GEOMETRIC, G_GEOMETRIC_READ, G_POSITION, G_POSITION_READ};
 use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 use serde::{Deserialize, Serialize};
@@ -46,18 +46,8 @@ pub fn job_buffer_bytes(capacity: u64) -> u64 {
 }
 
 pub const SLOTS: &[SlotSpec] = &[
-    SlotSpec::new(
-        G_POSITION,
-        SlotType::ColorTexture,
-        Access::Read,
-        Usage::Sampled,
-    ),
-    SlotSpec::new(
-        G_GEOMETRIC,
-        SlotType::ColorTexture,
-        Access::Read,
-        Usage::Sampled,
-    ),
+    G_POSITION_READ,
+    G_GEOMETRIC_READ,
     super::LIGHT_GEOMETRY_READ,
     super::LIGHT_PROPERTIES_READ,
     SlotSpec::new(
@@ -77,16 +67,11 @@ pub fn check(p: &ShadowRayJobs, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
             p.jobs_per_pixel
         )));
     }
-    for s in [G_POSITION, G_GEOMETRIC] {
-        if let Some(name) = ctx.slot(s) {
-            if !ctx.is_single_rgba32f(name) {
-                errors.push(ctx.mismatch(
-                    name,
-                    "ray-cast shadows read world positions and geometric normals from single-sample Rgba32Float G-buffer textures (not the packed G-buffer)",
-                ));
-            }
-        }
-    }
+    ctx.require_single_rgba32f(
+        &[G_POSITION, G_GEOMETRIC],
+        "ray-cast shadows read world positions and geometric normals from single-sample Rgba32Float G-buffer textures (not the packed G-buffer)",
+        errors,
+    );
 }
 
 #[cfg(test)]
