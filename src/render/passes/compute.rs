@@ -46,16 +46,7 @@ pub(super) fn prepare(
     let Pipeline::Compute(pipeline) = pipeline else {
         return Err(pass_error(&sp.name, "expected a compute pipeline".into()));
     };
-    let offered = generic_bindings(cx, sp)?;
-    let bind = offered
-        .bind(
-            &device,
-            &sp.name,
-            &pipeline.get_bind_group_layout(0),
-            &bindings,
-            0,
-        )
-        .map_err(|m| pass_error(&sp.name, m))?;
+    let bind = bind_generic(cx, sp, &pipeline.get_bind_group_layout(0), &bindings)?;
     let size = cx.size;
     let groups = match d {
         Dispatch::PerPixel { workgroup: (x, y) } => [
@@ -81,11 +72,14 @@ pub(super) fn prepare(
     })
 }
 
-/// A generic pass's declared resources plus the samplers every generic shader may use.
-pub(super) fn generic_bindings(
+/// A generic pass's group 0 on the auto-derived `layout`: its declared resources plus the
+/// samplers every generic shader may use, by reflected name.
+pub(super) fn bind_generic(
     cx: &PrepareCtx,
     sp: &ScheduledPass,
-) -> Result<crate::render::bind::BindingSet, RenderError> {
+    layout: &wgpu::BindGroupLayout,
+    bindings: &[crate::shader::ReflectedBinding],
+) -> Result<wgpu::BindGroup, RenderError> {
     let device = &cx.renderer.ctx.device;
     let mut set = cx.declared(sp)?;
     set.offer(
@@ -101,7 +95,8 @@ pub(super) fn generic_bindings(
         "nearest_sampler",
         Bound::Sampler(device.create_sampler(&Default::default())),
     );
-    Ok(set)
+    set.bind(device, &sp.name, layout, bindings, 0)
+        .map_err(|m| pass_error(&sp.name, m))
 }
 
 impl PreparedPass for ComputePass {

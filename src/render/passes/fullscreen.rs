@@ -1,7 +1,7 @@
 //! `Fullscreen`: a fragment shader the graph names over a full-screen triangle, into
 //! the pass's one render target; bound by reflected binding names (auto layout).
 
-use super::compute::generic_bindings;
+use super::compute::bind_generic;
 use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::{ResourceDesc, ScheduledPass};
 use crate::render::draws::color_attachment;
@@ -97,16 +97,7 @@ pub(super) fn prepare(
     let Pipeline::Render(pipeline) = pipeline else {
         return Err(pass_error(&sp.name, "expected a render pipeline".into()));
     };
-    let offered = generic_bindings(cx, sp)?;
-    let bind = offered
-        .bind(
-            &device,
-            &sp.name,
-            &pipeline.get_bind_group_layout(0),
-            &bindings,
-            0,
-        )
-        .map_err(|m| pass_error(&sp.name, m))?;
+    let bind = bind_generic(cx, sp, &pipeline.get_bind_group_layout(0), &bindings)?;
     Ok(FullscreenPass {
         name: sp.name.clone(),
         pipeline,
