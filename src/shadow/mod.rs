@@ -12,6 +12,7 @@
 //! open; `dir` need not be unit length, `t` is in units of `dir`). Offsetting the origin
 //! off the surface is the caller's job.
 
+pub mod atlas;
 pub mod bvh;
 pub mod reference;
 mod traverse;

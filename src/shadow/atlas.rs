@@ -1,0 +1,514 @@
+//! The shadow atlas's allocation, CPU side: which shadow-casting lights get a shadow
+//! map this frame, how large, where in the atlas, and each view's projection.
+//!
+//! Policy (after Unity URP's, with the drops reported instead of silent):
+//! - every shadow-casting light whose range sphere touches the camera's frustum asks for
+//!   a square tile of its screen-space diameter × `importance`, rounded up to a power of
+//!   two and clamped to `[min_tile, max_tile]`; a point light (or a spot wider than
+//!   [`CUBE_SPOT_ANGLE`]) asks for six such faces;
+//! - requests are ranked: larger first, then spot before point, then nearer the camera,
+//!   then by light index (so the same view always allocates the same way);
+//! - past `max_lights`, the lowest ranked are dropped; then, while the tiles' total area
+//!   exceeds the atlas, every tile above `min_tile` is halved; when all are at
+//!   `min_tile`, the lowest ranked light is dropped instead;
+//! - tiles are placed in Morton order in decreasing size, which packs power-of-two
+//!   squares without gaps, so a set fits exactly when its area does.
+//!
+//! Cube faces are rendered with a field of view widened by [`GUARD_TEXELS`] on every
+//! side, so a 5×5 filter around any point of a face's inner 90° stays on that face.
+
+use crate::scene::{Camera, Light, LightShape};
+use glam::{Mat4, Vec3, Vec4};
+
+/// Texels of each cube face (and spot tile) rendered beyond its inner field of view:
+/// the 5×5 filter reaches 2 texels out, plus one for the bilinear comparison.
+pub const GUARD_TEXELS: u32 = 3;
+/// Spot lights whose outer cone half-angle exceeds this take six faces like a point
+/// light: one perspective tile loses too much resolution towards the rim of a wide cone.
+pub const CUBE_SPOT_ANGLE: f32 = std::f32::consts::FRAC_PI_3;
+/// The light's near plane as a fraction of its range.
+pub const NEAR_FRACTION: f32 = 0.002;
+
+/// The allocator's knobs (the ShadowAtlas pass's parameters and its texture's size).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AtlasConfig {
+    /// The atlas's side in texels (a power of two).
+    pub size: u32,
+    pub min_tile: u32,
+    pub max_tile: u32,
+    pub importance: f32,
+    pub max_lights: u32,
+}
+
+/// One rendered view: a square tile of the atlas and the projection that fills it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AtlasView {
+    pub light: u32,
+    /// Cube face (0 +X, 1 −X, 2 +Y, 3 −Y, 4 +Z, 5 −Z), or 0 for a spot tile.
+    pub face: u8,
+    /// Top-left texel and side.
+    pub x: u32,
+    pub y: u32,
+    pub tile: u32,
+    pub view_proj: Mat4,
+    /// World size of one texel at unit distance along the view axis.
+    pub texel_scale: f32,
+}
+
+/// A shadowed light: its first view and whether it has six.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AtlasLight {
+    pub light: u32,
+    pub first_view: u32,
+    pub cube: bool,
+    pub tile: u32,
+}
+
+/// Why a shadow-casting light in view got no shadow this frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DropReason {
+    /// Past the pass's `max_lights`.
+    MaxLights,
+    /// No room at the minimum tile size.
+    NoRoom,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DroppedLight {
+    pub light: u32,
+    /// The tile side it asked for before any halving.
+    pub wanted: u32,
+    pub reason: DropReason,
+}
+
+/// One frame's allocation.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Allocation {
+    pub views: Vec<AtlasView>,
+    pub lights: Vec<AtlasLight>,
+    pub dropped: Vec<DroppedLight>,
+    /// Shadow-casting lights whose range does not reach the camera's frustum.
+    pub off_screen: u32,
+    /// How many times the tiles were halved to fit.
+    pub halvings: u32,
+    /// Texels covered by tiles.
+    pub used_texels: u64,
+}
+
+struct Request {
+    light: u32,
+    cube: bool,
+    spot: bool,
+    wanted: u32,
+    tile: u32,
+    distance: f32,
+}
+
+impl Request {
+    fn area(&self) -> u64 {
+        let faces = if self.cube { 6 } else { 1 };
+        faces * self.tile as u64 * self.tile as u64
+    }
+}
+
+/// The planes of a view-projection's frustum (wgpu depth 0..1), inward-facing, each
+/// `(n, d)` with `n·p + d >= 0` inside.
+pub fn frustum_planes(view_proj: Mat4) -> [Vec4; 6] {
+    let r = [
+        view_proj.row(0),
+        view_proj.row(1),
+        view_proj.row(2),
+        view_proj.row(3),
+    ];
+    let planes = [
+        r[3] + r[0],
+        r[3] - r[0],
+        r[3] + r[1],
+        r[3] - r[1],
+        r[2],
+        r[3] - r[2],
+    ];
+    planes.map(|p| p / p.truncate().length().max(f32::MIN_POSITIVE))
+}
+
+/// Whether a sphere touches the frustum (conservative near the corners).
+pub fn sphere_in_frustum(planes: &[Vec4; 6], center: Vec3, radius: f32) -> bool {
+    planes
+        .iter()
+        .all(|p| p.truncate().dot(center) + p.w >= -radius)
+}
+
+/// Whether an axis-aligned box touches the frustum (conservative near the corners).
+pub fn box_in_frustum(planes: &[Vec4; 6], min: Vec3, max: Vec3) -> bool {
+    planes.iter().all(|p| {
+        let n = p.truncate();
+        let corner = Vec3::select(n.cmpge(Vec3::ZERO), max, min);
+        n.dot(corner) + p.w >= 0.0
+    })
+}
+
+/// The light's diameter on screen in pixels (the frame's height when the camera is
+/// inside its range).
+fn screen_size(light: &Light, camera: &Camera, height: u32) -> f32 {
+    let d = light.position.distance(camera.eye);
+    if d <= light.range {
+        return height as f32;
+    }
+    let half_angle = (light.range / d).asin();
+    let px = half_angle.tan() / (camera.fov_y * 0.5).tan() * height as f32;
+    px.min(height as f32)
+}
+
+fn is_cube(light: &Light) -> bool {
+    match light.shape {
+        LightShape::Point => true,
+        LightShape::Spot { outer_angle, .. } => outer_angle > CUBE_SPOT_ANGLE,
+    }
+}
+
+/// Allocates the atlas for every light with `CASTS_SHADOW` seen from `camera` rendering
+/// `width`×`height`.
+pub fn allocate(
+    lights: &[Light],
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    cfg: &AtlasConfig,
+) -> Allocation {
+    let aspect = width as f32 / height.max(1) as f32;
+    let planes = frustum_planes(camera.projection(aspect) * camera.view());
+    let mut out = Allocation::default();
+    let mut requests = Vec::new();
+    for (i, l) in lights.iter().enumerate() {
+        if l.flags & crate::scene::light_flags::CASTS_SHADOW == 0 {
+            continue;
+        }
+        if !sphere_in_frustum(&planes, l.position, l.range) {
+            out.off_screen += 1;
+            continue;
+        }
+        let size = (screen_size(l, camera, height) * cfg.importance).ceil();
+        let wanted = (size.max(1.0) as u32)
+            .checked_next_power_of_two()
+            .unwrap_or(cfg.max_tile)
+            .clamp(cfg.min_tile, cfg.max_tile);
+        requests.push(Request {
+            light: i as u32,
+            cube: is_cube(l),
+            spot: matches!(l.shape, LightShape::Spot { .. }),
+            wanted,
+            tile: wanted,
+            distance: l.position.distance(camera.eye),
+        });
+    }
+    requests.sort_by(|a, b| {
+        b.wanted
+            .cmp(&a.wanted)
+            .then(b.spot.cmp(&a.spot))
+            .then(a.distance.total_cmp(&b.distance))
+            .then(a.light.cmp(&b.light))
+    });
+    let drop = |r: Request, reason, out: &mut Allocation| {
+        out.dropped.push(DroppedLight {
+            light: r.light,
+            wanted: r.wanted,
+            reason,
+        })
+    };
+    while requests.len() > cfg.max_lights as usize {
+        let r = requests.pop().expect("longer than max_lights");
+        drop(r, DropReason::MaxLights, &mut out);
+    }
+    let capacity = cfg.size as u64 * cfg.size as u64;
+    while requests.iter().map(Request::area).sum::<u64>() > capacity {
+        if requests.iter().any(|r| r.tile > cfg.min_tile) {
+            for r in requests.iter_mut().filter(|r| r.tile > cfg.min_tile) {
+                r.tile /= 2;
+            }
+            out.halvings += 1;
+        } else {
+            let r = requests.pop().expect("over capacity with requests left");
+            drop(r, DropReason::NoRoom, &mut out);
+        }
+    }
+    // Halving keeps the ranking's order of sizes, so tiles come in decreasing size.
+    let mut cursor = 0u64; // in min_tile cells, Morton order
+    for r in &requests {
+        let l = &lights[r.light as usize];
+        let cells = (r.tile / cfg.min_tile) as u64;
+        let faces = if r.cube { 6 } else { 1 };
+        out.lights.push(AtlasLight {
+            light: r.light,
+            first_view: out.views.len() as u32,
+            cube: r.cube,
+            tile: r.tile,
+        });
+        for face in 0..faces {
+            let (cx, cy) = morton_decode(cursor);
+            cursor += cells * cells;
+            let (view_proj, texel_scale) = view_projection(l, r.cube, face, r.tile);
+            out.views.push(AtlasView {
+                light: r.light,
+                face,
+                x: cx * cfg.min_tile,
+                y: cy * cfg.min_tile,
+                tile: r.tile,
+                view_proj,
+                texel_scale,
+            });
+        }
+        out.used_texels += r.area();
+    }
+    out
+}
+
+/// The (x, y) cell of Morton index `i` (x in the even bits).
+fn morton_decode(i: u64) -> (u32, u32) {
+    fn compact(mut v: u64) -> u32 {
+        v &= 0x5555_5555_5555_5555;
+        v = (v | (v >> 1)) & 0x3333_3333_3333_3333;
+        v = (v | (v >> 2)) & 0x0f0f_0f0f_0f0f_0f0f;
+        v = (v | (v >> 4)) & 0x00ff_00ff_00ff_00ff;
+        v = (v | (v >> 8)) & 0x0000_ffff_0000_ffff;
+        v = (v | (v >> 16)) & 0x0000_0000_ffff_ffff;
+        v as u32
+    }
+    (compact(i), compact(i >> 1))
+}
+
+/// Cube face directions and ups, in face order.
+const FACES: [(Vec3, Vec3); 6] = [
+    (Vec3::X, Vec3::NEG_Y),
+    (Vec3::NEG_X, Vec3::NEG_Y),
+    (Vec3::Y, Vec3::Z),
+    (Vec3::NEG_Y, Vec3::NEG_Z),
+    (Vec3::Z, Vec3::NEG_Y),
+    (Vec3::NEG_Z, Vec3::NEG_Y),
+];
+
+/// The face a direction from the light falls on: its major axis (ties to the lower
+/// face, as the shader picks).
+pub fn cube_face(d: Vec3) -> u8 {
+    let a = d.abs();
+    if a.x >= a.y && a.x >= a.z {
+        if d.x >= 0.0 {
+            0
+        } else {
+            1
+        }
+    } else if a.y >= a.z {
+        if d.y >= 0.0 {
+            2
+        } else {
+            3
+        }
+    } else if d.z >= 0.0 {
+        4
+    } else {
+        5
+    }
+}
+
+/// A view's projection and the world size of a texel at unit distance.
+fn view_projection(light: &Light, cube: bool, face: u8, tile: u32) -> (Mat4, f32) {
+    let (dir, up, half) = if cube {
+        let (dir, up) = FACES[face as usize];
+        (dir, up, std::f32::consts::FRAC_PI_4)
+    } else {
+        let LightShape::Spot {
+            direction,
+            outer_angle,
+            ..
+        } = light.shape
+        else {
+            unreachable!("a point light is always a cube")
+        };
+        let dir = direction.normalize_or(Vec3::NEG_Y);
+        let up = if dir.y.abs() > 0.9 { Vec3::Z } else { Vec3::Y };
+        (dir, up, outer_angle.max(1e-3))
+    };
+    // The inner field of view covers tile − 2·guard texels; the guard is extra.
+    let inner = (tile.saturating_sub(2 * GUARD_TEXELS)).max(1) as f32;
+    let tan_half = half.tan() * tile as f32 / inner;
+    let near = light.range * NEAR_FRACTION;
+    let proj = Mat4::perspective_rh(2.0 * tan_half.atan(), 1.0, near, light.range);
+    let view = Mat4::look_to_rh(light.position, dir, up);
+    (proj * view, 2.0 * tan_half / tile as f32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::light_flags::CASTS_SHADOW;
+
+    fn caster(position: Vec3, range: f32) -> Light {
+        Light {
+            flags: CASTS_SHADOW,
+            ..Light::point(position, range, Vec3::ONE, 1.0)
+        }
+    }
+
+    fn spot(position: Vec3, range: f32) -> Light {
+        Light {
+            shape: LightShape::Spot {
+                direction: Vec3::NEG_Y,
+                inner_angle: 0.3,
+                outer_angle: 0.5,
+            },
+            ..caster(position, range)
+        }
+    }
+
+    fn camera() -> Camera {
+        Camera {
+            eye: Vec3::new(0.0, 2.0, 20.0),
+            target: Vec3::ZERO,
+            ..Default::default()
+        }
+    }
+
+    fn cfg(size: u32) -> AtlasConfig {
+        AtlasConfig {
+            size,
+            min_tile: 16,
+            max_tile: 1024,
+            importance: 1.0,
+            max_lights: 512,
+        }
+    }
+
+    fn check_packing(a: &Allocation, size: u32) {
+        for (i, v) in a.views.iter().enumerate() {
+            assert!(v.x + v.tile <= size && v.y + v.tile <= size, "{v:?}");
+            for w in &a.views[..i] {
+                let apart = v.x + v.tile <= w.x
+                    || w.x + w.tile <= v.x
+                    || v.y + v.tile <= w.y
+                    || w.y + w.tile <= v.y;
+                assert!(apart, "{v:?} overlaps {w:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn packs_without_overlap_and_ranks_spots_first() {
+        let mut lights: Vec<Light> = (0..12)
+            .map(|i| caster(Vec3::new(i as f32 - 6.0, 1.0, 0.0), 2.0))
+            .collect();
+        lights.extend((0..12).map(|i| spot(Vec3::new(i as f32 - 6.0, 3.0, -2.0), 2.0)));
+        let a = allocate(&lights, &camera(), 1920, 1080, &cfg(4096));
+        assert_eq!(a.lights.len(), 24);
+        assert_eq!(a.views.len(), 12 * 6 + 12);
+        assert!(a.dropped.is_empty());
+        check_packing(&a, 4096);
+        // Same size: spots rank first.
+        let first = &lights[a.lights[0].light as usize];
+        assert!(matches!(first.shape, LightShape::Spot { .. }));
+        // Deterministic for the same view.
+        assert_eq!(a, allocate(&lights, &camera(), 1920, 1080, &cfg(4096)));
+    }
+
+    #[test]
+    fn halves_then_drops_and_reports() {
+        let lights: Vec<Light> = (0..50)
+            .map(|i| caster(Vec3::new(i as f32 * 0.5 - 12.5, 1.0, 5.0), 3.0))
+            .collect();
+        let big = allocate(&lights, &camera(), 1920, 1080, &cfg(16384));
+        assert!(big.dropped.is_empty());
+        let small = allocate(&lights, &camera(), 1920, 1080, &cfg(256));
+        assert!(small.halvings > 0);
+        // 256² holds 256 min tiles: 42 point lights of six faces at 16 texels.
+        assert_eq!(small.lights.len(), 256 / 6);
+        assert_eq!(small.dropped.len(), 50 - 256 / 6);
+        assert!(small
+            .dropped
+            .iter()
+            .all(|d| d.reason == DropReason::NoRoom && d.wanted >= 16));
+        assert!(small.views.iter().all(|v| v.tile == 16));
+        check_packing(&small, 256);
+        // The kept ones are the highest ranked: the nearest to the camera.
+        let far = |l: u32| lights[l as usize].position.distance(camera().eye);
+        let kept_max = small
+            .lights
+            .iter()
+            .map(|l| far(l.light))
+            .fold(0.0, f32::max);
+        let dropped_min = small
+            .dropped
+            .iter()
+            .map(|d| far(d.light))
+            .fold(f32::MAX, f32::min);
+        assert!(kept_max <= dropped_min);
+        let capped = allocate(
+            &lights,
+            &camera(),
+            1920,
+            1080,
+            &AtlasConfig {
+                max_lights: 5,
+                ..cfg(16384)
+            },
+        );
+        assert_eq!(capped.lights.len(), 5);
+        assert_eq!(capped.dropped.len(), 45);
+        assert!(capped
+            .dropped
+            .iter()
+            .all(|d| d.reason == DropReason::MaxLights));
+    }
+
+    #[test]
+    fn off_screen_and_unflagged_lights_ask_for_nothing() {
+        let lights = vec![
+            caster(Vec3::new(0.0, 0.0, 40.0), 1.0), // behind the camera
+            Light::point(Vec3::ZERO, 3.0, Vec3::ONE, 1.0),
+            caster(Vec3::ZERO, 3.0),
+        ];
+        let a = allocate(&lights, &camera(), 640, 360, &cfg(2048));
+        assert_eq!(a.off_screen, 1);
+        assert_eq!(a.lights.len(), 1);
+        assert_eq!(a.lights[0].light, 2);
+    }
+
+    #[test]
+    fn tiles_follow_screen_size_and_importance() {
+        let near = caster(Vec3::new(0.0, 0.0, 15.0), 2.0);
+        let far = caster(Vec3::new(0.0, 0.0, -40.0), 2.0);
+        let a = allocate(&[near, far], &camera(), 1920, 1080, &cfg(16384));
+        let tile = |l: u32| a.lights.iter().find(|x| x.light == l).unwrap().tile;
+        assert!(tile(0) > tile(1), "{:?}", a.lights);
+        let half = allocate(
+            &[near, far],
+            &camera(),
+            1920,
+            1080,
+            &AtlasConfig {
+                importance: 0.5,
+                ..cfg(16384)
+            },
+        );
+        assert_eq!(half.lights[0].tile * 2, a.lights[0].tile);
+    }
+
+    #[test]
+    fn cube_faces_cover_their_axis_with_a_guard_band() {
+        let l = caster(Vec3::new(1.0, 2.0, 3.0), 5.0);
+        for face in 0..6u8 {
+            let (m, _) = view_projection(&l, true, face, 64);
+            let (dir, _) = FACES[face as usize];
+            assert_eq!(cube_face(dir), face);
+            // A point at the inner 45° edge lands GUARD_TEXELS inside the tile's edge.
+            let side = if dir.x != 0.0 { Vec3::Y } else { Vec3::X };
+            let p = l.position + dir + side;
+            let ndc = m.project_point3(p);
+            let edge_texels = (1.0 - ndc.x.abs().max(ndc.y.abs())) * 32.0;
+            assert!(
+                (edge_texels - GUARD_TEXELS as f32).abs() < 1e-3,
+                "face {face}: {edge_texels}"
+            );
+            let center = m.project_point3(l.position + dir * 2.0);
+            assert!(center.x.abs() < 1e-5 && center.y.abs() < 1e-5);
+            assert!(center.z > 0.0 && center.z < 1.0);
+        }
+    }
+}
