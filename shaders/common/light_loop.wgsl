@@ -16,13 +16,13 @@ fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f
 #if SHADOWS
         let g = light_geometry[i];
         let inc = incident_light(g, props, p.position);
-        var lit = any(inc.radiance > vec3<f32>(0.0));
-        if (lit && (props.flags & LIGHT_CASTS_SHADOW) != 0u) {
-            lit = shadow_visible(pixel_index, caster, g.position, p.position);
+        var visibility = select(0.0, 1.0, any(inc.radiance > vec3<f32>(0.0)));
+        if (visibility > 0.0 && (props.flags & LIGHT_CASTS_SHADOW) != 0u) {
+            visibility = shadow_visibility(pixel_index, caster, i, g.position, p);
             caster += 1u;
         }
-        if (lit && (props.material_mask & MATERIAL_TYPE_BIT) != 0u) {
-            color += inc.radiance * material_eval(m, inc.dir);
+        if (visibility > 0.0 && (props.material_mask & MATERIAL_TYPE_BIT) != 0u) {
+            color += (visibility * inc.radiance) * material_eval(m, inc.dir);
         }
 #else
         if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {

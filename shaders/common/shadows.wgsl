@@ -8,8 +8,13 @@
 // unshadowed and counted by job creation (ShadowReport::overflow_pixels).
 //
 // Defines: SHADOW_NORMAL_OFFSET (origin offset along the geometric normal, relative to
-// the position's magnitude), and in the light loop SHADOW_MASK (read the mask) or
-// SHADOW_TRACE (cast in the loop: the naive variant; needs the BVH and `shadow_ng`).
+// the position's magnitude), and in the light loop SHADOW_MASK (read the mask),
+// SHADOW_TRACE (cast in the loop: the naive variant; needs the BVH and `shadow_ng`) or
+// SHADOW_ATLAS (sample a ShadowAtlas pass's depth atlas, with SHADOW_PCF5 for the 5×5
+// filter, else one 2×2 hardware-comparison tap).
+//
+// The light loop asks `shadow_visibility` for the fraction of light that reaches p:
+// 0 or 1 from the mask and the tracer, filtered from the atlas.
 
 const LIGHT_CASTS_SHADOW: u32 = 1u;
 const SHADOW_MAX_CASTERS: u32 = 128u;
@@ -30,6 +35,10 @@ fn shadow_faces(p: vec3<f32>, ng: vec3<f32>, light_pos: vec3<f32>) -> bool {
 }
 
 #if SHADOW_MASK
+fn shadow_visibility(pixel_index: u32, caster: u32, light: u32, light_pos: vec3<f32>, p: ShadingPoint) -> f32 {
+    return select(0.0, 1.0, shadow_visible(pixel_index, caster, light_pos, p.position));
+}
+
 fn shadow_visible(pixel_index: u32, caster: u32, light_pos: vec3<f32>, p: vec3<f32>) -> bool {
     if (caster >= SHADOW_MAX_CASTERS) {
         return true;
@@ -43,11 +52,86 @@ fn shadow_visible(pixel_index: u32, caster: u32, light_pos: vec3<f32>, p: vec3<f
 // The fragment's geometric normal, set by the fragment shader before shading.
 var<private> shadow_ng: vec3<f32>;
 
+fn shadow_visibility(pixel_index: u32, caster: u32, light: u32, light_pos: vec3<f32>, p: ShadingPoint) -> f32 {
+    return select(0.0, 1.0, shadow_visible(pixel_index, caster, light_pos, p.position));
+}
+
 fn shadow_visible(pixel_index: u32, caster: u32, light_pos: vec3<f32>, p: vec3<f32>) -> bool {
     if (!shadow_faces(p, shadow_ng, light_pos)) {
         return false;
     }
     let origin = shadow_origin(p, shadow_ng);
     return !bvh_occluded(origin, light_pos - origin, 1.0);
+}
+#endif
+
+#if SHADOW_ATLAS
+// The view table (src/graph/kinds/shadow_atlas.rs): a header (views, atlas side, lights,
+// room for views), per view its view-projection, its tile in atlas UV (min, max) and
+// (texel size at unit distance, normal offset in texels); then per light its first
+// view + 1 (0: no shadow map this frame), bit 31 set for six cube faces.
+const SHADOW_VIEW_VEC4S: u32 = 6u;
+const SHADOW_CUBE_BIT: u32 = 0x80000000u;
+
+// The cube face a direction from the light falls on (src/shadow/atlas.rs: cube_face).
+fn shadow_cube_face(d: vec3<f32>) -> u32 {
+    let a = abs(d);
+    if (a.x >= a.y && a.x >= a.z) {
+        return select(1u, 0u, d.x >= 0.0);
+    }
+    if (a.y >= a.z) {
+        return select(3u, 2u, d.y >= 0.0);
+    }
+    return select(5u, 4u, d.z >= 0.0);
+}
+
+fn shadow_visibility(pixel_index: u32, caster: u32, light: u32, light_pos: vec3<f32>, p: ShadingPoint) -> f32 {
+    let header = bitcast<vec4<u32>>(shadow_views[0]);
+    let table = 1u + SHADOW_VIEW_VEC4S * header.w;
+    let entry = bitcast<u32>(shadow_views[table + light / 4u][light % 4u]);
+    if (entry == 0u) {
+        return 1.0;
+    }
+    let first = (entry & ~SHADOW_CUBE_BIT) - 1u;
+    let cube = (entry & SHADOW_CUBE_BIT) != 0u;
+    // Off the surface by a few texels of the view the point falls in: a texel's world
+    // size grows with the distance from the light.
+    var base = 1u + SHADOW_VIEW_VEC4S * first;
+    let dist = length(p.position - light_pos);
+    let offset = shadow_views[base + 5u].y * shadow_views[base + 5u].x * dist;
+    let q = p.position + p.normal * offset;
+    if (cube) {
+        base += SHADOW_VIEW_VEC4S * shadow_cube_face(q - light_pos);
+    }
+    let view_proj = mat4x4<f32>(
+        shadow_views[base],
+        shadow_views[base + 1u],
+        shadow_views[base + 2u],
+        shadow_views[base + 3u],
+    );
+    let tile = shadow_views[base + 4u];
+    let clip = view_proj * vec4<f32>(q, 1.0);
+    if (clip.w <= 0.0) {
+        return 1.0;
+    }
+    let ndc = clip.xyz / clip.w;
+    let uv = mix(tile.xy, tile.zw, vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5));
+    // Every tap stays half a texel inside the light's own tile, so the comparison's
+    // 2×2 footprint never reads a neighbour's depths.
+    let texel = 1.0 / f32(header.y);
+    let lo = tile.xy + vec2<f32>(0.5 * texel);
+    let hi = tile.zw - vec2<f32>(0.5 * texel);
+#if SHADOW_PCF5
+    var sum = 0.0;
+    for (var j = -2; j <= 2; j++) {
+        for (var i = -2; i <= 2; i++) {
+            let t = clamp(uv + vec2<f32>(f32(i), f32(j)) * texel, lo, hi);
+            sum += textureSampleCompareLevel(shadow_atlas, shadow_sampler, t, ndc.z);
+        }
+    }
+    return sum / 25.0;
+#else
+    return textureSampleCompareLevel(shadow_atlas, shadow_sampler, clamp(uv, lo, hi), ndc.z);
+#endif
 }
 #endif

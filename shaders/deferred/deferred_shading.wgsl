@@ -5,7 +5,7 @@
 // With G_PACKED the G-buffer is one texture: view depth, octahedral normal, material;
 // the position is rebuilt on the pixel's view ray.
 // Defines: MATERIAL_INDEX, LIGHT_LISTS, G_PACKED, SHADOWS with SHADOW_MASK (ray-cast
-// shadows from shadow/shadow_ray_cast.wgsl).
+// shadows from shadow/shadow_ray_cast.wgsl) or SHADOW_ATLAS (a ShadowAtlas pass's maps).
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"
@@ -28,6 +28,11 @@
 #include "common/light_lists.wgsl"
 #if SHADOW_MASK
 @group(0) @binding(8) var<storage, read> shadow_mask: array<u32>;
+#endif
+#if SHADOW_ATLAS
+@group(0) @binding(9) var<storage, read> shadow_views: array<vec4<f32>>;
+@group(0) @binding(10) var shadow_atlas: texture_depth_2d;
+@group(0) @binding(11) var shadow_sampler: sampler_comparison;
 #endif
 #if SHADOWS
 #include "common/shadows.wgsl"

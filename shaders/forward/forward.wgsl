@@ -1,6 +1,6 @@
 // Mesh draws of one material (src/render/draws.rs): the depth prepass (DEPTH_ONLY), the
-// G-buffer (GBUFFER, GBUFFER_PACKED) and forward shading (SHADE, with LIGHT_LISTS for
-// culled lists). The material's generated code is included as <material>; ALPHA_MASK
+// G-buffer (GBUFFER, GBUFFER_PACKED), forward shading (SHADE, with LIGHT_LISTS for
+// culled lists) and a shadow atlas's views (DEPTH_ONLY with ATLAS_DEPTH). The material's generated code is included as <material>; ALPHA_MASK
 // discards below the cutoff. Only SHADE binds lights: a pass binds what it declares.
 
 #include "common/types.wgsl"
@@ -24,9 +24,18 @@
 @group(0) @binding(7) var<storage, read> bvh_triangles: array<BvhTriangle>;
 #include "shadow/bvh.wgsl"
 #endif
+#if SHADOW_ATLAS
+@group(0) @binding(8) var<storage, read> shadow_views: array<vec4<f32>>;
+@group(0) @binding(9) var shadow_atlas: texture_depth_2d;
+@group(0) @binding(10) var shadow_sampler: sampler_comparison;
+#endif
 #if SHADOWS
 #include "common/shadows.wgsl"
 #endif
+#endif
+#if ATLAS_DEPTH
+// A ShadowAtlas pass: the instance index is the view (see common/shadows.wgsl).
+@group(0) @binding(8) var<storage, read> shadow_views: array<vec4<f32>>;
 #endif
 
 struct ShadingPoint {
@@ -58,10 +67,16 @@ struct VertexOut {
 };
 
 @vertex
-fn vs_main(v: VertexIn) -> VertexOut {
+fn vs_main(v: VertexIn, @builtin(instance_index) instance: u32) -> VertexOut {
     var out: VertexOut;
+#if ATLAS_DEPTH
+    let b = 1u + 6u * instance;
+    let view_proj = mat4x4<f32>(shadow_views[b], shadow_views[b + 1u], shadow_views[b + 2u], shadow_views[b + 3u]);
+    out.clip = view_proj * vec4<f32>(v.position, 1.0);
+#else
     // The prepass and the shading pass run this same code, so depths match exactly.
     out.clip = frame.view_proj * vec4<f32>(v.position, 1.0);
+#endif
     out.world = v.position;
     out.normal = v.normal;
     out.uv = v.uv;

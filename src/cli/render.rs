@@ -162,7 +162,7 @@ fn shadow_report(scene: &Scene, gpu: &SceneGpu, result: &FrameResult) {
         .iter()
         .filter(|l| l.flags & lightgraph::scene::light_flags::CASTS_SHADOW != 0)
         .count();
-    if casters == 0 && result.shadows.is_empty() {
+    if casters == 0 && result.shadows.is_empty() && result.atlases.is_empty() {
         return;
     }
     println!(
@@ -181,6 +181,9 @@ fn shadow_report(scene: &Scene, gpu: &SceneGpu, result: &FrameResult) {
             s.build_time.as_secs_f64() * 1e3,
             b.bytes() as f64 / (1 << 20) as f64
         );
+    }
+    for a in &result.atlases {
+        atlas_report(a);
     }
     for s in &result.shadows {
         println!(
@@ -204,6 +207,45 @@ fn shadow_report(scene: &Scene, gpu: &SceneGpu, result: &FrameResult) {
                 s.overflow_pixels
             );
         }
+    }
+}
+
+/// What each shadow atlas gave this frame, and every light it could not shadow.
+fn atlas_report(a: &lightgraph::render::AtlasReport) {
+    let mib = |b: u64| b as f64 / (1 << 20) as f64;
+    let tiers: Vec<String> = a
+        .tiers()
+        .iter()
+        .map(|(t, n)| format!("{n} at {t}²"))
+        .collect();
+    println!(
+        "  {}: {}² atlas ({:.1} MiB, table {:.2} MiB), {} lights shadowed in {} views ({}), {:.0}% of the atlas used, {} halvings, {} caster draws; {} casters off screen",
+        a.pass,
+        a.side,
+        mib(a.atlas_bytes),
+        mib(a.table_bytes),
+        a.shadowed.len(),
+        a.views,
+        if tiers.is_empty() { "none".to_string() } else { tiers.join(", ") },
+        100.0 * a.used_texels as f64 / (a.side as f64 * a.side as f64),
+        a.halvings,
+        a.draws,
+        a.off_screen
+    );
+    if !a.dropped.is_empty() {
+        let list: Vec<String> = a
+            .dropped
+            .iter()
+            .take(16)
+            .map(|d| format!("light {} (wanted {}², {:?})", d.light, d.wanted, d.reason))
+            .collect();
+        println!(
+            "  WARNING: {} shadow-casting lights in view got no room in '{}' and are lit unshadowed: {}{}",
+            a.dropped.len(),
+            a.pass,
+            list.join(", "),
+            if a.dropped.len() > 16 { ", ..." } else { "" }
+        );
     }
 }
 

@@ -32,20 +32,33 @@ pub(super) enum DrawMode {
         blend: bool,
         shadows: Shadows,
     },
+    /// A shadow atlas's views: depth only, the view from the instance index, both faces,
+    /// biased.
+    AtlasDepth {
+        format: wgpu::TextureFormat,
+        depth_bias: i32,
+        /// `f32::to_bits` of the slope-scaled bias (the mode is a pipeline key).
+        slope_bias_bits: u32,
+    },
 }
 
 impl DrawMode {
     fn writes_depth(self) -> bool {
         match self {
-            DrawMode::DepthOnly => true,
+            DrawMode::DepthOnly | DrawMode::AtlasDepth { .. } => true,
             DrawMode::GBuffer { writes_depth, .. } => writes_depth,
             DrawMode::Shade { .. } => false,
         }
+    }
+    fn depth_only(self) -> bool {
+        matches!(self, DrawMode::DepthOnly | DrawMode::AtlasDepth { .. })
     }
 }
 
 /// One mesh drawn with its material's pipeline.
 struct Draw {
+    /// Index into the scene's GPU meshes.
+    mesh: usize,
     pipeline: Arc<wgpu::RenderPipeline>,
     /// The material's textures (group 2), if it has any.
     material: Option<wgpu::BindGroup>,
@@ -80,6 +93,17 @@ pub(super) fn shadow_defines(shadows: Shadows) -> Vec<(&'static str, String)> {
             ("SHADOW_TRACE", "1".into()),
             ("SHADOW_NORMAL_OFFSET", offset),
         ],
+        Shadows::Atlas(filter) => {
+            let mut d = vec![
+                ("SHADOWS", "1".into()),
+                ("SHADOW_ATLAS", "1".into()),
+                ("SHADOW_NORMAL_OFFSET", offset),
+            ];
+            if filter == crate::graph::kinds::shadow_atlas::ShadowFilter::Pcf5x5 {
+                d.push(("SHADOW_PCF5", "1".into()));
+            }
+            d
+        }
     }
 }
 /// The bind group the generated material code declares its textures in.
@@ -129,6 +153,10 @@ impl Renderer {
             let mut d: Vec<(&str, String)> = vec![];
             match mode {
                 DrawMode::DepthOnly => d.push(("DEPTH_ONLY", "1".into())),
+                DrawMode::AtlasDepth { .. } => {
+                    d.push(("DEPTH_ONLY", "1".into()));
+                    d.push(("ATLAS_DEPTH", "1".into()));
+                }
                 DrawMode::GBuffer {
                     packed,
                     normals,
@@ -179,7 +207,9 @@ impl Renderer {
                     m.double_sided
                 ),
             };
-            let cull_mode = (!m.double_sided).then_some(wgpu::Face::Back);
+            // Shadow views draw both faces: any surface occludes, as for a ray.
+            let cull_mode = (!m.double_sided && !matches!(mode, DrawMode::AtlasDepth { .. }))
+                .then_some(wgpu::Face::Back);
             let (pipeline, bindings) = self
                 .pipelines
                 .get_or_build_reflected(
@@ -239,6 +269,7 @@ impl Renderer {
             };
             let gm = &gpu.meshes[mesh];
             draws.push(Draw {
+                mesh,
                 material,
                 pipeline,
                 vertices: gm.vertices.clone(),
@@ -282,6 +313,7 @@ fn build_pipeline(
             1 + usize::from(normals) + usize::from(geometric),
         ),
         DrawMode::Shade { .. } => ("fs_main", 1),
+        DrawMode::AtlasDepth { .. } => ("fs_depth", 0),
     };
     let blend = match mode {
         DrawMode::Shade { blend: true, .. } => Some(wgpu::BlendState::ALPHA_BLENDING),
@@ -294,7 +326,7 @@ fn build_pipeline(
     });
     let targets = vec![target; colour_targets];
     // A depth-only draw needs a fragment stage only to discard masked fragments.
-    let fragment = (mode != DrawMode::DepthOnly || masked).then(|| wgpu::FragmentState {
+    let fragment = (!mode.depth_only() || masked).then(|| wgpu::FragmentState {
         module,
         entry_point: Some(entry),
         compilation_options: Default::default(),
@@ -315,7 +347,10 @@ fn build_pipeline(
                 ..Default::default()
             },
             depth_stencil: Some(wgpu::DepthStencilState {
-                format: wgpu::TextureFormat::Depth32Float,
+                format: match mode {
+                    DrawMode::AtlasDepth { format, .. } => format,
+                    _ => wgpu::TextureFormat::Depth32Float,
+                },
                 depth_write_enabled: Some(writes_depth),
                 depth_compare: Some(if writes_depth {
                     wgpu::CompareFunction::Less
@@ -323,7 +358,18 @@ fn build_pipeline(
                     wgpu::CompareFunction::LessEqual
                 }),
                 stencil: Default::default(),
-                bias: Default::default(),
+                bias: match mode {
+                    DrawMode::AtlasDepth {
+                        depth_bias,
+                        slope_bias_bits,
+                        ..
+                    } => wgpu::DepthBiasState {
+                        constant: depth_bias,
+                        slope_scale: f32::from_bits(slope_bias_bits),
+                        clamp: 0.0,
+                    },
+                    _ => Default::default(),
+                },
             }),
             multisample: wgpu::MultisampleState {
                 count: samples,
@@ -352,7 +398,54 @@ fn neutral_material_wgsl() -> Option<&'static str> {
     .as_deref()
 }
 
+/// One view of a multi-view draw: its viewport (a square tile) and the meshes it sees.
+pub(super) struct ViewDraw {
+    pub x: u32,
+    pub y: u32,
+    pub tile: u32,
+    /// Per mesh draw (in [`MeshDraws::meshes`] order), whether the view sees it.
+    pub visible: Vec<bool>,
+}
+
 impl MeshDraws {
+    /// The scene mesh of each draw, in draw order.
+    pub fn meshes(&self) -> impl Iterator<Item = usize> + '_ {
+        self.draws.iter().map(|d| d.mesh)
+    }
+
+    /// Draws each view's visible meshes into its viewport, with the view's index as the
+    /// instance (the shader reads its projection from it).
+    pub fn record_views(&self, pass: &mut wgpu::RenderPass<'_>, views: &[ViewDraw]) {
+        if let Some(bind) = &self.bind {
+            pass.set_bind_group(0, bind, &[]);
+        }
+        let mut current: Option<*const wgpu::RenderPipeline> = None;
+        for (v, view) in views.iter().enumerate() {
+            let (x, y, t) = (view.x, view.y, view.tile);
+            pass.set_viewport(x as f32, y as f32, t as f32, t as f32, 0.0, 1.0);
+            pass.set_scissor_rect(x, y, t, t);
+            let instance = v as u32;
+            for (d, _) in self
+                .draws
+                .iter()
+                .zip(&view.visible)
+                .filter(|(_, &seen)| seen)
+            {
+                let ptr = Arc::as_ptr(&d.pipeline);
+                if current != Some(ptr) {
+                    pass.set_pipeline(&d.pipeline);
+                    current = Some(ptr);
+                    if let Some(group) = &d.material {
+                        pass.set_bind_group(MATERIAL_GROUP, group, &[]);
+                    }
+                }
+                pass.set_vertex_buffer(0, d.vertices.slice(..));
+                pass.set_index_buffer(d.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..d.index_count, 0, instance..instance + 1);
+            }
+        }
+    }
+
     /// Draws every mesh into `pass`.
     pub fn record(&self, pass: &mut wgpu::RenderPass<'_>) {
         if let Some(bind) = &self.bind {

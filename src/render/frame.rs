@@ -117,6 +117,7 @@ impl Renderer {
             resources: &resources,
             frame_uniform: &frame_uniform,
             size,
+            scene,
         };
         let mut prepared = Vec::with_capacity(graph.passes.len());
         for sp in &graph.passes {
@@ -237,11 +238,12 @@ impl PreparedFrame {
     pub fn render(&self, r: &Renderer) -> Result<FrameResult, RenderError> {
         let pass_ms = self.execute(r)?;
         let image = read_rgba32f(&r.ctx.device, &r.ctx.queue, self.output_texture())?;
-        let (mut culling, mut shadows) = (Vec::new(), Vec::new());
+        let (mut culling, mut shadows, mut atlases) = (Vec::new(), Vec::new(), Vec::new());
         for report in self.pass_reports(r)? {
             match report {
                 PassReport::Culling(c) => culling.push(c),
                 PassReport::Shadow(s) => shadows.push(s),
+                PassReport::Atlas(a) => atlases.push(a),
             }
         }
         let light_stats = self.read_light_stats(r)?;
@@ -252,6 +254,7 @@ impl PreparedFrame {
             pass_ms,
             culling,
             shadows,
+            atlases,
             light_stats,
         })
     }
@@ -301,7 +304,7 @@ impl PreparedFrame {
             .into_iter()
             .filter_map(|report| match report {
                 PassReport::Shadow(s) => Some(s),
-                PassReport::Culling(_) => None,
+                PassReport::Culling(_) | PassReport::Atlas(_) => None,
             })
             .collect())
     }
@@ -366,5 +369,8 @@ impl PreparedFrame {
         r.ctx
             .queue
             .write_buffer(&self.frame_uniform, 0, bytemuck::bytes_of(&f));
+        for (_, pass) in &self.passes {
+            pass.set_view(r, camera);
+        }
     }
 }

@@ -86,11 +86,48 @@ impl ShadowReport {
     }
 }
 
-/// What a pass counted on the GPU.
+/// Per shadow atlas pass: what this frame's allocation gave and refused.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AtlasReport {
+    pub pass: String,
+    /// The atlas's side in texels.
+    pub side: u32,
+    /// Bytes of the atlas texture and of its view table.
+    pub atlas_bytes: u64,
+    pub table_bytes: u64,
+    /// Shadow-casting lights in view, with a tile each, and without room.
+    pub shadowed: Vec<crate::shadow::atlas::AtlasLight>,
+    pub dropped: Vec<crate::shadow::atlas::DroppedLight>,
+    /// Shadow-casting lights whose range misses the camera's frustum.
+    pub off_screen: u32,
+    pub views: u32,
+    pub halvings: u32,
+    pub used_texels: u64,
+    /// Mesh draws over all views after culling per view.
+    pub draws: u64,
+}
+
+impl AtlasReport {
+    /// Tile sides and how many lights got each, largest first.
+    pub fn tiers(&self) -> Vec<(u32, usize)> {
+        let mut tiers: Vec<(u32, usize)> = Vec::new();
+        for l in &self.shadowed {
+            match tiers.iter_mut().find(|(t, _)| *t == l.tile) {
+                Some((_, n)) => *n += 1,
+                None => tiers.push((l.tile, 1)),
+            }
+        }
+        tiers.sort_by_key(|t| std::cmp::Reverse(t.0));
+        tiers
+    }
+}
+
+/// What a pass counted on the GPU (or decided on the CPU for this frame).
 #[derive(Clone, Debug)]
 pub enum PassReport {
     Culling(CullingReport),
     Shadow(ShadowReport),
+    Atlas(AtlasReport),
 }
 
 pub struct FrameResult {
@@ -102,5 +139,6 @@ pub struct FrameResult {
     pub pass_ms: Option<Vec<(String, f64)>>,
     pub culling: Vec<CullingReport>,
     pub shadows: Vec<ShadowReport>,
+    pub atlases: Vec<AtlasReport>,
     pub light_stats: Option<LightStats>,
 }

@@ -12,6 +12,8 @@ pub struct GpuMesh {
     pub indices: wgpu::Buffer,
     pub index_count: u32,
     pub material: usize,
+    /// World-space bounds (min, max) of the vertices: for culling per shadow view.
+    pub bounds: [glam::Vec3; 2],
 }
 
 /// Cheap to clone (the GPU objects are shared handles): hot reload builds a changed copy
@@ -122,6 +124,10 @@ impl SceneGpu {
                     }),
                     index_count: m.indices.len() as u32,
                     material: m.material.min(materials.len() - 1),
+                    bounds: m.positions.iter().fold(
+                        [glam::Vec3::INFINITY, glam::Vec3::NEG_INFINITY],
+                        |[lo, hi], &p| [lo.min(p), hi.max(p)],
+                    ),
                 }
             })
             .collect();

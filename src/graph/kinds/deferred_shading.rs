@@ -45,11 +45,15 @@ pub const SLOTS: &[SlotSpec] = &[
     SlotSpec::new(HDR, SlotType::ColorTexture, Access::Write, Usage::Storage),
     // Ray-cast shadows: the hit mask of a ShadowRayCast pass.
     SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound).optional(),
+    // Shadow maps: a ShadowAtlas pass's atlas and view table.
+    super::SHADOW_ATLAS_READ,
+    super::SHADOW_VIEWS_READ,
 ];
 
 pub fn check(p: &DeferredShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     check_light_source(ctx, p.lights, errors);
     super::check_shadow_mask(ctx, errors);
+    super::check_shadow_atlas(ctx, errors);
     ctx.require_single_rgba32f(
         &[HDR],
         "deferred shading stores into a single-sample Rgba32Float texture",
@@ -77,8 +81,9 @@ mod tests {
             ),
             "hdr",
         );
+        // The only depth slot is a shadow atlas's.
         assert!(
-            e.contains("DeferredShading has no free slot for a depth texture in reads"),
+            e.contains("a shadow atlas is sampled through its view table"),
             "{e}"
         );
     }

@@ -56,6 +56,9 @@ pub const SLOTS: &[SlotSpec] = &[
         Usage::Bound,
     )
     .optional(),
+    // Shadow maps: a ShadowAtlas pass's atlas and view table.
+    super::SHADOW_ATLAS_READ,
+    super::SHADOW_VIEWS_READ,
 ];
 
 /// How a shading pass shadows its lights, from the slots it filled.
@@ -66,13 +69,27 @@ pub enum Shadows {
     Mask,
     /// Casts a ray per light in the light loop.
     Trace,
+    /// Samples a shadow atlas, filtered as its ShadowAtlas pass says.
+    Atlas(super::shadow_atlas::ShadowFilter),
 }
 
-pub fn shadows(roles: &crate::graph::PassRoles) -> Shadows {
+/// The shadow source of a shading pass's slots; an atlas's filter is published on its
+/// view table's planned layout.
+pub fn shadows(roles: &crate::graph::PassRoles, plan: &crate::graph::ResourcePlan) -> Shadows {
+    use super::shadow_atlas::SHADOW_VIEWS;
     if roles.slot(SHADOW_MASK).is_some() {
         Shadows::Mask
     } else if roles.slot(BVH_NODES).is_some() {
         Shadows::Trace
+    } else if let Some(views) = roles.slot(SHADOW_VIEWS) {
+        let filter = plan
+            .get(views)
+            .and_then(|r| match r.layout {
+                Some(super::BufferLayout::ShadowViews { filter, .. }) => Some(filter),
+                _ => None,
+            })
+            .unwrap_or_default();
+        Shadows::Atlas(filter)
     } else {
         Shadows::None
     }
@@ -91,6 +108,7 @@ pub fn check(p: &ForwardShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         _ => {}
     }
     super::check_shadow_mask(ctx, errors);
+    super::check_shadow_atlas(ctx, errors);
     if let (Some(c), Some(d)) = (ctx.slot(slot::COLOR), ctx.slot(slot::DEPTH)) {
         let (cs, ds) = (ctx.samples(c), ctx.samples(d));
         if cs != ds {

@@ -8,6 +8,7 @@ pub mod depth_prepass;
 pub mod forward_shading;
 pub mod g_buffer;
 pub mod light_culling;
+pub mod shadow_atlas;
 pub mod shadow_ray_cast;
 pub mod shadow_ray_jobs;
 
@@ -128,6 +129,12 @@ pub enum BufferLayout {
     ShadowMask {
         pixels: u64,
     },
+    /// A shadow atlas's view table, and how shading filters the atlas.
+    ShadowViews {
+        lights: u32,
+        max_views: u64,
+        filter: shadow_atlas::ShadowFilter,
+    },
 }
 
 impl BufferLayout {
@@ -136,6 +143,9 @@ impl BufferLayout {
             BufferLayout::LightLists(l) => l.bytes(),
             BufferLayout::ShadowJobs { capacity } => shadow_ray_jobs::job_buffer_bytes(*capacity),
             BufferLayout::ShadowMask { pixels } => 4 * shadow_ray_jobs::MASK_WORDS * pixels,
+            BufferLayout::ShadowViews {
+                lights, max_views, ..
+            } => shadow_atlas::view_table_bytes(*lights, *max_views),
         }
     }
 }
@@ -172,6 +182,7 @@ pub fn slots(kind: &PassKind) -> Option<&'static [SlotSpec]> {
         PassKind::DeferredShading(_) => deferred_shading::SLOTS,
         PassKind::ShadowRayJobs(_) => shadow_ray_jobs::SLOTS,
         PassKind::ShadowRayCast(_) => shadow_ray_cast::SLOTS,
+        PassKind::ShadowAtlas(_) => shadow_atlas::SLOTS,
         PassKind::Compute { .. } | PassKind::Fullscreen { .. } => return None,
     })
 }
@@ -186,6 +197,7 @@ fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         PassKind::DeferredShading(p) => deferred_shading::check(p, ctx, errors),
         PassKind::ShadowRayJobs(p) => shadow_ray_jobs::check(p, ctx, errors),
         PassKind::ShadowRayCast(p) => shadow_ray_cast::check(p, ctx, errors),
+        PassKind::ShadowAtlas(p) => shadow_atlas::check(p, ctx, errors),
         PassKind::Compute { .. } | PassKind::Fullscreen { .. } => {}
     }
 }
@@ -204,6 +216,13 @@ pub fn buffer_layout(kind: &PassKind, slot: &str, frame: FrameSize) -> Option<Bu
         PassKind::ShadowRayJobs(_) if slot == shadow_ray_jobs::SHADOW_MASK => {
             Some(BufferLayout::ShadowMask {
                 pixels: frame.width as u64 * frame.height as u64,
+            })
+        }
+        PassKind::ShadowAtlas(p) if slot == shadow_atlas::SHADOW_VIEWS => {
+            Some(BufferLayout::ShadowViews {
+                lights: frame.lights,
+                max_views: p.max_views(),
+                filter: p.filter,
             })
         }
         _ => None,
@@ -275,7 +294,8 @@ fn slot_type_of(ctx: &RoleCtx, name: &str) -> Option<SlotType> {
 }
 
 /// Matches a built-in pass's declared resources to its kind's slots: by name where the
-/// declaration says `slot=resource`, else to the first free slot of the resource's type
+/// declaration says `slot=resource` or the resource is named like a slot of its type,
+/// else to the first free slot of the resource's type
 /// that takes it from that list (reads or writes), in the table's order. Every resource
 /// must fill a slot and every required slot must be filled; then the kind checks.
 pub(crate) fn resolve(
@@ -287,66 +307,82 @@ pub(crate) fn resolve(
     let mut errors = Vec::new();
     let kind = pass.kind.label();
     let names = || specs.iter().map(|s| s.name).collect::<Vec<_>>().join(", ");
-    for (write, list) in [(false, &pass.reads), (true, &pass.writes)] {
-        for name in list {
-            let Some(ty) = slot_type_of(ctx, name) else {
-                continue; // unknown resources are reported by validation
-            };
-            if write && matches!(ty, SlotType::Import(_)) {
-                continue; // a write to a read-only import, reported by validation
-            }
-            if roles.slots.values().any(|v| v == name) {
-                continue; // in reads and writes: one slot
-            }
-            let spec = match pass.explicit_slot(name) {
-                Some(wanted) => match specs.iter().find(|s| s.name == wanted) {
-                    None => {
-                        errors.push(ctx.mismatch(
-                            pass,
-                            name,
-                            format!("{kind} has no slot '{wanted}' (its slots: {})", names()),
-                        ));
-                        continue;
-                    }
-                    Some(s) if s.ty != ty || !s.access.allows(write) => {
-                        errors.push(ctx.mismatch(
-                            pass,
-                            name,
-                            format!(
-                                "slot '{wanted}' takes {} {}",
-                                s.ty.describe(),
-                                s.access.describe()
-                            ),
-                        ));
-                        continue;
-                    }
-                    Some(s) => s,
-                },
-                None => match specs.iter().find(|s| {
-                    s.ty == ty && s.access.allows(write) && !roles.slots.contains_key(s.name)
-                }) {
-                    Some(s) => s,
-                    None => {
-                        let list = if write { "writes" } else { "reads" };
-                        errors.push(ctx.mismatch(
-                            pass,
-                            name,
-                            format!(
-                                "{kind} has no free slot for {} in {list} (its slots: {})",
-                                ty.describe(),
-                                names()
-                            ),
-                        ));
-                        continue;
-                    }
-                },
-            };
-            if let Some(prev) = roles.slots.insert(spec.name, name.clone()) {
-                errors.push(ctx.mismatch(
-                    pass,
-                    name,
-                    format!("slot '{}' already filled by '{prev}'", spec.name),
-                ));
+    // Explicit slots and resources named like a free slot of their type go first, so
+    // one that fills by type order cannot take the slot a later one is named after.
+    let named_like = |name: &str, ty: SlotType, write: bool| {
+        specs
+            .iter()
+            .any(|s| s.name == name && s.ty == ty && s.access.allows(write))
+    };
+    for by_name in [true, false] {
+        for (write, list) in [(false, &pass.reads), (true, &pass.writes)] {
+            for name in list {
+                let Some(ty) = slot_type_of(ctx, name) else {
+                    continue; // unknown resources are reported by validation
+                };
+                let first = pass.explicit_slot(name).is_some() || named_like(name, ty, write);
+                if first != by_name {
+                    continue;
+                }
+                if write && matches!(ty, SlotType::Import(_)) {
+                    continue; // a write to a read-only import, reported by validation
+                }
+                if roles.slots.values().any(|v| v == name) {
+                    continue; // in reads and writes: one slot
+                }
+                let wanted = pass
+                    .explicit_slot(name)
+                    .or_else(|| named_like(name, ty, write).then_some(name.as_str()));
+                let spec = match wanted {
+                    Some(wanted) => match specs.iter().find(|s| s.name == wanted) {
+                        None => {
+                            errors.push(ctx.mismatch(
+                                pass,
+                                name,
+                                format!("{kind} has no slot '{wanted}' (its slots: {})", names()),
+                            ));
+                            continue;
+                        }
+                        Some(s) if s.ty != ty || !s.access.allows(write) => {
+                            errors.push(ctx.mismatch(
+                                pass,
+                                name,
+                                format!(
+                                    "slot '{wanted}' takes {} {}",
+                                    s.ty.describe(),
+                                    s.access.describe()
+                                ),
+                            ));
+                            continue;
+                        }
+                        Some(s) => s,
+                    },
+                    None => match specs.iter().find(|s| {
+                        s.ty == ty && s.access.allows(write) && !roles.slots.contains_key(s.name)
+                    }) {
+                        Some(s) => s,
+                        None => {
+                            let list = if write { "writes" } else { "reads" };
+                            errors.push(ctx.mismatch(
+                                pass,
+                                name,
+                                format!(
+                                    "{kind} has no free slot for {} in {list} (its slots: {})",
+                                    ty.describe(),
+                                    names()
+                                ),
+                            ));
+                            continue;
+                        }
+                    },
+                };
+                if let Some(prev) = roles.slots.insert(spec.name, name.clone()) {
+                    errors.push(ctx.mismatch(
+                        pass,
+                        name,
+                        format!("slot '{}' already filled by '{prev}'", spec.name),
+                    ));
+                }
             }
         }
     }
@@ -393,6 +429,55 @@ pub fn check_shadow_mask(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     }
 }
 
+/// Rows every shading pass shares: a ShadowAtlas pass's atlas and view table, read.
+pub const SHADOW_ATLAS_READ: SlotSpec = SlotSpec::new(
+    shadow_atlas::SHADOW_ATLAS,
+    SlotType::DepthTexture,
+    Access::Read,
+    Usage::Sampled,
+)
+.optional();
+pub const SHADOW_VIEWS_READ: SlotSpec = SlotSpec::new(
+    shadow_atlas::SHADOW_VIEWS,
+    SlotType::Buffer,
+    Access::Read,
+    Usage::Bound,
+)
+.optional();
+
+/// A shading pass samples an atlas through its view table, and shadows one way only.
+pub fn check_shadow_atlas(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+    use shadow_atlas::{SHADOW_ATLAS, SHADOW_VIEWS};
+    match (ctx.slot(SHADOW_ATLAS), ctx.slot(SHADOW_VIEWS)) {
+        (Some(atlas), None) => errors.push(ctx.mismatch(
+            atlas,
+            "a shadow atlas is sampled through its view table: read the ShadowAtlas pass's shadow_views buffer too",
+        )),
+        (None, Some(views)) => errors.push(ctx.mismatch(
+            views,
+            "a view table is read with its atlas: read the ShadowAtlas pass's depth texture too",
+        )),
+        (Some(atlas), Some(_)) => {
+            if shadow_atlas::atlas_side(ctx.graph.resources.get(atlas).copied()).is_none() {
+                errors.push(ctx.mismatch(
+                    atlas,
+                    "a shadow atlas is a single-sample square depth texture of a fixed power-of-two size (size: Fixed(4096, 4096))",
+                ));
+            }
+            let other = [shadow_ray_jobs::SHADOW_MASK, shadow_ray_cast::BVH_NODES]
+                .into_iter()
+                .find_map(|s| ctx.slot(s));
+            if let Some(other) = other {
+                errors.push(ctx.mismatch(
+                    other,
+                    "a pass shadows its lights one way: from the atlas, the ray-cast mask or the BVH",
+                ));
+            }
+        }
+        (None, None) => {}
+    }
+}
+
 /// What every shading pass (forward or deferred) needs to read its lights.
 pub fn check_light_source(
     ctx: &KindCtx,
@@ -430,6 +515,10 @@ pub(crate) mod test_support {
         Texture(name: "nrm", format: Rgba32Float),
         Texture(name: "small", format: Rgba8Unorm),
         Texture(name: "geo", format: Rgba32Float),
+        Texture(name: "atlas", format: Depth32Float, size: Fixed(2048, 2048)),
+        Texture(name: "atlas_odd", format: Depth32Float, size: Fixed(1000, 1000)),
+        Buffer(name: "views"),
+        Buffer(name: "shadow_views"),
         Buffer(name: "jobs"),
         Buffer(name: "mask"),
         Buffer(name: "small_buf", size: Bytes(16)),

@@ -2,9 +2,7 @@
 //! G-buffer and storing lit colour.
 
 use super::{defines, pass_error, PrepareCtx, PreparedPass, Timestamps};
-use crate::graph::kinds::forward_shading::Shadows;
 use crate::graph::kinds::g_buffer::G_NORMAL;
-use crate::graph::kinds::shadow_ray_jobs::SHADOW_MASK;
 use crate::graph::{slot, DeferredShading, LightSource, ScheduledPass};
 use crate::render::pipelines::PipelineKey;
 use crate::render::RenderError;
@@ -31,10 +29,7 @@ pub(super) fn prepare(
         let params = cx.list_params(&sp.name, sp.required(slot::LIGHT_LISTS))?;
         offered.buffer("list_params", &params);
     }
-    let shadows = match sp.roles.slot(SHADOW_MASK) {
-        Some(_) => Shadows::Mask,
-        None => Shadows::None,
-    };
+    let shadows = cx.shading_shadows(sp, &mut offered);
     let mut pipelines = Vec::new();
     let mut bind = None;
     for (index, m) in cx.gpu.materials.iter().enumerate() {

@@ -27,10 +27,11 @@ pub(super) fn prepare(
         let params = cx.list_params(&sp.name, sp.required(slot::LIGHT_LISTS))?;
         offered.buffer("list_params", &params);
     }
+    let shadows = cx.shading_shadows(sp, &mut offered);
     let mode = DrawMode::Shade {
         culled,
         blend: false,
-        shadows: crate::graph::kinds::forward_shading::shadows(&sp.roles),
+        shadows,
     };
     let draws = cx
         .renderer

@@ -9,6 +9,7 @@ mod forward_shading;
 mod fullscreen;
 mod g_buffer;
 pub(super) mod light_culling;
+mod shadow_atlas;
 mod shadow_ray_cast;
 mod shadow_ray_jobs;
 
@@ -32,6 +33,9 @@ pub(super) trait PreparedPass {
     fn report(&self, _r: &Renderer) -> Result<Option<PassReport>, RenderError> {
         Ok(None)
     }
+    /// The camera moved without re-preparing: passes that depend on the view (the
+    /// shadow atlas's allocation) update for the next frame.
+    fn set_view(&self, _r: &Renderer, _camera: &crate::scene::Camera) {}
 }
 
 /// Prepares one scheduled pass.
@@ -47,6 +51,7 @@ pub(super) fn prepare(
         PassKind::DeferredShading(p) => Box::new(deferred_shading::prepare(cx, sp, p)?),
         PassKind::ShadowRayJobs(p) => Box::new(shadow_ray_jobs::prepare(cx, sp, p)?),
         PassKind::ShadowRayCast(p) => Box::new(shadow_ray_cast::prepare(cx, sp, p)?),
+        PassKind::ShadowAtlas(p) => Box::new(shadow_atlas::prepare(cx, sp, p)?),
         PassKind::Compute {
             shader,
             entry,
@@ -88,6 +93,7 @@ pub(super) struct PrepareCtx<'a> {
     pub resources: &'a FrameResources,
     pub frame_uniform: &'a wgpu::Buffer,
     pub size: FrameSize,
+    pub scene: &'a crate::scene::Scene,
 }
 
 impl PrepareCtx<'_> {
@@ -164,6 +170,29 @@ impl PrepareCtx<'_> {
             }
         }
         Ok(set)
+    }
+
+    /// What a shading pass binds to sample a shadow atlas: the comparison sampler
+    /// (nearest within a tap: each tap compares a 2×2 footprint; taps are clamped to
+    /// their tile), and its shadow source.
+    pub fn shading_shadows(
+        &self,
+        sp: &ScheduledPass,
+        offered: &mut BindingSet,
+    ) -> crate::graph::kinds::forward_shading::Shadows {
+        use crate::graph::kinds::forward_shading::{shadows, Shadows};
+        let s = shadows(&sp.roles, &self.graph.plan);
+        if let Shadows::Atlas(_) = s {
+            let sampler = self.device().create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("shadow_sampler"),
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                compare: Some(wgpu::CompareFunction::LessEqual),
+                ..Default::default()
+            });
+            offered.offer("shadow_sampler", Bound::Sampler(sampler));
+        }
+        s
     }
 
     /// The uniform describing the light lists in `lists` (their layout is published on

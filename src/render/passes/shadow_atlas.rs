@@ -1,0 +1,232 @@
+//! `ShadowAtlas`: allocates the atlas for the current view on the CPU
+//! (`shadow::atlas::allocate`), uploads the view table, and draws every view's visible
+//! casters into its tile, all views in one render pass (a viewport each, the view as
+//! the instance index). The allocation is redone whenever the camera moves.
+
+use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
+use crate::graph::kinds::shadow_atlas::{
+    atlas_side, view_table_bytes, ShadowAtlas, SHADOW_ATLAS, SHADOW_VIEWS, VIEW_VEC4S,
+};
+use crate::graph::{FrameSize, ResourceDesc, ScheduledPass};
+use crate::render::draws::{DrawMode, MeshDraws, ViewDraw};
+use crate::render::report::{AtlasReport, PassReport};
+use crate::render::{RenderError, Renderer};
+use crate::scene::{Camera, Light};
+use crate::shadow::atlas::{allocate, box_in_frustum, frustum_planes, Allocation, AtlasConfig};
+use std::sync::Mutex;
+
+pub(super) struct ShadowAtlasPass {
+    name: String,
+    config: AtlasConfig,
+    normal_offset: f32,
+    size: FrameSize,
+    lights: Vec<Light>,
+    /// World bounds of each draw's mesh, in draw order.
+    bounds: Vec<[glam::Vec3; 2]>,
+    atlas: wgpu::TextureView,
+    atlas_bytes: u64,
+    views: wgpu::Buffer,
+    /// The table as the CPU wrote it for the current view; copied into `views` when
+    /// the frame runs (the planned buffer may be shared with passes before this one).
+    staging: wgpu::Buffer,
+    table_bytes: u64,
+    draws: MeshDraws,
+    frame: Mutex<(Allocation, Vec<ViewDraw>)>,
+}
+
+pub(super) fn prepare(
+    cx: &mut PrepareCtx,
+    sp: &ScheduledPass,
+    p: &ShadowAtlas,
+) -> Result<ShadowAtlasPass, RenderError> {
+    let atlas_name = sp.required(SHADOW_ATLAS);
+    let desc = cx
+        .graph
+        .checked
+        .desc
+        .resources
+        .iter()
+        .find(|r| r.name() == atlas_name);
+    let side = atlas_side(desc).ok_or_else(|| {
+        pass_error(
+            &sp.name,
+            format!("'{atlas_name}' is not a square power-of-two atlas"),
+        )
+    })?;
+    let format = match desc {
+        Some(ResourceDesc::Texture { format, .. }) => format.to_wgpu(),
+        _ => wgpu::TextureFormat::Depth32Float,
+    };
+    let limit = cx.renderer.ctx.device.limits().max_texture_dimension_2d;
+    if side > limit {
+        return Err(pass_error(
+            &sp.name,
+            format!("the atlas '{atlas_name}' ({side}²) is larger than this adapter's textures ({limit}²)"),
+        ));
+    }
+    let views = cx.buffer(&sp.name, sp.required(SHADOW_VIEWS))?;
+    let table_bytes = view_table_bytes(cx.gpu.light_count, p.max_views());
+    if views.size() < table_bytes {
+        return Err(pass_error(
+            &sp.name,
+            format!(
+                "buffer '{}' holds {} bytes; the view table for {} lights and {} views needs {table_bytes} (size: Auto)",
+                sp.required(SHADOW_VIEWS),
+                views.size(),
+                cx.gpu.light_count,
+                p.max_views()
+            ),
+        ));
+    }
+    let device = cx.device();
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("shadow view table (upload)"),
+        size: table_bytes,
+        usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut offered = cx.declared(sp)?;
+    // The vertex stage reads the table it is about to receive.
+    offered.buffer("shadow_views", &views);
+    let mode = DrawMode::AtlasDepth {
+        format,
+        depth_bias: p.depth_bias as i32,
+        slope_bias_bits: p.slope_bias.to_bits(),
+    };
+    let draws = cx
+        .renderer
+        .mesh_draws(cx.gpu, mode, 1, &sp.name, &offered)?;
+    let bounds = draws.meshes().map(|m| cx.gpu.meshes[m].bounds).collect();
+    let bytes_per_texel = format
+        .block_copy_size(Some(wgpu::TextureAspect::DepthOnly))
+        .unwrap_or(4);
+    let pass = ShadowAtlasPass {
+        name: sp.name.clone(),
+        config: AtlasConfig {
+            size: side,
+            min_tile: p.min_tile,
+            max_tile: p.max_tile,
+            importance: p.importance,
+            max_lights: p.max_lights,
+        },
+        normal_offset: p.normal_offset,
+        size: cx.size,
+        lights: cx.scene.lights.clone(),
+        bounds,
+        atlas: cx.view(&sp.name, atlas_name)?,
+        atlas_bytes: side as u64 * side as u64 * bytes_per_texel as u64,
+        views,
+        staging,
+        table_bytes,
+        draws,
+        frame: Mutex::new((Allocation::default(), Vec::new())),
+    };
+    pass.allocate(cx.renderer, &cx.scene.camera);
+    Ok(pass)
+}
+
+impl ShadowAtlasPass {
+    /// Allocates for `camera`, uploads the table and culls each view's casters.
+    fn allocate(&self, r: &Renderer, camera: &Camera) {
+        let a = allocate(
+            &self.lights,
+            camera,
+            self.size.width,
+            self.size.height,
+            &self.config,
+        );
+        let max_views = 6 * self.config.max_lights as usize;
+        let mut table = vec![[0u32; 4]; (self.table_bytes / 16) as usize];
+        table[0] = [
+            a.views.len() as u32,
+            self.config.size,
+            self.lights.len() as u32,
+            max_views as u32,
+        ];
+        let n = self.config.size as f32;
+        for (v, view) in a.views.iter().enumerate() {
+            let base = 1 + VIEW_VEC4S as usize * v;
+            for (c, col) in view.view_proj.to_cols_array_2d().iter().enumerate() {
+                table[base + c] = col.map(f32::to_bits);
+            }
+            let (x0, y0) = (view.x as f32 / n, view.y as f32 / n);
+            let (x1, y1) = (
+                (view.x + view.tile) as f32 / n,
+                (view.y + view.tile) as f32 / n,
+            );
+            table[base + 4] = [x0, y0, x1, y1].map(f32::to_bits);
+            table[base + 5] = [view.texel_scale, self.normal_offset, 0.0, 0.0].map(f32::to_bits);
+        }
+        let light_table = 1 + VIEW_VEC4S as usize * max_views;
+        for l in &a.lights {
+            let entry = (l.first_view + 1) | if l.cube { 1 << 31 } else { 0 };
+            let i = l.light as usize;
+            table[light_table + i / 4][i % 4] = entry;
+        }
+        r.ctx
+            .queue
+            .write_buffer(&self.staging, 0, bytemuck::cast_slice(&table));
+        let draws = a
+            .views
+            .iter()
+            .map(|view| {
+                let planes = frustum_planes(view.view_proj);
+                ViewDraw {
+                    x: view.x,
+                    y: view.y,
+                    tile: view.tile,
+                    visible: self
+                        .bounds
+                        .iter()
+                        .map(|[lo, hi]| box_in_frustum(&planes, *lo, *hi))
+                        .collect(),
+                }
+            })
+            .collect();
+        *self.frame.lock().unwrap_or_else(|e| e.into_inner()) = (a, draws);
+    }
+}
+
+impl PreparedPass for ShadowAtlasPass {
+    fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
+        encoder.copy_buffer_to_buffer(&self.staging, 0, &self.views, 0, self.table_bytes);
+        let frame = self.frame.lock().unwrap_or_else(|e| e.into_inner());
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(&self.name),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(crate::render::draws::depth_attachment(
+                &self.atlas,
+                true,
+            )),
+            timestamp_writes: ts.render(),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        self.draws.record_views(&mut pass, &frame.1);
+    }
+
+    fn report(&self, _r: &Renderer) -> Result<Option<PassReport>, RenderError> {
+        let frame = self.frame.lock().unwrap_or_else(|e| e.into_inner());
+        let (a, draws) = &*frame;
+        Ok(Some(PassReport::Atlas(AtlasReport {
+            pass: self.name.clone(),
+            side: self.config.size,
+            atlas_bytes: self.atlas_bytes,
+            table_bytes: self.table_bytes,
+            shadowed: a.lights.clone(),
+            dropped: a.dropped.clone(),
+            off_screen: a.off_screen,
+            views: a.views.len() as u32,
+            halvings: a.halvings,
+            used_texels: a.used_texels,
+            draws: draws
+                .iter()
+                .map(|d| d.visible.iter().filter(|&&v| v).count() as u64)
+                .sum(),
+        })))
+    }
+
+    fn set_view(&self, r: &Renderer, camera: &Camera) {
+        self.allocate(r, camera);
+    }
+}
