@@ -325,6 +325,10 @@ fn describe(
             if format.is_depth() || *name == desc.output {
                 usage |= T::TEXTURE_BINDING;
             }
+            // A depth texture whose writer was culled is cleared by a render pass.
+            if format.is_depth() {
+                usage |= T::RENDER_ATTACHMENT;
+            }
             for &p in users {
                 let role = &roles[p];
                 let slot = role.slot_of(name).and_then(|slot| {

@@ -190,7 +190,9 @@ mod tests {
     fn a_buffer_fills_the_slot_it_is_named_after() {
         // By type order "views" would fill the first free buffer slot (light_lists).
         let e = errors(
-            &PASSES.replace("ATLAS", "").replace("shadow_views=views", "views"),
+            &PASSES
+                .replace("ATLAS", "")
+                .replace("shadow_views=views", "views"),
             "hdr",
         );
         assert!(e.contains("lights: AllLights reads no light lists"), "{e}");
