@@ -341,6 +341,19 @@ fn a_point_lights_shadows_across_cube_faces_agree_with_ray_casting() {
             "{filter}: {disagree} of {floor_pixels} pixels disagree"
         );
     }
+    // The benchmark's measure, on the GPU against the ray-cast mask, every (pixel, light)
+    // pair of floor and boxes: as close as the CPU's count on the floor.
+    let compare = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/graphs/shadow_atlas_vs_raycast.ron"),
+    )
+    .unwrap()
+    .replace("importance: 1.0", "importance: 8.0");
+    let result = render(&mut r, &compare, &scene);
+    let c = &result.shadow_compare[0];
+    eprintln!("{c:?}");
+    assert!(c.pairs > 4000, "{c:?}");
+    assert!(c.error_pcf5() < 0.02 && c.error_2x2() < 0.02, "{c:?}");
+    assert!(c.disagree_pcf5 > 0 && c.penumbra_pcf5 > 0, "{c:?}");
 }
 
 #[test]

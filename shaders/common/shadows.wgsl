@@ -85,21 +85,35 @@ fn shadow_cube_face(d: vec3<f32>) -> u32 {
     return select(5u, 4u, d.z >= 0.0);
 }
 
-fn shadow_visibility(pixel_index: u32, caster: u32, light: u32, light_pos: vec3<f32>, p: ShadingPoint) -> f32 {
+// Where a point falls in its light's atlas tile: the tap's centre, the clamp range
+// keeping every tap half a texel inside the tile (so the comparison's 2×2 footprint never
+// reads a neighbour's depths), the reference depth; `lit` when no map covers it.
+struct AtlasTap {
+    uv: vec2<f32>,
+    lo: vec2<f32>,
+    hi: vec2<f32>,
+    depth: f32,
+    texel: f32,
+    lit: bool,
+};
+
+fn shadow_atlas_tap(light: u32, light_pos: vec3<f32>, position: vec3<f32>, normal: vec3<f32>) -> AtlasTap {
+    var tap: AtlasTap;
+    tap.lit = true;
     let header = bitcast<vec4<u32>>(shadow_views[0]);
     let table = 1u + SHADOW_VIEW_VEC4S * header.w;
     let entry = bitcast<u32>(shadow_views[table + light / 4u][light % 4u]);
     if (entry == 0u) {
-        return 1.0;
+        return tap; // no room this frame: unshadowed (reported by the atlas pass)
     }
     let first = (entry & ~SHADOW_CUBE_BIT) - 1u;
     let cube = (entry & SHADOW_CUBE_BIT) != 0u;
     // Off the surface by a few texels of the view the point falls in: a texel's world
     // size grows with the distance from the light.
     var base = 1u + SHADOW_VIEW_VEC4S * first;
-    let dist = length(p.position - light_pos);
+    let dist = length(position - light_pos);
     let offset = shadow_views[base + 5u].y * shadow_views[base + 5u].x * dist;
-    let q = p.position + p.normal * offset;
+    let q = position + normal * offset;
     if (cube) {
         base += SHADOW_VIEW_VEC4S * shadow_cube_face(q - light_pos);
     }
@@ -112,26 +126,47 @@ fn shadow_visibility(pixel_index: u32, caster: u32, light: u32, light_pos: vec3<
     let tile = shadow_views[base + 4u];
     let clip = view_proj * vec4<f32>(q, 1.0);
     if (clip.w <= 0.0) {
-        return 1.0;
+        return tap;
     }
     let ndc = clip.xyz / clip.w;
-    let uv = mix(tile.xy, tile.zw, vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5));
-    // Every tap stays half a texel inside the light's own tile, so the comparison's
-    // 2×2 footprint never reads a neighbour's depths.
-    let texel = 1.0 / f32(header.y);
-    let lo = tile.xy + vec2<f32>(0.5 * texel);
-    let hi = tile.zw - vec2<f32>(0.5 * texel);
-#if SHADOW_PCF5
+    tap.uv = mix(tile.xy, tile.zw, vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5));
+    tap.texel = 1.0 / f32(header.y);
+    tap.lo = tile.xy + vec2<f32>(0.5 * tap.texel);
+    tap.hi = tile.zw - vec2<f32>(0.5 * tap.texel);
+    tap.depth = ndc.z;
+    tap.lit = false;
+    return tap;
+}
+
+// 25 comparison taps on a 5×5 texel grid (AMD TiledLighting11).
+fn shadow_atlas_pcf5(t: AtlasTap) -> f32 {
+    if (t.lit) {
+        return 1.0;
+    }
     var sum = 0.0;
     for (var j = -2; j <= 2; j++) {
         for (var i = -2; i <= 2; i++) {
-            let t = clamp(uv + vec2<f32>(f32(i), f32(j)) * texel, lo, hi);
-            sum += textureSampleCompareLevel(shadow_atlas, shadow_sampler, t, ndc.z);
+            let uv = clamp(t.uv + vec2<f32>(f32(i), f32(j)) * t.texel, t.lo, t.hi);
+            sum += textureSampleCompareLevel(shadow_atlas, shadow_sampler, uv, t.depth);
         }
     }
     return sum / 25.0;
+}
+
+// One comparison tap: the hardware's bilinear 2×2 comparison.
+fn shadow_atlas_2x2(t: AtlasTap) -> f32 {
+    if (t.lit) {
+        return 1.0;
+    }
+    return textureSampleCompareLevel(shadow_atlas, shadow_sampler, clamp(t.uv, t.lo, t.hi), t.depth);
+}
+
+fn shadow_visibility(pixel_index: u32, caster: u32, light: u32, light_pos: vec3<f32>, p: ShadingPoint) -> f32 {
+    let tap = shadow_atlas_tap(light, light_pos, p.position, p.normal);
+#if SHADOW_PCF5
+    return shadow_atlas_pcf5(tap);
 #else
-    return textureSampleCompareLevel(shadow_atlas, shadow_sampler, clamp(uv, lo, hi), ndc.z);
+    return shadow_atlas_2x2(tap);
 #endif
 }
 #endif

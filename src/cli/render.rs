@@ -185,6 +185,16 @@ fn shadow_report(scene: &Scene, gpu: &SceneGpu, result: &FrameResult) {
     for a in &result.atlases {
         atlas_report(a);
     }
+    for c in &result.shadow_compare {
+        println!(
+            "  {}: {} (pixel, light) pairs; the atlas disagrees with the rays on {:.3}% (5×5 PCF) and {:.3}% (2×2), {:.2}% in a 5×5 penumbra",
+            c.pass,
+            c.pairs,
+            100.0 * c.error_pcf5(),
+            100.0 * c.error_2x2(),
+            100.0 * c.penumbra_pcf5 as f64 / c.pairs.max(1) as f64
+        );
+    }
     for s in &result.shadows {
         println!(
             "  {}: {} rays traced ({:.2} a pixel), job buffer {:.1} MiB for {} jobs, mask {:.1} MiB",

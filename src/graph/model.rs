@@ -275,6 +275,8 @@ pub enum PassKind {
     ShadowRayCast(ShadowRayCast),
     /// Every shadow-casting light's depth views into one atlas, in one render pass.
     ShadowAtlas(ShadowAtlas),
+    /// Counts (pixel, light) pairs where the atlas and ray-cast shadows disagree.
+    ShadowCompare,
     /// A compute shader the graph file names; bindings are matched by name.
     Compute {
         shader: String,
@@ -307,6 +309,7 @@ impl PassKind {
             PassKind::DeferredShading(_) => "DeferredShading",
             PassKind::ShadowRayJobs(_) => "ShadowRayJobs",
             PassKind::ShadowAtlas(_) => "ShadowAtlas",
+            PassKind::ShadowCompare => "ShadowCompare",
             PassKind::ShadowRayCast(_) => "ShadowRayCast",
             PassKind::Compute { .. } => "Compute",
             PassKind::Fullscreen { .. } => "Fullscreen",

@@ -260,11 +260,13 @@ impl PreparedFrame {
         let pass_ms = self.execute(r)?;
         let image = read_rgba32f(&r.ctx.device, &r.ctx.queue, self.output_texture())?;
         let (mut culling, mut shadows, mut atlases) = (Vec::new(), Vec::new(), Vec::new());
+        let mut shadow_compare = Vec::new();
         for report in self.pass_reports(r)? {
             match report {
                 PassReport::Culling(c) => culling.push(c),
                 PassReport::Shadow(s) => shadows.push(s),
                 PassReport::Atlas(a) => atlases.push(a),
+                PassReport::ShadowCompare(c) => shadow_compare.push(c),
             }
         }
         let light_stats = self.read_light_stats(r)?;
@@ -276,6 +278,7 @@ impl PreparedFrame {
             culling,
             shadows,
             atlases,
+            shadow_compare,
             light_stats,
         })
     }
@@ -325,7 +328,7 @@ impl PreparedFrame {
             .into_iter()
             .filter_map(|report| match report {
                 PassReport::Shadow(s) => Some(s),
-                PassReport::Culling(_) | PassReport::Atlas(_) => None,
+                _ => None,
             })
             .collect())
     }

@@ -18,7 +18,10 @@ pub use frame::PreparedFrame;
 pub use materials::MaterialProgram;
 pub use pipelines::{CacheCounters, Pipeline, PipelineCache, PipelineKey};
 pub use prepare_stats::PrepareStats;
-pub use report::{AtlasReport, CullingReport, FrameResult, LightStats, PassReport, ShadowReport};
+pub use report::{
+    AtlasReport, CullingReport, FrameResult, LightStats, PassReport, ShadowCompareReport,
+    ShadowReport,
+};
 pub use resources::FrameResources;
 pub use scene_gpu::{GpuBvh, GpuMesh, SceneGpu};
 

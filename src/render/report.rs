@@ -122,12 +122,35 @@ impl AtlasReport {
     }
 }
 
+/// Per ShadowCompare pass: the atlas against ray-cast shadows, per (pixel, light) pair.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ShadowCompareReport {
+    pub pass: String,
+    /// Pairs of a pixel and a shadow-casting light that reaches it.
+    pub pairs: u64,
+    /// Pairs whose filtered visibility is on the other side of one half from the ray's.
+    pub disagree_pcf5: u64,
+    pub disagree_2x2: u64,
+    /// Pairs partly lit by the 5×5 filter.
+    pub penumbra_pcf5: u64,
+}
+
+impl ShadowCompareReport {
+    pub fn error_pcf5(&self) -> f64 {
+        self.disagree_pcf5 as f64 / self.pairs.max(1) as f64
+    }
+    pub fn error_2x2(&self) -> f64 {
+        self.disagree_2x2 as f64 / self.pairs.max(1) as f64
+    }
+}
+
 /// What a pass counted on the GPU (or decided on the CPU for this frame).
 #[derive(Clone, Debug)]
 pub enum PassReport {
     Culling(CullingReport),
     Shadow(ShadowReport),
     Atlas(AtlasReport),
+    ShadowCompare(ShadowCompareReport),
 }
 
 pub struct FrameResult {
@@ -140,5 +163,6 @@ pub struct FrameResult {
     pub culling: Vec<CullingReport>,
     pub shadows: Vec<ShadowReport>,
     pub atlases: Vec<AtlasReport>,
+    pub shadow_compare: Vec<ShadowCompareReport>,
     pub light_stats: Option<LightStats>,
 }

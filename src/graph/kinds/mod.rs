@@ -9,6 +9,7 @@ pub mod forward_shading;
 pub mod g_buffer;
 pub mod light_culling;
 pub mod shadow_atlas;
+pub mod shadow_compare;
 pub mod shadow_ray_cast;
 pub mod shadow_ray_jobs;
 
@@ -183,6 +184,7 @@ pub fn slots(kind: &PassKind) -> Option<&'static [SlotSpec]> {
         PassKind::ShadowRayJobs(_) => shadow_ray_jobs::SLOTS,
         PassKind::ShadowRayCast(_) => shadow_ray_cast::SLOTS,
         PassKind::ShadowAtlas(_) => shadow_atlas::SLOTS,
+        PassKind::ShadowCompare => shadow_compare::SLOTS,
         PassKind::Compute { .. } | PassKind::Fullscreen { .. } => return None,
     })
 }
@@ -198,6 +200,7 @@ fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         PassKind::ShadowRayJobs(p) => shadow_ray_jobs::check(p, ctx, errors),
         PassKind::ShadowRayCast(p) => shadow_ray_cast::check(p, ctx, errors),
         PassKind::ShadowAtlas(p) => shadow_atlas::check(p, ctx, errors),
+        PassKind::ShadowCompare => shadow_compare::check(ctx, errors),
         PassKind::Compute { .. } | PassKind::Fullscreen { .. } => {}
     }
 }
@@ -457,13 +460,8 @@ pub fn check_shadow_atlas(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
             views,
             "a view table is read with its atlas: read the ShadowAtlas pass's depth texture too",
         )),
-        (Some(atlas), Some(_)) => {
-            if shadow_atlas::atlas_side(ctx.graph.resources.get(atlas).copied()).is_none() {
-                errors.push(ctx.mismatch(
-                    atlas,
-                    "a shadow atlas is a single-sample square depth texture of a fixed power-of-two size (size: Fixed(4096, 4096))",
-                ));
-            }
+        (Some(_), Some(_)) => {
+            check_shadow_atlas_texture(ctx, errors);
             let other = [shadow_ray_jobs::SHADOW_MASK, shadow_ray_cast::BVH_NODES]
                 .into_iter()
                 .find_map(|s| ctx.slot(s));
@@ -475,6 +473,18 @@ pub fn check_shadow_atlas(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
             }
         }
         (None, None) => {}
+    }
+}
+
+/// A read shadow atlas is one a ShadowAtlas pass can have written.
+pub fn check_shadow_atlas_texture(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+    if let Some(atlas) = ctx.slot(shadow_atlas::SHADOW_ATLAS) {
+        if shadow_atlas::atlas_side(ctx.graph.resources.get(atlas).copied()).is_none() {
+            errors.push(ctx.mismatch(
+                atlas,
+                "a shadow atlas is a single-sample square depth texture of a fixed power-of-two size (size: Fixed(4096, 4096))",
+            ));
+        }
     }
 }
 

@@ -10,6 +10,7 @@ mod fullscreen;
 mod g_buffer;
 pub(super) mod light_culling;
 mod shadow_atlas;
+mod shadow_compare;
 mod shadow_ray_cast;
 mod shadow_ray_jobs;
 
@@ -52,6 +53,7 @@ pub(super) fn prepare(
         PassKind::ShadowRayJobs(p) => Box::new(shadow_ray_jobs::prepare(cx, sp, p)?),
         PassKind::ShadowRayCast(p) => Box::new(shadow_ray_cast::prepare(cx, sp, p)?),
         PassKind::ShadowAtlas(p) => Box::new(shadow_atlas::prepare(cx, sp, p)?),
+        PassKind::ShadowCompare => Box::new(shadow_compare::prepare(cx, sp)?),
         PassKind::Compute {
             shader,
             entry,
@@ -183,14 +185,7 @@ impl PrepareCtx<'_> {
         use crate::graph::kinds::forward_shading::{shadows, Shadows};
         let s = shadows(&sp.roles, &self.graph.plan);
         if let Shadows::Atlas(_) = s {
-            let sampler = self.device().create_sampler(&wgpu::SamplerDescriptor {
-                label: Some("shadow_sampler"),
-                mag_filter: wgpu::FilterMode::Linear,
-                min_filter: wgpu::FilterMode::Linear,
-                compare: Some(wgpu::CompareFunction::LessEqual),
-                ..Default::default()
-            });
-            offered.offer("shadow_sampler", Bound::Sampler(sampler));
+            offered.offer("shadow_sampler", comparison_sampler(&self.device()));
         }
         s
     }
@@ -250,6 +245,18 @@ impl PrepareCtx<'_> {
             .map_err(|m| pass_error(pass, m))?;
         Ok((pipeline, bind))
     }
+}
+
+/// The shadow atlas's sampler: bilinear comparison (each tap compares a 2×2 footprint),
+/// lit where the reference depth is at most the stored one.
+pub(super) fn comparison_sampler(device: &wgpu::Device) -> Bound {
+    Bound::Sampler(device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("shadow_sampler"),
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        compare: Some(wgpu::CompareFunction::LessEqual),
+        ..Default::default()
+    }))
 }
 
 pub(super) fn pass_error(pass: &str, message: String) -> RenderError {
