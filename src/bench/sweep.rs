@@ -383,7 +383,30 @@ fn measure(
         row.listed_exact_ratio = Some(s.false_positive_ratio());
     }
     set_shadow_columns(row, &prepared.graph, gpu, &result.shadows);
+    set_atlas_columns(row, &result);
     Ok(())
+}
+
+/// The shadow atlas columns: memory, lights shadowed and dropped, views; the pair error
+/// when a ShadowCompare pass ran.
+fn set_atlas_columns(row: &mut BenchRow, result: &crate::render::FrameResult) {
+    if !result.atlases.is_empty() {
+        let a = &result.atlases;
+        row.atlas_mib = Some(
+            a.iter()
+                .map(|a| (a.atlas_bytes + a.table_bytes) as f64)
+                .sum::<f64>()
+                / MIB,
+        );
+        row.atlas_shadowed = Some(a.iter().map(|a| a.shadowed.len() as u64).sum());
+        row.atlas_dropped = Some(a.iter().map(|a| a.dropped.len() as u64).sum());
+        row.atlas_views = Some(a.iter().map(|a| a.views as u64).sum());
+    }
+    if let Some(c) = result.shadow_compare.first() {
+        row.shadow_pairs = Some(c.pairs);
+        row.pair_error_pcf5 = Some(c.error_pcf5());
+        row.pair_error_2x2 = Some(c.error_2x2());
+    }
 }
 
 const MIB: f64 = (1u64 << 20) as f64;

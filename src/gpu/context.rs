@@ -67,6 +67,8 @@ impl GpuContext {
             // targets (48 bytes a sample; the default allows 32).
             max_color_attachment_bytes_per_sample: adapter_limits
                 .max_color_attachment_bytes_per_sample,
+            // Shadow atlases up to 16384² (the default allows 8192).
+            max_texture_dimension_2d: adapter_limits.max_texture_dimension_2d,
             ..wgpu::Limits::default()
         };
         let (device, queue) = adapter

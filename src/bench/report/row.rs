@@ -72,6 +72,17 @@ pub struct BenchRow {
     pub bvh_mib: Option<f64>,
     /// How long building that BVH took on the CPU, ms.
     pub bvh_build_ms: Option<f64>,
+    /// Shadow atlases: texture and view table, MiB.
+    pub atlas_mib: Option<f64>,
+    /// Shadow-casting lights in view given a tile, and those without room (unshadowed).
+    pub atlas_shadowed: Option<u64>,
+    pub atlas_dropped: Option<u64>,
+    pub atlas_views: Option<u64>,
+    /// (pixel, light) pairs a ShadowCompare pass checked, and the fraction where the
+    /// atlas disagrees with ray-cast shadows, per filter.
+    pub shadow_pairs: Option<u64>,
+    pub pair_error_pcf5: Option<f64>,
+    pub pair_error_2x2: Option<f64>,
 }
 
 impl BenchRow {

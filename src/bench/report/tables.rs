@@ -37,7 +37,7 @@ fn opt<T: ToString>(v: Option<T>) -> String {
 /// row (first-seen order): `pass_ms:<name>` (median), `pass_ms_p10:<name>`, `pass_ms_p90:<name>`,
 /// empty where a row lacks that pass. Time columns are empty, not 0, for untimed rows; the
 /// ray-cast shadow columns (`shadow_*`, `bvh_*`) are empty for graphs without those passes.
-pub const CSV_COLUMNS: [&str; 31] = [
+pub const CSV_COLUMNS: [&str; 38] = [
     "scene",
     "technique",
     "params",
@@ -69,6 +69,13 @@ pub const CSV_COLUMNS: [&str; 31] = [
     "shadow_buffers_mib",
     "bvh_mib",
     "bvh_build_ms",
+    "atlas_mib",
+    "atlas_shadowed",
+    "atlas_dropped",
+    "atlas_views",
+    "shadow_pairs",
+    "pair_error_pcf5",
+    "pair_error_2x2",
 ];
 
 /// The rows as CSV (RFC 4180 quoting; floats in Rust's shortest round-trip form, `inf` for an
@@ -118,6 +125,13 @@ pub fn to_csv(rows: &[BenchRow]) -> String {
             opt(r.shadow_buffers_mib),
             opt(r.bvh_mib),
             opt(r.bvh_build_ms),
+            opt(r.atlas_mib),
+            opt(r.atlas_shadowed),
+            opt(r.atlas_dropped),
+            opt(r.atlas_views),
+            opt(r.shadow_pairs),
+            opt(r.pair_error_pcf5),
+            opt(r.pair_error_2x2),
         ];
         for p in &passes {
             let t = pass_ms(r, p);
@@ -227,6 +241,7 @@ pub fn to_markdown(rows: &[BenchRow]) -> String {
         );
     }
     shadow_markdown(&mut out, rows);
+    atlas_markdown(&mut out, rows);
     if let Some(reason) = untimed_reason(rows).filter(|_| !rows.is_empty()) {
         let _ = writeln!(
             out,
@@ -312,6 +327,44 @@ fn shadow_markdown(out: &mut String, rows: &[BenchRow]) {
     }
 }
 
+/// The shadow atlas table, if some row ran a ShadowAtlas pass.
+fn atlas_markdown(out: &mut String, rows: &[BenchRow]) {
+    if !rows.iter().any(|r| r.atlas_mib.is_some()) {
+        return;
+    }
+    out.push_str(
+        "\nShadow atlases (lights without room are lit unshadowed; pair error: the fraction of \
+         (pixel, light) pairs in front of the surface whose visibility disagrees with ray-cast \
+         shadows, from a ShadowCompare pass):\n\n\
+         | scene | technique | lights | size | atlas MiB | shadowed | dropped | views | pairs | pair error 5×5 | pair error 2×2 | RMSE | FLIP |\n\
+         |---|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n",
+    );
+    let pct = |x: Option<f64>| match x {
+        Some(x) => format!("{}%", md_num(Some(100.0 * x), 3)),
+        None => "–".into(),
+    };
+    for r in rows.iter().filter(|r| r.atlas_mib.is_some()) {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {}x{} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            md_cell(&r.scene),
+            md_cell(&r.technique),
+            r.light_count,
+            r.width,
+            r.height,
+            md_num(r.atlas_mib, 1),
+            r.atlas_shadowed.map_or("–".into(), |n| n.to_string()),
+            r.atlas_dropped.map_or("–".into(), |n| n.to_string()),
+            r.atlas_views.map_or("–".into(), |n| n.to_string()),
+            r.shadow_pairs.map_or("–".into(), |n| n.to_string()),
+            pct(r.pair_error_pcf5),
+            pct(r.pair_error_2x2),
+            md_num(r.rmse, 6),
+            md_num(r.flip_mean, 5),
+        );
+    }
+}
+
 /// Write [`to_csv`] to `path` (creating the parent directory).
 pub fn write_csv(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(), ReportError> {
     write_file(path.as_ref(), &to_csv(rows))
@@ -351,11 +404,15 @@ mod tests {
         let csv = to_csv(&[plain.clone(), shadowed.clone()]);
         let lines: Vec<&str> = csv.lines().collect();
         assert!(lines[0].ends_with(
-            ",passes_ms_total,reference,shadow_rays,shadow_rays_per_s,shadow_jobs_dropped,shadow_overflow_pixels,shadow_buffers_mib,bvh_mib,bvh_build_ms"
+            ",passes_ms_total,reference,shadow_rays,shadow_rays_per_s,shadow_jobs_dropped,shadow_overflow_pixels,shadow_buffers_mib,bvh_mib,bvh_build_ms,atlas_mib,atlas_shadowed,atlas_dropped,atlas_views,shadow_pairs,pair_error_pcf5,pair_error_2x2"
         ));
-        assert!(lines[1].ends_with(",0,,brute_force,,,,,,,"), "{}", lines[1]);
         assert!(
-            lines[2].ends_with(",raycast_shadows_naive,16,2500000000,0,1,1.5,20.4,180"),
+            lines[1].ends_with(",0,,brute_force,,,,,,,,,,,,,,"),
+            "{}",
+            lines[1]
+        );
+        assert!(
+            lines[2].ends_with(",raycast_shadows_naive,16,2500000000,0,1,1.5,20.4,180,,,,,,,"),
             "{}",
             lines[2]
         );
