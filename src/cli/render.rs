@@ -229,7 +229,7 @@ fn atlas_report(a: &lightgraph::render::AtlasReport) {
         .map(|(t, n)| format!("{n} at {t}²"))
         .collect();
     println!(
-        "  {}: {}² atlas ({:.1} MiB, table {:.2} MiB), {} lights shadowed in {} views ({}), {:.0}% of the atlas used, {} halvings, {} caster draws; {} casters off screen",
+        "  {}: {}² atlas ({:.1} MiB, table {:.2} MiB), {} lights shadowed in {} views ({}), {:.0}% of the atlas used, {} halvings, {} caster draws of {} triangles; {} casters off screen",
         a.pass,
         a.side,
         mib(a.atlas_bytes),
@@ -240,6 +240,7 @@ fn atlas_report(a: &lightgraph::render::AtlasReport) {
         100.0 * a.used_texels as f64 / (a.side as f64 * a.side as f64),
         a.halvings,
         a.draws,
+        a.triangles,
         a.off_screen
     );
     if !a.dropped.is_empty() {

@@ -268,12 +268,17 @@ impl Renderer {
                 _ => None,
             };
             let gm = &gpu.meshes[mesh];
+            let shadow_view = matches!(mode, DrawMode::AtlasDepth { .. });
             draws.push(Draw {
                 mesh,
                 material,
                 pipeline,
                 vertices: gm.vertices.clone(),
-                indices: gm.indices.clone(),
+                indices: if shadow_view {
+                    gm.shadow_indices.clone()
+                } else {
+                    gm.indices.clone()
+                },
                 index_count: gm.index_count,
             });
         }
@@ -398,13 +403,14 @@ fn neutral_material_wgsl() -> Option<&'static str> {
     .as_deref()
 }
 
-/// One view of a multi-view draw: its viewport (a square tile) and the meshes it sees.
+/// One view of a multi-view draw: its viewport (a square tile) and what it sees.
 pub(super) struct ViewDraw {
     pub x: u32,
     pub y: u32,
     pub tile: u32,
-    /// Per mesh draw (in [`MeshDraws::meshes`] order), whether the view sees it.
-    pub visible: Vec<bool>,
+    /// Index ranges to draw: (draw in [`MeshDraws::meshes`] order, first index, count),
+    /// sorted by draw.
+    pub ranges: Vec<(usize, u32, u32)>,
 }
 
 impl MeshDraws {
@@ -425,12 +431,9 @@ impl MeshDraws {
             pass.set_viewport(x as f32, y as f32, t as f32, t as f32, 0.0, 1.0);
             pass.set_scissor_rect(x, y, t, t);
             let instance = v as u32;
-            for (d, _) in self
-                .draws
-                .iter()
-                .zip(&view.visible)
-                .filter(|(_, &seen)| seen)
-            {
+            let mut bound: Option<usize> = None;
+            for &(draw, first, count) in &view.ranges {
+                let d = &self.draws[draw];
                 let ptr = Arc::as_ptr(&d.pipeline);
                 if current != Some(ptr) {
                     pass.set_pipeline(&d.pipeline);
@@ -439,9 +442,12 @@ impl MeshDraws {
                         pass.set_bind_group(MATERIAL_GROUP, group, &[]);
                     }
                 }
-                pass.set_vertex_buffer(0, d.vertices.slice(..));
-                pass.set_index_buffer(d.indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..d.index_count, 0, instance..instance + 1);
+                if bound != Some(draw) {
+                    pass.set_vertex_buffer(0, d.vertices.slice(..));
+                    pass.set_index_buffer(d.indices.slice(..), wgpu::IndexFormat::Uint32);
+                    bound = Some(draw);
+                }
+                pass.draw_indexed(first..first + count, 0, instance..instance + 1);
             }
         }
     }

@@ -103,8 +103,9 @@ pub struct AtlasReport {
     pub views: u32,
     pub halvings: u32,
     pub used_texels: u64,
-    /// Mesh draws over all views after culling per view.
+    /// Draw calls and triangles over all views after culling chunks per view.
     pub draws: u64,
+    pub triangles: u64,
 }
 
 impl AtlasReport {

@@ -14,6 +14,10 @@ pub struct GpuMesh {
     pub material: usize,
     /// World-space bounds (min, max) of the vertices: for culling per shadow view.
     pub bounds: [glam::Vec3; 2],
+    /// The triangles reordered into spatial chunks (`shadow::chunks`), drawn by shadow
+    /// views, which cull chunk by chunk.
+    pub shadow_indices: wgpu::Buffer,
+    pub chunks: std::sync::Arc<[crate::shadow::chunks::Chunk]>,
 }
 
 /// Cheap to clone (the GPU objects are shared handles): hot reload builds a changed copy
@@ -103,6 +107,8 @@ impl SceneGpu {
             .iter()
             .filter(|m| !m.indices.is_empty())
             .map(|m| {
+                let (shadow_indices, chunks) =
+                    crate::shadow::chunks::chunk_triangles(&m.positions, &m.indices);
                 let vertices: Vec<GpuVertex> = (0..m.positions.len())
                     .map(|i| GpuVertex {
                         position: m.positions[i].into(),
@@ -128,6 +134,17 @@ impl SceneGpu {
                         [glam::Vec3::INFINITY, glam::Vec3::NEG_INFINITY],
                         |[lo, hi], &p| [lo.min(p), hi.max(p)],
                     ),
+                    shadow_indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some(&m.name),
+                        // Never empty: a mesh of only bad triangles binds one unused entry.
+                        contents: bytemuck::cast_slice(if shadow_indices.is_empty() {
+                            &[0u32; 3][..]
+                        } else {
+                            &shadow_indices[..]
+                        }),
+                        usage: wgpu::BufferUsages::INDEX,
+                    }),
+                    chunks: chunks.into(),
                 }
             })
             .collect();

@@ -14,6 +14,7 @@
 
 pub mod atlas;
 pub mod bvh;
+pub mod chunks;
 pub mod reference;
 mod traverse;
 

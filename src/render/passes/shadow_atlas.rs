@@ -21,8 +21,11 @@ pub(super) struct ShadowAtlasPass {
     normal_offset: f32,
     size: FrameSize,
     lights: Vec<Light>,
-    /// World bounds of each draw's mesh, in draw order.
-    bounds: Vec<[glam::Vec3; 2]>,
+    /// Each draw's mesh: its bounds and triangle chunks, in draw order.
+    meshes: Vec<(
+        [glam::Vec3; 2],
+        std::sync::Arc<[crate::shadow::chunks::Chunk]>,
+    )>,
     atlas: wgpu::TextureView,
     atlas_bytes: u64,
     views: wgpu::Buffer,
@@ -96,7 +99,10 @@ pub(super) fn prepare(
     let draws = cx
         .renderer
         .mesh_draws(cx.gpu, mode, 1, &sp.name, &offered)?;
-    let bounds = draws.meshes().map(|m| cx.gpu.meshes[m].bounds).collect();
+    let meshes = draws
+        .meshes()
+        .map(|m| (cx.gpu.meshes[m].bounds, cx.gpu.meshes[m].chunks.clone()))
+        .collect();
     let bytes_per_texel = format
         .block_copy_size(Some(wgpu::TextureAspect::DepthOnly))
         .unwrap_or(4);
@@ -112,7 +118,7 @@ pub(super) fn prepare(
         normal_offset: p.normal_offset,
         size: cx.size,
         lights: cx.scene.lights.clone(),
-        bounds,
+        meshes,
         atlas: cx.view(&sp.name, atlas_name)?,
         atlas_bytes: side as u64 * side as u64 * bytes_per_texel as u64,
         views,
@@ -171,15 +177,29 @@ impl ShadowAtlasPass {
             .iter()
             .map(|view| {
                 let planes = frustum_planes(view.view_proj);
+                let mut ranges: Vec<(usize, u32, u32)> = Vec::new();
+                for (draw, ([lo, hi], chunks)) in self.meshes.iter().enumerate() {
+                    if !box_in_frustum(&planes, *lo, *hi) {
+                        continue;
+                    }
+                    for c in chunks
+                        .iter()
+                        .filter(|c| box_in_frustum(&planes, c.min, c.max))
+                    {
+                        // Consecutive visible chunks make one draw.
+                        match ranges.last_mut() {
+                            Some((d, first, count)) if *d == draw && *first + *count == c.first => {
+                                *count += c.count
+                            }
+                            _ => ranges.push((draw, c.first, c.count)),
+                        }
+                    }
+                }
                 ViewDraw {
                     x: view.x,
                     y: view.y,
                     tile: view.tile,
-                    visible: self
-                        .bounds
-                        .iter()
-                        .map(|[lo, hi]| box_in_frustum(&planes, *lo, *hi))
-                        .collect(),
+                    ranges,
                 }
             })
             .collect();
@@ -219,9 +239,10 @@ impl PreparedPass for ShadowAtlasPass {
             views: a.views.len() as u32,
             halvings: a.halvings,
             used_texels: a.used_texels,
-            draws: draws
+            draws: draws.iter().map(|d| d.ranges.len() as u64).sum(),
+            triangles: draws
                 .iter()
-                .map(|d| d.visible.iter().filter(|&&v| v).count() as u64)
+                .flat_map(|d| d.ranges.iter().map(|r| r.2 as u64 / 3))
                 .sum(),
         })))
     }
