@@ -419,17 +419,25 @@ impl MeshDraws {
         self.draws.iter().map(|d| d.mesh)
     }
 
-    /// Draws each view's visible meshes into its viewport, with the view's index as the
-    /// instance (the shader reads its projection from it).
-    pub fn record_views(&self, pass: &mut wgpu::RenderPass<'_>, views: &[ViewDraw]) {
-        if let Some(bind) = &self.bind {
-            pass.set_bind_group(0, bind, &[]);
-        }
-        let mut current: Option<*const wgpu::RenderPipeline> = None;
+    /// Clears each view's viewport with `clear` (a pipeline without bindings), then draws
+    /// its visible meshes there with the view's index as the instance (the shader reads
+    /// its projection from it).
+    pub fn record_views(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        views: &[ViewDraw],
+        clear: &wgpu::RenderPipeline,
+    ) {
         for (v, view) in views.iter().enumerate() {
             let (x, y, t) = (view.x, view.y, view.tile);
             pass.set_viewport(x as f32, y as f32, t as f32, t as f32, 0.0, 1.0);
             pass.set_scissor_rect(x, y, t, t);
+            pass.set_pipeline(clear);
+            pass.draw(0..3, 0..1);
+            let mut current: Option<*const wgpu::RenderPipeline> = None;
+            if let Some(bind) = &self.bind {
+                pass.set_bind_group(0, bind, &[]);
+            }
             let instance = v as u32;
             let mut bound: Option<usize> = None;
             for &(draw, first, count) in &view.ranges {
