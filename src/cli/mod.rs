@@ -188,7 +188,11 @@ pub fn run() -> Result<()> {
     }
     assets::set_project(project);
     match cli.command {
-        None => render::render(RenderArgs::default()),
+        // The README's first command: the default scene, sized for the adapter, to a file.
+        None => render::render(RenderArgs {
+            out: Some(PathBuf::from("lightgraph.png")),
+            ..RenderArgs::default()
+        }),
         Some(Command::Render(args)) => render::render(args),
         Some(Command::Validate { files }) => render::validate(&files),
         Some(Command::Graph { graph, scene, dot }) => {
@@ -206,6 +210,23 @@ pub fn run() -> Result<()> {
         Some(Command::Bench { sweep, out }) => bench::run_bench(sweep.as_deref(), &out),
         Some(Command::View(args)) => live::view(args),
         Some(Command::ReloadBench(args)) => bench::reload_bench(&args),
+    }
+}
+
+/// Sets `XDG_RUNTIME_DIR` to a private folder under the temporary directory when it is
+/// unset (containers, ssh without a login session): Mesa's Vulkan drivers load the Wayland
+/// client library, which prints "XDG_RUNTIME_DIR is invalid or not set" twice otherwise.
+/// A set value, even a wrong one, is left alone. Call before any thread starts.
+pub fn runtime_dir_fallback() {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_some() {
+        return;
+    }
+    let user = std::env::var("USER").unwrap_or_else(|_| "user".into());
+    let dir = std::env::temp_dir().join(format!("lightgraph-runtime-{user}"));
+    use std::os::unix::fs::DirBuilderExt;
+    let made = std::fs::DirBuilder::new().mode(0o700).create(&dir);
+    if made.is_ok() || dir.is_dir() {
+        std::env::set_var("XDG_RUNTIME_DIR", &dir);
     }
 }
 
