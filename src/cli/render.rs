@@ -19,18 +19,14 @@ pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
                 eprintln!("warning: {w}");
             }
             let mut scene = loaded.scene;
-            if scene.lights.is_empty() {
-                if let Some(bounds) = scene.bounds() {
-                    let l = scene::lights::fallback_light(bounds);
-                    eprintln!(
-                        "warning: {} has no lights; added a point light at {:.2?} (range {:.2}, {:.2} cd)",
-                        p.display(),
-                        l.position,
-                        l.range,
-                        l.intensity
-                    );
-                    scene.lights.push(l);
-                }
+            if let Some(l) = scene.add_headlight_if_unlit() {
+                eprintln!(
+                    "warning: {} has no lights; added a headlight at the camera {:.2?} (range {:.2}, {:.2} cd)",
+                    p.display(),
+                    l.position,
+                    l.range,
+                    l.intensity
+                );
             }
             Ok(scene)
         }
