@@ -355,8 +355,37 @@ pub fn compare(a: &Path, b: &Path) -> Result<()> {
         ia.height,
         &Default::default(),
     )?;
-    println!("{m:#?}");
+    println!("{}", compare_summary(&m));
+    println!("{m}");
     Ok(())
+}
+
+/// One line first: identical, or how far apart and where it matters.
+fn compare_summary(m: &bench::ImageMetrics) -> String {
+    let non_finite = m.reference_non_finite.nan_pixels
+        + m.reference_non_finite.inf_pixels
+        + m.test_non_finite.nan_pixels
+        + m.test_non_finite.inf_pixels;
+    if m.rmse == 0.0 && m.max_abs == 0.0 && non_finite == 0 {
+        return format!("identical ({}x{})", m.width, m.height);
+    }
+    let flip = m
+        .flip_mean
+        .map(|f| format!(", FLIP mean {f:.4}"))
+        .unwrap_or_default();
+    format!(
+        "differ: RMSE {:.3e}, max abs {:.3e}, {} of {} pixels over {}{flip}{}",
+        m.rmse,
+        m.max_abs,
+        m.bad_pixels,
+        m.width as usize * m.height as usize,
+        m.bad_pixel_threshold,
+        if non_finite > 0 {
+            format!(", {non_finite} non-finite pixels")
+        } else {
+            String::new()
+        }
+    )
 }
 
 pub fn material(path: &Path, wgsl: bool) -> Result<()> {
