@@ -323,6 +323,7 @@ fn tiled_deferred_matches_forward_brute_force() {
     // the two points differ by up to ~1/512 px sideways, a few 1e-5 of the view depth
     // here, and lighting changes by about twice that over the light's distance.
     let out = render_file(&mut r, "tiled_deferred_packed.ron", &scene, W, H);
+    assert_eq!(out.image.len(), reference.image.len());
     let mut worst = 0.0f32;
     for (a, b) in out.image.iter().zip(&reference.image) {
         for ch in 0..3 {
