@@ -141,4 +141,29 @@ fn bench_without_sweep_says_which_it_runs() {
         "{all}"
     );
     assert!(dir.path().join("report/results.md").exists());
+    // The smoke sweep lights most of its frame (it lit 76 of 14,400 pixels once).
+    let csv = std::fs::read_to_string(dir.path().join("report/results.csv")).unwrap();
+    let mut lines = csv.lines().map(csv_fields);
+    let header = lines.next().unwrap();
+    let lit = header.iter().position(|h| h == "lit_pixels").unwrap();
+    let rows: Vec<Vec<String>> = lines.collect();
+    assert_eq!(rows.len(), 3);
+    for row in rows {
+        let n: u64 = row[lit].parse().unwrap();
+        assert!(n * 2 > 160 * 90, "{n} of 14,400 pixels lit: {row:?}");
+    }
+}
+
+/// One CSV line's fields (quoted fields may hold commas; no escaped quotes here).
+fn csv_fields(line: &str) -> Vec<String> {
+    let (mut fields, mut field, mut quoted) = (Vec::new(), String::new(), false);
+    for ch in line.chars() {
+        match ch {
+            '"' => quoted = !quoted,
+            ',' if !quoted => fields.push(std::mem::take(&mut field)),
+            c => field.push(c),
+        }
+    }
+    fields.push(field);
+    fields
 }
