@@ -1,31 +1,58 @@
 #!/usr/bin/env bash
-# The test command (README): installs Mesa's software Vulkan driver (lavapipe) when it is
-# missing, then runs the whole test suite on whatever adapter wgpu picks.
+# The test command (README): installs what is missing of Mesa's software Vulkan driver
+# (lavapipe), Xvfb and the X11 client libraries (for the viewer's window test), then runs
+# the whole test suite on whatever adapter wgpu picks.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+missing=()
 # An ICD file alone does not make an adapter (a GPU driver's JSON can exist without the
-# GPU), so the check is for lavapipe itself: it always works.
-if ! ls /usr/share/vulkan/icd.d/lvp_icd*.json /etc/vulkan/icd.d/lvp_icd*.json >/dev/null 2>&1; then
-    echo "no lavapipe Vulkan driver found: installing mesa-vulkan-drivers"
-    SUDO=""
-    [ "$(id -u)" -ne 0 ] && SUDO="sudo"
-    $SUDO apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq mesa-vulkan-drivers >/dev/null
-fi
+# GPU), so the check is for lavapipe itself: it always works. A loop, not `ls A B`: ls
+# fails when either glob matches nothing.
+have_lavapipe() {
+    local f
+    for f in /usr/share/vulkan/icd.d/lvp_icd*.json /etc/vulkan/icd.d/lvp_icd*.json; do
+        [ -e "$f" ] && return 0
+    done
+    return 1
+}
+have_lavapipe || missing+=(mesa-vulkan-drivers)
 # The viewer's test opens a real window on a virtual X server; winit loads the X11
 # client libraries at run time.
-need_x11=""
-command -v xvfb-run >/dev/null 2>&1 || need_x11=1
-for lib in libX11-xcb.so.1 libXcursor.so.1 libXrandr.so.2 libXi.so.6 libxkbcommon-x11.so.0; do
-    ldconfig -p | grep "$lib" >/dev/null || need_x11=1
+command -v xvfb-run >/dev/null 2>&1 || missing+=(xvfb)
+command -v xauth >/dev/null 2>&1 || missing+=(xauth)
+libs=$(ldconfig -p 2>/dev/null || true)
+for pair in libX11-xcb.so.1:libx11-xcb1 libXcursor.so.1:libxcursor1 libXrandr.so.2:libxrandr2 \
+    libXi.so.6:libxi6 libxkbcommon-x11.so.0:libxkbcommon-x11-0; do
+    case "$libs" in
+    *"${pair%%:*}"*) ;;
+    *) missing+=("${pair#*:}") ;;
+    esac
 done
-if [ -n "$need_x11" ]; then
-    echo "installing Xvfb and the X11 client libraries (for the viewer's window test)"
-    SUDO=""
-    [ "$(id -u)" -ne 0 ] && SUDO="sudo"
-    $SUDO apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq xvfb xauth libx11-xcb1 \
-        libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0 >/dev/null
+
+fail_install() {
+    echo "test.sh: cannot install ${missing[*]}: $1" >&2
+    echo "test.sh: install them yourself (Debian/Ubuntu: apt-get install ${missing[*]}) and rerun" >&2
+    exit 1
+}
+if [ ${#missing[@]} -eq 0 ]; then
+    echo "test.sh: lavapipe, Xvfb and the X11 libraries are installed; nothing to install"
+else
+    echo "test.sh: installing what is missing: ${missing[*]}"
+    command -v apt-get >/dev/null 2>&1 || fail_install "no apt-get on this machine"
+    if [ "$(id -u)" -eq 0 ]; then
+        as_root=()
+    elif ! command -v sudo >/dev/null 2>&1; then
+        fail_install "not root and no sudo"
+    elif [ -t 0 ]; then
+        as_root=(sudo)
+    else
+        # No terminal to ask for a password on: fail instead of hanging.
+        as_root=(sudo -n)
+    fi
+    "${as_root[@]}" apt-get update -qq || fail_install "apt-get update failed (no network, or not allowed?)"
+    "${as_root[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >/dev/null ||
+        fail_install "apt-get install failed"
 fi
 # Headless tests need no display server; the runtime dir quiets winit and Mesa.
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp}"

@@ -3,6 +3,8 @@
 mod cli;
 
 fn main() -> anyhow::Result<()> {
+    // Before anything starts a thread: Mesa's Vulkan loader reads the environment.
+    cli::runtime_dir_fallback();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     cli::run()
 }

@@ -34,6 +34,7 @@ fn graph_text(tile: u32, variant: &str, capacity: u32, coarse: Option<u32>) -> S
 fn check_scene(scene: &Scene, expect_lit: bool) {
     let mut r = renderer();
     let reference = render_file(&mut r, "brute_force.ron", scene, W, H);
+    assert_eq!(reference.image.len(), (W * H) as usize);
     assert!(
         reference
             .image
@@ -90,6 +91,7 @@ fn check_scene(scene: &Scene, expect_lit: bool) {
                 W,
                 H,
             );
+            assert_eq!(c.counts.len(), direct.culling[0].counts.len());
             let grew = c
                 .counts
                 .iter()
@@ -101,8 +103,9 @@ fn check_scene(scene: &Scene, expect_lit: bool) {
                 "{} tile {tile} {variant}: the coarse stage grew {grew} lists",
                 scene.name
             );
+            assert_eq!(out.image.len(), reference.image.len());
             assert!(
-                out.image == direct.image,
+                !out.image.is_empty() && out.image == direct.image,
                 "{} tile {tile} {variant}: the coarse stage changed the image",
                 scene.name
             );
@@ -320,6 +323,7 @@ fn tiled_deferred_matches_forward_brute_force() {
     // the two points differ by up to ~1/512 px sideways, a few 1e-5 of the view depth
     // here, and lighting changes by about twice that over the light's distance.
     let out = render_file(&mut r, "tiled_deferred_packed.ron", &scene, W, H);
+    assert_eq!(out.image.len(), reference.image.len());
     let mut worst = 0.0f32;
     for (a, b) in out.image.iter().zip(&reference.image) {
         for ch in 0..3 {

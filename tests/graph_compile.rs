@@ -111,10 +111,56 @@ fn forward_plus_schedule_and_brute_force_culling() {
     );
 }
 
+/// Three independent passes kept by `side_effects` and a two-pass chain, declared in
+/// the order of `names`.
+fn independent_passes(names: &[&str]) -> String {
+    let pass = |n: &str| {
+        match n {
+        "make_a" => r#"Pass(name: "make_a", kind: Fullscreen(shader: "examples/solid.wgsl"), writes: ["a"])"#.to_string(),
+        "a_to_out" => r#"Pass(name: "a_to_out", kind: Fullscreen(shader: "examples/copy.wgsl"), reads: ["a"], writes: ["out"])"#.to_string(),
+        s => format!(r#"Pass(name: "{s}", kind: Fullscreen(shader: "examples/solid.wgsl"), writes: ["t_{s}"])"#),
+    }
+    };
+    let passes: Vec<String> = names.iter().map(|n| pass(n)).collect();
+    format!(
+        r#"Graph(
+    name: "independent",
+    resources: [
+        Texture(name: "a", format: Rgba32Float),
+        Texture(name: "out", format: Rgba32Float),
+        Texture(name: "t_s1", format: Rgba32Float),
+        Texture(name: "t_s2", format: Rgba32Float),
+        Texture(name: "t_s3", format: Rgba32Float),
+    ],
+    passes: [
+        {}
+    ],
+    output: "out",
+    side_effects: ["s2", "s3", "s1"],
+)"#,
+        passes.join(",\n        ")
+    )
+}
+
 #[test]
 fn order_is_stable_by_declaration() {
-    // Independent passes keep their declared order whatever the edges' insertion order.
-    let g = compile(CHAIN, SceneFeatures::default());
-    let again = compile(CHAIN, SceneFeatures::default());
-    assert_eq!(g.pass_names(), again.pass_names());
+    // Among passes whose inputs are ready the one declared first runs first, so the
+    // schedule follows the declaration, not a hash or the edges' insertion order.
+    for (declared, expected) in [
+        (
+            ["s1", "s2", "make_a", "a_to_out", "s3"],
+            ["s1", "s2", "make_a", "a_to_out", "s3"],
+        ),
+        (
+            ["s3", "a_to_out", "s1", "make_a", "s2"],
+            ["s3", "s1", "make_a", "a_to_out", "s2"],
+        ),
+        (
+            ["a_to_out", "s2", "s3", "s1", "make_a"],
+            ["s2", "s3", "s1", "make_a", "a_to_out"],
+        ),
+    ] {
+        let g = compile(&independent_passes(&declared), SceneFeatures::default());
+        assert_eq!(g.pass_names(), expected, "declared {declared:?}");
+    }
 }

@@ -36,11 +36,11 @@ fn every_bad_graph_gives_its_message() {
                         path.display()
                     ));
                 }
-                // Every message names the file and a line.
+                // Every message names the file, a line of it and a column.
                 let name = path.file_name().unwrap().to_str().unwrap();
-                if !message.contains(&format!("{name}:")) {
+                if !names_line_and_column(&message, name, text.lines().count()) {
                     failures.push(format!(
-                        "{}: message does not name the file: {message}",
+                        "{}: message does not name file:line:col: {message}",
                         path.display()
                     ));
                 }
@@ -52,14 +52,51 @@ fn every_bad_graph_gives_its_message() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
+/// Whether `message` has `name:LINE:COL` with LINE inside the file's `lines` and COL >= 1.
+fn names_line_and_column(message: &str, name: &str, lines: usize) -> bool {
+    let at = format!("{name}:");
+    message.match_indices(&at).any(|(i, _)| {
+        let mut parts = message[i + at.len()..].splitn(3, ':');
+        let line = parts.next().and_then(|l| l.parse::<usize>().ok());
+        let col = parts.next().and_then(|c| c.parse::<usize>().ok());
+        matches!((line, col), (Some(l), Some(c)) if (1..=lines).contains(&l) && c >= 1)
+    })
+}
+
+#[test]
+fn the_location_check_needs_a_line_and_column() {
+    assert!(names_line_and_column("x.ron:3:7: bad", "x.ron", 5));
+    assert!(!names_line_and_column("x.ron: bad", "x.ron", 5));
+    assert!(!names_line_and_column("x.ron:9:1: bad", "x.ron", 5));
+    assert!(!names_line_and_column("x.ron:3: bad", "x.ron", 5));
+}
+
 #[test]
 fn shipped_graphs_validate() {
+    let mut checked = 0;
     for entry in std::fs::read_dir(root().join("graphs")).unwrap() {
         let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "ron") {
+            continue;
+        }
         if let Err(e) = graph::check_file(&path, &ShaderLibrary::builtin()) {
             panic!("{}: {e}", path.display());
         }
+        checked += 1;
     }
+    // An empty or misplaced graphs/ must not pass: the README lists these.
+    for name in [
+        "forward_plus.ron",
+        "brute_force.ron",
+        "tiled_deferred.ron",
+        "raycast_shadows.ron",
+    ] {
+        assert!(
+            root().join("graphs").join(name).is_file(),
+            "graphs/{name} is missing"
+        );
+    }
+    assert!(checked >= 15, "only {checked} shipped graphs");
 }
 
 #[test]

@@ -63,7 +63,10 @@ fn shader_and_graph_edits_reload_and_errors_keep_the_last_frame() {
     )
     .unwrap();
     let first = s.frame.as_ref().unwrap().image.clone();
+    assert_eq!(first.len(), 96 * 64);
     assert!(first.iter().any(|p| p[0] > 0.0), "the scene is lit");
+    // Frustum culling's lists: a graph reload to DepthMask must change them.
+    let frustum_counts = s.frame.as_ref().unwrap().culling[0].counts.clone();
 
     // 1. A shader constant: twice the range window doubles every light's contribution.
     let lighting = shaders.join("common/lighting.wgsl");
@@ -77,6 +80,7 @@ fn shader_and_graph_edits_reload_and_errors_keep_the_last_frame() {
     let latency = reload_of(&mut s, &lighting).expect("the edited shader compiles");
     println!("shader edit to new frame: {latency:?} (lavapipe)");
     let second = s.frame.as_ref().unwrap().image.clone();
+    assert_eq!(second.len(), first.len());
     for (a, b) in second.iter().zip(&first) {
         for c in 0..3 {
             // The window is at most 1, doubled exactly; the sum of doubled terms is the
@@ -117,6 +121,14 @@ fn shader_and_graph_edits_reload_and_errors_keep_the_last_frame() {
     reload_of(&mut s, &graph).expect("the edited graph compiles");
     let (d, _) = max_rel_diff(&s.frame.as_ref().unwrap().image, &first);
     assert!(d < 2e-6, "{d}");
+    // The same image from other lists: the new graph ran (a no-op reload keeps Frustum's).
+    let mask_counts = &s.frame.as_ref().unwrap().culling[0].counts;
+    assert_eq!(mask_counts.len(), frustum_counts.len());
+    assert!(
+        mask_counts.iter().zip(&frustum_counts).all(|(m, f)| m <= f)
+            && mask_counts.iter().sum::<u32>() < frustum_counts.iter().sum::<u32>(),
+        "DepthMask lists are shorter than Frustum's"
+    );
 
     // 5. A broken graph (an unknown resource) keeps the frame and names the line.
     let bad = text.replace("writes: [\"light_lists\"]", "writes: [\"light_list\"]");
@@ -134,4 +146,9 @@ fn shader_and_graph_edits_reload_and_errors_keep_the_last_frame() {
     std::fs::write(&graph, &text).unwrap();
     reload_of(&mut s, &graph).expect("the fixed graph loads");
     assert_eq!(s.frame.as_ref().unwrap().image, first);
+    assert_eq!(
+        s.frame.as_ref().unwrap().culling[0].counts,
+        frustum_counts,
+        "back to Frustum's lists"
+    );
 }

@@ -112,8 +112,7 @@ fn cornell_box_has_red_and_green_walls_and_a_lit_interior() {
         s.lights.is_empty(),
         "the asset has no lights; the CLI adds one"
     );
-    s.lights
-        .push(scene::lights::fallback_light(s.bounds().unwrap()));
+    assert!(s.add_headlight_if_unlit().is_some());
     let (w, h) = (96, 96);
     let mut r = renderer();
     let out = render_file(&mut r, "forward_plus.ron", &s, w, h);

@@ -109,7 +109,11 @@ const CORPUS: &[(&str, Expect)] = &[
     ),
     (
         "sparse_accessor.gltf",
-        Error(&["POSITION accessor 0", "sparse"]),
+        Error(&[
+            "POSITION accessor 0",
+            "sparse index 0 is 1065353216",
+            "past the accessor's count 3",
+        ]),
     ),
     (
         "position_wrong_type.gltf",

@@ -117,4 +117,14 @@ fn window_shows_the_rendered_scene_and_the_overlay() {
         overlay_pixels > 5_000,
         "the overlay should cover the top left; only {overlay_pixels} pixels differ there"
     );
+    // But no more than a quarter of the window (it covered 40% of this one once).
+    let covered = (0..WINDOW[1])
+        .flat_map(|y| (0..WINDOW[0]).map(move |x| (x, y)))
+        .filter(|&(x, y)| diff(x, y) > 24)
+        .count() as u32;
+    assert!(
+        covered * 4 <= WINDOW[0] * WINDOW[1],
+        "the overlay covers {covered} of {} window pixels",
+        WINDOW[0] * WINDOW[1]
+    );
 }

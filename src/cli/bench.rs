@@ -8,13 +8,29 @@ use std::path::Path;
 
 pub fn run_bench(sweep: Option<&Path>, out: &Path) -> Result<()> {
     use bench::sweep::SweepEvent;
-    let path = sweep
-        .map(Path::to_path_buf)
-        .unwrap_or_else(|| project_path("benches/sweeps/headline.ron"));
-    let sweep = bench::sweep::Sweep::load(&path)?;
     let mut renderer = Renderer::headless()?;
+    let (path, sweep, why) = match sweep {
+        Some(p) => (p.to_path_buf(), bench::sweep::Sweep::load(p)?, None),
+        None => {
+            let (rel, text, why) = default_sweep(renderer.ctx.is_software());
+            // The root's copy if it has one, else the one built into the binary.
+            let path = project_path(rel);
+            let sweep = match std::fs::read_to_string(&path) {
+                Ok(own) => bench::sweep::Sweep::parse(&own, &path)?,
+                Err(_) => bench::sweep::Sweep::parse(text, Path::new(rel))?,
+            };
+            (path, sweep, Some(why))
+        }
+    };
     let progress = bench::progress::SweepProgress::new(sweep.point_count());
     progress.println(&format!("adapter: {}", renderer.ctx.adapter_name()));
+    if let Some(why) = why {
+        progress.println(&format!(
+            "no --sweep: running {} ({} points; {why})",
+            path.display(),
+            sweep.point_count()
+        ));
+    }
     if !renderer.ctx.has_timestamps {
         progress.warn(&format!(
             "{} has no timestamp queries: no GPU times will be reported (time columns stay empty, no time plots)",
@@ -41,6 +57,24 @@ pub fn run_bench(sweep: Option<&Path>, out: &Path) -> Result<()> {
     }
     println!("wrote {}", files.markdown.display());
     Ok(())
+}
+
+/// The sweep `bench` runs without --sweep: (path, built-in text, why). headline.ron is
+/// 25 points up to 65,536 lights at 1080p, hours on lavapipe; smoke.ron takes seconds.
+fn default_sweep(software: bool) -> (&'static str, &'static str, &'static str) {
+    if software {
+        (
+            "benches/sweeps/smoke.ron",
+            include_str!("../../benches/sweeps/smoke.ron"),
+            "software adapter: the smoke sweep; --sweep benches/sweeps/headline.ron for the full one",
+        )
+    } else {
+        (
+            "benches/sweeps/headline.ron",
+            include_str!("../../benches/sweeps/headline.ron"),
+            "GPU adapter: the headline sweep",
+        )
+    }
 }
 
 /// One log line per point: time, error against the reference, NaN / Inf counts.

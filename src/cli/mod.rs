@@ -30,13 +30,23 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene through a graph, headless; print per-pass GPU times and light statistics.
     Render(RenderArgs),
-    /// Validate graph files; every error is printed as file:line:col. Exit 1 if any.
-    Validate { files: Vec<PathBuf> },
-    /// Print the compiled schedule (after culling for the scene) as Graphviz.
+    /// Validate graph, scene and material files; every error is printed as file:line:col.
+    /// Exit 1 if any.
+    Validate {
+        /// Files to check: graph RON, scene RON/.gltf/.glb or material RON (told apart by
+        /// their contents).
+        #[arg(required = true, value_name = "FILE")]
+        files: Vec<PathBuf>,
+    },
+    /// Print the compiled schedule (after culling for the scene): passes in order, culled
+    /// passes and the resource count, or Graphviz with --dot.
     Graph {
+        /// The graph file (RON).
         graph: PathBuf,
+        /// The scene the graph is specialised to (default: the built-in atrium).
         #[arg(long)]
         scene: Option<PathBuf>,
+        /// Print Graphviz DOT instead of the list (`| dot -Tsvg > g.svg`).
         #[arg(long)]
         dot: bool,
     },
@@ -44,14 +54,20 @@ pub enum Command {
     /// graph or the scene; print the reload latency or the error (the last good frame
     /// stays in --out).
     Watch {
+        /// Scene: .ron, .gltf or .glb (default: the built-in atrium). Watched with every file
+        /// it reads.
         #[arg(long)]
         scene: Option<PathBuf>,
+        /// Graph file (default: graphs/forward_plus.ron of the root, else built in). Watched.
         #[arg(long)]
         graph: Option<PathBuf>,
+        /// Frame width in pixels.
         #[arg(long, default_value_t = 640)]
         width: u32,
+        /// Frame height in pixels.
         #[arg(long, default_value_t = 360)]
         height: u32,
+        /// Where every good frame is written: .png (tonemapped) or .exr (linear HDR).
         #[arg(long)]
         out: PathBuf,
     },
@@ -60,16 +76,27 @@ pub enum Command {
     View(ViewArgs),
     /// Check a layered material; with --wgsl print the WGSL generated for it.
     Material {
+        /// The material file (RON).
         file: PathBuf,
+        /// Print the WGSL generated for the material.
         #[arg(long)]
         wgsl: bool,
     },
-    /// Compare two EXR images: RMSE, max abs, PSNR, FLIP mean, bad pixels.
-    Compare { a: PathBuf, b: PathBuf },
+    /// Compare two EXR images: a summary line, then RMSE, max abs and rel, PSNR, FLIP
+    /// mean and bad pixels as a table.
+    Compare {
+        /// The reference image (.exr).
+        a: PathBuf,
+        /// The image compared with it (.exr, same size).
+        b: PathBuf,
+    },
     /// Time against error: run a sweep file, write CSV, Markdown and plots to --out.
     Bench {
+        /// The sweep file (RON; see benches/sweeps/). Default: a sweep sized for the
+        /// adapter, the built-in smoke sweep on a software adapter and headline.ron on a GPU.
         #[arg(long)]
         sweep: Option<PathBuf>,
+        /// The folder the report is written to (created if missing).
         #[arg(long)]
         out: PathBuf,
     },
@@ -80,10 +107,13 @@ pub enum Command {
 
 #[derive(clap::Args)]
 pub struct ReloadBenchArgs {
+    /// The folder the CSV and Markdown are written to (created if missing).
     #[arg(long)]
     pub out: PathBuf,
+    /// Frame width in pixels.
     #[arg(long, default_value_t = 160)]
     pub width: u32,
+    /// Frame height in pixels.
     #[arg(long, default_value_t = 90)]
     pub height: u32,
     /// Random lights in the benchmark scene.
@@ -102,8 +132,11 @@ pub struct RenderArgs {
     /// Graph file (default: graphs/forward_plus.ron).
     #[arg(long)]
     pub graph: Option<PathBuf>,
+    /// Frame width in pixels (default: the scene's; on a software adapter, without
+    /// --width and --height, scaled to fit 640x360).
     #[arg(long)]
     pub width: Option<u32>,
+    /// Frame height in pixels (default: as for --width).
     #[arg(long)]
     pub height: Option<u32>,
     /// Output image: .png (tonemapped sRGB) or .exr (linear HDR, 32-bit float).
@@ -123,8 +156,10 @@ pub struct ViewArgs {
     /// graphs in its folder are offered as variants.
     #[arg(long)]
     pub graph: Option<PathBuf>,
+    /// Window width in pixels.
     #[arg(long, default_value_t = 1280)]
     pub width: u32,
+    /// Window height in pixels.
     #[arg(long, default_value_t = 720)]
     pub height: u32,
     /// Render size relative to the window (0.5 shades a quarter of the pixels).
@@ -136,6 +171,7 @@ pub struct ViewArgs {
     /// Save what the window shows to this PNG after --frames frames, then exit.
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
+    /// Frames shown before --screenshot is taken.
     #[arg(long, default_value_t = 10)]
     pub frames: u32,
 }
@@ -188,7 +224,11 @@ pub fn run() -> Result<()> {
     }
     assets::set_project(project);
     match cli.command {
-        None => render::render(RenderArgs::default()),
+        // The README's first command: the default scene, sized for the adapter, to a file.
+        None => render::render(RenderArgs {
+            out: Some(PathBuf::from("lightgraph.png")),
+            ..RenderArgs::default()
+        }),
         Some(Command::Render(args)) => render::render(args),
         Some(Command::Validate { files }) => render::validate(&files),
         Some(Command::Graph { graph, scene, dot }) => {
@@ -209,7 +249,50 @@ pub fn run() -> Result<()> {
     }
 }
 
+/// Sets `XDG_RUNTIME_DIR` to a private folder under the temporary directory when it is
+/// unset (containers, ssh without a login session): Mesa's Vulkan drivers load the Wayland
+/// client library, which prints "XDG_RUNTIME_DIR is invalid or not set" twice otherwise.
+/// A set value, even a wrong one, is left alone. Call before any thread starts.
+pub fn runtime_dir_fallback() {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_some() {
+        return;
+    }
+    let user = std::env::var("USER").unwrap_or_else(|_| "user".into());
+    let dir = std::env::temp_dir().join(format!("lightgraph-runtime-{user}"));
+    use std::os::unix::fs::DirBuilderExt;
+    let made = std::fs::DirBuilder::new().mode(0o700).create(&dir);
+    if made.is_ok() || dir.is_dir() {
+        std::env::set_var("XDG_RUNTIME_DIR", &dir);
+    }
+}
+
 /// Project file `rel` (`graphs/forward_plus.ron`): the root's own, else the built-in one.
 pub fn project_path(rel: &str) -> PathBuf {
     assets::project().locate(rel)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Cli;
+    use clap::CommandFactory;
+
+    /// Every subcommand says what it does and every flag and argument what it takes.
+    #[test]
+    fn every_subcommand_and_argument_has_help() {
+        let cli = Cli::command();
+        cli.clone().debug_assert();
+        let mut missing = Vec::new();
+        for sub in cli.get_subcommands() {
+            if sub.get_about().is_none() {
+                missing.push(sub.get_name().to_string());
+            }
+            for arg in sub.get_arguments() {
+                let builtin = matches!(arg.get_id().as_str(), "help" | "version");
+                if !builtin && arg.get_help().is_none() {
+                    missing.push(format!("{} {}", sub.get_name(), arg.get_id()));
+                }
+            }
+        }
+        assert!(missing.is_empty(), "no help for: {missing:?}");
+    }
 }

@@ -19,18 +19,14 @@ pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
                 eprintln!("warning: {w}");
             }
             let mut scene = loaded.scene;
-            if scene.lights.is_empty() {
-                if let Some(bounds) = scene.bounds() {
-                    let l = scene::lights::fallback_light(bounds);
-                    eprintln!(
-                        "warning: {} has no lights; added a point light at {:.2?} (range {:.2}, {:.2} cd)",
-                        p.display(),
-                        l.position,
-                        l.range,
-                        l.intensity
-                    );
-                    scene.lights.push(l);
-                }
+            if let Some(l) = scene.add_headlight_if_unlit() {
+                eprintln!(
+                    "warning: {} has no lights; added a headlight at the camera {:.2?} (range {:.2}, {:.2} cd)",
+                    p.display(),
+                    l.position,
+                    l.range,
+                    l.intensity
+                );
             }
             Ok(scene)
         }
@@ -104,24 +100,96 @@ pub fn print_graph(path: &Path, scene_path: Option<&Path>, dot: bool) -> Result<
     Ok(())
 }
 
+/// What `render` does without --width/--height on a software adapter: fit the scene's
+/// size into this (the atrium at 1920×1080 takes minutes on lavapipe, 640×360 seconds).
+const SOFTWARE_SIZE: (u32, u32) = (640, 360);
+
+/// The frame size and why: flags first, else the scene's own size on a GPU, scaled down
+/// to fit [`SOFTWARE_SIZE`] on a software adapter.
+fn pick_size(
+    args: &RenderArgs,
+    scene_size: (u32, u32),
+    software: bool,
+) -> ((u32, u32), &'static str) {
+    let (dw, dh) = scene_size;
+    match (args.width, args.height) {
+        (None, None) if software && (dw > SOFTWARE_SIZE.0 || dh > SOFTWARE_SIZE.1) => {
+            let k = (SOFTWARE_SIZE.0 as f64 / dw as f64).min(SOFTWARE_SIZE.1 as f64 / dh as f64);
+            let scaled = |v: u32| ((v as f64 * k).round() as u32).max(1);
+            (
+                (scaled(dw), scaled(dh)),
+                "software adapter: small size, --width/--height for another",
+            )
+        }
+        (None, None) if software => ((dw, dh), "the scene's size"),
+        (None, None) => ((dw, dh), "GPU adapter: the scene's full size"),
+        (w, h) => ((w.unwrap_or(dw), h.unwrap_or(dh)), "from --width/--height"),
+    }
+}
+
+/// The lower-case extension of `path`, if any.
+fn extension(path: &Path) -> Option<String> {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+}
+
+/// Checks the output flags before anything is loaded or rendered.
+fn check_outputs(args: &RenderArgs) -> Result<()> {
+    if let Some(out) = &args.out {
+        if !matches!(extension(out).as_deref(), Some("png" | "exr")) {
+            bail!(
+                "--out {}: the output must end in .png or .exr",
+                out.display()
+            );
+        }
+    }
+    if let Some(h) = &args.heatmap {
+        if extension(h).as_deref() != Some("png") {
+            bail!("--heatmap {}: the heat map must end in .png", h.display());
+        }
+    }
+    if args.width == Some(0) || args.height == Some(0) {
+        bail!("--width and --height must be at least 1");
+    }
+    Ok(())
+}
+
 pub fn render(args: RenderArgs) -> Result<()> {
+    check_outputs(&args)?;
     let scene = load_scene(args.scene.as_deref())?;
     let graph_path = args
         .graph
         .clone()
         .unwrap_or_else(|| project_path("graphs/forward_plus.ron"));
-    let (dw, dh) = scene.output_size.unwrap_or((1280, 720));
+    let mut renderer = Renderer::headless()?;
+    let checked = assets::check_graph(&graph_path, &renderer.shaders)?;
+    let ((width, height), why) = pick_size(
+        &args,
+        scene.output_size.unwrap_or((1280, 720)),
+        renderer.ctx.is_software(),
+    );
     let size = FrameSize {
-        width: args.width.unwrap_or(dw),
-        height: args.height.unwrap_or(dh),
+        width,
+        height,
         lights: scene.lights.len() as u32,
     };
     if size.width == 0 || size.height == 0 {
         bail!("output size {}x{} is empty", size.width, size.height);
     }
-    let mut renderer = Renderer::headless()?;
-    let checked = assets::check_graph(&graph_path, &renderer.shaders)?;
     let compiled = graph::compile(checked, &scene.features(), size);
+    if args.heatmap.is_some() && !compiled.has_light_culling() {
+        bail!(
+            "--heatmap needs a graph with a LightCulling pass; {} has none after culling",
+            graph_path.display()
+        );
+    }
+    eprintln!(
+        "rendering {} ({} lights) at {width}x{height} ({why}) on {}...",
+        scene.name,
+        scene.lights.len(),
+        renderer.ctx.adapter_name()
+    );
     let gpu = SceneGpu::upload(&renderer.ctx.device, &renderer.ctx.queue, &scene)?;
     let stats = compiled.has_forward_shading();
     let prepared = renderer.prepare(compiled, &scene, &gpu, size, stats)?;
@@ -130,9 +198,13 @@ pub fn render(args: RenderArgs) -> Result<()> {
     let result = prepared.render(&renderer)?;
     report(&renderer, &scene, &graph_path, &result);
     shadow_report(&scene, &gpu, &result);
-    if let Some(out) = &args.out {
-        write_image(out, &result)?;
-        println!("wrote {}", out.display());
+    match &args.out {
+        Some(out) => {
+            write_image(out, &result)?;
+            let shown = std::path::absolute(out).unwrap_or_else(|_| out.clone());
+            println!("wrote {}", shown.display());
+        }
+        None => println!("(no image written: add --out F.png or --out F.exr)"),
     }
     if let Some(path) = &args.heatmap {
         let Some(c) = result.culling.first() else {
@@ -312,12 +384,7 @@ fn report(r: &Renderer, scene: &Scene, graph: &Path, result: &FrameResult) {
 }
 
 pub fn write_image(out: &Path, result: &FrameResult) -> Result<()> {
-    match out
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .as_deref()
-    {
+    match extension(out).as_deref() {
         Some("exr") => bench::write_exr(out, &result.image, result.width, result.height)?,
         Some("png") => bench::write_png_tonemapped(
             out,
@@ -341,8 +408,37 @@ pub fn compare(a: &Path, b: &Path) -> Result<()> {
         ia.height,
         &Default::default(),
     )?;
-    println!("{m:#?}");
+    println!("{}", compare_summary(&m));
+    println!("{m}");
     Ok(())
+}
+
+/// One line first: identical, or how far apart and where it matters.
+fn compare_summary(m: &bench::ImageMetrics) -> String {
+    let non_finite = m.reference_non_finite.nan_pixels
+        + m.reference_non_finite.inf_pixels
+        + m.test_non_finite.nan_pixels
+        + m.test_non_finite.inf_pixels;
+    if m.rmse == 0.0 && m.max_abs == 0.0 && non_finite == 0 {
+        return format!("identical ({}x{})", m.width, m.height);
+    }
+    let flip = m
+        .flip_mean
+        .map(|f| format!(", FLIP mean {f:.4}"))
+        .unwrap_or_default();
+    format!(
+        "differ: RMSE {:.3e}, max abs {:.3e}, {} of {} pixels over {}{flip}{}",
+        m.rmse,
+        m.max_abs,
+        m.bad_pixels,
+        m.width as usize * m.height as usize,
+        m.bad_pixel_threshold,
+        if non_finite > 0 {
+            format!(", {non_finite} non-finite pixels")
+        } else {
+            String::new()
+        }
+    )
 }
 
 pub fn material(path: &Path, wgsl: bool) -> Result<()> {

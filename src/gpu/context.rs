@@ -91,6 +91,12 @@ impl GpuContext {
         })
     }
 
+    /// Whether the adapter runs on the CPU (lavapipe, llvmpipe, SwiftShader): callers pick
+    /// smaller default workloads there.
+    pub fn is_software(&self) -> bool {
+        self.adapter.get_info().device_type == wgpu::DeviceType::Cpu
+    }
+
     /// "NVIDIA H200 (Vulkan)" or "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan)".
     pub fn adapter_name(&self) -> String {
         let info = self.adapter.get_info();

@@ -71,6 +71,12 @@ impl CompiledGraph {
             .iter()
             .any(|p| matches!(p.kind, PassKind::ForwardShading { .. }))
     }
+    /// Whether a light-culling pass runs (the lights-per-tile heat map needs one).
+    pub fn has_light_culling(&self) -> bool {
+        self.passes
+            .iter()
+            .any(|p| matches!(p.kind, PassKind::LightCulling(_)))
+    }
     pub fn output(&self) -> &str {
         &self.checked.desc.output
     }

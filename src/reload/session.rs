@@ -108,8 +108,13 @@ fn normalize(path: &Path) -> PathBuf {
 /// The scene and every file it was read from (models, their buffers and images).
 fn load_scene(source: &SceneSource) -> Result<(Scene, Vec<PathBuf>), String> {
     match source {
+        // A light-less model gets the headlight `render` gives it (the window shows what
+        // `render --out` writes). It stays where the scene's camera was.
         SceneSource::File(p) => scene::load(p)
-            .map(|l| (l.scene, l.files))
+            .map(|mut l| {
+                l.scene.add_headlight_if_unlit();
+                (l.scene, l.files)
+            })
             .map_err(|e| e.to_string()),
         SceneSource::Fixed(s) => Ok(((**s).clone(), Vec::new())),
     }

@@ -416,22 +416,20 @@ pub fn check_light(l: &Light) -> Result<(), String> {
     Ok(())
 }
 
-/// For a scene that brings no lights (many glTF files): one point light just under the
-/// top of the bounds, centred, reaching the whole scene. Callers warn that they added it.
-pub fn fallback_light(bounds: (Vec3, Vec3)) -> Light {
+/// For a scene that brings no lights (many glTF files): a headlight, a point light at the
+/// camera, as most glTF viewers do. Every surface the camera sees faces it, so all of them
+/// are lit (a light inside the bounds leaves closed models such as the Khronos Box dark).
+/// About unit irradiance at the centre of the bounds; the range reaches twice past the
+/// farthest corner, so the range window dims nothing visible by more than ~12%.
+pub fn headlight(camera: &Camera, bounds: (Vec3, Vec3)) -> Light {
     let (lo, hi) = bounds;
-    let extent = hi - lo;
-    let diagonal = extent.length().max(1e-3);
-    let position = Vec3::new(
-        (lo.x + hi.x) * 0.5,
-        hi.y - 0.1 * extent.y,
-        (lo.z + hi.z) * 0.5,
-    );
-    // About unit irradiance at half the diagonal.
+    let centre = (lo + hi) * 0.5;
+    let to_centre = (centre - camera.eye).length();
+    let reach = (to_centre + 0.5 * (hi - lo).length()).max(1e-3);
     Light::point(
-        position,
-        2.0 * diagonal,
+        camera.eye,
+        2.0 * reach,
         Vec3::ONE,
-        0.25 * diagonal * diagonal,
+        to_centre.max(1e-3).powi(2),
     )
 }

@@ -260,6 +260,17 @@ impl Scene {
     }
 
     /// Axis-aligned bounds of all geometry, or `None` for an empty scene.
+    /// Adds a [`headlight`](super::lights::headlight) when the scene has no lights but has
+    /// geometry; returns it so that the caller can say so (the library never prints).
+    pub fn add_headlight_if_unlit(&mut self) -> Option<Light> {
+        if !self.lights.is_empty() {
+            return None;
+        }
+        let light = super::lights::headlight(&self.camera, self.bounds()?);
+        self.lights.push(light);
+        Some(light)
+    }
+
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         let mut it = self.meshes.iter().flat_map(|m| m.positions.iter().copied());
         let first = it.next()?;

@@ -176,13 +176,27 @@ mod tests {
 
     #[test]
     fn switching_modes_does_not_move_the_view() {
+        // `camera()` does not read the mode, so what a switch must keep is the state the
+        // next mode starts from: fly looks around the eye that orbiting left, and orbit
+        // then turns around the target that flying left.
         let mut c = CameraController::new(&scene_camera());
         c.drag(50.0, 10.0);
-        let before = c.camera();
+        let orbit_eye = c.eye();
         c.mode = CameraMode::Fly;
-        let after = c.camera();
-        assert_eq!(before.eye, after.eye);
-        assert_eq!(before.target, after.target);
+        c.drag(-120.0, 35.0);
+        assert!(close(c.eye(), orbit_eye), "fly starts at the orbit's eye");
+        let fly_target = c.camera().target;
+        assert!(
+            !close(fly_target, scene_camera().target),
+            "fly turned the view"
+        );
+        c.mode = CameraMode::Orbit;
+        c.drag(80.0, -20.0);
+        assert!(
+            close(c.camera().target, fly_target),
+            "orbit turns around fly's target"
+        );
+        assert!(!close(c.eye(), orbit_eye), "and moves the eye");
     }
 
     #[test]

@@ -56,9 +56,16 @@ impl Overlay {
         if !self.visible {
             return actions;
         }
+        // At most half the window's width and half its height, a quarter of it, however
+        // many passes and variants it lists (the rest scrolls); the title bar collapses it.
+        let screen = ctx.content_rect().size();
         egui::Window::new("lightgraph")
             .default_pos([8.0, 8.0])
-            .default_width(300.0)
+            .default_width(300.0f32.min(screen.x * 0.5))
+            .max_width(screen.x * 0.5)
+            .max_height(screen.y * 0.5)
+            .vscroll(true)
+            .collapsible(true)
             .show(ctx, |ui| {
                 ui.label(format!(
                     "{} · {} lights · {}×{}",
@@ -75,11 +82,15 @@ impl Overlay {
                 } else if let Some(r) = &info.last_reload {
                     ui.label(format!("reloaded: {r}"));
                 }
-                ui.separator();
-                self.pass_times(ui, info);
-                self.light_statistics(ui, info);
-                ui.separator();
-                self.controls(ui, &mut actions);
+                egui::CollapsingHeader::new("GPU times and light statistics")
+                    .default_open(true)
+                    .show(ui, |ui| {
+                        self.pass_times(ui, info);
+                        self.light_statistics(ui, info);
+                    });
+                egui::CollapsingHeader::new("graph variant, camera, exposure")
+                    .default_open(true)
+                    .show(ui, |ui| self.controls(ui, &mut actions));
                 ui.small(
                     "drag: rotate · wheel: zoom/speed · WASD QE: move · Tab: mode · F1: overlay",
                 );

@@ -213,6 +213,9 @@ pub fn render_file(
 
 /// Largest absolute difference, relative to the brightest reference pixel.
 pub fn max_rel_diff(a: &[[f32; 4]], b: &[[f32; 4]]) -> (f32, usize) {
+    // Without this an empty or truncated image would pass as identical.
+    assert_eq!(a.len(), b.len(), "images of different sizes");
+    assert!(!b.is_empty(), "empty images");
     let peak = b
         .iter()
         .flat_map(|p| p[..3].iter().copied())

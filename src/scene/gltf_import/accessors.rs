@@ -3,6 +3,7 @@
 use super::Importer;
 use crate::scene::error::SceneError;
 use gltf::accessor::{DataType, Dimensions};
+use std::borrow::Cow;
 
 impl Importer {
     /// Reads an accessor into `count` rows of `N` components as f32 (normalized integers are
@@ -89,11 +90,12 @@ impl Importer {
     }
 
     /// (bytes from the first element, stride, count), with every element proven in bounds.
+    /// Sparse accessors and those without a bufferView come back as a dense copy.
     fn accessor_layout<'s>(
         &'s self,
         acc: &gltf::Accessor,
         element: &str,
-    ) -> Result<(&'s [u8], usize, usize), SceneError> {
+    ) -> Result<(Cow<'s, [u8]>, usize, usize), SceneError> {
         let count = acc.count() as u64;
         self.limit(
             element,
@@ -101,11 +103,26 @@ impl Importer {
             count,
             self.limits.max_accessor_count,
         )?;
-        if acc.sparse().is_some() {
-            return Err(self.err(element, "sparse accessors are not supported"));
+        let base = self.view_layout(acc, element)?;
+        match (acc.sparse(), base) {
+            (None, Some((bytes, stride))) => Ok((Cow::Borrowed(bytes), stride, count as usize)),
+            (sparse, base) => {
+                let dense = self.dense_accessor(acc, element, base, sparse.as_ref())?;
+                Ok((Cow::Owned(dense), acc.size(), count as usize))
+            }
         }
+    }
+
+    /// The accessor's elements in its bufferView, if it has one: (bytes from the first
+    /// element, stride), every element proven in bounds.
+    pub(super) fn view_layout<'s>(
+        &'s self,
+        acc: &gltf::Accessor,
+        element: &str,
+    ) -> Result<Option<(&'s [u8], usize)>, SceneError> {
+        let count = acc.count() as u64;
         let Some(view) = acc.view() else {
-            return Err(self.err(element, "accessor has no bufferView"));
+            return Ok(None);
         };
         let elem = acc.size() as u64;
         let stride = view.stride().map(|s| s as u64).unwrap_or(elem);
@@ -132,10 +149,9 @@ impl Importer {
                 ),
             ));
         }
-        Ok((
+        Ok(Some((
             &bytes[off.min(bytes.len() as u64) as usize..],
             stride as usize,
-            count as usize,
-        ))
+        )))
     }
 }

@@ -143,7 +143,7 @@ impl Importer {
             }
             let world = parent * local;
             if let Some(mesh) = node.mesh() {
-                self.import_mesh(&mesh, &world)?;
+                self.import_mesh(&mesh, &world, node.weights())?;
             }
             if let Some(cam) = node.camera() {
                 match cam.projection() {

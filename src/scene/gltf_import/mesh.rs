@@ -1,6 +1,7 @@
 //! Mesh primitives: triangles (strips and fans unrolled) with normals, UVs and tangents,
 //! transformed to world space.
 
+use super::morph::MorphAttribute;
 use super::{named, Importer};
 use crate::scene::error::SceneError;
 use crate::scene::geometry::{compute_normals, compute_tangents};
@@ -13,7 +14,9 @@ impl Importer {
         &mut self,
         mesh: &gltf::Mesh,
         world: &Mat4,
+        node_weights: Option<&[f32]>,
     ) -> Result<(), SceneError> {
+        let weights = node_weights.or(mesh.weights());
         let mesh_el = named("mesh", mesh.index(), mesh.name());
         let prim_count = mesh.primitives().len();
         for prim in mesh.primitives() {
@@ -36,7 +39,8 @@ impl Importer {
             let el =
                 |sem: &str, acc: &gltf::Accessor| format!("{pel} {sem} accessor {}", acc.index());
             let pe = el("POSITION", &pos_acc);
-            let local: Vec<[f32; 3]> = self.read_f32(&pos_acc, &pe, &[DataType::F32])?;
+            let mut local: Vec<[f32; 3]> = self.read_f32(&pos_acc, &pe, &[DataType::F32])?;
+            self.apply_morph(&prim, weights, MorphAttribute::Position, &mut local, &pel)?;
             let n = local.len();
             if let Some(i) = local.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
                 return Err(self.err(
@@ -114,7 +118,8 @@ impl Importer {
             let normals_local: Option<Vec<[f32; 3]>> =
                 match read_attr(self, gltf::Semantic::Normals, "NORMAL")? {
                     Some((acc, e)) => {
-                        let v = self.read_f32(&acc, &e, &[DataType::F32])?;
+                        let mut v = self.read_f32(&acc, &e, &[DataType::F32])?;
+                        self.apply_morph(&prim, weights, MorphAttribute::Normal, &mut v, &pel)?;
                         if v.iter().any(|p| !p.iter().all(|c| c.is_finite())) {
                             self.warn(format!("{e}: non-finite normals; normals regenerated"));
                             None
@@ -178,14 +183,7 @@ impl Importer {
                 }
             }
             let normals = match &normals_local {
-                Some(v) => v
-                    .iter()
-                    .map(|n| {
-                        (normal_m * Vec3::from(*n))
-                            .try_normalize()
-                            .unwrap_or(Vec3::Y)
-                    })
-                    .collect(),
+                Some(v) => self.world_normals(&pel, v, normal_m, &positions, &indices),
                 None => compute_normals(&positions, &indices),
             };
             let tangents = match &tangents_local {
@@ -220,5 +218,36 @@ impl Importer {
             });
         }
         Ok(())
+    }
+}
+
+impl Importer {
+    /// The file's normals in world space. Zero-length ones (exporters write them for
+    /// unused or degenerate vertices) take the normal computed from the triangles, with a
+    /// warning: a made-up direction would light them wrongly without a word.
+    fn world_normals(
+        &mut self,
+        pel: &str,
+        local: &[[f32; 3]],
+        normal_m: Mat3,
+        positions: &[Vec3],
+        indices: &[u32],
+    ) -> Vec<Vec3> {
+        let mut normals: Vec<Option<Vec3>> = local
+            .iter()
+            .map(|n| (normal_m * Vec3::from(*n)).try_normalize())
+            .collect();
+        let zero = normals.iter().filter(|n| n.is_none()).count();
+        if zero > 0 {
+            let first = normals.iter().position(Option::is_none).unwrap_or(0);
+            self.warn(format!(
+                "{pel}: {zero} zero-length normals (the first at vertex {first}); replaced by normals computed from the triangles"
+            ));
+            let computed = compute_normals(positions, indices);
+            for (n, c) in normals.iter_mut().zip(computed) {
+                n.get_or_insert(c);
+            }
+        }
+        normals.into_iter().map(|n| n.unwrap_or(Vec3::Y)).collect()
     }
 }

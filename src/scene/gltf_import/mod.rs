@@ -6,8 +6,10 @@
 //! sliced, and a missing texture only costs a warning.
 //!
 //! One job per module: `document` parses, validates and walks the node graph; `buffers`
-//! and `accessors` read the binary data; `mesh`, `materials`, `images`, `lights` and
-//! `camera` turn glTF elements into scene ones; `encoding` holds the URI / base64 codecs.
+//! and `accessors` read the binary data (`sparse`: sparse accessors and those without a
+//! bufferView, made dense); `mesh`, `morph` (morph targets at their default weights),
+//! `materials`, `images`, `lights` and `camera` turn glTF elements into scene ones;
+//! `encoding` holds the URI / base64 codecs.
 
 mod accessors;
 mod buffers;
@@ -18,6 +20,8 @@ mod images;
 mod lights;
 mod materials;
 mod mesh;
+mod morph;
+mod sparse;
 
 pub use encoding::{base64_decode, base64_encode};
 pub use lights::INFINITE_RANGE_CUTOFF;

@@ -101,7 +101,9 @@ write("bad_base64.gltf", doc(buffer_uri="data:application/octet-stream;base64,@@
 def short_buffer(d): d["buffers"][0]["byteLength"] = 1000
 write("buffer_shorter_than_declared.gltf", doc(extra=short_buffer))
 def sparse(d):
-    d["accessors"][0]["sparse"] = {"count": 1, "indices": {"bufferView": 0, "componentType": 5125},
+    # The index is read from the bytes of 1.0f: far past the 3 elements.
+    d["accessors"][0]["sparse"] = {"count": 1, "indices": {"bufferView": 0, "byteOffset": 12,
+                                                           "componentType": 5125},
                                     "values": {"bufferView": 0}}
 write("sparse_accessor.gltf", doc(extra=sparse))
 def vec2_pos(d): d["accessors"][0]["type"] = "VEC2"

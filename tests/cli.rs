@@ -1,0 +1,169 @@
+//! The command line's manners, run as a new user would: the README's first command writes
+//! a picture, usage errors and bad flags are reported before anything renders, `compare`
+//! leads with a summary line, `bench` without --sweep says which sweep it picked.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// The built binary in `dir`, with no root and no runtime dir from the environment.
+fn lightgraph(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_lightgraph"))
+        .current_dir(dir)
+        .args(args)
+        .env_remove("LIGHTGRAPH_ROOT")
+        .env_remove("XDG_RUNTIME_DIR")
+        .output()
+        .expect("the binary runs")
+}
+
+fn text(o: &Output) -> (String, String) {
+    (
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn no_arguments_writes_lightgraph_png_sized_for_the_adapter() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = lightgraph(dir.path(), &[]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{out}\n{err}");
+    let png = dir.path().join("lightgraph.png");
+    let shown = std::path::absolute(&png).unwrap();
+    assert!(out.contains(&format!("wrote {}", shown.display())), "{out}");
+    let image = image::open(&png).expect("a PNG").to_rgb8();
+    // The progress line says how the size was picked; a software adapter gets 640x360.
+    assert!(err.contains("rendering atrium (1024 lights) at "), "{err}");
+    if err.contains("software adapter: small size") {
+        assert_eq!(image.dimensions(), (640, 360));
+    } else {
+        assert!(err.contains("GPU adapter: the scene's full size"), "{err}");
+        assert_eq!(image.dimensions(), (1920, 1080));
+    }
+    assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
+    let lit = image
+        .pixels()
+        .filter(|p| p.0.iter().any(|&c| c > 8))
+        .count();
+    assert!(lit * 2 > image.pixels().len(), "{lit} lit pixels");
+}
+
+#[test]
+fn validate_without_files_is_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = lightgraph(dir.path(), &["validate"]);
+    let (_, err) = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("<FILE>"), "{err}");
+}
+
+#[test]
+fn bad_flags_are_reported_before_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, says) in [
+        (
+            &["render", "--out", "x.jpg"][..],
+            "must end in .png or .exr",
+        ),
+        (&["render", "--heatmap", "h.jpg"][..], "must end in .png"),
+        (
+            &[
+                "render",
+                "--graph",
+                "<built-in>/graphs/brute_force.ron",
+                "--heatmap",
+                "h.png",
+            ][..],
+            "--heatmap needs a graph with a LightCulling pass",
+        ),
+    ] {
+        let o = lightgraph(dir.path(), args);
+        let (out, err) = text(&o);
+        assert!(!o.status.success(), "{args:?}: {out}");
+        assert!(err.contains(says), "{args:?}: {err}");
+        // The progress line comes just before the GPU work: none was started.
+        assert!(!err.contains("rendering"), "{args:?}: {err}");
+        assert!(!out.contains("adapter:"), "{args:?}: {out}");
+    }
+    assert!(!dir.path().join("h.png").exists());
+}
+
+#[test]
+fn compare_prints_a_summary_line_then_a_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let a: Vec<[f32; 4]> = (0..64).map(|i| [i as f32 / 64.0, 0.5, 0.25, 1.0]).collect();
+    let mut b = a.clone();
+    b[10][0] += 0.5;
+    lightgraph::bench::write_exr(dir.path().join("a.exr"), &a, 8, 8).unwrap();
+    lightgraph::bench::write_exr(dir.path().join("b.exr"), &b, 8, 8).unwrap();
+    let o = lightgraph(dir.path(), &["compare", "a.exr", "a.exr"]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    assert_eq!(out.lines().next(), Some("identical (8x8)"), "{out}");
+    let o = lightgraph(dir.path(), &["compare", "a.exr", "b.exr"]);
+    let (out, _) = text(&o);
+    let mut lines = out.lines();
+    let summary = lines.next().unwrap();
+    assert!(
+        summary.starts_with("differ: RMSE 3.608e-2, max abs 5.000e-1, 1 of 64 pixels over"),
+        "{out}"
+    );
+    let table: Vec<&str> = lines.collect();
+    for row in [
+        "size        8x8",
+        "RMSE        3.608",
+        "max abs     5.0",
+        "bad pixels  1",
+    ] {
+        assert!(
+            table.iter().any(|l| l.starts_with(row)),
+            "no row {row:?} in {out}"
+        );
+    }
+    assert!(!out.contains("ImageMetrics {"), "{out}");
+}
+
+#[test]
+fn bench_without_sweep_says_which_it_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let probe = lightgraph(dir.path(), &["render", "--width", "8", "--height", "8"]);
+    let software = text(&probe).1.contains("llvmpipe") || text(&probe).0.contains("llvmpipe");
+    if !software {
+        return; // the headline sweep takes minutes even on a GPU: not run here
+    }
+    let o = lightgraph(dir.path(), &["bench", "--out", "report"]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{out}\n{err}");
+    let all = format!("{out}{err}");
+    assert!(
+        all.contains("no --sweep: running benches/sweeps/smoke.ron (3 points; software adapter"),
+        "{all}"
+    );
+    assert!(dir.path().join("report/results.md").exists());
+    // The smoke sweep lights most of its frame (it lit 76 of 14,400 pixels once).
+    let csv = std::fs::read_to_string(dir.path().join("report/results.csv")).unwrap();
+    let mut lines = csv.lines().map(csv_fields);
+    let header = lines.next().unwrap();
+    let lit = header.iter().position(|h| h == "lit_pixels").unwrap();
+    let rows: Vec<Vec<String>> = lines.collect();
+    assert_eq!(rows.len(), 3);
+    for row in rows {
+        let n: u64 = row[lit].parse().unwrap();
+        assert!(n * 2 > 160 * 90, "{n} of 14,400 pixels lit: {row:?}");
+    }
+}
+
+/// One CSV line's fields (quoted fields may hold commas; no escaped quotes here).
+fn csv_fields(line: &str) -> Vec<String> {
+    let (mut fields, mut field, mut quoted) = (Vec::new(), String::new(), false);
+    for ch in line.chars() {
+        match ch {
+            '"' => quoted = !quoted,
+            ',' if !quoted => fields.push(std::mem::take(&mut field)),
+            c => field.push(c),
+        }
+    }
+    fields.push(field);
+    fields
+}
