@@ -41,25 +41,7 @@ pub fn validate(files: &[PathBuf]) -> Result<()> {
     let shaders = ShaderLibrary::builtin();
     let mut failed = false;
     for f in files {
-        let text = std::fs::read_to_string(f).unwrap_or_default();
-        // Graphs, scenes and materials are all RON: the top-level name tells them apart.
-        let head = text
-            .lines()
-            .map(str::trim)
-            .find(|l| !l.is_empty() && !l.starts_with("//"))
-            .unwrap_or("");
-        let result: Result<(), String> = if head.starts_with("Graph") {
-            graph::check_file(f, &shaders)
-                .map(|_| ())
-                .map_err(|e| e.to_string())
-        } else if head.starts_with("Scene") || f.extension().is_none_or(|e| e != "ron") {
-            scene::load(f).map(|_| ()).map_err(|e| e.to_string())
-        } else {
-            lightgraph::material::Material::load(f)
-                .and_then(|m| m.wgsl().map(|_| ()))
-                .map_err(|e| e.to_string())
-        };
-        match result {
+        match validate_one(f, &shaders) {
             Ok(()) => println!("{}: ok", f.display()),
             Err(e) => {
                 failed = true;
@@ -71,6 +53,30 @@ pub fn validate(files: &[PathBuf]) -> Result<()> {
         std::process::exit(1);
     }
     Ok(())
+}
+
+/// One file, by its extension and (for RON) its top-level struct name.
+fn validate_one(f: &Path, shaders: &ShaderLibrary) -> Result<(), String> {
+    use lightgraph::file_kind::{detect, FileKind};
+    use lightgraph::files::{caps, read_text};
+    let kind = detect(f, || read_text(f, caps::RON).ok())?;
+    match kind {
+        FileKind::Graph => graph::check_file(f, shaders)
+            .map(|_| ())
+            .map_err(|e| e.to_string()),
+        FileKind::Scene | FileKind::Gltf => scene::load(f).map(|_| ()).map_err(|e| e.to_string()),
+        FileKind::Material => lightgraph::material::Material::load(f)
+            .and_then(|m| m.wgsl().map(|_| ()))
+            .map_err(|e| e.to_string()),
+        FileKind::Shader => {
+            let dir = f.parent().unwrap_or(Path::new("."));
+            let name = f.file_name().unwrap_or_default().to_string_lossy();
+            ShaderLibrary::new(dir)
+                .compose(&name, &Default::default(), &Default::default())
+                .and_then(|c| c.validate().map(|_| ()))
+                .map_err(|e| e.to_string())
+        }
+    }
 }
 
 pub fn print_graph(path: &Path, scene_path: Option<&Path>, dot: bool) -> Result<()> {

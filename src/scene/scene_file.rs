@@ -257,7 +257,8 @@ pub fn parse_scene_file(text: &str, file: &Path) -> Result<SceneFile, SceneError
 
 /// Loads a scene RON file: parses it and builds the scene.
 pub fn load_scene_file(path: &Path) -> Result<Loaded, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError::io(path, e))?;
+    let text = crate::files::read_text(path, crate::files::caps::RON)
+        .map_err(|e| SceneError::io(path, e))?;
     let spec = parse_scene_file(&text, path)?;
     build_scene(&spec, path)
 }

@@ -77,7 +77,8 @@ pub(crate) fn import_gltf_inner(
     path: &Path,
     limits: &ImportLimits,
 ) -> Result<(Loaded, bool), SceneError> {
-    let bytes = std::fs::read(path).map_err(|e| SceneError::io(path, e))?;
+    let bytes = crate::files::read_bytes(path, crate::files::caps::GLTF)
+        .map_err(|e| SceneError::io(path, e))?;
     let base = path.parent().unwrap_or(Path::new("."));
     import_slice_inner(&bytes, base, path, limits)
 }
@@ -114,7 +115,8 @@ fn import_slice_inner(
         has_camera: false,
         files_read: std::cell::RefCell::new(vec![file.to_path_buf()]),
     };
-    imp.run(bytes)?;
+    // A byte-order mark before the JSON is tolerated, as in every other input format.
+    imp.run(bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes))?;
     Ok((
         Loaded {
             scene: imp.scene,
