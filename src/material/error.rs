@@ -33,6 +33,13 @@ pub enum MaterialError {
     WrongType { at: Location, message: String },
     #[error("{at}: empty layer list: a material needs at least one layer")]
     EmptyLayers { at: Location },
+    #[error("{at}: {what} {count} is over the limit of {limit} (each is unrolled into the generated shader)")]
+    TooMany {
+        at: Location,
+        what: &'static str,
+        count: usize,
+        limit: usize,
+    },
     #[error("{at}: empty lobe list: layer {layer} has no lobes")]
     EmptyLobes { at: Location, layer: usize },
     #[error("{at}: missing texture file `{path}` (looked for {resolved})", resolved = .resolved.display())]

@@ -97,6 +97,7 @@ impl Renderer {
         pool: Option<&FrameResources>,
     ) -> Result<PreparedFrame, RenderError> {
         let device = self.ctx.device.clone();
+        super::device_limits::check_plan(&graph, &device.limits())?;
         let resources = FrameResources::create_reusing(&device, &graph.plan, pool);
         let gpu_frame = GpuFrame::new(
             &scene.camera,

@@ -10,6 +10,7 @@ pub mod geometry;
 pub mod gltf_import;
 pub mod gltf_writer;
 pub mod lights;
+mod model_budget;
 pub mod ranges;
 pub mod scene_file;
 mod types;

@@ -32,8 +32,9 @@
 //! written `Random(count: ...)` (RON extensions `implicit_some` and `unwrap_variant_newtypes`).
 
 use super::error::SceneError;
-use super::gltf_import::{import_gltf_inner, ImportLimits};
+use super::gltf_import::import_gltf_inner;
 use super::lights::{amd_camera, check_light, fit_camera, AmdLights, RandomLights};
+use super::model_budget::ModelBudget;
 use super::types::{light_flags, Camera, Light, LightShape, Scene};
 use super::{builtin, Loaded};
 use glam::{EulerRot, Mat3, Mat4, Quat, Vec3};
@@ -322,6 +323,7 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
             scene.lights.clear();
         }
     }
+    let mut budget = ModelBudget::default();
     for (i, model) in spec.models.iter().enumerate() {
         let element = format!("models[{i}] (\"{}\")", model.path.display());
         let m = model.transform.matrix();
@@ -343,7 +345,9 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
                 "a model must be a .gltf or .glb file",
             ));
         }
-        let (loaded, has_camera) = import_gltf_inner(&path, &ImportLimits::default())?;
+        let (loaded, has_camera, expansion) = import_gltf_inner(&path, &budget.limits())
+            .map_err(|e| budget.explain(file, &element, e))?;
+        budget.record(expansion);
         let mut sub = loaded.scene;
         warnings.extend(loaded.warnings);
         files.extend(loaded.files);
