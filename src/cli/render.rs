@@ -69,10 +69,14 @@ fn validate_one(f: &Path, shaders: &ShaderLibrary) -> Result<(), String> {
             .and_then(|m| m.wgsl().map(|_| ()))
             .map_err(|e| e.to_string()),
         FileKind::Shader => {
-            let dir = f.parent().unwrap_or(Path::new("."));
-            let name = f.file_name().unwrap_or_default().to_string_lossy();
-            ShaderLibrary::new(dir)
-                .compose(&name, &Default::default(), &Default::default())
+            // Includes resolve against the shader root, as for a graph's shaders.
+            let file = std::path::absolute(f).map_err(|e| format!("{}: {e}", f.display()))?;
+            shaders
+                .compose(
+                    &file.to_string_lossy(),
+                    &Default::default(),
+                    &Default::default(),
+                )
                 .and_then(|c| c.validate().map(|_| ()))
                 .map_err(|e| e.to_string())
         }

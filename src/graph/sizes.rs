@@ -36,13 +36,25 @@ pub fn check_resources(desc: &GraphDesc, source: &SourceText, errors: &mut Vec<G
             ResourceDesc::Buffer { size, .. } => buffer_problem(*size),
             ResourceDesc::Import { .. } => None,
         };
-        if let Some(problem) = problem {
-            errors.push(GraphError::BadResource {
+        let Some(problem) = problem else { continue };
+        // Named with the pass that writes it, where it is too small or too big.
+        let writer = desc
+            .passes
+            .iter()
+            .find(|p| p.writes.iter().any(|w| w == r.name()));
+        errors.push(match writer {
+            Some(pass) => GraphError::Mismatch {
+                at: source.in_pass(&pass.name, r.name()),
+                pass: pass.name.clone(),
+                resource: r.name().to_string(),
+                problem,
+            },
+            None => GraphError::BadResource {
                 at: source.of_declaration(r.name()),
                 resource: r.name().to_string(),
                 problem,
-            });
-        }
+            },
+        });
     }
 }
 

@@ -30,7 +30,7 @@ impl Scene {
                     file,
                     format!("mesh {mi} (\"{}\") vertex {vi}", mesh.name),
                     format!(
-                        "position {p} after the scene transform is not finite or beyond ±{MAX_COORDINATE:e} m"
+                        "position {p:?} after the scene transform is not finite or beyond ±{MAX_COORDINATE:e} m"
                     ),
                 ));
             }
@@ -50,7 +50,7 @@ fn in_range(p: glam::Vec3) -> bool {
 pub fn check_light_range(l: &Light) -> Result<(), String> {
     if !in_range(l.position) {
         return Err(format!(
-            "position {} is not finite or beyond ±{MAX_COORDINATE:e} m",
+            "position {:?} is not finite or beyond ±{MAX_COORDINATE:e} m",
             l.position
         ));
     }
@@ -63,7 +63,7 @@ pub fn check_light_range(l: &Light) -> Result<(), String> {
     let power = l.intensity * l.color.max_element();
     if !(power.is_finite() && power <= MAX_LIGHT_POWER) {
         return Err(format!(
-            "intensity {} × colour {} is {power:e} cd, over the limit of {MAX_LIGHT_POWER:e}",
+            "intensity {:?} × colour {:?} is {power:e} cd, over the limit of {MAX_LIGHT_POWER:e}",
             l.intensity, l.color
         ));
     }
@@ -74,7 +74,7 @@ pub fn check_light_range(l: &Light) -> Result<(), String> {
 pub fn check_camera(c: &Camera) -> Result<(), String> {
     if !in_range(c.eye) || !in_range(c.target) {
         return Err(format!(
-            "eye {} and target {} must be finite and within ±{MAX_COORDINATE:e} m",
+            "eye {:?} and target {:?} must be finite and within ±{MAX_COORDINATE:e} m",
             c.eye, c.target
         ));
     }

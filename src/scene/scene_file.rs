@@ -345,8 +345,19 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
                 "a model must be a .gltf or .glb file",
             ));
         }
-        let (loaded, has_camera, expansion) = import_gltf_inner(&path, &budget.limits())
-            .map_err(|e| budget.explain(file, &element, e))?;
+        let (loaded, has_camera, expansion) =
+            import_gltf_inner(&path, &budget.limits()).map_err(|e| match e {
+                // Named from the scene file: the model path may be the mistake.
+                SceneError::Io {
+                    file: model,
+                    source,
+                } => SceneError::invalid(
+                    file,
+                    &element,
+                    format!("cannot read {}: {source}", model.display()),
+                ),
+                e => budget.explain(file, &element, e),
+            })?;
         budget.record(expansion);
         let mut sub = loaded.scene;
         warnings.extend(loaded.warnings);

@@ -297,8 +297,12 @@ impl Composed {
             .lines()
             .nth(line.saturating_sub(1))
             .unwrap_or("")
-            .trim()
-            .to_string();
+            .trim();
+        // A generated line can be megabytes long: quote its start.
+        let source_line = match source_line.char_indices().nth(160) {
+            Some((i, _)) => format!("{} …", &source_line[..i]),
+            None => source_line.to_string(),
+        };
         ShaderError::Invalid {
             file,
             line: file_line,

@@ -27,7 +27,9 @@ impl Expansion {
 
 /// The expansion of the scene the importer walks; `None` if the reachable nodes form a
 /// cycle (the walk reports it, naming the node).
-pub(super) fn expansion(root: &Root) -> Option<Expansion> {
+/// An accessor over `max_accessor` elements counts none here: reading it is refused with
+/// its own message.
+pub(super) fn expansion(root: &Root, max_accessor: u64) -> Option<Expansion> {
     let n = root.nodes.len();
     let children = |i: usize| {
         root.nodes[i]
@@ -83,8 +85,8 @@ pub(super) fn expansion(root: &Root) -> Option<Expansion> {
             let tris = mesh
                 .primitives
                 .iter()
-                .map(|p| triangles(root, p))
-                .sum::<u64>();
+                .map(|p| triangles(root, p, max_accessor))
+                .fold(0, u64::saturating_add);
             total.primitives = total.primitives.saturating_add(k.saturating_mul(prims));
             total.triangles = total.triangles.saturating_add(k.saturating_mul(tris));
         }
@@ -102,7 +104,7 @@ pub(super) fn expansion(root: &Root) -> Option<Expansion> {
 impl super::Importer {
     /// Refuses a document whose expansion is past the limits, before any buffer is read.
     pub(super) fn check_expansion(&mut self, root: &Root) -> Result<(), SceneError> {
-        let Some(e) = expansion(root) else {
+        let Some(e) = expansion(root, self.limits.max_accessor_count) else {
             return Ok(()); // a cycle: the walk names the node
         };
         let l = self.limits;
@@ -122,8 +124,15 @@ impl super::Importer {
 }
 
 /// Triangles a primitive makes, from its index (else POSITION) accessor's count.
-fn triangles(root: &Root, p: &gltf::json::mesh::Primitive) -> u64 {
-    let count = |i: usize| root.accessors.get(i).map_or(0, |a| a.count.0);
+fn triangles(root: &Root, p: &gltf::json::mesh::Primitive, max_accessor: u64) -> u64 {
+    let count = |i: usize| {
+        let n = root.accessors.get(i).map_or(0, |a| a.count.0);
+        if n > max_accessor {
+            0
+        } else {
+            n
+        }
+    };
     let n = match &p.indices {
         Some(i) => count(i.value()),
         None => p
@@ -167,11 +176,11 @@ mod tests {
 
     #[test]
     fn counts_every_path_to_a_node() {
-        let e = expansion(&diamond(3)).unwrap();
+        let e = expansion(&diamond(3), u64::MAX).unwrap();
         // Level 0: node 0 once (node 1 is unreachable); level 1: 1 + 1; level 2: 2 + 2.
         assert_eq!(e.node_instances, 1 + 2 + 4);
         assert_eq!((e.primitives, e.triangles), (4, 4));
-        let e = expansion(&diamond(40)).unwrap();
+        let e = expansion(&diamond(40), 1 << 20).unwrap();
         assert_eq!(e.triangles, 1 << 39);
     }
 }
