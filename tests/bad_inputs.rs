@@ -28,6 +28,8 @@ struct Outcome {
 fn lightgraph(args: &[OsString]) -> Outcome {
     let dir = tempfile::tempdir().unwrap();
     let (out, err) = (dir.path().join("out"), dir.path().join("err"));
+    // Reaped by wait4 below, which also gives its peak memory.
+    #[allow(clippy::zombie_processes)]
     let child = std::process::Command::new(env!("CARGO_BIN_EXE_lightgraph"))
         .args(args)
         .current_dir(root())

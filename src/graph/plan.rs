@@ -168,7 +168,7 @@ fn buffer_bytes(size: BufferSize, layout: Option<BufferLayout>, frame: FrameSize
         BufferSize::Auto => layout.map_or(16, |l| l.bytes()),
     };
     // Storage bindings need a multiple of 4 and at least one element.
-    bytes.max(16).min(u64::MAX - 3).next_multiple_of(4)
+    bytes.clamp(16, u64::MAX - 3).next_multiple_of(4)
 }
 
 /// Plans physical resources for the passes in `schedule` (pass indices, in order).

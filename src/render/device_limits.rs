@@ -24,7 +24,7 @@ pub fn check_plan(graph: &CompiledGraph, limits: &wgpu::Limits) -> Result<(), Re
                 // Every planned buffer may be bound as storage.
                 let max = limits
                     .max_buffer_size
-                    .min(limits.max_storage_buffer_binding_size as u64);
+                    .min(limits.max_storage_buffer_binding_size);
                 (bytes > max).then(|| {
                     format!("buffer of {bytes} bytes is over the device's limit of {max} bytes for a storage buffer")
                 })

@@ -27,7 +27,7 @@ impl ModelBudget {
     }
 
     pub fn record(&mut self, e: Expansion) {
-        self.used = self.used.add(e);
+        self.used = self.used.saturating_add(e);
     }
 
     /// A model's limit error, restated as the scene's when earlier models used part of it.

@@ -16,7 +16,7 @@ pub struct Expansion {
 }
 
 impl Expansion {
-    pub fn add(self, o: Expansion) -> Expansion {
+    pub fn saturating_add(self, o: Expansion) -> Expansion {
         Expansion {
             node_instances: self.node_instances.saturating_add(o.node_instances),
             primitives: self.primitives.saturating_add(o.primitives),
