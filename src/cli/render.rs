@@ -140,6 +140,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
     let result = prepared.render(&renderer)?;
     report(&renderer, &scene, &graph_path, &result);
     shadow_report(&scene, &gpu, &result);
+    overflow_report(&result);
     if let Some(out) = &args.out {
         write_image(out, &result)?;
         println!("wrote {}", out.display());
@@ -163,6 +164,25 @@ pub fn render(args: RenderArgs) -> Result<()> {
         println!("wrote {} and {}", path.display(), csv.display());
     }
     Ok(())
+}
+
+/// Pixels whose shading overflowed f32 (a light very bright for its distance on a
+/// sharp lobe): counted, never clamped, so the user sees where.
+fn overflow_report(result: &FrameResult) {
+    let (n, first) = bench::non_finite_pixels(&result.image, result.width, 3);
+    if n.nan_pixels + n.inf_pixels == 0 {
+        return;
+    }
+    let at: Vec<String> = first
+        .iter()
+        .map(|p| format!("({}, {})", p.x, p.y))
+        .collect();
+    eprintln!(
+        "warning: {} Inf and {} NaN pixels (an f32 overflow in shading), first at {}",
+        n.inf_pixels,
+        n.nan_pixels,
+        at.join(", ")
+    );
 }
 
 /// What ray-cast shadows cast this frame: casters, rays, drops, memory, the BVH.

@@ -242,10 +242,13 @@ impl Composed {
 
     /// Maps a 1-based line of the composed text to (file, line).
     pub fn origin_of(&self, line: usize) -> (PathBuf, usize) {
-        self.origin
-            .get(line.saturating_sub(1))
-            .cloned()
-            .unwrap_or_else(|| (PathBuf::from("<composed>"), line))
+        match (self.origin.get(line.saturating_sub(1)), self.origin.last()) {
+            (Some(o), _) => o.clone(),
+            // Past the end (naga points after the last line for an unclosed item): the
+            // last file, past its last line.
+            (None, Some((file, last))) => (file.clone(), last + line - self.origin.len()),
+            (None, None) => (PathBuf::from("<composed>"), line),
+        }
     }
 
     /// Parses and validates with naga; errors name the original file and line.
@@ -385,6 +388,28 @@ mod tests {
                 assert!(file.ends_with("b.wgsl"), "{file:?}");
                 assert_eq!(line, 3);
             }
+            e => panic!("unexpected {e}"),
+        }
+    }
+
+    #[test]
+    fn an_error_at_the_end_names_the_last_file() {
+        let (_d, lib) = library(&[
+            ("a.wgsl", "#include \"b.wgsl\"\nconst A = 1;\n"),
+            ("b.wgsl", "const B = 3;\n"),
+        ]);
+        let c = lib
+            .compose("a.wgsl", &BTreeMap::new(), &BTreeMap::new())
+            .unwrap();
+        let (file, line) = c.origin_of(c.origin.len() + 1);
+        assert!(file.ends_with("a.wgsl"), "{file:?}");
+        assert_eq!(line, 3);
+        let (_d, lib) = library(&[("a.wgsl", "fn f() {\n")]);
+        let c = lib
+            .compose("a.wgsl", &BTreeMap::new(), &BTreeMap::new())
+            .unwrap();
+        match c.validate().unwrap_err() {
+            ShaderError::Invalid { file, .. } => assert!(file.ends_with("a.wgsl"), "{file:?}"),
             e => panic!("unexpected {e}"),
         }
     }
