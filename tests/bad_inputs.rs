@@ -392,3 +392,58 @@ fn generated_large_and_special_inputs() {
     );
     assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
 }
+
+/// What only the device can refuse, at prepare, named with the graph file:line and pass:
+/// an output wider than its texture limit, a per-light dispatch over its workgroup limit.
+#[test]
+fn device_limits_are_checked_at_prepare() {
+    let tmp = tempfile::tempdir().unwrap();
+    let t = tmp.path();
+    let mut failures = Vec::new();
+    let mut expect = |args: Vec<OsString>, want: &str| {
+        let o = lightgraph(&args);
+        if o.code != Some(1) || !o.output.contains(want) {
+            failures.push(format!("{args:?}: want {want:?}, got:\n{}", o.output));
+        }
+    };
+    let wide: Vec<OsString> = ["render", "--width", "9000", "--height", "4"]
+        .iter()
+        .map(OsString::from)
+        .collect();
+    expect(
+        wide,
+        "forward_plus.ron:19:22: pass 'depth_prepass': resource 'depth': texture of 9000×4 is over the device's limit of 8192 per side",
+    );
+    let graph = t.join("per_light.ron");
+    write(
+        &graph,
+        r#"Graph(
+    name: "per_light",
+    resources: [
+        Texture(name: "hdr", format: Rgba32Float),
+        Buffer(name: "scratch", size: Bytes(64)),
+    ],
+    passes: [
+        Pass(name: "count", kind: Compute(shader: "../tests/bad/shaders/per_light.wgsl", dispatch: PerLight(workgroup: 1)), writes: ["scratch"]),
+        Pass(name: "solid", kind: Fullscreen(shader: "examples/solid.wgsl"), writes: ["hdr"]),
+    ],
+    output: "hdr",
+    side_effects: ["count"],
+)"#,
+    );
+    let scene = t.join("lights.ron");
+    write(
+        &scene,
+        "Scene(builtin: \"atrium\", keep_model_lights: false, light_sets: [Random(count: 70000, spot_fraction: 0, placement: SceneBounds(margin: 0), range: (0.2, 0.6), intensity: (0.5, 2), seed: 7)])",
+    );
+    let mut args = os(
+        &["render", "--width", "64", "--height", "36", "--graph"],
+        &graph,
+    );
+    args.extend([OsString::from("--scene"), scene.into()]);
+    expect(
+        args,
+        "per_light.ron:8:20: pass 'count': dispatch of [70000, 1, 1] workgroups is over the device's limit of 65535 per dimension",
+    );
+    assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
+}
