@@ -4,7 +4,7 @@ use super::{project_path, RenderArgs};
 use anyhow::{bail, Context, Result};
 use lightgraph::bench::{self, heatmap, Tonemap};
 use lightgraph::graph::{self, FrameSize};
-use lightgraph::render::{FrameResult, Renderer, SceneGpu};
+use lightgraph::render::{materials, FrameResult, Renderer, SceneGpu};
 use lightgraph::scene::{self, Scene};
 use lightgraph::shader::{assets, ShaderLibrary};
 use std::path::{Path, PathBuf};
@@ -64,7 +64,18 @@ fn validate_one(f: &Path, shaders: &ShaderLibrary) -> Result<(), String> {
         FileKind::Graph => graph::check_file(f, shaders)
             .map(|_| ())
             .map_err(|e| e.to_string()),
-        FileKind::Scene | FileKind::Gltf => scene::load(f).map(|_| ()).map_err(|e| e.to_string()),
+        FileKind::Scene | FileKind::Gltf => {
+            let scene = scene::load(f).map_err(|e| e.to_string())?.scene;
+            // Render loads every override; a broken one is known without a GPU.
+            for (name, _) in &scene.material_overrides {
+                if let Some(path) = lightgraph::render::materials::override_path(&scene, name) {
+                    lightgraph::material::Material::load(&path)
+                        .and_then(|m| m.wgsl())
+                        .map_err(|e| materials::override_error(&scene, name, e).to_string())?;
+                }
+            }
+            Ok(())
+        }
         FileKind::Material => lightgraph::material::Material::load(f)
             .and_then(|m| m.wgsl().map(|_| ()))
             .map_err(|e| e.to_string()),

@@ -60,6 +60,13 @@ pub enum MaterialError {
         path: PathBuf,
         message: String,
     },
+    /// A scene's material override that failed: names the scene file and the material.
+    #[error("{scene}: material_overrides \"{name}\": {source}", scene = .scene.display())]
+    Override {
+        scene: PathBuf,
+        name: String,
+        source: Box<MaterialError>,
+    },
     /// naga rejected the generated WGSL (a bug in the generator or the lobe library).
     #[error("material `{material}`: generated WGSL is invalid: {message}")]
     Wgsl { material: String, message: String },

@@ -126,7 +126,8 @@ impl MaterialProgram {
     ) -> Result<(Self, Vec<PathBuf>), MaterialError> {
         let (material, files) = match override_path(scene, &surface.name) {
             Some(path) => {
-                let material = Material::load(&path)?;
+                let material = Material::load(&path).and_then(|m| m.wgsl().map(|_| m));
+                let material = material.map_err(|e| override_error(scene, &surface.name, e))?;
                 let mut files = vec![path];
                 files.extend(
                     material
@@ -149,6 +150,15 @@ impl MaterialProgram {
             surface.double_sided,
         )?;
         Ok((program, files))
+    }
+}
+
+/// An override's error, named with the scene file and the material it replaces.
+pub fn override_error(scene: &Scene, name: &str, e: MaterialError) -> MaterialError {
+    MaterialError::Override {
+        scene: scene.source_path.clone().unwrap_or_default(),
+        name: name.to_string(),
+        source: Box::new(e),
     }
 }
 
