@@ -102,3 +102,6 @@ def wide(d):
 write("wide_texture.gltf", tri_doc(extra=wide))
 with open("models/wide.png", "wb") as f:
     f.write(png(9000, 1))
+# glTF JSON with a UTF-8 byte-order mark: accepted as in every other format.
+with open("bom.gltf", "wb") as f:
+    f.write(b"\xef\xbb\xbf" + json.dumps(tri_doc(extra=with_light), indent=1).encode())
