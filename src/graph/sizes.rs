@@ -176,12 +176,6 @@ pub fn check_dispatch(
                     "dispatch PerPixel(workgroup: ({a}, {b})) does not match {file}'s @workgroup_size({x}, {y}, {z}): pixels would be missed or run twice"
                 )));
             }
-            // At the largest frame, the groups per side must stay within the limit.
-            if MAX_FRAME_SIDE.div_ceil(a.min(b).max(1)) > max {
-                return Some(bad(format!(
-                    "dispatch PerPixel(workgroup: ({a}, {b})) needs over {max} workgroups a side at {MAX_FRAME_SIDE} pixels"
-                )));
-            }
         }
         Dispatch::PerLight { workgroup: w } => {
             if (w, 1, 1) != (x, y, z) {
