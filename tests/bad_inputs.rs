@@ -70,6 +70,15 @@ fn lightgraph(args: &[OsString]) -> Outcome {
         "lightgraph {args:?} peaked at {} MiB",
         usage.ru_maxrss / 1024
     );
+    let secs = start.elapsed().as_secs_f64();
+    eprintln!(
+        "{secs:.2} s {:>4} MiB  lightgraph {}",
+        usage.ru_maxrss / 1024,
+        args.iter()
+            .map(|a| a.to_string_lossy())
+            .collect::<Vec<_>>()
+            .join(" ")
+    );
     Outcome {
         code: Some(libc::WEXITSTATUS(status)),
         output,
