@@ -39,7 +39,8 @@ impl ModelBudget {
             return e;
         };
         let (before, full) = match *what {
-            "node instance count" => (self.used.node_instances, self.full.max_nodes),
+            // A file's own node count is held to what is left of the node budget too.
+            "node instance count" | "node count" => (self.used.node_instances, self.full.max_nodes),
             "mesh primitive count after instancing" => {
                 (self.used.primitives, self.full.max_primitives)
             }
