@@ -5,6 +5,8 @@
 
 pub mod bench;
 pub mod cull;
+pub mod file_kind;
+pub mod files;
 pub mod gpu;
 pub mod graph;
 pub mod material;

@@ -135,7 +135,7 @@ fn check(name: &str, text: &str) -> Result<Outcome, String> {
     };
     if let Some(v) = &fast {
         match &ron {
-            Ok(r) if r == v => {}
+            Ok(r) if same(r, v) => {}
             Ok(r) => {
                 return Err(format!(
                     "{name}: fast and ron values differ\nfast: {v:?}\nron:  {r:?}\n--- text ---\n{text}"
@@ -150,7 +150,7 @@ fn check(name: &str, text: &str) -> Result<Outcome, String> {
     }
     let public = caught(|| graph::parse(&source))
         .map_err(|p| format!("{name}: graph::parse panicked: {p}\n--- text ---\n{text}"))?;
-    if public != ron {
+    if !same(&public, &ron) {
         return Err(format!(
             "{name}: graph::parse differs from ron\npublic: {public:?}\nron:    {ron:?}\n--- text ---\n{text}"
         ));
@@ -190,7 +190,14 @@ fn bad_graphs_give_ron_errors() {
     let mut parsed = 0;
     for (path, text) in ron_files("tests/bad/graphs") {
         let out = check_ok(&path.display().to_string(), &text);
-        assert_eq!(out.ron_ok, out.fast.is_some(), "{}", path.display());
+        // `NaN` is outside the fast subset: ron parses it (validation refuses it).
+        let falls_back = path.ends_with("texture_scaled_nan.ron");
+        assert_eq!(
+            out.ron_ok && !falls_back,
+            out.fast.is_some(),
+            "{}",
+            path.display()
+        );
         parsed += usize::from(out.ron_ok);
     }
     assert!(parsed > 5, "only {parsed} bad graphs parse at all");
@@ -522,4 +529,10 @@ fn mutated_graphs_never_fast_accept_what_ron_does_not() {
         fast_ok * 10 >= total,
         "only {fast_ok} of {total} mutants took the fast path"
     );
+}
+
+/// Equal as written: `Debug` output, so that `Scaled(NaN)` (refused later, at validation)
+/// equals itself.
+fn same<T: std::fmt::Debug>(a: &T, b: &T) -> bool {
+    format!("{a:?}") == format!("{b:?}")
 }

@@ -4,7 +4,7 @@ use super::{project_path, RenderArgs};
 use anyhow::{bail, Context, Result};
 use lightgraph::bench::{self, heatmap, Tonemap};
 use lightgraph::graph::{self, FrameSize};
-use lightgraph::render::{FrameResult, Renderer, SceneGpu};
+use lightgraph::render::{materials, FrameResult, Renderer, SceneGpu};
 use lightgraph::scene::{self, Scene};
 use lightgraph::shader::{assets, ShaderLibrary};
 use std::path::{Path, PathBuf};
@@ -37,25 +37,7 @@ pub fn validate(files: &[PathBuf]) -> Result<()> {
     let shaders = ShaderLibrary::builtin();
     let mut failed = false;
     for f in files {
-        let text = std::fs::read_to_string(f).unwrap_or_default();
-        // Graphs, scenes and materials are all RON: the top-level name tells them apart.
-        let head = text
-            .lines()
-            .map(str::trim)
-            .find(|l| !l.is_empty() && !l.starts_with("//"))
-            .unwrap_or("");
-        let result: Result<(), String> = if head.starts_with("Graph") {
-            graph::check_file(f, &shaders)
-                .map(|_| ())
-                .map_err(|e| e.to_string())
-        } else if head.starts_with("Scene") || f.extension().is_none_or(|e| e != "ron") {
-            scene::load(f).map(|_| ()).map_err(|e| e.to_string())
-        } else {
-            lightgraph::material::Material::load(f)
-                .and_then(|m| m.wgsl().map(|_| ()))
-                .map_err(|e| e.to_string())
-        };
-        match result {
+        match validate_one(f, &shaders) {
             Ok(()) => println!("{}: ok", f.display()),
             Err(e) => {
                 failed = true;
@@ -67,6 +49,45 @@ pub fn validate(files: &[PathBuf]) -> Result<()> {
         std::process::exit(1);
     }
     Ok(())
+}
+
+/// One file, by its extension and (for RON) its top-level struct name.
+fn validate_one(f: &Path, shaders: &ShaderLibrary) -> Result<(), String> {
+    use lightgraph::file_kind::{detect, FileKind};
+    use lightgraph::files::{caps, read_text};
+    let kind = detect(f, || read_text(f, caps::RON).ok())?;
+    match kind {
+        FileKind::Graph => graph::check_file(f, shaders)
+            .map(|_| ())
+            .map_err(|e| e.to_string()),
+        FileKind::Scene | FileKind::Gltf => {
+            let scene = scene::load(f).map_err(|e| e.to_string())?.scene;
+            // Render loads every override; a broken one is known without a GPU.
+            for (name, _) in &scene.material_overrides {
+                if let Some(path) = lightgraph::render::materials::override_path(&scene, name) {
+                    lightgraph::material::Material::load(&path)
+                        .and_then(|m| m.wgsl())
+                        .map_err(|e| materials::override_error(&scene, name, e).to_string())?;
+                }
+            }
+            Ok(())
+        }
+        FileKind::Material => lightgraph::material::Material::load(f)
+            .and_then(|m| m.wgsl().map(|_| ()))
+            .map_err(|e| e.to_string()),
+        FileKind::Shader => {
+            // Includes resolve against the shader root, as for a graph's shaders.
+            let file = std::path::absolute(f).map_err(|e| format!("{}: {e}", f.display()))?;
+            shaders
+                .compose(
+                    &file.to_string_lossy(),
+                    &Default::default(),
+                    &Default::default(),
+                )
+                .and_then(|c| c.validate().map(|_| ()))
+                .map_err(|e| e.to_string())
+        }
+    }
 }
 
 pub fn print_graph(path: &Path, scene_path: Option<&Path>, dot: bool) -> Result<()> {
@@ -198,6 +219,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
     let result = prepared.render(&renderer)?;
     report(&renderer, &scene, &graph_path, &result);
     shadow_report(&scene, &gpu, &result);
+    overflow_report(&result);
     match &args.out {
         Some(out) => {
             write_image(out, &result)?;
@@ -225,6 +247,25 @@ pub fn render(args: RenderArgs) -> Result<()> {
         println!("wrote {} and {}", path.display(), csv.display());
     }
     Ok(())
+}
+
+/// Pixels whose shading overflowed f32 (a light very bright for its distance on a
+/// sharp lobe): counted, never clamped, so the user sees where.
+fn overflow_report(result: &FrameResult) {
+    let (n, first) = bench::non_finite_pixels(&result.image, result.width, 3);
+    if n.nan_pixels + n.inf_pixels == 0 {
+        return;
+    }
+    let at: Vec<String> = first
+        .iter()
+        .map(|p| format!("({}, {})", p.x, p.y))
+        .collect();
+    eprintln!(
+        "warning: {} Inf and {} NaN pixels (an f32 overflow in shading), first at {}",
+        n.inf_pixels,
+        n.nan_pixels,
+        at.join(", ")
+    );
 }
 
 /// What ray-cast shadows cast this frame: casters, rays, drops, memory, the BVH.

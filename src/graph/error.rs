@@ -64,6 +64,12 @@ pub enum GraphError {
         resource: String,
         problem: String,
     },
+    #[error("{at}: resource '{resource}': {problem}")]
+    BadResource {
+        at: Location,
+        resource: String,
+        problem: String,
+    },
     #[error("{at}: pass '{pass}': {problem}")]
     BadPass {
         at: Location,
@@ -117,6 +123,7 @@ impl GraphError {
             | GraphError::UnorderedWriters { at, .. }
             | GraphError::Cycle { at, .. }
             | GraphError::Mismatch { at, .. }
+            | GraphError::BadResource { at, .. }
             | GraphError::BadPass { at, .. }
             | GraphError::UndeclaredBinding { at, .. }
             | GraphError::UnboundResource { at, .. }

@@ -13,6 +13,7 @@ mod order;
 mod parse;
 pub mod plan;
 mod roles;
+pub mod sizes;
 mod specialise;
 mod validate;
 

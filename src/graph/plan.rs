@@ -160,14 +160,15 @@ fn buffer_bytes(size: BufferSize, layout: Option<BufferLayout>, frame: FrameSize
         BufferSize::Bytes(b) => b,
         BufferSize::PerTile { tile, bytes } => {
             let t = tile.max(1);
-            frame.width.div_ceil(t) as u64 * frame.height.div_ceil(t) as u64 * bytes
+            (frame.width.div_ceil(t) as u64 * frame.height.div_ceil(t) as u64).saturating_mul(bytes)
         }
-        BufferSize::PerPixel(b) => frame.width as u64 * frame.height as u64 * b,
-        BufferSize::PerLight(b) => frame.lights.max(1) as u64 * b,
+        // Saturating: an absurd size is refused against the device's limit, never wrapped.
+        BufferSize::PerPixel(b) => (frame.width as u64 * frame.height as u64).saturating_mul(b),
+        BufferSize::PerLight(b) => (frame.lights.max(1) as u64).saturating_mul(b),
         BufferSize::Auto => layout.map_or(16, |l| l.bytes()),
     };
     // Storage bindings need a multiple of 4 and at least one element.
-    bytes.max(16).next_multiple_of(4)
+    bytes.clamp(16, u64::MAX - 3).next_multiple_of(4)
 }
 
 /// Plans physical resources for the passes in `schedule` (pass indices, in order).

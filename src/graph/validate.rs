@@ -29,6 +29,7 @@ pub fn validate(
     let mut errors = Vec::new();
     let (resources, passes) = names_and_duplicates(&desc, &source, &mut errors);
     check_references(&desc, &source, &resources, &passes, &mut errors);
+    super::sizes::check_resources(&desc, &source, &mut errors);
     if !errors.is_empty() {
         // Role and order checks assume every name resolves.
         return Err(GraphErrors(errors));
@@ -74,6 +75,9 @@ pub fn validate(
             Err(mut e) => errors.append(&mut e),
         }
         composed.push(c);
+    }
+    if errors.is_empty() {
+        super::sizes::check_laid_out_buffers(&desc, &roles, &source, &mut errors);
     }
     if errors.is_empty() {
         Ok(CheckedGraph {
@@ -294,6 +298,13 @@ fn generic_shader(
         return Err(shader_error(format!(
             "{file} has no {stage:?} entry point named '{entry}'"
         )));
+    }
+    if let PassKind::Compute { dispatch, .. } = &pass.kind {
+        let ep = module.entry_points.iter().find(|e| &e.name == entry);
+        let workgroup = ep.map_or([1, 1, 1], |e| e.workgroup_size);
+        if let Some(e) = super::sizes::check_dispatch(pass, *dispatch, workgroup, source, file) {
+            return Err(e);
+        }
     }
     Ok((composed, module))
 }

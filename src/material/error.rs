@@ -33,6 +33,13 @@ pub enum MaterialError {
     WrongType { at: Location, message: String },
     #[error("{at}: empty layer list: a material needs at least one layer")]
     EmptyLayers { at: Location },
+    #[error("{at}: {what} {count} is over the limit of {limit} (each is unrolled into the generated shader)")]
+    TooMany {
+        at: Location,
+        what: &'static str,
+        count: usize,
+        limit: usize,
+    },
     #[error("{at}: empty lobe list: layer {layer} has no lobes")]
     EmptyLobes { at: Location, layer: usize },
     #[error("{at}: missing texture file `{path}` (looked for {resolved})", resolved = .resolved.display())]
@@ -52,6 +59,13 @@ pub enum MaterialError {
         name: String,
         path: PathBuf,
         message: String,
+    },
+    /// A scene's material override that failed: names the scene file and the material.
+    #[error("{scene}: material_overrides \"{name}\": {source}", scene = .scene.display())]
+    Override {
+        scene: PathBuf,
+        name: String,
+        source: Box<MaterialError>,
     },
     /// naga rejected the generated WGSL (a bug in the generator or the lobe library).
     #[error("material `{material}`: generated WGSL is invalid: {message}")]

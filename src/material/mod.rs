@@ -69,7 +69,13 @@ impl TextureSource {
                     path: path.clone(),
                     message,
                 };
-                let img = image::open(path).map_err(|e| err(e.to_string()))?;
+                let bytes = crate::files::read_bytes(path, crate::files::caps::IMAGE)
+                    .map_err(|e| err(e.to_string()))?;
+                let img = image::ImageReader::new(std::io::Cursor::new(bytes))
+                    .with_guessed_format()
+                    .map_err(|e| err(e.to_string()))?
+                    .decode()
+                    .map_err(|e| err(e.to_string()))?;
                 let rgba = img.to_rgba8();
                 Ok(Arc::new(TextureImage {
                     name: path.display().to_string(),
@@ -105,9 +111,11 @@ impl Material {
     /// Reads and validates a material file.
     pub fn load(path: impl AsRef<Path>) -> Result<Material, MaterialError> {
         let path = path.as_ref();
-        let src = std::fs::read_to_string(path).map_err(|e| MaterialError::Io {
-            file: path.to_path_buf(),
-            message: e.to_string(),
+        let src = crate::files::read_text(path, crate::files::caps::RON).map_err(|e| {
+            MaterialError::Io {
+                file: path.to_path_buf(),
+                message: e.to_string(),
+            }
         })?;
         Self::parse(&src, path)
     }

@@ -111,6 +111,11 @@ pub fn parse_desc(src: &str, path: &Path) -> Result<MaterialDesc, MaterialError>
     Ok(desc)
 }
 
+/// Most layers in a material, and lobes in a layer: compile time grows faster than
+/// linearly with them (4,000 layers took 6 s).
+pub const MAX_LAYERS: usize = 32;
+pub const MAX_LOBES_PER_LAYER: usize = 8;
+
 /// Semantic checks that serde cannot express.
 fn check(desc: &MaterialDesc, src: &str, path: &Path) -> Result<(), MaterialError> {
     if desc.layers.is_empty() {
@@ -123,8 +128,24 @@ fn check(desc: &MaterialDesc, src: &str, path: &Path) -> Result<(), MaterialErro
         );
         return Err(MaterialError::EmptyLayers { at });
     }
+    if desc.layers.len() > MAX_LAYERS {
+        return Err(MaterialError::TooMany {
+            at: locate(src, path, "layers", 0),
+            what: "layer count",
+            count: desc.layers.len(),
+            limit: MAX_LAYERS,
+        });
+    }
     let lists = empty_lists(src, "lobes");
     for (i, layer) in desc.layers.iter().enumerate() {
+        if layer.lobes.len() > MAX_LOBES_PER_LAYER {
+            return Err(MaterialError::TooMany {
+                at: locate(src, path, "lobes", i),
+                what: "lobe count of a layer",
+                count: layer.lobes.len(),
+                limit: MAX_LOBES_PER_LAYER,
+            });
+        }
         if layer.lobes.is_empty() {
             let at = lists.get(i).map_or(loc(path, 1, 1), |&(o, _)| {
                 let (l, c) = line_col(src, o);

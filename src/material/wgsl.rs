@@ -304,9 +304,22 @@ pub fn generate(m: &Material, opts: &WgslOptions) -> String {
 /// Parses and validates `code` (after the `ShadingPoint` declaration) with naga.
 pub fn validate(code: &str, material: &str) -> Result<(), MaterialError> {
     let full = format!("{SHADING_POINT_WGSL}\n{code}");
-    let module = naga::front::wgsl::parse_str(&full).map_err(|e| MaterialError::Wgsl {
+    if let Some(line) = crate::shader::limits::longest_statement_over_limit(&full) {
+        return Err(MaterialError::Wgsl {
+            material: material.to_string(),
+            message: format!(
+                "generated line {line}: a statement over {} operators",
+                crate::shader::limits::MAX_OPERATORS_PER_STATEMENT
+            ),
+        });
+    }
+    crate::shader::limits::on_naga_stack(|| validate_with_naga(&full, material))
+}
+
+fn validate_with_naga(full: &str, material: &str) -> Result<(), MaterialError> {
+    let module = naga::front::wgsl::parse_str(full).map_err(|e| MaterialError::Wgsl {
         material: material.to_string(),
-        message: e.emit_to_string(&full),
+        message: e.emit_to_string(full),
     })?;
     naga::valid::Validator::new(
         naga::valid::ValidationFlags::all(),
@@ -315,7 +328,7 @@ pub fn validate(code: &str, material: &str) -> Result<(), MaterialError> {
     .validate(&module)
     .map_err(|e| MaterialError::Wgsl {
         material: material.to_string(),
-        message: e.emit_to_string(&full),
+        message: e.emit_to_string(full),
     })?;
     Ok(())
 }

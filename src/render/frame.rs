@@ -17,6 +17,20 @@ use crate::scene::{Camera, Scene};
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
+/// A pass's error, named with the graph file:line that declares the pass.
+fn at_pass(graph: &CompiledGraph, sp: &crate::graph::ScheduledPass, e: RenderError) -> RenderError {
+    let problem = match e {
+        RenderError::Pass { message, .. } => message,
+        RenderError::Shader { source, .. } => source.to_string(),
+        e => return e,
+    };
+    RenderError::AtPass {
+        at: graph.checked.source.of_declaration(&sp.name),
+        pass: sp.name.clone(),
+        problem,
+    }
+}
+
 pub struct PreparedFrame {
     pub graph: CompiledGraph,
     pub size: FrameSize,
@@ -66,6 +80,7 @@ impl Renderer {
         let before = self.pipelines.counters();
         self.pipelines.take_built();
         let pool = previous.map(|p| &p.resources);
+        let file = graph.checked.source.file.clone();
         let result = self.prepare_unscoped(graph, scene, gpu, size, light_stats, pool);
         let built = self
             .pipelines
@@ -75,7 +90,7 @@ impl Renderer {
             .collect();
         let stats = PrepareStats::from_cache(self.pipelines.counters() - before, built, generation);
         match pollster::block_on(scope.pop()) {
-            Some(e) => Err(RenderError::Wgpu(e.to_string())),
+            Some(e) => Err(RenderError::Wgpu(format!("{}: {e}", file.display()))),
             None => result.map(|mut frame| {
                 frame.prepare_stats = PrepareStats {
                     resources_created: frame.resources.created(),
@@ -97,6 +112,7 @@ impl Renderer {
         pool: Option<&FrameResources>,
     ) -> Result<PreparedFrame, RenderError> {
         let device = self.ctx.device.clone();
+        super::device_limits::check_plan(&graph, &device.limits())?;
         let resources = FrameResources::create_reusing(&device, &graph.plan, pool);
         let gpu_frame = GpuFrame::new(
             &scene.camera,
@@ -121,7 +137,8 @@ impl Renderer {
         };
         let mut prepared = Vec::with_capacity(graph.passes.len());
         for sp in &graph.passes {
-            prepared.push((sp.name.clone(), passes::prepare(&mut cx, sp)?));
+            let pass = passes::prepare(&mut cx, sp).map_err(|e| at_pass(&graph, sp, e))?;
+            prepared.push((sp.name.clone(), pass));
         }
         let absent = graph
             .plan

@@ -48,6 +48,15 @@ impl MaterialProgram {
             );
             for (i, slot) in slots.iter().enumerate() {
                 let image = slot.source.load()?;
+                let max = device.limits().max_texture_dimension_2d;
+                let fitted = super::texture_fit::fit_to_device(&image, max).map_err(|message| {
+                    MaterialError::TextureDecode {
+                        name: image.name.clone(),
+                        path: material.path().to_path_buf(),
+                        message,
+                    }
+                })?;
+                let image = fitted.as_ref().unwrap_or(&image);
                 let format = if image.srgb {
                     wgpu::TextureFormat::Rgba8UnormSrgb
                 } else {
@@ -117,7 +126,8 @@ impl MaterialProgram {
     ) -> Result<(Self, Vec<PathBuf>), MaterialError> {
         let (material, files) = match override_path(scene, &surface.name) {
             Some(path) => {
-                let material = Material::load(&path)?;
+                let material = Material::load(&path).and_then(|m| m.wgsl().map(|_| m));
+                let material = material.map_err(|e| override_error(scene, &surface.name, e))?;
                 let mut files = vec![path];
                 files.extend(
                     material
@@ -140,6 +150,15 @@ impl MaterialProgram {
             surface.double_sided,
         )?;
         Ok((program, files))
+    }
+}
+
+/// An override's error, named with the scene file and the material it replaces.
+pub fn override_error(scene: &Scene, name: &str, e: MaterialError) -> MaterialError {
+    MaterialError::Override {
+        scene: scene.source_path.clone().unwrap_or_default(),
+        name: name.to_string(),
+        source: Box::new(e),
     }
 }
 

@@ -2,6 +2,7 @@
 //! the cache, one wgpu pass per graph pass with GPU timestamps around it, readback.
 
 mod bind;
+mod device_limits;
 mod draws;
 mod frame;
 mod light_stats;
@@ -12,6 +13,7 @@ mod prepare_stats;
 mod report;
 mod resources;
 mod scene_gpu;
+mod texture_fit;
 
 pub use bind::LayoutCache;
 pub use frame::PreparedFrame;
@@ -37,6 +39,13 @@ pub enum RenderError {
     Shader { pass: String, source: ShaderError },
     #[error("pass '{pass}': {message}")]
     Pass { pass: String, message: String },
+    /// Past a device limit: names the graph file:line where the pass uses what is too big.
+    #[error("{at}: pass '{pass}': {problem}")]
+    AtPass {
+        at: crate::graph::Location,
+        pass: String,
+        problem: String,
+    },
     #[error("output '{0}' must be an Rgba32Float texture to be read back")]
     OutputFormat(String),
     #[error("wgpu reported: {0}")]

@@ -73,10 +73,9 @@ impl FrameResources {
             .physical
             .iter()
             .zip(&matches)
-            .enumerate()
-            .map(|(i, (p, m))| match (m, pool) {
+            .map(|(p, m)| match (m, pool) {
                 (Some(j), Some(pool)) => pool.physical[*j].clone(),
-                _ => create_one(device, i, p),
+                _ => create_one(device, p),
             })
             .collect();
         Self {
@@ -116,8 +115,9 @@ impl FrameResources {
     }
 }
 
-fn create_one(device: &wgpu::Device, i: usize, p: &PhysicalResource) -> Physical {
-    let label = format!("physical #{i} ({})", p.serves.join(", "));
+fn create_one(device: &wgpu::Device, p: &PhysicalResource) -> Physical {
+    // wgpu's messages quote the label: name what the graph file names.
+    let label = format!("graph resource '{}'", p.serves.join("', '"));
     match &p.desc {
         PhysicalDesc::Texture {
             format,

@@ -10,6 +10,8 @@ pub mod geometry;
 pub mod gltf_import;
 pub mod gltf_writer;
 pub mod lights;
+mod model_budget;
+pub mod ranges;
 pub mod scene_file;
 mod types;
 
@@ -47,5 +49,7 @@ pub fn load(path: &Path) -> Result<Loaded, SceneError> {
         }
     };
     loaded.scene.source_path = Some(path.to_path_buf());
+    // After every transform (node, model, scene), before anything reaches the GPU.
+    loaded.scene.check_gpu_ranges(path)?;
     Ok(loaded)
 }

@@ -32,8 +32,9 @@
 //! written `Random(count: ...)` (RON extensions `implicit_some` and `unwrap_variant_newtypes`).
 
 use super::error::SceneError;
-use super::gltf_import::{import_gltf_inner, ImportLimits};
+use super::gltf_import::import_gltf_inner;
 use super::lights::{amd_camera, check_light, fit_camera, AmdLights, RandomLights};
+use super::model_budget::ModelBudget;
 use super::types::{light_flags, Camera, Light, LightShape, Scene};
 use super::{builtin, Loaded};
 use glam::{EulerRot, Mat3, Mat4, Quat, Vec3};
@@ -257,7 +258,8 @@ pub fn parse_scene_file(text: &str, file: &Path) -> Result<SceneFile, SceneError
 
 /// Loads a scene RON file: parses it and builds the scene.
 pub fn load_scene_file(path: &Path) -> Result<Loaded, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError::io(path, e))?;
+    let text = crate::files::read_text(path, crate::files::caps::RON)
+        .map_err(|e| SceneError::io(path, e))?;
     let spec = parse_scene_file(&text, path)?;
     build_scene(&spec, path)
 }
@@ -321,6 +323,7 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
             scene.lights.clear();
         }
     }
+    let mut budget = ModelBudget::default();
     for (i, model) in spec.models.iter().enumerate() {
         let element = format!("models[{i}] (\"{}\")", model.path.display());
         let m = model.transform.matrix();
@@ -342,7 +345,20 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
                 "a model must be a .gltf or .glb file",
             ));
         }
-        let (loaded, has_camera) = import_gltf_inner(&path, &ImportLimits::default())?;
+        let (loaded, has_camera, expansion) =
+            import_gltf_inner(&path, &budget.limits()).map_err(|e| match e {
+                // Named from the scene file: the model path may be the mistake.
+                SceneError::Io {
+                    file: model,
+                    source,
+                } => SceneError::invalid(
+                    file,
+                    &element,
+                    format!("cannot read {}: {source}", model.display()),
+                ),
+                e => budget.explain(file, &element, e),
+            })?;
+        budget.record(expansion);
         let mut sub = loaded.scene;
         warnings.extend(loaded.warnings);
         files.extend(loaded.files);

@@ -96,7 +96,7 @@ pub fn read_path(path: &Path) -> std::io::Result<String> {
                 format!("no built-in file {rel}"),
             )
         }),
-        None => std::fs::read_to_string(path),
+        None => crate::files::read_text(path, crate::files::caps::SHADER),
     }
 }
 

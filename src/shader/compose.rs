@@ -1,3 +1,6 @@
+use super::limits::{
+    longest_statement_over_limit, on_naga_stack, MAX_INCLUDE_DEPTH, MAX_OPERATORS_PER_STATEMENT,
+};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -118,7 +121,7 @@ impl ShaderLibrary {
                 0,
             );
         }
-        self.include(file, defines, virtual_files, &mut out)?;
+        self.include(file, defines, virtual_files, &mut out, 0)?;
         Ok(out)
     }
 
@@ -131,6 +134,7 @@ impl ShaderLibrary {
         defines: &BTreeMap<String, String>,
         virtual_files: &BTreeMap<String, String>,
         out: &mut Composed,
+        depth: usize,
     ) -> Result<(), ShaderError> {
         let disk = self.root.join(rel);
         if out.files.iter().any(|f| f == &disk) {
@@ -139,9 +143,10 @@ impl ShaderLibrary {
         let path = self.locate(rel);
         let text = self.read_source(rel)?;
         out.files.push(disk);
-        self.expand(&path, &text, defines, virtual_files, out)
+        self.expand(&path, &text, defines, virtual_files, out, depth)
     }
 
+    /// `depth`: how many `#include`s led here (recursion is one stack frame pair each).
     fn expand(
         &self,
         path: &Path,
@@ -149,6 +154,7 @@ impl ShaderLibrary {
         defines: &BTreeMap<String, String>,
         virtual_files: &BTreeMap<String, String>,
         out: &mut Composed,
+        depth: usize,
     ) -> Result<(), ShaderError> {
         // Stack of (this branch active, some branch taken) for nested #if.
         let mut conditions: Vec<(bool, bool)> = Vec::new();
@@ -184,15 +190,24 @@ impl ShaderLibrary {
                     continue;
                 }
                 let rest = rest.trim();
+                if depth >= MAX_INCLUDE_DEPTH {
+                    return Err(directive_error(
+                        n,
+                        format!(
+                            "#include {rest} is nested {} deep, over the limit of {MAX_INCLUDE_DEPTH} (an include cycle through generated code, or a chain too long)",
+                            depth + 1
+                        ),
+                    ));
+                }
                 if let Some(name) = rest.strip_prefix('<').and_then(|r| r.strip_suffix('>')) {
                     let code = virtual_files.get(name).ok_or_else(|| {
                         directive_error(n, format!("no generated code named <{name}>"))
                     })?;
                     let vpath = PathBuf::from(format!("<{name}>"));
-                    self.expand(&vpath, code, defines, virtual_files, out)?;
+                    self.expand(&vpath, code, defines, virtual_files, out, depth + 1)?;
                 } else if let Some(name) = rest.strip_prefix('"').and_then(|r| r.strip_suffix('"'))
                 {
-                    self.include(name, defines, virtual_files, out)?;
+                    self.include(name, defines, virtual_files, out, depth + 1)?;
                 } else {
                     return Err(directive_error(n, format!("malformed #include {rest}")));
                 }
@@ -227,14 +242,32 @@ impl Composed {
 
     /// Maps a 1-based line of the composed text to (file, line).
     pub fn origin_of(&self, line: usize) -> (PathBuf, usize) {
-        self.origin
-            .get(line.saturating_sub(1))
-            .cloned()
-            .unwrap_or_else(|| (PathBuf::from("<composed>"), line))
+        match (self.origin.get(line.saturating_sub(1)), self.origin.last()) {
+            (Some(o), _) => o.clone(),
+            // Past the end (naga points after the last line for an unclosed item): the
+            // last file, past its last line.
+            (None, Some((file, last))) => (file.clone(), last + line - self.origin.len()),
+            (None, None) => (PathBuf::from("<composed>"), line),
+        }
     }
 
     /// Parses and validates with naga; errors name the original file and line.
     pub fn validate(&self) -> Result<naga::Module, ShaderError> {
+        if let Some(line) = longest_statement_over_limit(&self.text) {
+            return Err(self.invalid(
+                Some(naga::SourceLocation {
+                    line_number: line as u32,
+                    line_position: 1,
+                    offset: 0,
+                    length: 0,
+                }),
+                format!("this statement has over {MAX_OPERATORS_PER_STATEMENT} operators, the limit (naga nests one expression per operator): split it"),
+            ));
+        }
+        on_naga_stack(|| self.validate_with_naga())
+    }
+
+    fn validate_with_naga(&self) -> Result<naga::Module, ShaderError> {
         let module = naga::front::wgsl::parse_str(&self.text).map_err(|e| {
             let loc = e.location(&self.text);
             self.invalid(loc, e.message().to_string())
@@ -267,8 +300,12 @@ impl Composed {
             .lines()
             .nth(line.saturating_sub(1))
             .unwrap_or("")
-            .trim()
-            .to_string();
+            .trim();
+        // A generated line can be megabytes long: quote its start.
+        let source_line = match source_line.char_indices().nth(160) {
+            Some((i, _)) => format!("{} …", &source_line[..i]),
+            None => source_line.to_string(),
+        };
         ShaderError::Invalid {
             file,
             line: file_line,
@@ -351,6 +388,28 @@ mod tests {
                 assert!(file.ends_with("b.wgsl"), "{file:?}");
                 assert_eq!(line, 3);
             }
+            e => panic!("unexpected {e}"),
+        }
+    }
+
+    #[test]
+    fn an_error_at_the_end_names_the_last_file() {
+        let (_d, lib) = library(&[
+            ("a.wgsl", "#include \"b.wgsl\"\nconst A = 1;\n"),
+            ("b.wgsl", "const B = 3;\n"),
+        ]);
+        let c = lib
+            .compose("a.wgsl", &BTreeMap::new(), &BTreeMap::new())
+            .unwrap();
+        let (file, line) = c.origin_of(c.origin.len() + 1);
+        assert!(file.ends_with("a.wgsl"), "{file:?}");
+        assert_eq!(line, 3);
+        let (_d, lib) = library(&[("a.wgsl", "fn f() {\n")]);
+        let c = lib
+            .compose("a.wgsl", &BTreeMap::new(), &BTreeMap::new())
+            .unwrap();
+        match c.validate().unwrap_err() {
+            ShaderError::Invalid { file, .. } => assert!(file.ends_with("a.wgsl"), "{file:?}"),
             e => panic!("unexpected {e}"),
         }
     }

@@ -4,6 +4,7 @@
 
 pub mod assets;
 mod compose;
+pub mod limits;
 mod reflect;
 
 pub use compose::{Composed, ShaderError, ShaderLibrary};

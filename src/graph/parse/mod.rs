@@ -14,10 +14,11 @@ use std::path::Path;
 
 /// Reads and parses a graph file.
 pub fn load(path: &Path) -> Result<(GraphDesc, SourceText), GraphError> {
-    let text = std::fs::read_to_string(path).map_err(|e| GraphError::Io {
-        at: SourceText::new(path, "").at(1, 1),
-        message: e.to_string(),
-    })?;
+    let text =
+        crate::files::read_text(path, crate::files::caps::RON).map_err(|e| GraphError::Io {
+            at: SourceText::new(path, "").at(1, 1),
+            message: e.to_string(),
+        })?;
     let source = SourceText::new(path, text);
     let desc = parse(&source)?;
     Ok((desc, source))

@@ -64,6 +64,7 @@ pub(super) fn prepare(
         }
         Dispatch::Fixed(x, y, z) => [x, y, z],
     };
+    crate::render::device_limits::check_dispatch(cx.graph, &sp.name, groups, &device.limits())?;
     Ok(ComputePass {
         name: sp.name.clone(),
         pipeline,

@@ -124,6 +124,9 @@ impl Importer {
         let Some(view) = acc.view() else {
             return Ok(None);
         };
+        if let Some(problem) = super::alignment::misalignment(acc, &view) {
+            return Err(self.err(element, problem));
+        }
         let elem = acc.size() as u64;
         let stride = view.stride().map(|s| s as u64).unwrap_or(elem);
         if stride < elem {

@@ -55,7 +55,7 @@ impl Importer {
         let path = self.base_dir.join(percent_decode(uri));
         // Recorded even if the read fails: fixing the file should trigger a reload.
         self.files_read.borrow_mut().push(path.clone());
-        std::fs::read(&path)
+        crate::files::read_bytes(&path, crate::files::caps::GLTF)
             .map_err(|e| self.err(element, format!("cannot read \"{}\": {e}", path.display())))
     }
 

@@ -72,6 +72,7 @@ impl Importer {
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
+        self.check_expansion(root)?;
         self.load_buffers(&gltf)?;
         for (i, img) in root.images.iter().enumerate() {
             // Read from the JSON: the gltf crate's `Image::source` unwraps mimeType.
@@ -140,6 +141,13 @@ impl Importer {
             let local = Mat4::from_cols_array_2d(&node.transform().matrix());
             if !local.is_finite() {
                 return Err(self.err(element, "transform is not finite (NaN or Inf)"));
+            }
+            // As for a scene file's model: no normals, no winding, nothing to see.
+            if local.determinant() == 0.0 {
+                return Err(self.err(
+                    element,
+                    "transform is not invertible (a scale of 0 or an all-zero matrix)",
+                ));
             }
             let world = parent * local;
             if let Some(mesh) = node.mesh() {

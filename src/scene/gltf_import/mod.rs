@@ -12,11 +12,13 @@
 //! `encoding` holds the URI / base64 codecs.
 
 mod accessors;
+mod alignment;
 mod buffers;
 mod camera;
 mod document;
 mod encoding;
 mod images;
+pub mod instancing;
 mod lights;
 mod materials;
 mod mesh;
@@ -47,7 +49,10 @@ pub struct ImportLimits {
     pub max_triangles: u64,
     /// Declared `byteLength` of one buffer.
     pub max_buffer_bytes: u64,
+    /// Nodes in the file, and node instances after instancing.
     pub max_nodes: u64,
+    /// Mesh primitives after instancing (each becomes a mesh with its own draw).
+    pub max_primitives: u64,
     pub max_lights: u64,
     /// Pixels in one decoded image.
     pub max_image_pixels: u64,
@@ -57,9 +62,11 @@ impl Default for ImportLimits {
     fn default() -> Self {
         ImportLimits {
             max_accessor_count: 1 << 27,
-            max_triangles: 1 << 26,
+            // After instancing; about 1.3 GB of vertices if none are shared.
+            max_triangles: 1 << 23,
             max_buffer_bytes: 1 << 32,
             max_nodes: 1 << 20,
+            max_primitives: 1 << 15,
             max_lights: 1 << 20,
             max_image_pixels: 1 << 26,
         }
@@ -73,15 +80,17 @@ pub fn import_gltf(path: &Path) -> Result<Loaded, SceneError> {
 
 /// Imports a .gltf or .glb file. Relative URIs resolve against the file's folder.
 pub fn import_gltf_with(path: &Path, limits: &ImportLimits) -> Result<Loaded, SceneError> {
-    import_gltf_inner(path, limits).map(|(l, _)| l)
+    import_gltf_inner(path, limits).map(|(l, ..)| l)
 }
 
-/// Imports and tells whether the file had a perspective camera (else one was fitted).
+/// Imports and tells whether the file had a perspective camera (else one was fitted),
+/// and what its node graph expanded to.
 pub(crate) fn import_gltf_inner(
     path: &Path,
     limits: &ImportLimits,
-) -> Result<(Loaded, bool), SceneError> {
-    let bytes = std::fs::read(path).map_err(|e| SceneError::io(path, e))?;
+) -> Result<(Loaded, bool, instancing::Expansion), SceneError> {
+    let bytes = crate::files::read_bytes(path, crate::files::caps::GLTF)
+        .map_err(|e| SceneError::io(path, e))?;
     let base = path.parent().unwrap_or(Path::new("."));
     import_slice_inner(&bytes, base, path, limits)
 }
@@ -93,7 +102,7 @@ pub fn import_gltf_slice(
     file: &Path,
     limits: &ImportLimits,
 ) -> Result<Loaded, SceneError> {
-    import_slice_inner(bytes, base_dir, file, limits).map(|(l, _)| l)
+    import_slice_inner(bytes, base_dir, file, limits).map(|(l, ..)| l)
 }
 
 fn import_slice_inner(
@@ -101,7 +110,7 @@ fn import_slice_inner(
     base_dir: &Path,
     file: &Path,
     limits: &ImportLimits,
-) -> Result<(Loaded, bool), SceneError> {
+) -> Result<(Loaded, bool, instancing::Expansion), SceneError> {
     let mut imp = Importer {
         file: file.to_path_buf(),
         base_dir: base_dir.to_path_buf(),
@@ -116,9 +125,11 @@ fn import_slice_inner(
         scene: Scene::default(),
         triangles: 0,
         has_camera: false,
+        expansion: Default::default(),
         files_read: std::cell::RefCell::new(vec![file.to_path_buf()]),
     };
-    imp.run(bytes)?;
+    // A byte-order mark before the JSON is tolerated, as in every other input format.
+    imp.run(bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes))?;
     Ok((
         Loaded {
             scene: imp.scene,
@@ -126,6 +137,7 @@ fn import_slice_inner(
             files: imp.files_read.into_inner(),
         },
         imp.has_camera,
+        imp.expansion,
     ))
 }
 
@@ -145,6 +157,8 @@ struct Importer {
     scene: Scene,
     triangles: u64,
     has_camera: bool,
+    /// What the node graph expands to, counted before anything is read.
+    expansion: instancing::Expansion,
     /// The glTF file and every external buffer and image read for it.
     files_read: std::cell::RefCell<Vec<PathBuf>>,
 }

@@ -1,0 +1,66 @@
+//! What a frame asks of the device, checked against its limits before anything is
+//! created: wgpu would report these as raw validation text with internal labels, or
+//! panic in its default error handler. Errors name the graph file:line, the pass and the
+//! resource.
+
+use super::RenderError;
+use crate::graph::plan::PhysicalDesc;
+use crate::graph::CompiledGraph;
+
+/// Every planned texture and buffer against the device's size limits.
+pub fn check_plan(graph: &CompiledGraph, limits: &wgpu::Limits) -> Result<(), RenderError> {
+    for r in &graph.plan.resources {
+        let physical = &graph.plan.physical[r.physical];
+        let problem = match physical.desc {
+            PhysicalDesc::Texture { width, height, .. } => {
+                let max = limits.max_texture_dimension_2d;
+                (width > max || height > max).then(|| {
+                    format!(
+                        "texture of {width}×{height} is over the device's limit of {max} per side"
+                    )
+                })
+            }
+            PhysicalDesc::Buffer { bytes } => {
+                // Every planned buffer may be bound as storage.
+                let max = limits
+                    .max_buffer_size
+                    .min(limits.max_storage_buffer_binding_size);
+                (bytes > max).then(|| {
+                    format!("buffer of {bytes} bytes is over the device's limit of {max} bytes for a storage buffer")
+                })
+            }
+        };
+        if let Some(problem) = problem {
+            let pass = graph
+                .passes
+                .get(r.first)
+                .map_or_else(|| graph.output().to_string(), |p| p.name.clone());
+            return Err(RenderError::AtPass {
+                at: graph.checked.source.in_pass(&pass, &r.name),
+                pass,
+                problem: format!("resource '{}': {problem}", r.name),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// A compute dispatch's workgroup counts against the device's limit per dimension.
+pub fn check_dispatch(
+    graph: &CompiledGraph,
+    pass: &str,
+    groups: [u32; 3],
+    limits: &wgpu::Limits,
+) -> Result<(), RenderError> {
+    let max = limits.max_compute_workgroups_per_dimension;
+    if groups.iter().all(|&g| g <= max) {
+        return Ok(());
+    }
+    Err(RenderError::AtPass {
+        at: graph.checked.source.in_pass(pass, "dispatch"),
+        pass: pass.to_string(),
+        problem: format!(
+            "dispatch of {groups:?} workgroups is over the device's limit of {max} per dimension (use a larger workgroup)"
+        ),
+    })
+}

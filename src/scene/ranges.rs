@@ -1,0 +1,124 @@
+//! What a scene hands the GPU, checked for range after every transform: positions, light
+//! power and reach, and the camera basis. The shaders compute squares and products of
+//! these in f32; past these limits a finite input still overflows to Inf or NaN there.
+
+use super::error::SceneError;
+use super::types::{Camera, Light, Scene};
+use std::path::Path;
+
+/// Largest coordinate of a vertex, light or camera, in metres. Past it f32 spacing is
+/// over a metre, and squared distances stay far below f32's range.
+pub const MAX_COORDINATE: f32 = 1e7;
+/// Largest light range, in metres (the fallback light reaches twice the scene diagonal).
+pub const MAX_RANGE: f32 = 1e8;
+/// Largest intensity × colour channel of a light, in candela. A light this bright at
+/// 1 cm from a mirror-like lobe still stays below f32's maximum of 3.4e38.
+pub const MAX_LIGHT_POWER: f32 = 1e15;
+
+impl Scene {
+    /// Checks every vertex, light and the camera against the limits above; `file` names
+    /// the scene in the error.
+    pub fn check_gpu_ranges(&self, file: &Path) -> Result<(), SceneError> {
+        for (mi, mesh) in self.meshes.iter().enumerate() {
+            if let Some((vi, p)) = mesh
+                .positions
+                .iter()
+                .enumerate()
+                .find(|(_, p)| !in_range(**p))
+            {
+                return Err(SceneError::invalid(
+                    file,
+                    format!("mesh {mi} (\"{}\") vertex {vi}", mesh.name),
+                    format!(
+                        "position {p:?} after the scene transform is not finite or beyond ±{MAX_COORDINATE:e} m"
+                    ),
+                ));
+            }
+        }
+        for (i, l) in self.lights.iter().enumerate() {
+            check_light_range(l).map_err(|m| SceneError::invalid(file, format!("light {i}"), m))?;
+        }
+        check_camera(&self.camera).map_err(|m| SceneError::invalid(file, "camera", m))
+    }
+}
+
+fn in_range(p: glam::Vec3) -> bool {
+    p.is_finite() && p.abs().max_element() <= MAX_COORDINATE
+}
+
+/// A light's position, reach and power after every transform.
+pub fn check_light_range(l: &Light) -> Result<(), String> {
+    if !in_range(l.position) {
+        return Err(format!(
+            "position {:?} is not finite or beyond ±{MAX_COORDINATE:e} m",
+            l.position
+        ));
+    }
+    if !(l.range > 0.0 && l.range <= MAX_RANGE) {
+        return Err(format!(
+            "range {} must lie in (0, {MAX_RANGE:e}] m",
+            l.range
+        ));
+    }
+    let power = l.intensity * l.color.max_element();
+    if !(power.is_finite() && power <= MAX_LIGHT_POWER) {
+        return Err(format!(
+            "intensity {:?} × colour {:?} is {power:e} cd, over the limit of {MAX_LIGHT_POWER:e}",
+            l.intensity, l.color
+        ));
+    }
+    Ok(())
+}
+
+/// The view basis must exist: eye and target distinct and in range, up not along the view.
+pub fn check_camera(c: &Camera) -> Result<(), String> {
+    if !in_range(c.eye) || !in_range(c.target) {
+        return Err(format!(
+            "eye {:?} and target {:?} must be finite and within ±{MAX_COORDINATE:e} m",
+            c.eye, c.target
+        ));
+    }
+    let view = c.target - c.eye;
+    let (v, u) = (view.normalize_or_zero(), c.up.normalize_or_zero());
+    if v == glam::Vec3::ZERO || u == glam::Vec3::ZERO || v.cross(u).length() < 1e-4 {
+        return Err(format!(
+            "up {} is zero or parallel to the view direction {view} (eye {} to target {}): the view has no basis",
+            c.up, c.eye, c.target
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn refuses_overbright_lights_far_vertices_and_a_degenerate_camera() {
+        let l = Light::point(Vec3::ZERO, 1.0, Vec3::splat(3e38), 1.0);
+        let e = check_light_range(&l).unwrap_err();
+        assert!(e.contains("over the limit of 1e15"), "{e}");
+        let l = Light::point(Vec3::ZERO, 1.0, Vec3::ONE, 1e15);
+        assert!(check_light_range(&l).is_ok());
+        let mut c = Camera::default();
+        assert!(check_camera(&c).is_ok());
+        c.up = c.target - c.eye;
+        let e = check_camera(&c).unwrap_err();
+        assert!(e.contains("parallel to the view direction"), "{e}");
+        let mut s = Scene::default();
+        s.meshes.push(crate::scene::Mesh {
+            name: "far".into(),
+            positions: vec![Vec3::ZERO, Vec3::new(0.0, 2e7, 0.0)],
+            ..Default::default()
+        });
+        let e = s
+            .check_gpu_ranges(Path::new("s.ron"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("s.ron: mesh 0 (\"far\") vertex 1: position"),
+            "{e}"
+        );
+    }
+}

@@ -1,0 +1,487 @@
+//! Hostile input through the command line, as a user meets it: `lightgraph validate` must
+//! refuse each bad file with its message (naming the file), `lightgraph render` at 64×36
+//! must refuse it the same way, and neither may crash, take over 10 s or 1 GiB. Hostile
+//! but valid files (a byte-order mark, a texture wider than the device allows) must pass
+//! both. Inputs: every graph in tests/bad/graphs/, every file in tests/bad/hostile/ (made
+//! by its make_hostile.py), and the large or special ones generated here into a temporary
+//! folder: a 20,000-term WGSL expression, a 10,000-file include chain, a 20,000-layer
+//! material, and /dev/zero, /dev/urandom and FIFOs in every place a file is read.
+
+use std::ffi::OsString;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+const LIMIT: Duration = Duration::from_secs(10);
+const MAX_RSS_KIB: i64 = 1 << 20;
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+struct Outcome {
+    code: Option<i32>,
+    output: String,
+}
+
+/// Runs the CLI from the repository root with the output in files (no pipe to fill),
+/// reaping it with wait4 for its peak memory; fails past the time or memory limit.
+fn lightgraph(args: &[OsString]) -> Outcome {
+    let dir = tempfile::tempdir().unwrap();
+    let (out, err) = (dir.path().join("out"), dir.path().join("err"));
+    // Reaped by wait4 below, which also gives its peak memory.
+    #[allow(clippy::zombie_processes)]
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_lightgraph"))
+        .args(args)
+        .current_dir(root())
+        .env(
+            "XDG_RUNTIME_DIR",
+            std::env::var_os("XDG_RUNTIME_DIR").unwrap_or("/tmp".into()),
+        )
+        .env("RUST_BACKTRACE", "0")
+        .stdout(std::fs::File::create(&out).unwrap())
+        .stderr(std::fs::File::create(&err).unwrap())
+        .spawn()
+        .unwrap();
+    let pid = child.id() as libc::pid_t;
+    let start = Instant::now();
+    let (mut status, mut usage) = (0, unsafe { std::mem::zeroed::<libc::rusage>() });
+    loop {
+        // SAFETY: waits for our own child; `status` and `usage` outlive the call.
+        let r = unsafe { libc::wait4(pid, &mut status, libc::WNOHANG, &mut usage) };
+        if r == pid {
+            break;
+        }
+        assert!(r == 0, "wait4: {}", std::io::Error::last_os_error());
+        if start.elapsed() > LIMIT {
+            unsafe { libc::kill(pid, libc::SIGKILL) };
+            unsafe { libc::waitpid(pid, &mut status, 0) };
+            panic!("lightgraph {args:?} ran past {LIMIT:?}");
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let output = std::fs::read_to_string(&out).unwrap() + &std::fs::read_to_string(&err).unwrap();
+    assert!(
+        libc::WIFEXITED(status),
+        "lightgraph {args:?} was killed by signal {}:\n{output}",
+        libc::WTERMSIG(status)
+    );
+    assert!(
+        usage.ru_maxrss <= MAX_RSS_KIB,
+        "lightgraph {args:?} peaked at {} MiB",
+        usage.ru_maxrss / 1024
+    );
+    let secs = start.elapsed().as_secs_f64();
+    eprintln!(
+        "{secs:.2} s {:>4} MiB  lightgraph {}",
+        usage.ru_maxrss / 1024,
+        args.iter()
+            .map(|a| a.to_string_lossy())
+            .collect::<Vec<_>>()
+            .join(" ")
+    );
+    Outcome {
+        code: Some(libc::WEXITSTATUS(status)),
+        output,
+    }
+}
+
+fn os(args: &[&str], file: &Path) -> Vec<OsString> {
+    let mut v: Vec<OsString> = args.iter().map(OsString::from).collect();
+    v.push(file.into());
+    v
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Input {
+    Graph,
+    Scene,
+    /// Checked by `validate` only (materials, shaders: they render through a scene or graph).
+    ValidateOnly,
+}
+
+#[derive(Clone, Debug)]
+enum Expect {
+    /// Refused by validate and render; the message contains this and names the file.
+    Error(String),
+    /// Accepted by both; render's output contains this, if given.
+    Accept(Option<String>),
+}
+
+/// Runs one input through validate and, for graphs and scenes, render at 64×36.
+fn check(file: &Path, input: Input, expect: &Expect, failures: &mut Vec<String>) {
+    let name = file.file_name().unwrap().to_string_lossy().into_owned();
+    let mut runs = vec![("validate", lightgraph(&os(&["validate"], file)))];
+    let size = ["--width", "64", "--height", "36"];
+    match input {
+        Input::Graph => runs.push((
+            "render",
+            lightgraph(&os(&[&["render"][..], &size, &["--graph"]].concat(), file)),
+        )),
+        Input::Scene => runs.push((
+            "render",
+            lightgraph(&os(&[&["render"][..], &size, &["--scene"]].concat(), file)),
+        )),
+        Input::ValidateOnly => {}
+    }
+    for (command, o) in runs {
+        let ok = match expect {
+            Expect::Error(m) => {
+                o.code == Some(1) && o.output.contains(m) && o.output.contains(&name)
+            }
+            Expect::Accept(m) => {
+                o.code == Some(0)
+                    && (command == "validate" || m.as_ref().is_none_or(|m| o.output.contains(m)))
+            }
+        };
+        if !ok {
+            failures.push(format!(
+                "{} ({command}, exit {:?}): expected {expect:?}, got:\n{}",
+                file.display(),
+                o.code,
+                o.output.lines().take(6).collect::<Vec<_>>().join("\n")
+            ));
+        }
+    }
+}
+
+/// `// expect: MESSAGE` on the first line (after a byte-order mark), or `// accept: WHY`
+/// with an optional `// warns: WARNING` on the second.
+fn expectation(file: &Path) -> Expect {
+    let text = std::fs::read_to_string(file).unwrap();
+    let mut lines = text.trim_start_matches('\u{feff}').lines();
+    let first = lines.next().unwrap_or("");
+    if let Some(m) = first.strip_prefix("// expect: ") {
+        Expect::Error(m.to_string())
+    } else if first.starts_with("// accept: ") {
+        let warns = lines.next().and_then(|l| l.strip_prefix("// warns: "));
+        Expect::Accept(warns.map(str::to_string))
+    } else {
+        panic!(
+            "{}: first line must be `// expect: ...` or `// accept: ...`",
+            file.display()
+        )
+    }
+}
+
+fn files(dir: &Path, ext: &str) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == ext))
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn every_bad_graph_is_refused_by_validate_and_render() {
+    let mut failures = Vec::new();
+    let graphs = files(&root().join("tests/bad/graphs"), "ron");
+    for g in &graphs {
+        check(g, Input::Graph, &expectation(g), &mut failures);
+    }
+    assert!(graphs.len() >= 25, "only {} bad graphs", graphs.len());
+    assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
+}
+
+/// What a glTF file of tests/bad/hostile/ must give.
+enum Gltf {
+    Refused(&'static str),
+    /// Accepted; render's output contains this warning.
+    Warns(&'static str),
+}
+use Gltf::*;
+
+/// The glTF files of tests/bad/hostile/ (JSON has no comments to hold the expectation).
+const HOSTILE_GLTF: &[(&str, Gltf)] = &[
+    (
+        "dag_triangles.gltf",
+        Refused("meshes: triangle count after instancing 51200000 exceeds the limit of 8388608"),
+    ),
+    (
+        "dag_primitives.gltf",
+        Refused("meshes: mesh primitive count after instancing 65536 exceeds the limit of 32768"),
+    ),
+    (
+        "node_scale_zero.gltf",
+        Refused("node 0 (\"tri_node\"): transform is not invertible (a scale of 0 or an all-zero matrix)"),
+    ),
+    (
+        "node_zero_matrix.gltf",
+        Refused("node 0 (\"tri_node\"): transform is not invertible"),
+    ),
+    (
+        "misaligned_accessor.gltf",
+        Refused("POSITION accessor 0: byteOffset 2 is not a multiple of its component size 4"),
+    ),
+    (
+        "vertex_3e38.gltf",
+        Refused("mesh 0 (\"tri\") vertex 1: position Vec3(3e38, 0.0, 0.0) after the scene transform is not finite or beyond ±1e7 m"),
+    ),
+    (
+        "light_3e38.gltf",
+        Refused("light 0: intensity 3e38 × colour Vec3(1.0, 1.0, 1.0) is 3e38 cd, over the limit of 1e15"),
+    ),
+    ("wide_texture.gltf", Warns("is 40000×1, over the device's limit of")),
+    ("bom.gltf", Warns("")),
+];
+
+#[test]
+fn hostile_scenes_models_and_materials() {
+    let dir = root().join("tests/bad/hostile");
+    let mut failures = Vec::new();
+    for f in files(&dir, "ron") {
+        let text = std::fs::read_to_string(&f).unwrap();
+        let input = match lightgraph::file_kind::top_level_name(&text) {
+            Some("Graph") => Input::Graph,
+            Some("Scene") => Input::Scene,
+            _ => Input::ValidateOnly,
+        };
+        check(&f, input, &expectation(&f), &mut failures);
+    }
+    for (name, outcome) in HOSTILE_GLTF {
+        let expect = match outcome {
+            Refused(m) => Expect::Error(m.to_string()),
+            Warns(m) => Expect::Accept(Some(m.to_string())),
+        };
+        check(&dir.join(name), Input::Scene, &expect, &mut failures);
+    }
+    for f in files(&dir, "gltf") {
+        let name = f.file_name().unwrap().to_string_lossy();
+        if !HOSTILE_GLTF.iter().any(|(n, _)| *n == name) {
+            failures.push(format!("{name}: not in HOSTILE_GLTF"));
+        }
+    }
+    assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
+}
+
+fn write(path: &Path, text: &str) {
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    std::fs::write(path, text).unwrap();
+}
+
+fn symlink(target: &str, link: &Path) {
+    std::fs::create_dir_all(link.parent().unwrap()).unwrap();
+    std::os::unix::fs::symlink(target, link).unwrap();
+}
+
+fn mkfifo(path: &Path) {
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    let c = std::ffi::CString::new(path.as_os_str().as_encoded_bytes()).unwrap();
+    // SAFETY: a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o644) }, 0);
+}
+
+/// A copy of graphs/light_throughput_probe.ron running `shader` (an absolute path).
+fn probe_graph(shader: &Path) -> String {
+    let text = std::fs::read_to_string(root().join("graphs/light_throughput_probe.ron")).unwrap();
+    let probe = "examples/light_throughput_probe.wgsl";
+    assert!(text.contains(probe));
+    text.replace(probe, &shader.display().to_string())
+}
+
+/// The probe shader with `statement` before its entry point.
+fn probe_shader(statement: &str) -> String {
+    let text = std::fs::read_to_string(root().join("shaders/examples/light_throughput_probe.wgsl"))
+        .unwrap();
+    format!("{statement}\n{text}")
+}
+
+#[test]
+fn generated_large_and_special_inputs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let t = tmp.path();
+    let mut failures = Vec::new();
+    let error = |m: &str| Expect::Error(m.to_string());
+
+    // WGSL: 20,000 terms in one expression (a stack overflow in naga before).
+    let long = t.join("long_expression.wgsl");
+    write(
+        &long,
+        &probe_shader(&format!("const x = 1{};", " + 1".repeat(20_000))),
+    );
+    let long_graph = t.join("graphs/long_expression.ron");
+    write(&long_graph, &probe_graph(&long));
+    let over = "long_expression.wgsl:1:1: this statement has over 1024 operators";
+    check(&long_graph, Input::Graph, &error(over), &mut failures);
+    check(&long, Input::ValidateOnly, &error(over), &mut failures);
+
+    // An include chain 10,000 files deep.
+    let chain = t.join("chain");
+    for i in 0..10_000 {
+        write(
+            &chain.join(format!("inc{i}.wgsl")),
+            &format!(
+                "#include \"{}\"\n",
+                chain.join(format!("inc{}.wgsl", i + 1)).display()
+            ),
+        );
+    }
+    write(&chain.join("inc10000.wgsl"), "const deepest = 1;\n");
+    let top = chain.join("top.wgsl");
+    let first = chain.join("inc0.wgsl");
+    write(
+        &top,
+        &probe_shader(&format!("#include \"{}\"", first.display())),
+    );
+    let chain_graph = t.join("graphs/include_chain.ron");
+    write(&chain_graph, &probe_graph(&top));
+    let deep = format!(
+        "inc31.wgsl:1: #include \"{}\" is nested 33 deep, over the limit of 32",
+        chain.join("inc32.wgsl").display()
+    );
+    check(&chain_graph, Input::Graph, &error(&deep), &mut failures);
+
+    // A material of 20,000 layers (over 30 s to compile before).
+    let layers = t.join("materials/layers.ron");
+    let layer = "(lobes: [Lambert(color: (0.5, 0.5, 0.5))]),";
+    write(
+        &layers,
+        &format!("(name: \"deep\", layers: [{}])", layer.repeat(20_000)),
+    );
+    let too_many = "layers.ron:1:16: layer count 20000 is over the limit of 32";
+    check(
+        &layers,
+        Input::ValidateOnly,
+        &error(too_many),
+        &mut failures,
+    );
+
+    // Devices and FIFOs wherever a file is read: graph, scene, material, shader, model,
+    // glTF buffer and image.
+    let device = "not a regular file (a device)";
+    let fifo = "not a regular file (a FIFO)";
+    symlink("/dev/zero", &t.join("graphs/zero.ron"));
+    check(
+        &t.join("graphs/zero.ron"),
+        Input::Graph,
+        &error(device),
+        &mut failures,
+    );
+    mkfifo(&t.join("scenes/fifo.ron"));
+    check(
+        &t.join("scenes/fifo.ron"),
+        Input::Scene,
+        &error(fifo),
+        &mut failures,
+    );
+    symlink("/dev/urandom", &t.join("materials/urandom.ron"));
+    check(
+        &t.join("materials/urandom.ron"),
+        Input::ValidateOnly,
+        &error(device),
+        &mut failures,
+    );
+    mkfifo(&t.join("fifo.wgsl"));
+    let fifo_shader = t.join("graphs/fifo_shader.ron");
+    write(&fifo_shader, &probe_graph(&t.join("fifo.wgsl")));
+    check(&fifo_shader, Input::Graph, &error(fifo), &mut failures);
+    symlink("/dev/zero", &t.join("zero.gltf"));
+    let model = t.join("scenes/zero_model.ron");
+    write(&model, "Scene(models: [(path: \"../zero.gltf\")])");
+    check(&model, Input::Scene, &error(device), &mut failures);
+    let tri = std::fs::read_to_string(root().join("tests/bad/hostile/models/tri.gltf")).unwrap();
+    let data_uri = tri.find("data:application").unwrap();
+    let uri_end = data_uri + tri[data_uri..].find('"').unwrap();
+    symlink("/dev/zero", &t.join("zero.bin"));
+    let zero_buffer = t.join("zero_buffer.gltf");
+    write(
+        &zero_buffer,
+        &format!("{}zero.bin{}", &tri[..data_uri], &tri[uri_end..]),
+    );
+    check(&zero_buffer, Input::Scene, &error(device), &mut failures);
+    // A texture that never ends costs a warning, as a missing one does.
+    symlink("/dev/urandom", &t.join("urandom.png"));
+    let image = t.join("urandom_image.gltf");
+    let with_image = tri.replacen(
+        "\"materials\": [",
+        "\"images\": [{\"uri\": \"urandom.png\"}], \"textures\": [{\"source\": 0}], \"materials\": [",
+        1,
+    );
+    let with_image = with_image.replacen(
+        "\"name\": \"tri_mat\"",
+        "\"name\": \"tri_mat\", \"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0}}",
+        1,
+    );
+    write(&image, &with_image);
+    check(
+        &image,
+        Input::Scene,
+        &Expect::Accept(Some(device.into())),
+        &mut failures,
+    );
+    assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
+}
+
+/// What only the device can refuse, at prepare, named with the graph file:line and pass:
+/// an output wider than its texture limit, a per-light dispatch over its workgroup limit.
+#[test]
+fn device_limits_are_checked_at_prepare() {
+    let tmp = tempfile::tempdir().unwrap();
+    let t = tmp.path();
+    let mut failures = Vec::new();
+    let mut expect = |args: Vec<OsString>, want: &str| {
+        let o = lightgraph(&args);
+        if o.code != Some(1) || !o.output.contains(want) {
+            failures.push(format!("{args:?}: want {want:?}, got:\n{}", o.output));
+        }
+    };
+    // Every side within the graph's own limits (16384 frames, Scaled up to 4), but the
+    // scaled texture is 32,800 wide: over any device's limit (8192 to 32768).
+    let scaled = t.join("scaled.ron");
+    write(
+        &scaled,
+        r#"Graph(
+    name: "scaled",
+    resources: [
+        Texture(name: "hdr", format: Rgba32Float),
+        Texture(name: "big", format: Rgba8Unorm, size: Scaled(4.0)),
+    ],
+    passes: [
+        Pass(name: "solid", kind: Fullscreen(shader: "examples/solid.wgsl"), writes: ["hdr"]),
+        Pass(name: "wide", kind: Fullscreen(shader: "examples/solid.wgsl"), writes: ["big"]),
+    ],
+    output: "hdr",
+    side_effects: ["wide"],
+)"#,
+    );
+    let mut args = os(&["render", "--width", "8200", "--height", "4", "--graph"], &scaled);
+    args.push(OsString::from("--out"));
+    args.push(t.join("x.png").into());
+    expect(
+        args,
+        "scaled.ron:9:86: pass 'wide': resource 'big': texture of 32800×16 is over the device's limit of",
+    );
+    let graph = t.join("per_light.ron");
+    write(
+        &graph,
+        r#"Graph(
+    name: "per_light",
+    resources: [
+        Texture(name: "hdr", format: Rgba32Float),
+        Buffer(name: "scratch", size: Bytes(64)),
+    ],
+    passes: [
+        Pass(name: "count", kind: Compute(shader: "../tests/bad/shaders/per_light.wgsl", dispatch: PerLight(workgroup: 1)), writes: ["scratch"]),
+        Pass(name: "solid", kind: Fullscreen(shader: "examples/solid.wgsl"), writes: ["hdr"]),
+    ],
+    output: "hdr",
+    side_effects: ["count"],
+)"#,
+    );
+    let scene = t.join("lights.ron");
+    write(
+        &scene,
+        "Scene(builtin: \"atrium\", keep_model_lights: false, light_sets: [Random(count: 70000, spot_fraction: 0, placement: SceneBounds(margin: 0), range: (0.2, 0.6), intensity: (0.5, 2), seed: 7)])",
+    );
+    let mut args = os(
+        &["render", "--width", "64", "--height", "36", "--graph"],
+        &graph,
+    );
+    args.extend([OsString::from("--scene"), scene.into()]);
+    expect(
+        args,
+        "per_light.ron:8:20: pass 'count': dispatch of [70000, 1, 1] workgroups is over the device's limit of 65535 per dimension",
+    );
+    assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
+}
