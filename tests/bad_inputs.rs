@@ -445,7 +445,10 @@ fn device_limits_are_checked_at_prepare() {
     side_effects: ["wide"],
 )"#,
     );
-    let mut args = os(&["render", "--width", "8200", "--height", "4", "--graph"], &scaled);
+    let mut args = os(
+        &["render", "--width", "8200", "--height", "4", "--graph"],
+        &scaled,
+    );
     args.push(OsString::from("--out"));
     args.push(t.join("x.png").into());
     expect(
