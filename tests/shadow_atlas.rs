@@ -12,11 +12,9 @@ mod common;
 
 use common::{lambert, renderer};
 use glam::{Vec2, Vec3};
-use lightgraph::graph::{self, FrameSize};
-use lightgraph::render::{FrameResult, Renderer, SceneGpu};
+use lightgraph::render::{FrameResult, Renderer};
 use lightgraph::scene::geometry::MeshBuilder;
 use lightgraph::scene::{light_flags, Camera, Light, LightShape, Scene};
-use lightgraph::shader::ShaderLibrary;
 use lightgraph::shadow::atlas::{DropReason, GUARD_TEXELS};
 use std::path::Path;
 
@@ -33,19 +31,7 @@ fn graph_text(name: &str) -> String {
 }
 
 fn render(r: &mut Renderer, text: &str, scene: &Scene) -> FrameResult {
-    let checked =
-        graph::check_text(Path::new("<test>"), text, &ShaderLibrary::builtin()).expect("valid");
-    let size = FrameSize {
-        width: W,
-        height: H,
-        lights: scene.lights.len() as u32,
-    };
-    let compiled = graph::compile(checked, &scene.features(), size);
-    let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, scene).expect("materials");
-    let prepared = r
-        .prepare(compiled, scene, &gpu, size, false)
-        .expect("prepare");
-    prepared.render(r).expect("render")
+    common::render_text(r, text, scene, W, H)
 }
 
 /// The same scene with no light casting a shadow: every pixel's unshadowed light.
