@@ -468,7 +468,7 @@ fn set_shadow_columns(
             .iter()
             .any(|r| bvh_imports.contains(&r.as_str()))
     });
-    if let (true, Some(bvh)) = (reads_bvh, &gpu.bvh) {
+    if let (true, Some(bvh)) = (reads_bvh, gpu.built_bvh()) {
         row.bvh_mib = Some(bvh.bytes() as f64 / MIB);
         row.bvh_build_ms = Some(bvh.stats.build_time.as_secs_f64() * 1e3);
     }

@@ -282,7 +282,7 @@ fn shadow_report(scene: &Scene, gpu: &SceneGpu, result: &FrameResult) {
         "  shadow-casting lights: {casters} of {}",
         scene.lights.len()
     );
-    if let Some(b) = &gpu.bvh {
+    if let Some(b) = gpu.built_bvh() {
         let s = &b.stats;
         println!(
             "  shadow BVH: {} triangles ({} degenerate, {} non-finite, {} bad indices skipped), {} nodes, built in {:.1} ms, {:.1} MiB",

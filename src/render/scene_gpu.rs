@@ -29,8 +29,9 @@ pub struct SceneGpu {
     pub light_geometry: wgpu::Buffer,
     pub light_properties: wgpu::Buffer,
     pub light_count: u32,
-    /// The shadow BVH, when the scene has shadow-casting lights.
-    pub bvh: Option<GpuBvh>,
+    /// The shadow BVH, built the first time a pass binds it (see [`SceneGpu::bvh`]);
+    /// shared by clones of this upload.
+    bvh: std::sync::Arc<std::sync::OnceLock<Result<GpuBvh, String>>>,
 }
 
 /// The shadow BVH's two storage buffers and what building it found.
@@ -90,11 +91,22 @@ impl SceneGpu {
         Ok(Self::upload_with(device, scene, materials))
     }
 
-    /// The scene's BVH buffers, or why there are none.
-    pub fn bvh(&self) -> Result<&GpuBvh, String> {
+    /// The scene's BVH buffers, or why there are none: built on first use, so graphs
+    /// that import no BVH (or scenes without casters, which get an empty one) never pay
+    /// for it. `scene` must be the scene this was uploaded from.
+    pub fn bvh(&self, device: &wgpu::Device, scene: &Scene) -> Result<&GpuBvh, String> {
         self.bvh
+            .get_or_init(|| {
+                GpuBvh::build(device, scene, scene.features().has_shadow_casters)
+                    .map_err(|e| format!("the scene's shadow BVH could not be built: {e}"))
+            })
             .as_ref()
-            .ok_or_else(|| "the scene's shadow BVH could not be built (see the log)".to_string())
+            .map_err(Clone::clone)
+    }
+
+    /// The BVH, if a pass has built it.
+    pub fn built_bvh(&self) -> Option<&GpuBvh> {
+        self.bvh.get().and_then(|b| b.as_ref().ok())
     }
 
     pub fn upload_with(
@@ -170,15 +182,8 @@ impl SceneGpu {
             light_geometry: storage("light geometry", bytemuck::cast_slice(&geometry)),
             light_properties: storage("light properties", bytemuck::cast_slice(&properties)),
             light_count: scene.lights.len() as u32,
-            // Rebuilt with every upload, so hot reload of geometry rebuilds it. Without
-            // shadow-casting lights no ray is cast: an empty BVH keeps bindings valid.
-            bvh: match GpuBvh::build(device, scene, scene.features().has_shadow_casters) {
-                Ok(b) => Some(b),
-                Err(e) => {
-                    log::error!("shadow BVH: {e}");
-                    None
-                }
-            },
+            // A new upload (hot reload of geometry) builds its own when first bound.
+            bvh: Default::default(),
         }
     }
 

@@ -117,6 +117,13 @@ impl PrepareCtx<'_> {
             .ok_or_else(|| pass_error(pass, format!("buffer '{name}' is not planned")))
     }
 
+    /// The scene's shadow BVH, built on the first pass that binds it.
+    fn bvh(&self, pass: &str) -> Result<&super::scene_gpu::GpuBvh, RenderError> {
+        self.gpu
+            .bvh(&self.renderer.ctx.device, self.scene)
+            .map_err(|m| pass_error(pass, m))
+    }
+
     /// A declared resource as something to bind: scene imports, planned buffers and
     /// textures. `None` for scene geometry (drawn, never bound).
     fn bound(&self, pass: &str, name: &str) -> Result<Option<Bound>, RenderError> {
@@ -132,20 +139,8 @@ impl PrepareCtx<'_> {
                 SceneResource::LightGeometry => Bound::Buffer(self.gpu.light_geometry.clone()),
                 SceneResource::LightProperties => Bound::Buffer(self.gpu.light_properties.clone()),
                 SceneResource::Geometry => return Ok(None),
-                SceneResource::BvhNodes => Bound::Buffer(
-                    self.gpu
-                        .bvh()
-                        .map_err(|m| pass_error(pass, m))?
-                        .nodes
-                        .clone(),
-                ),
-                SceneResource::BvhTriangles => Bound::Buffer(
-                    self.gpu
-                        .bvh()
-                        .map_err(|m| pass_error(pass, m))?
-                        .triangles
-                        .clone(),
-                ),
+                SceneResource::BvhNodes => Bound::Buffer(self.bvh(pass)?.nodes.clone()),
+                SceneResource::BvhTriangles => Bound::Buffer(self.bvh(pass)?.triangles.clone()),
             },
             Some(ResourceDesc::Buffer { .. }) => Bound::Buffer(self.buffer(pass, name)?),
             Some(ResourceDesc::Texture { .. }) => Bound::View(self.view(pass, name)?),
