@@ -20,6 +20,8 @@ use std::sync::{Arc, Mutex};
 pub(super) struct ShadowAtlasPass {
     name: String,
     config: AtlasConfig,
+    /// Room for views in the table (six per light), as the planned layout has it.
+    max_views: u64,
     normal_offset: f32,
     size: FrameSize,
     lights: Vec<Light>,
@@ -64,13 +66,8 @@ pub(super) fn prepare(
         Some(ResourceDesc::Texture { format, .. }) => format.to_wgpu(),
         _ => wgpu::TextureFormat::Depth32Float,
     };
-    let limit = cx.renderer.ctx.device.limits().max_texture_dimension_2d;
-    if side > limit {
-        return Err(pass_error(
-            &sp.name,
-            format!("the atlas '{atlas_name}' ({side}²) is larger than this adapter's textures ({limit}²)"),
-        ));
-    }
+    // Its side against the device's limit was checked with every planned texture
+    // (render/device_limits.rs) before any was created.
     let views = cx.buffer(&sp.name, sp.required(SHADOW_VIEWS))?;
     let table_bytes = view_table_bytes(cx.gpu.light_count, p.max_views());
     if views.size() < table_bytes {
@@ -120,6 +117,7 @@ pub(super) fn prepare(
             importance: p.importance,
             max_lights: p.max_lights,
         },
+        max_views: p.max_views(),
         normal_offset: p.normal_offset,
         size: cx.size,
         lights: cx.scene.lights.clone(),
@@ -209,7 +207,7 @@ impl ShadowAtlasPass {
             self.size.height,
             &self.config,
         );
-        let max_views = 6 * self.config.max_lights as usize;
+        let max_views = self.max_views as usize;
         let mut table = vec![[0u32; 4]; (self.table_bytes / 16) as usize];
         table[0] = [
             a.views.len() as u32,
