@@ -207,9 +207,10 @@ impl Renderer {
                     m.double_sided
                 ),
             };
-            // Shadow views draw both faces: any surface occludes, as for a ray.
-            let cull_mode = (!m.double_sided && !matches!(mode, DrawMode::AtlasDepth { .. }))
-                .then_some(wgpu::Face::Back);
+            // Shadow views draw both faces (any surface occludes, as for a ray) and their
+            // triangles in spatial chunks.
+            let shadow_view = matches!(mode, DrawMode::AtlasDepth { .. });
+            let cull_mode = (!m.double_sided && !shadow_view).then_some(wgpu::Face::Back);
             let (pipeline, bindings) = self
                 .pipelines
                 .get_or_build_reflected(
@@ -268,7 +269,6 @@ impl Renderer {
                 _ => None,
             };
             let gm = &gpu.meshes[mesh];
-            let shadow_view = matches!(mode, DrawMode::AtlasDepth { .. });
             draws.push(Draw {
                 mesh,
                 material,
@@ -442,17 +442,9 @@ impl MeshDraws {
             let mut bound: Option<usize> = None;
             for &(draw, first, count) in &view.ranges {
                 let d = &self.draws[draw];
-                let ptr = Arc::as_ptr(&d.pipeline);
-                if current != Some(ptr) {
-                    pass.set_pipeline(&d.pipeline);
-                    current = Some(ptr);
-                    if let Some(group) = &d.material {
-                        pass.set_bind_group(MATERIAL_GROUP, group, &[]);
-                    }
-                }
+                d.switch_pipeline(pass, &mut current);
                 if bound != Some(draw) {
-                    pass.set_vertex_buffer(0, d.vertices.slice(..));
-                    pass.set_index_buffer(d.indices.slice(..), wgpu::IndexFormat::Uint32);
+                    d.bind_buffers(pass);
                     bound = Some(draw);
                 }
                 pass.draw_indexed(first..first + count, 0, instance..instance + 1);
@@ -468,18 +460,33 @@ impl MeshDraws {
         let mut current: Option<*const wgpu::RenderPipeline> = None;
         for d in &self.draws {
             // Draws are sorted by material: switch pipelines only when it changes.
-            let ptr = Arc::as_ptr(&d.pipeline);
-            if current != Some(ptr) {
-                pass.set_pipeline(&d.pipeline);
-                current = Some(ptr);
-                if let Some(group) = &d.material {
-                    pass.set_bind_group(MATERIAL_GROUP, group, &[]);
-                }
-            }
-            pass.set_vertex_buffer(0, d.vertices.slice(..));
-            pass.set_index_buffer(d.indices.slice(..), wgpu::IndexFormat::Uint32);
+            d.switch_pipeline(pass, &mut current);
+            d.bind_buffers(pass);
             pass.draw_indexed(0..d.index_count, 0, 0..1);
         }
+    }
+}
+
+impl Draw {
+    /// Sets this draw's pipeline and material group unless `current` already is it.
+    fn switch_pipeline(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        current: &mut Option<*const wgpu::RenderPipeline>,
+    ) {
+        let ptr = Arc::as_ptr(&self.pipeline);
+        if *current != Some(ptr) {
+            pass.set_pipeline(&self.pipeline);
+            *current = Some(ptr);
+            if let Some(group) = &self.material {
+                pass.set_bind_group(MATERIAL_GROUP, group, &[]);
+            }
+        }
+    }
+
+    fn bind_buffers(&self, pass: &mut wgpu::RenderPass<'_>) {
+        pass.set_vertex_buffer(0, self.vertices.slice(..));
+        pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
     }
 }
 
