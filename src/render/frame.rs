@@ -216,27 +216,29 @@ impl PreparedFrame {
             if let Some(b) = self.resources.buffer(plan, name) {
                 encoder.clear_buffer(b, 0, None);
             } else if let Some(t) = self.resources.texture(plan, name) {
-                if t.format().is_depth_stencil_format() {
+                match self.resources.view(plan, name) {
                     // clear_texture needs a feature for depth formats; a render pass's
                     // clear does not.
-                    let view = t.create_view(&Default::default());
-                    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                        label: Some(name),
-                        color_attachments: &[],
-                        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                            view: &view,
-                            depth_ops: Some(wgpu::Operations {
-                                load: wgpu::LoadOp::Clear(0.0),
-                                store: wgpu::StoreOp::Store,
-                            }),
-                            stencil_ops: None,
-                        }),
-                        timestamp_writes: None,
-                        occlusion_query_set: None,
-                        multiview_mask: None,
-                    });
-                } else {
-                    encoder.clear_texture(t, &Default::default());
+                    Some(view) if t.format().is_depth_stencil_format() => {
+                        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                            label: Some(name),
+                            color_attachments: &[],
+                            depth_stencil_attachment: Some(
+                                wgpu::RenderPassDepthStencilAttachment {
+                                    view,
+                                    depth_ops: Some(wgpu::Operations {
+                                        load: wgpu::LoadOp::Clear(0.0),
+                                        store: wgpu::StoreOp::Store,
+                                    }),
+                                    stencil_ops: None,
+                                },
+                            ),
+                            timestamp_writes: None,
+                            occlusion_query_set: None,
+                            multiview_mask: None,
+                        });
+                    }
+                    _ => encoder.clear_texture(t, &Default::default()),
                 }
             }
         }
