@@ -8,6 +8,10 @@ use lightgraph::shader::ShaderLibrary;
 use std::fmt::Write;
 use std::path::Path;
 
+/// The binary's allocator (src/main.rs), so this measures what `lightgraph` pays.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn main() {
     divan::main();
 }

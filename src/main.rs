@@ -2,6 +2,10 @@
 
 mod cli;
 
+/// See Cargo.toml: many small allocations (graph compiles, scene imports).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn main() -> anyhow::Result<()> {
     // Before anything starts a thread: Mesa's Vulkan loader reads the environment.
     cli::runtime_dir_fallback();

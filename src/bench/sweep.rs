@@ -441,7 +441,7 @@ fn set_shadow_columns(
             .map(|p| {
                 row.pass_ms
                     .iter()
-                    .find(|(n, _)| *n == p.name)
+                    .find(|(n, _)| p.name == *n)
                     .map(|(_, t)| t.median)
             })
             .collect();

@@ -1,22 +1,23 @@
 //! A compiled graph: plain data you can print and assert on.
 
-use super::model::{PassKind, ResourceDesc};
+use super::model::{Name, PassKind, ResourceDesc};
 use super::plan::ResourcePlan;
 use super::roles::PassRoles;
 use super::specialise::CullReason;
 use super::validate::CheckedGraph;
 use std::fmt::Write;
+use std::sync::Arc;
 
 #[derive(Clone, Debug)]
 pub struct ScheduledPass {
-    pub name: String,
+    pub name: Name,
     /// Index into the graph file's passes.
     pub index: usize,
     pub kind: PassKind,
-    pub roles: PassRoles,
+    pub roles: Arc<PassRoles>,
     /// Resources this pass writes first in the schedule: its attachments clear them,
     /// later writers load.
-    pub clears: Vec<String>,
+    pub clears: Vec<Name>,
     /// Sample count of the textures in its slots (validation made them agree).
     pub samples: u32,
 }
@@ -39,7 +40,7 @@ impl ScheduledPass {
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct CulledPass {
-    pub name: String,
+    pub name: Name,
     pub reason: CullReason,
 }
 
@@ -128,18 +129,11 @@ impl CompiledGraph {
     }
 }
 
-/// The scheduled passes, in order; `index` is [`super::plan::first_declarations`].
-pub(crate) fn scheduled_passes(
-    checked: &CheckedGraph,
-    schedule: &[usize],
-    index: &super::fxmap::FxHashMap<&str, usize>,
-) -> Vec<ScheduledPass> {
-    let mut written = super::fxmap::FxHashSet::default();
-    // Sample count of a texture by name (the first declaration of a name).
-    let texture_samples = |name: &str| match checked.desc.resources.get(*index.get(name)?)? {
-        ResourceDesc::Texture { samples, .. } => Some(*samples),
-        _ => None,
-    };
+/// The scheduled passes, in order.
+pub(crate) fn scheduled_passes(checked: &CheckedGraph, schedule: &[usize]) -> Vec<ScheduledPass> {
+    let resources = &checked.desc.resources;
+    let mut written = vec![false; resources.len()];
+    let ids = &checked.ids;
     schedule
         .iter()
         .map(|&i| {
@@ -148,16 +142,32 @@ pub(crate) fn scheduled_passes(
             let clears = desc
                 .writes
                 .iter()
-                .filter(|w| written.insert(w.as_str()))
-                .cloned()
+                .zip(ids.writes(i))
+                .filter(|&(_, &id)| !std::mem::replace(&mut written[id], true))
+                .map(|(w, _)| w.clone())
                 .collect();
-            let samples = roles
-                .slots
-                .values()
-                .chain(roles.target.iter())
-                .filter_map(|name| texture_samples(name.as_str()))
-                .max()
-                .unwrap_or(1);
+            let samples_of = |id: usize| match resources[id] {
+                ResourceDesc::Texture { samples, .. } => Some(samples),
+                _ => None,
+            };
+            // A built-in kind's resources all fill slots; a generic pass draws at its
+            // target's count whatever its bindings sample.
+            let samples = match &roles.target {
+                _ if desc.kind.shader_file().is_none() => ids
+                    .reads(i)
+                    .iter()
+                    .chain(ids.writes(i))
+                    .filter_map(|&id| samples_of(id))
+                    .max(),
+                Some(target) => desc
+                    .writes
+                    .iter()
+                    .zip(ids.writes(i))
+                    .find(|(w, _)| *w == target)
+                    .and_then(|(_, &id)| samples_of(id)),
+                None => None,
+            }
+            .unwrap_or(1);
             ScheduledPass {
                 name: desc.name.clone(),
                 index: i,

@@ -1,14 +1,15 @@
 //! The dependency graph between passes (petgraph): an edge W -> R for every resource
 //! that R reads and another pass W writes.
 
-use super::model::GraphDesc;
+use super::model::{GraphDesc, Name};
 use petgraph::graph::{DiGraph, NodeIndex};
 
 /// Node weights are pass indices into `GraphDesc::passes`; edge weights resource names.
-pub type DepGraph = DiGraph<usize, String>;
+pub type DepGraph = DiGraph<usize, Name>;
 
 /// Declared-resource indices of every pass's reads and writes, flat, in declaration
 /// order: pass `p`'s reads are `reads[read_start[p]..read_start[p + 1]]`.
+#[derive(Clone, Debug)]
 pub struct PassIds {
     pub reads: Vec<usize>,
     pub read_start: Vec<usize>,
@@ -88,7 +89,11 @@ pub fn cycles(desc: &GraphDesc, g: &DepGraph) -> Vec<Vec<String>> {
     found.sort();
     found
         .into_iter()
-        .map(|c| c.into_iter().map(|i| desc.passes[i].name.clone()).collect())
+        .map(|c| {
+            c.into_iter()
+                .map(|i| desc.passes[i].name.to_string())
+                .collect()
+        })
         .collect()
 }
 

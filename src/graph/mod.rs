@@ -9,6 +9,7 @@ mod fxmap;
 pub mod kinds;
 mod location;
 pub mod model;
+mod name;
 mod order;
 mod parse;
 pub mod plan;
@@ -56,9 +57,13 @@ pub fn compile(checked: CheckedGraph, features: &SceneFeatures, frame: FrameSize
     let culled = specialise::specialise(&checked, features);
     let keep: Vec<bool> = culled.iter().map(Option::is_none).collect();
     let schedule = order::order(&checked, &keep);
-    let index = plan::first_declarations(&checked.desc);
-    let plan = plan::plan_indexed(&checked.desc, &checked.roles, &schedule, frame, &index);
-    let passes = compiled::scheduled_passes(&checked, &schedule, &index);
-    drop(index);
+    let plan = plan::plan(
+        &checked.desc,
+        &checked.roles,
+        &checked.ids,
+        &schedule,
+        frame,
+    );
+    let passes = compiled::scheduled_passes(&checked, &schedule);
     compiled::assemble(checked, culled, passes, plan)
 }

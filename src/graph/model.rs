@@ -6,6 +6,7 @@ pub use super::kinds::light_culling::LightCulling;
 pub use super::kinds::shadow_atlas::ShadowAtlas;
 pub use super::kinds::shadow_ray_cast::ShadowRayCast;
 pub use super::kinds::shadow_ray_jobs::ShadowRayJobs;
+pub use super::name::Name;
 use serde::{Deserialize, Serialize};
 
 /// A whole graph file (`graphs/*.ron`).
@@ -18,17 +19,17 @@ pub struct GraphDesc {
     pub resources: Vec<ResourceDesc>,
     pub passes: Vec<PassDesc>,
     /// The resource presented as the frame (a colour texture).
-    pub output: String,
+    pub output: Name,
     /// Passes kept even though nothing reads what they write (statistics, readbacks).
     #[serde(default)]
-    pub side_effects: Vec<String>,
+    pub side_effects: Vec<Name>,
 }
 
 /// A named resource. Sizes are plain data relative to the output.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 pub enum ResourceDesc {
     Texture {
-        name: String,
+        name: Name,
         format: TextureFormat,
         #[serde(default)]
         size: TextureSize,
@@ -36,12 +37,12 @@ pub enum ResourceDesc {
         samples: u32,
     },
     Buffer {
-        name: String,
+        name: Name,
         #[serde(default)]
         size: BufferSize,
     },
     /// Data owned by the scene, bound read-only.
-    Import { name: String, from: SceneResource },
+    Import { name: Name, from: SceneResource },
 }
 
 fn one() -> u32 {
@@ -50,6 +51,10 @@ fn one() -> u32 {
 
 impl ResourceDesc {
     pub fn name(&self) -> &str {
+        self.shared_name()
+    }
+    /// The name as shared text, for the compile steps to keep without copying it.
+    pub fn shared_name(&self) -> &Name {
         match self {
             ResourceDesc::Texture { name, .. }
             | ResourceDesc::Buffer { name, .. }
@@ -164,18 +169,18 @@ impl SceneFeature {
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(rename = "Pass", deny_unknown_fields)]
 pub struct PassDesc {
-    pub name: String,
+    pub name: Name,
     pub kind: PassKind,
     #[serde(default)]
-    pub reads: Vec<String>,
+    pub reads: Vec<Name>,
     #[serde(default)]
-    pub writes: Vec<String>,
+    pub writes: Vec<Name>,
     #[serde(default)]
     pub when: Option<SceneFeature>,
     /// `slot=resource` entries of reads and writes, split off by the parser: (slot,
     /// resource). Built-in kinds match these by name; the rest by type and order.
     #[serde(skip)]
-    pub named_slots: Vec<(String, String)>,
+    pub named_slots: Vec<(Name, Name)>,
 }
 
 impl PassDesc {
@@ -193,7 +198,7 @@ impl PassDesc {
         for list in [&mut self.reads, &mut self.writes] {
             for entry in list.iter_mut() {
                 if let Some((slot, resource)) = entry.split_once('=') {
-                    let (slot, resource) = (slot.trim().to_string(), resource.trim().to_string());
+                    let (slot, resource) = (Name::from(slot.trim()), Name::from(resource.trim()));
                     self.named_slots.push((slot, resource.clone()));
                     *entry = resource;
                 }

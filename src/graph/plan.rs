@@ -2,14 +2,18 @@
 //! one physical texture or buffer serving several graph resources with the same
 //! descriptor whose lifetimes (first to last use in the schedule) do not overlap.
 
+use super::deps::PassIds;
 use super::fxmap::FxHashMap;
 use super::kinds::{self, BufferLayout, Usage};
-use super::model::{BufferSize, CullVariant, GraphDesc, ResourceDesc, TextureFormat, TextureSize};
+use super::model::{
+    BufferSize, CullVariant, GraphDesc, Name, ResourceDesc, TextureFormat, TextureSize,
+};
 use super::roles::PassRoles;
 use crate::shader::BindingKind;
+use std::sync::Arc;
 
 /// What a physical resource is; two graph resources may share one only if these are equal.
-#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum PhysicalDesc {
     Texture {
         format: TextureFormat,
@@ -28,14 +32,14 @@ pub struct PhysicalResource {
     pub texture_usage: wgpu::TextureUsages,
     pub buffer_usage: wgpu::BufferUsages,
     /// Graph resources this one serves, in order of use.
-    pub serves: Vec<String>,
+    pub serves: Vec<Name>,
     /// Last schedule position of any resource it serves.
     pub last_use: usize,
 }
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct PlannedResource {
-    pub name: String,
+    pub name: Name,
     /// Index into [`ResourcePlan::physical`].
     pub physical: usize,
     /// First and last schedule position that uses it (inclusive).
@@ -133,23 +137,23 @@ fn texture_extent(size: TextureSize, frame: FrameSize) -> (u32, u32) {
 
 /// Per written resource, the layout the built-in pass declared to write it gives it:
 /// the first pass in declaration order that writes it into a slot whose kind gives one.
-fn buffer_layouts<'a>(
+/// Indexed by declared resource.
+fn buffer_layouts(
     desc: &GraphDesc,
-    roles: &'a [PassRoles],
+    roles: &[Arc<PassRoles>],
+    ids: &PassIds,
     frame: FrameSize,
-) -> FxHashMap<&'a str, BufferLayout> {
-    let mut layouts = FxHashMap::default();
-    for (p, r) in desc.passes.iter().zip(roles) {
-        for name in r.slots.values() {
-            if layouts.contains_key(name.as_str()) || !p.writes.iter().any(|w| w == name) {
+) -> Vec<Option<BufferLayout>> {
+    let mut layouts = vec![None; desc.resources.len()];
+    for (p, (pass, r)) in desc.passes.iter().zip(roles).enumerate() {
+        for (name, &id) in pass.writes.iter().zip(ids.writes(p)) {
+            if layouts[id].is_some() {
                 continue;
             }
             let Some(slot) = r.slot_of(name) else {
                 continue;
             };
-            if let Some(layout) = kinds::buffer_layout(&p.kind, slot, frame) {
-                layouts.insert(name.as_str(), layout);
-            }
+            layouts[id] = kinds::buffer_layout(&pass.kind, slot, frame);
         }
     }
     layouts
@@ -171,33 +175,14 @@ fn buffer_bytes(size: BufferSize, layout: Option<BufferLayout>, frame: FrameSize
     bytes.clamp(16, u64::MAX - 3).next_multiple_of(4)
 }
 
-/// Plans physical resources for the passes in `schedule` (pass indices, in order).
-pub fn plan(
+/// Plans physical resources for the passes in `schedule` (pass indices, in order) of
+/// a validated graph; `ids` are its passes' resource indices.
+pub(crate) fn plan(
     desc: &GraphDesc,
-    roles: &[PassRoles],
+    roles: &[Arc<PassRoles>],
+    ids: &PassIds,
     schedule: &[usize],
     frame: FrameSize,
-) -> ResourcePlan {
-    plan_indexed(desc, roles, schedule, frame, &first_declarations(desc))
-}
-
-/// Resource name -> index of its first declaration (which stands for the name).
-pub(crate) fn first_declarations(desc: &GraphDesc) -> FxHashMap<&str, usize> {
-    let mut index: FxHashMap<&str, usize> =
-        FxHashMap::with_capacity_and_hasher(desc.resources.len(), Default::default());
-    for (i, r) in desc.resources.iter().enumerate() {
-        index.entry(r.name()).or_insert(i);
-    }
-    index
-}
-
-/// [`plan`] with `index` = [`first_declarations`] of `desc`.
-pub(crate) fn plan_indexed(
-    desc: &GraphDesc,
-    roles: &[PassRoles],
-    schedule: &[usize],
-    frame: FrameSize,
-    index: &FxHashMap<&str, usize>,
 ) -> ResourcePlan {
     let mut plan = ResourcePlan::default();
     // Schedule positions that use each resource, from one walk over the schedule, as
@@ -206,11 +191,7 @@ pub(crate) fn plan_indexed(
     let mut last_pos = vec![usize::MAX; desc.resources.len()];
     let mut start = vec![0usize; desc.resources.len() + 1];
     for (pos, &p) in schedule.iter().enumerate() {
-        let pass = &desc.passes[p];
-        for n in pass.reads.iter().chain(&pass.writes) {
-            let Some(&i) = index.get(n.as_str()) else {
-                continue; // not declared: nothing to plan
-            };
+        for &i in ids.reads(p).iter().chain(ids.writes(p)) {
             if last_pos[i] != pos {
                 last_pos[i] = pos;
                 uses_at.push((i, pos));
@@ -227,17 +208,14 @@ pub(crate) fn plan_indexed(
         positions[fill[i]] = pos;
         fill[i] += 1;
     }
-    let used_at = |r: &ResourceDesc| -> &[usize] {
-        let i = index[r.name()];
-        &positions[start[i]..start[i + 1]]
-    };
+    let used_at = |i: usize| -> &[usize] { &positions[start[i]..start[i + 1]] };
     // Transients in order of first use.
-    let mut uses: Vec<(usize, usize, &ResourceDesc)> = Vec::new();
-    for r in &desc.resources {
+    let mut uses: Vec<(usize, usize, usize)> = Vec::new();
+    for (i, r) in desc.resources.iter().enumerate() {
         if matches!(r, ResourceDesc::Import { .. }) {
             continue;
         }
-        let used_at = used_at(r);
+        let used_at = used_at(i);
         if used_at.is_empty() {
             continue;
         }
@@ -248,25 +226,24 @@ pub(crate) fn plan_indexed(
         } else {
             last
         };
-        uses.push((first, last, r));
+        uses.push((first, last, i));
     }
     uses.sort_by_key(|u| u.0);
-    let layouts = buffer_layouts(desc, roles, frame);
+    let layouts = buffer_layouts(desc, roles, ids, frame);
     // Physical resources by descriptor, in index order: reuse takes the first free one.
     let mut by_desc: FxHashMap<PhysicalDesc, Vec<usize>> = FxHashMap::default();
     let mut users: Vec<usize> = Vec::new();
-    for (first, last, r) in uses {
+    for (first, last, i) in uses {
+        let r = &desc.resources[i];
         users.clear();
-        users.extend(used_at(r).iter().map(|&pos| schedule[pos]));
+        users.extend(used_at(i).iter().map(|&pos| schedule[pos]));
         let layout = match r {
-            ResourceDesc::Buffer { .. } => layouts.get(r.name()).copied(),
+            ResourceDesc::Buffer { .. } => layouts[i],
             _ => None,
         };
         let (pdesc, tex_usage, buf_usage) = describe(r, desc, roles, &users, frame, layout);
-        let absent = !users
-            .iter()
-            .any(|&p| desc.passes[p].writes.iter().any(|w| w == r.name()));
-        let same = by_desc.entry(pdesc.clone()).or_default();
+        let absent = !users.iter().any(|&p| ids.writes(p).contains(&i));
+        let same = by_desc.entry(pdesc).or_default();
         let reuse = same
             .iter()
             .copied()
@@ -288,10 +265,10 @@ pub(crate) fn plan_indexed(
         let ph = &mut plan.physical[physical];
         ph.texture_usage |= tex_usage;
         ph.buffer_usage |= buf_usage;
-        ph.serves.push(r.name().to_string());
+        ph.serves.push(r.shared_name().clone());
         ph.last_use = ph.last_use.max(last);
         plan.resources.push(PlannedResource {
-            name: r.name().to_string(),
+            name: r.shared_name().clone(),
             physical,
             first,
             last,
@@ -305,7 +282,7 @@ pub(crate) fn plan_indexed(
 fn describe(
     r: &ResourceDesc,
     desc: &GraphDesc,
-    roles: &[PassRoles],
+    roles: &[Arc<PassRoles>],
     users: &[usize],
     frame: FrameSize,
     layout: Option<BufferLayout>,

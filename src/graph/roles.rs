@@ -4,7 +4,7 @@
 use super::error::GraphError;
 use super::fxmap::FxHashMap;
 use super::location::SourceText;
-use super::model::{PassDesc, PassKind, ResourceDesc, SceneResource};
+use super::model::{Name, PassDesc, PassKind, ResourceDesc, SceneResource};
 use crate::shader::{BindingKind, ReflectedBinding};
 use std::collections::BTreeMap;
 
@@ -15,16 +15,16 @@ pub const BUILTIN_BINDINGS: [&str; 3] = ["frame", "linear_sampler", "nearest_sam
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PassRoles {
     /// Built-in kinds: slot name (from the kind's table) -> resource name.
-    pub slots: BTreeMap<&'static str, String>,
+    pub slots: BTreeMap<&'static str, Name>,
     /// Generic kinds: reflected binding -> resource name (or a built-in binding name).
-    pub bindings: Vec<(ReflectedBinding, String)>,
+    pub bindings: Vec<(ReflectedBinding, Name)>,
     /// Fullscreen: the colour target it renders into.
-    pub target: Option<String>,
+    pub target: Option<Name>,
 }
 
 impl PassRoles {
     pub fn slot(&self, slot: &str) -> Option<&str> {
-        self.slots.get(slot).map(String::as_str)
+        self.slots.get(slot).map(Name::as_str)
     }
     /// The slot `resource` fills, if any.
     pub fn slot_of(&self, resource: &str) -> Option<&'static str> {
@@ -49,7 +49,7 @@ impl RoleCtx<'_> {
     ) -> GraphError {
         GraphError::Mismatch {
             at: self.source.in_pass(&pass.name, resource),
-            pass: pass.name.clone(),
+            pass: pass.name.to_string(),
             resource: resource.to_string(),
             problem: problem.into(),
         }
@@ -57,7 +57,7 @@ impl RoleCtx<'_> {
     pub(crate) fn bad(&self, pass: &PassDesc, problem: impl Into<String>) -> GraphError {
         GraphError::BadPass {
             at: self.source.of_declaration(&pass.name),
-            pass: pass.name.clone(),
+            pass: pass.name.to_string(),
             problem: problem.into(),
         }
     }
@@ -87,11 +87,12 @@ impl RoleCtx<'_> {
         let mut roles = PassRoles::default();
         let mut errors = Vec::new();
         if matches!(pass.kind, PassKind::Fullscreen { .. }) {
-            let targets: Vec<&String> = pass
+            let targets: Vec<&Name> = pass
                 .writes
                 .iter()
                 .filter(|w| {
-                    self.color_texture(w).is_some() && !bindings.iter().any(|b| &b.name == *w)
+                    self.color_texture(w).is_some()
+                        && !bindings.iter().any(|b| b.name == w.as_str())
                 })
                 .collect();
             match targets.as_slice() {
@@ -120,11 +121,13 @@ impl RoleCtx<'_> {
             let declared_write = pass.writes.iter().any(|w| w == &b.name);
             if !declared_read && !declared_write {
                 if BUILTIN_BINDINGS.contains(&b.name.as_str()) {
-                    roles.bindings.push((b.clone(), b.name.clone()));
+                    roles
+                        .bindings
+                        .push((b.clone(), Name::from(b.name.as_str())));
                 } else {
                     errors.push(GraphError::UndeclaredBinding {
                         at: self.source.in_pass(&pass.name, shader),
-                        pass: pass.name.clone(),
+                        pass: pass.name.to_string(),
                         shader: shader.to_string(),
                         binding: b.name.clone(),
                     });
@@ -134,16 +137,18 @@ impl RoleCtx<'_> {
             if let Some(problem) = self.binding_problem(b, declared_write) {
                 errors.push(self.mismatch(pass, &b.name, problem));
             }
-            roles.bindings.push((b.clone(), b.name.clone()));
+            roles
+                .bindings
+                .push((b.clone(), Name::from(b.name.as_str())));
         }
         for name in pass.reads.iter().chain(&pass.writes) {
-            let bound = bindings.iter().any(|b| &b.name == name);
+            let bound = bindings.iter().any(|b| b.name == name.as_str());
             if !bound && roles.target.as_deref() != Some(name.as_str()) {
                 errors.push(GraphError::UnboundResource {
                     at: self.source.in_pass(&pass.name, name),
-                    pass: pass.name.clone(),
+                    pass: pass.name.to_string(),
                     shader: shader.to_string(),
-                    resource: name.clone(),
+                    resource: name.to_string(),
                 });
             }
         }

@@ -5,10 +5,12 @@
 //! texture and buffer limits, per-light dispatch counts) is checked again at prepare.
 
 use super::error::GraphError;
+use super::fxmap::FxHashMap;
 use super::kinds;
 use super::location::SourceText;
 use super::model::{BufferSize, Dispatch, GraphDesc, PassDesc, ResourceDesc, TextureSize};
 use super::roles::PassRoles;
+use std::sync::Arc;
 
 /// Largest output side the CLI and scene files accept.
 pub const MAX_FRAME_SIDE: u32 = 16384;
@@ -45,7 +47,7 @@ pub fn check_resources(desc: &GraphDesc, source: &SourceText, errors: &mut Vec<G
         errors.push(match writer {
             Some(pass) => GraphError::Mismatch {
                 at: source.in_pass(&pass.name, r.name()),
-                pass: pass.name.clone(),
+                pass: pass.name.to_string(),
                 resource: r.name().to_string(),
                 problem,
             },
@@ -97,9 +99,10 @@ fn buffer_problem(size: BufferSize) -> Option<String> {
 
 /// A buffer a built-in pass lays out (light lists, shadow jobs, the shadow mask) follows
 /// the frame and the pass's parameters: only `size: Auto` is always big enough.
-pub fn check_laid_out_buffers(
+pub(crate) fn check_laid_out_buffers(
     desc: &GraphDesc,
-    roles: &[PassRoles],
+    resources: &FxHashMap<&str, &ResourceDesc>,
+    roles: &[Arc<PassRoles>],
     source: &SourceText,
     errors: &mut Vec<GraphError>,
 ) {
@@ -116,15 +119,15 @@ pub fn check_laid_out_buffers(
             let Some(layout) = kinds::buffer_layout(&pass.kind, slot, frame) else {
                 continue;
             };
-            let declared = desc.resources.iter().find_map(|d| match d {
-                ResourceDesc::Buffer { name: n, size, .. } if n == name => Some(*size),
+            let declared = match resources.get(name.as_str()) {
+                Some(ResourceDesc::Buffer { size, .. }) => Some(*size),
                 _ => None,
-            });
+            };
             if let Some(size) = declared.filter(|s| *s != BufferSize::Auto) {
                 errors.push(GraphError::Mismatch {
                     at: source.in_pass(&pass.name, name),
-                    pass: pass.name.clone(),
-                    resource: name.clone(),
+                    pass: pass.name.to_string(),
+                    resource: name.to_string(),
                     problem: format!(
                         "{} lays out slot '{slot}' from the frame and its parameters ({} bytes at 1280×720): declare the buffer `size: Auto`, not {size:?}",
                         pass.kind.label(),
@@ -146,7 +149,7 @@ pub fn check_dispatch(
 ) -> Option<GraphError> {
     let bad = |problem: String| GraphError::BadPass {
         at: source.in_pass(&pass.name, "dispatch"),
-        pass: pass.name.clone(),
+        pass: pass.name.to_string(),
         problem,
     };
     let [x, y, z] = workgroup;

@@ -1,6 +1,7 @@
 //! Step 3: keep only what this scene needs. Passes whose `when:` is false go first, then
 //! every pass from which no root (the output's writers, declared side effects) is reachable.
 
+use super::model::Name;
 use super::validate::CheckedGraph;
 use crate::scene::SceneFeatures;
 use petgraph::graph::NodeIndex;
@@ -27,7 +28,7 @@ pub fn specialise(graph: &CheckedGraph, features: &SceneFeatures) -> Vec<Option<
         })
         .collect();
     let side_effects: super::fxmap::FxHashSet<&str> =
-        desc.side_effects.iter().map(String::as_str).collect();
+        desc.side_effects.iter().map(Name::as_str).collect();
     let roots: Vec<usize> = (0..desc.passes.len())
         .filter(|&i| {
             culled[i].is_none()

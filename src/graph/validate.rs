@@ -4,10 +4,11 @@ use super::deps::{self, DepGraph, PassIds, Writers};
 use super::error::{GraphError, GraphErrors};
 use super::fxmap::{FxHashMap, FxHashSet};
 use super::location::SourceText;
-use super::model::{GraphDesc, PassKind, ResourceDesc, TextureFormat};
+use super::model::{GraphDesc, Name, PassKind, ResourceDesc, TextureFormat};
 use super::roles::{PassRoles, RoleCtx};
 use crate::shader::{reflect_bindings, Composed, ShaderLibrary};
 use std::collections::BTreeSet;
+use std::sync::Arc;
 
 /// A graph that passed validation: its roles resolved and its shaders composed.
 #[derive(Clone, Debug)]
@@ -16,9 +17,13 @@ pub struct CheckedGraph {
     pub source: SourceText,
     pub deps: DepGraph,
     /// Per pass, in declaration order.
-    pub roles: Vec<PassRoles>,
+    /// Shared with the scheduled passes of every compile.
+    pub roles: Vec<Arc<PassRoles>>,
     /// Per pass: the composed shader of a generic pass.
     pub shaders: Vec<Option<Composed>>,
+    /// Per pass: the declared-resource index of each read and write, so the compile
+    /// steps never look a name up.
+    pub(crate) ids: PassIds,
 }
 
 pub fn validate(
@@ -28,14 +33,13 @@ pub fn validate(
 ) -> Result<CheckedGraph, GraphErrors> {
     let mut errors = Vec::new();
     let (resources, passes) = names_and_duplicates(&desc, &source, &mut errors);
-    check_references(&desc, &source, &resources, &passes, &mut errors);
+    let ids = check_references(&desc, &source, &resources, &passes, &mut errors);
     super::sizes::check_resources(&desc, &source, &mut errors);
     if !errors.is_empty() {
         // Role and order checks assume every name resolves.
         return Err(GraphErrors(errors));
     }
     // Every name resolves and is declared once: from here on, resources by index.
-    let ids = pass_ids(&desc, &resources);
     let writers = deps::writers_by_resource(&ids, desc.resources.len());
     check_writes(&desc, &source, &ids, &writers, &mut errors);
 
@@ -71,13 +75,13 @@ pub fn validate(
             },
         };
         match r {
-            Ok(r) => roles.push(r),
+            Ok(r) => roles.push(Arc::new(r)),
             Err(mut e) => errors.append(&mut e),
         }
         composed.push(c);
     }
     if errors.is_empty() {
-        super::sizes::check_laid_out_buffers(&desc, &roles, &source, &mut errors);
+        super::sizes::check_laid_out_buffers(&desc, &resources, &roles, &source, &mut errors);
     }
     if errors.is_empty() {
         Ok(CheckedGraph {
@@ -86,19 +90,25 @@ pub fn validate(
             deps,
             roles,
             shaders: composed,
+            ids,
         })
     } else {
         Err(GraphErrors(errors))
     }
 }
 
-/// The declared-resource index of every read and write; every name must resolve.
+/// The index [`pass_ids`] gives a name no resource declares.
+const UNKNOWN: usize = usize::MAX;
+
+/// The declared-resource index of every read and write, or [`UNKNOWN`].
 fn pass_ids(desc: &GraphDesc, resources: &FxHashMap<&str, &ResourceDesc>) -> PassIds {
     // The map holds references into `desc.resources`: their index is their offset.
     let base = desc.resources.as_ptr() as usize;
     let size = std::mem::size_of::<ResourceDesc>();
-    let index_of =
-        |name: &String| (resources[name.as_str()] as *const ResourceDesc as usize - base) / size;
+    let index_of = |name: &Name| match resources.get(name.as_str()) {
+        Some(r) => (*r as *const ResourceDesc as usize - base) / size,
+        None => UNKNOWN,
+    };
     let n = desc.passes.len();
     let mut ids = PassIds {
         reads: Vec::with_capacity(n * 4),
@@ -142,7 +152,7 @@ fn names_and_duplicates<'a>(
             errors.push(GraphError::Duplicate {
                 at: source.of_declaration(&p.name),
                 what: "pass",
-                name: p.name.clone(),
+                name: p.name.to_string(),
             });
         }
     }
@@ -155,14 +165,16 @@ fn check_references(
     resources: &FxHashMap<&str, &ResourceDesc>,
     passes: &FxHashSet<&str>,
     errors: &mut Vec<GraphError>,
-) {
-    for pass in &desc.passes {
-        for name in pass.reads.iter().chain(&pass.writes) {
-            if !resources.contains_key(name.as_str()) {
+) -> PassIds {
+    let ids = pass_ids(desc, resources);
+    for (p, pass) in desc.passes.iter().enumerate() {
+        let names = pass.reads.iter().chain(&pass.writes);
+        for (name, &id) in names.zip(ids.reads(p).iter().chain(ids.writes(p))) {
+            if id == UNKNOWN {
                 errors.push(GraphError::UnknownResource {
                     at: source.in_pass(&pass.name, name),
-                    pass: pass.name.clone(),
-                    resource: name.clone(),
+                    pass: pass.name.to_string(),
+                    resource: name.to_string(),
                 });
             }
         }
@@ -186,7 +198,7 @@ fn check_references(
     if let Some(problem) = problem {
         errors.push(GraphError::BadOutput {
             at: output_at(),
-            resource: desc.output.clone(),
+            resource: desc.output.to_string(),
             problem,
         });
     }
@@ -195,10 +207,11 @@ fn check_references(
             let at = source.at_offset(source.text.find(&format!("\"{s}\"")).unwrap_or(0));
             errors.push(GraphError::UnknownSideEffect {
                 at,
-                pass: s.clone(),
+                pass: s.to_string(),
             });
         }
     }
+    ids
 }
 
 fn check_writes(
@@ -213,8 +226,8 @@ fn check_writes(
             if let ResourceDesc::Import { from, .. } = &desc.resources[id] {
                 errors.push(GraphError::Mismatch {
                     at: source.in_pass(&pass.name, name),
-                    pass: pass.name.clone(),
-                    resource: name.clone(),
+                    pass: pass.name.to_string(),
+                    resource: name.to_string(),
                     problem: format!("scene import {from:?} is read-only and cannot be written"),
                 });
             }
@@ -225,8 +238,8 @@ fn check_writes(
             if !is_import && !written_elsewhere {
                 errors.push(GraphError::ReadNeverWritten {
                     at: source.in_pass(&pass.name, name),
-                    pass: pass.name.clone(),
-                    resource: name.clone(),
+                    pass: pass.name.to_string(),
+                    resource: name.to_string(),
                 });
             }
         }
@@ -256,8 +269,8 @@ fn check_writer_order(
                     errors.push(GraphError::UnorderedWriters {
                         at: source.in_pass(&desc.passes[b].name, r.name()),
                         resource: r.name().to_string(),
-                        first: desc.passes[a].name.clone(),
-                        second: desc.passes[b].name.clone(),
+                        first: desc.passes[a].name.to_string(),
+                        second: desc.passes[b].name.to_string(),
                     });
                 }
             }
@@ -273,7 +286,7 @@ fn generic_shader(
 ) -> Result<(Composed, naga::Module), GraphError> {
     let shader_error = |message: String| GraphError::Shader {
         at: source.in_pass(&pass.name, file),
-        pass: pass.name.clone(),
+        pass: pass.name.to_string(),
         message,
     };
     let composed = shaders

@@ -34,7 +34,7 @@ pub fn check_plan(graph: &CompiledGraph, limits: &wgpu::Limits) -> Result<(), Re
             let pass = graph
                 .passes
                 .get(r.first)
-                .map_or_else(|| graph.output().to_string(), |p| p.name.clone());
+                .map_or_else(|| graph.output().to_string(), |p| p.name.to_string());
             return Err(RenderError::AtPass {
                 at: graph.checked.source.in_pass(&pass, &r.name),
                 pass,

@@ -12,6 +12,7 @@ use super::scene_gpu::SceneGpu;
 use super::{RenderError, Renderer};
 use crate::gpu::readback::{read_buffer, read_rgba32f};
 use crate::gpu::structs::GpuFrame;
+use crate::graph::Name;
 use crate::graph::{CompiledGraph, FrameSize};
 use crate::scene::{Camera, Scene};
 use glam::Vec3;
@@ -26,7 +27,7 @@ fn at_pass(graph: &CompiledGraph, sp: &crate::graph::ScheduledPass, e: RenderErr
     };
     RenderError::AtPass {
         at: graph.checked.source.of_declaration(&sp.name),
-        pass: sp.name.clone(),
+        pass: sp.name.to_string(),
         problem,
     }
 }
@@ -36,8 +37,8 @@ pub struct PreparedFrame {
     pub size: FrameSize,
     resources: FrameResources,
     frame_uniform: wgpu::Buffer,
-    passes: Vec<(String, Box<dyn PreparedPass>)>,
-    absent: Vec<String>,
+    passes: Vec<(Name, Box<dyn PreparedPass>)>,
+    absent: Vec<Name>,
     queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
     stats: Option<LightStatsPass>,
     prepare_stats: PrepareStats,
@@ -268,7 +269,7 @@ impl PreparedFrame {
                 .enumerate()
                 .map(|(i, (n, _))| {
                     let dt = ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period;
-                    (n.clone(), dt / 1e6)
+                    (n.to_string(), dt / 1e6)
                 })
                 .collect(),
         ))

@@ -168,7 +168,7 @@ mod tests {
             },
             texture_usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
             buffer_usage: wgpu::BufferUsages::empty(),
-            serves: vec![serves.to_string()],
+            serves: vec![crate::graph::Name::from(serves)],
             last_use: 0,
         }
     }

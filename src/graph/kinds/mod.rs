@@ -14,7 +14,7 @@ pub mod shadow_ray_cast;
 pub mod shadow_ray_jobs;
 
 use super::error::GraphError;
-use super::model::{PassDesc, PassKind, ResourceDesc, SceneResource};
+use super::model::{Name, PassDesc, PassKind, ResourceDesc, SceneResource};
 use super::plan::{FrameSize, ListLayout};
 use super::roles::{PassRoles, RoleCtx};
 
@@ -317,75 +317,76 @@ pub(crate) fn resolve(
             .iter()
             .any(|s| s.name == name && s.ty == ty && s.access.allows(write))
     };
+    // Each resource's slot type, looked up once for both rounds.
+    let typed: Vec<(bool, &Name, SlotType)> = [(false, &pass.reads), (true, &pass.writes)]
+        .into_iter()
+        .flat_map(|(write, list)| list.iter().map(move |name| (write, name)))
+        .filter_map(|(write, name)| Some((write, name, slot_type_of(ctx, name)?)))
+        .collect(); // unknown resources are reported by validation
     for by_name in [true, false] {
-        for (write, list) in [(false, &pass.reads), (true, &pass.writes)] {
-            for name in list {
-                let Some(ty) = slot_type_of(ctx, name) else {
-                    continue; // unknown resources are reported by validation
-                };
-                let first = pass.explicit_slot(name).is_some() || named_like(name, ty, write);
-                if first != by_name {
-                    continue;
-                }
-                if write && matches!(ty, SlotType::Import(_)) {
-                    continue; // a write to a read-only import, reported by validation
-                }
-                if roles.slots.values().any(|v| v == name) {
-                    continue; // in reads and writes: one slot
-                }
-                let wanted = pass
-                    .explicit_slot(name)
-                    .or_else(|| named_like(name, ty, write).then_some(name.as_str()));
-                let spec = match wanted {
-                    Some(wanted) => match specs.iter().find(|s| s.name == wanted) {
-                        None => {
-                            errors.push(ctx.mismatch(
-                                pass,
-                                name,
-                                format!("{kind} has no slot '{wanted}' (its slots: {})", names()),
-                            ));
-                            continue;
-                        }
-                        Some(s) if s.ty != ty || !s.access.allows(write) => {
-                            errors.push(ctx.mismatch(
-                                pass,
-                                name,
-                                format!(
-                                    "slot '{wanted}' takes {} {}",
-                                    s.ty.describe(),
-                                    s.access.describe()
-                                ),
-                            ));
-                            continue;
-                        }
-                        Some(s) => s,
-                    },
-                    None => match specs.iter().find(|s| {
-                        s.ty == ty && s.access.allows(write) && !roles.slots.contains_key(s.name)
-                    }) {
-                        Some(s) => s,
-                        None => {
-                            let list = if write { "writes" } else { "reads" };
-                            errors.push(ctx.mismatch(
-                                pass,
-                                name,
-                                format!(
-                                    "{kind} has no free slot for {} in {list} (its slots: {})",
-                                    ty.describe(),
-                                    names()
-                                ),
-                            ));
-                            continue;
-                        }
-                    },
-                };
-                if let Some(prev) = roles.slots.insert(spec.name, name.clone()) {
-                    errors.push(ctx.mismatch(
-                        pass,
-                        name,
-                        format!("slot '{}' already filled by '{prev}'", spec.name),
-                    ));
-                }
+        for &(write, name, ty) in &typed {
+            let first = pass.explicit_slot(name).is_some() || named_like(name, ty, write);
+            if first != by_name {
+                continue;
+            }
+            if write && matches!(ty, SlotType::Import(_)) {
+                continue; // a write to a read-only import, reported by validation
+            }
+            if roles.slots.values().any(|v| v == name) {
+                continue; // in reads and writes: one slot
+            }
+            let wanted = pass
+                .explicit_slot(name)
+                .or_else(|| named_like(name, ty, write).then_some(name.as_str()));
+            let spec = match wanted {
+                Some(wanted) => match specs.iter().find(|s| s.name == wanted) {
+                    None => {
+                        errors.push(ctx.mismatch(
+                            pass,
+                            name,
+                            format!("{kind} has no slot '{wanted}' (its slots: {})", names()),
+                        ));
+                        continue;
+                    }
+                    Some(s) if s.ty != ty || !s.access.allows(write) => {
+                        errors.push(ctx.mismatch(
+                            pass,
+                            name,
+                            format!(
+                                "slot '{wanted}' takes {} {}",
+                                s.ty.describe(),
+                                s.access.describe()
+                            ),
+                        ));
+                        continue;
+                    }
+                    Some(s) => s,
+                },
+                None => match specs.iter().find(|s| {
+                    s.ty == ty && s.access.allows(write) && !roles.slots.contains_key(s.name)
+                }) {
+                    Some(s) => s,
+                    None => {
+                        let list = if write { "writes" } else { "reads" };
+                        errors.push(ctx.mismatch(
+                            pass,
+                            name,
+                            format!(
+                                "{kind} has no free slot for {} in {list} (its slots: {})",
+                                ty.describe(),
+                                names()
+                            ),
+                        ));
+                        continue;
+                    }
+                },
+            };
+            if let Some(prev) = roles.slots.insert(spec.name, name.clone()) {
+                errors.push(ctx.mismatch(
+                    pass,
+                    name,
+                    format!("slot '{}' already filled by '{prev}'", spec.name),
+                ));
             }
         }
     }

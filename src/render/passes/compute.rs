@@ -2,6 +2,7 @@
 //! grid; bound by reflected binding names (auto layout).
 
 use super::{dispatch, pass_error, PrepareCtx, PreparedPass, Timestamps};
+use crate::graph::Name;
 use crate::graph::{Dispatch, ScheduledPass};
 use crate::render::bind::Bound;
 use crate::render::pipelines::{Pipeline, PipelineKey};
@@ -10,7 +11,7 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 pub(super) struct ComputePass {
-    name: String,
+    name: Name,
     pipeline: Arc<wgpu::ComputePipeline>,
     bind: wgpu::BindGroup,
     groups: [u32; 3],
@@ -40,7 +41,7 @@ pub(super) fn prepare(
             &device,
         )
         .map_err(|source| RenderError::Shader {
-            pass: sp.name.clone(),
+            pass: sp.name.to_string(),
             source,
         })?;
     let Pipeline::Compute(pipeline) = pipeline else {

@@ -3,6 +3,7 @@
 
 use super::{defines, pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::g_buffer::G_NORMAL;
+use crate::graph::Name;
 use crate::graph::{slot, DeferredShading, LightSource, ScheduledPass};
 use crate::render::pipelines::PipelineKey;
 use crate::render::RenderError;
@@ -10,7 +11,7 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 pub(super) struct DeferredShadingPass {
-    name: String,
+    name: Name,
     pipelines: Vec<Arc<wgpu::ComputePipeline>>,
     bind: Option<wgpu::BindGroup>,
     groups: [u32; 3],

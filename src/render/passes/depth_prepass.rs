@@ -1,12 +1,13 @@
 //! `DepthPrepass`: every opaque mesh, depth only.
 
 use super::{PrepareCtx, PreparedPass, Timestamps};
+use crate::graph::Name;
 use crate::graph::{slot, ScheduledPass};
 use crate::render::draws::{depth_attachment, DrawMode, MeshDraws};
 use crate::render::RenderError;
 
 pub(super) struct DepthPrepass {
-    name: String,
+    name: Name,
     depth: wgpu::TextureView,
     clear: bool,
     draws: MeshDraws,

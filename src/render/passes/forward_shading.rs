@@ -2,12 +2,13 @@
 //! the prepass depth (tested, not written).
 
 use super::{PrepareCtx, PreparedPass, Timestamps};
+use crate::graph::Name;
 use crate::graph::{slot, ForwardShading, LightSource, ScheduledPass};
 use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws};
 use crate::render::RenderError;
 
 pub(super) struct ForwardShadingPass {
-    name: String,
+    name: Name,
     color: wgpu::TextureView,
     depth: wgpu::TextureView,
     clear: bool,

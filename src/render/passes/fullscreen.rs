@@ -3,6 +3,7 @@
 
 use super::compute::bind_generic;
 use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
+use crate::graph::Name;
 use crate::graph::{ResourceDesc, ScheduledPass};
 use crate::render::draws::color_attachment;
 use crate::render::pipelines::{Pipeline, PipelineKey};
@@ -11,7 +12,7 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 pub(super) struct FullscreenPass {
-    name: String,
+    name: Name,
     pipeline: Arc<wgpu::RenderPipeline>,
     bind: wgpu::BindGroup,
     target: wgpu::TextureView,
@@ -91,7 +92,7 @@ pub(super) fn prepare(
             &device,
         )
         .map_err(|source| RenderError::Shader {
-            pass: sp.name.clone(),
+            pass: sp.name.to_string(),
             source,
         })?;
     let Pipeline::Render(pipeline) = pipeline else {

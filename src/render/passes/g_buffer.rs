@@ -4,12 +4,13 @@
 
 use super::{PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::g_buffer::{self as kind, G_GEOMETRIC, G_NORMAL, G_POSITION};
+use crate::graph::Name;
 use crate::graph::{slot, ScheduledPass};
 use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws};
 use crate::render::RenderError;
 
 pub(super) struct GBuffer {
-    name: String,
+    name: Name,
     depth: wgpu::TextureView,
     /// False after a depth prepass.
     clear_depth: bool,

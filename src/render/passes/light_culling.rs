@@ -3,6 +3,7 @@
 
 use super::{defines, PrepareCtx, PreparedPass, Timestamps};
 use crate::gpu::readback::read_buffer;
+use crate::graph::Name;
 use crate::graph::{slot, LightCulling, ListLayout, ScheduledPass};
 use crate::render::pipelines::PipelineKey;
 use crate::render::report::{CullingReport, PassReport};
@@ -15,7 +16,7 @@ use std::sync::Arc;
 const COARSE_CAPACITY: u64 = 8192;
 
 pub(super) struct LightCullingPass {
-    name: String,
+    name: Name,
     /// The coarse stage, run first in the same pass.
     coarse: Option<(Arc<wgpu::ComputePipeline>, [u32; 3])>,
     pipeline: Arc<wgpu::ComputePipeline>,
@@ -115,7 +116,7 @@ impl PreparedPass for LightCullingPass {
             })
             .collect();
         Ok(Some(PassReport::Culling(CullingReport {
-            pass: self.name.clone(),
+            pass: self.name.to_string(),
             layout: self.layout,
             overflowed_lists: words[1],
             longest_list: words[2],

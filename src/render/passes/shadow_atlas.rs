@@ -7,6 +7,7 @@ use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::shadow_atlas::{
     atlas_side, view_table_bytes, ShadowAtlas, SHADOW_ATLAS, SHADOW_VIEWS, VIEW_VEC4S,
 };
+use crate::graph::Name;
 use crate::graph::{FrameSize, ResourceDesc, ScheduledPass};
 use crate::render::draws::{DrawMode, MeshDraws, ViewDraw};
 use crate::render::pipelines::{Pipeline, PipelineKey};
@@ -18,7 +19,7 @@ use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 
 pub(super) struct ShadowAtlasPass {
-    name: String,
+    name: Name,
     config: AtlasConfig,
     /// Room for views in the table (six per light), as the planned layout has it.
     max_views: u64,
@@ -297,7 +298,7 @@ impl PreparedPass for ShadowAtlasPass {
         let frame = self.frame.lock().unwrap_or_else(|e| e.into_inner());
         let (a, draws) = &*frame;
         Ok(Some(PassReport::Atlas(AtlasReport {
-            pass: self.name.clone(),
+            pass: self.name.to_string(),
             side: self.config.size,
             atlas_bytes: self.atlas_bytes,
             table_bytes: self.table_bytes,

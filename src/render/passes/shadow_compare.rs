@@ -5,6 +5,7 @@ use super::{defines, dispatch, pass_error, PrepareCtx, PreparedPass, Timestamps}
 use crate::gpu::readback::read_buffer_range;
 use crate::graph::kinds::shadow_compare::{ERROR_WORDS, SHADOW_ERRORS};
 use crate::graph::kinds::shadow_ray_cast::DEFAULT_NORMAL_OFFSET;
+use crate::graph::Name;
 use crate::graph::{slot, ScheduledPass};
 use crate::render::pipelines::PipelineKey;
 use crate::render::report::{PassReport, ShadowCompareReport};
@@ -13,7 +14,7 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 pub(super) struct ShadowComparePass {
-    name: String,
+    name: Name,
     pipeline: Arc<wgpu::ComputePipeline>,
     bind: wgpu::BindGroup,
     groups: [u32; 3],
@@ -77,7 +78,7 @@ impl PreparedPass for ShadowComparePass {
         let bytes = read_buffer_range(&r.ctx.device, &r.ctx.queue, &self.errors, 0, 16)?;
         let w: &[u32] = bytemuck::cast_slice(&bytes);
         Ok(Some(PassReport::ShadowCompare(ShadowCompareReport {
-            pass: self.name.clone(),
+            pass: self.name.to_string(),
             pairs: w[0] as u64,
             disagree_pcf5: w[1] as u64,
             disagree_2x2: w[2] as u64,

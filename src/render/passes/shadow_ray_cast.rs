@@ -3,6 +3,7 @@
 
 use super::{defines, pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::shadow_ray_jobs::SHADOW_JOBS;
+use crate::graph::Name;
 use crate::graph::{BufferLayout, ScheduledPass, ShadowRayCast};
 use crate::render::pipelines::PipelineKey;
 use crate::render::RenderError;
@@ -13,7 +14,7 @@ use std::sync::Arc;
 const DISPATCH_OFFSET: u64 = 16;
 
 pub(super) struct ShadowRayCastPass {
-    name: String,
+    name: Name,
     pipeline: Arc<wgpu::ComputePipeline>,
     bind: wgpu::BindGroup,
     jobs: wgpu::Buffer,

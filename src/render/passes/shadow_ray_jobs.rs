@@ -6,6 +6,7 @@ use super::{defines, PrepareCtx, PreparedPass, Timestamps};
 use crate::gpu::readback::read_buffer_range;
 use crate::graph::kinds::shadow_ray_cast::DEFAULT_NORMAL_OFFSET;
 use crate::graph::kinds::shadow_ray_jobs::{self as kind, SHADOW_JOBS, SHADOW_MASK};
+use crate::graph::Name;
 use crate::graph::{slot, ScheduledPass, ShadowRayJobs};
 use crate::render::pipelines::PipelineKey;
 use crate::render::report::{PassReport, ShadowReport};
@@ -14,7 +15,7 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 pub(super) struct ShadowRayJobsPass {
-    name: String,
+    name: Name,
     pipeline: Arc<wgpu::ComputePipeline>,
     finalize: Arc<wgpu::ComputePipeline>,
     bind: wgpu::BindGroup,
@@ -85,7 +86,7 @@ impl PreparedPass for ShadowRayJobsPass {
         let bytes = read_buffer_range(&r.ctx.device, &r.ctx.queue, &self.jobs, 0, 16)?;
         let w: &[u32] = bytemuck::cast_slice(&bytes);
         Ok(Some(PassReport::Shadow(ShadowReport {
-            pass: self.name.clone(),
+            pass: self.name.to_string(),
             jobs_wanted: w[0] as u64,
             jobs_dropped: w[1] as u64,
             overflow_pixels: w[2] as u64,
