@@ -3,6 +3,7 @@
 //! PNG plots). Only the sweeps and the hot-reload latency benchmark need a GPU.
 
 pub mod cases;
+pub mod gpu_clock;
 pub mod heatmap;
 pub mod image_io;
 pub mod metrics;
@@ -11,6 +12,7 @@ pub mod progress;
 pub mod reload_latency;
 pub mod report;
 pub mod sweep;
+pub mod timing;
 pub mod tonemap;
 
 pub use image_io::{

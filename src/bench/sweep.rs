@@ -1,13 +1,15 @@
-//! Benchmark sweeps: scenes × light counts × resolutions × graphs, each point timed on
-//! the GPU (warm-up, then N frames, median and spread per pass) and compared with the
-//! reference image of the same scene (brute force unless the sweep names another graph).
+//! Benchmark sweeps: scenes × light counts × resolutions × graphs. The graphs of a point
+//! are timed together on the GPU (warmed up by time, then interleaved rounds: see
+//! [`super::timing`]) and each is compared with the reference image of the same scene
+//! (brute force unless the sweep names another graph).
 
 use super::cases::SceneCase;
 use super::metrics::non_finite_pixels;
 use super::report::{summarize, BenchRow, TimingSummary};
+use super::timing;
 use super::{compare, CompareOptions};
 use crate::graph::{self, FrameSize, PassKind, ResourceDesc, SceneResource};
-use crate::render::{RenderError, Renderer, SceneGpu, ShadowReport};
+use crate::render::{PreparedFrame, RenderError, Renderer, SceneGpu, ShadowReport};
 use crate::scene::{self, lights::RandomLights, Scene};
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -33,10 +35,19 @@ pub struct Sweep {
     #[serde(default)]
     pub cases: Vec<SceneCase>,
     pub resolutions: Vec<(u32, u32)>,
+    /// Warm-up frames every graph of a point runs at least.
     #[serde(default = "default_warmup")]
     pub warmup: u32,
+    /// Wall-clock seconds the graphs of a point run, in turn, before timing starts: GPUs
+    /// reach their clocks after about a second of work.
+    #[serde(default = "default_warmup_seconds")]
+    pub warmup_seconds: f64,
+    /// Timed frames per graph, split over `rounds` rounds (rounded up).
     #[serde(default = "default_frames")]
     pub frames: u32,
+    /// Rounds of timed frames; each runs every graph of the point in turn.
+    #[serde(default = "default_rounds")]
+    pub rounds: u32,
     /// Above this many lights the reference is not run (no error columns).
     #[serde(default = "default_brute_force_limit")]
     pub brute_force_limit: u32,
@@ -61,8 +72,14 @@ fn yes() -> bool {
 fn default_warmup() -> u32 {
     5
 }
+fn default_warmup_seconds() -> f64 {
+    1.0
+}
 fn default_frames() -> u32 {
     30
+}
+fn default_rounds() -> u32 {
+    5
 }
 fn default_brute_force_limit() -> u32 {
     16384
@@ -119,6 +136,13 @@ impl Sweep {
                 error(format!("{line}cases[{i}] (\"{}\"): {m}", c.name))
             })?;
         }
+        if !(0.0..=3600.0).contains(&sweep.warmup_seconds) {
+            let line = line_of("warmup_seconds");
+            return Err(error(format!(
+                "{line}warmup_seconds {} must lie in 0..=3600",
+                sweep.warmup_seconds
+            )));
+        }
         for &(w, h) in &sweep.resolutions {
             if w == 0 || h == 0 || w > 16384 || h > 16384 {
                 let line = line_of("resolutions");
@@ -139,6 +163,16 @@ impl Sweep {
     /// The reference graph the error columns of `graph` compare against.
     pub fn reference_for(&self, graph: &str) -> &str {
         self.references.get(graph).unwrap_or(&self.reference)
+    }
+
+    /// The timing settings.
+    pub fn method(&self) -> timing::Method {
+        timing::Method {
+            warmup_frames: self.warmup,
+            warmup_seconds: self.warmup_seconds,
+            rounds: self.rounds,
+            frames: self.frames,
+        }
     }
 
     /// Number of points the sweep runs.
@@ -245,36 +279,49 @@ pub fn run(
                             }
                         }
                     }
-                    for g in &sweep.graphs {
-                        let technique = g.trim_end_matches(".ron");
-                        let point = format!(
-                            "{} {technique} {} lights {width}x{height}",
-                            scene.name, size.lights
-                        );
-                        progress(SweepEvent::Start {
-                            index: rows.len(),
-                            total,
-                            point: &point,
-                        });
+                    let point = Point {
+                        scene: &scene,
+                        gpu: &gpu,
+                        size,
+                    };
+                    let label = |g: &str| {
+                        format!(
+                            "{} {} {} lights {width}x{height}",
+                            scene.name,
+                            g.trim_end_matches(".ron"),
+                            size.lights
+                        )
+                    };
+                    progress(SweepEvent::Start {
+                        index: rows.len(),
+                        total,
+                        point: &label(&sweep.graphs.join(", ")),
+                    });
+                    let prepared = sweep
+                        .graphs
+                        .iter()
+                        .map(|g| prepare(g, &point, renderer))
+                        .collect::<Result<Vec<_>, _>>()?;
+                    let frames: Vec<&PreparedFrame> = prepared.iter().collect();
+                    let times = timing::time_point(&frames, renderer, &sweep.method())?;
+                    for ((g, frame), graph_times) in
+                        sweep.graphs.iter().zip(&prepared).zip(&times.graphs)
+                    {
                         let mut row = BenchRow {
                             scene: scene.name.clone(),
-                            technique: technique.to_string(),
+                            technique: g.trim_end_matches(".ron").to_string(),
                             light_count: size.lights,
                             width,
                             height,
                             adapter: renderer.ctx.adapter_name(),
                             ..Default::default()
                         };
+                        set_timing_columns(&mut row, sweep, graph_times, &times, renderer);
                         let reference_name = sweep.reference_for(g);
                         let reference = references.iter().find(|r| r.0 == reference_name);
                         row.reference = reference.map(|r| r.0.trim_end_matches(".ron").to_string());
-                        let point = Point {
-                            scene: &scene,
-                            gpu: &gpu,
-                            size,
-                            reference: reference.map(|r| r.1.as_slice()),
-                        };
-                        measure(sweep, g, &point, renderer, &mut row)?;
+                        let reference = reference.map(|r| r.1.as_slice());
+                        fill_row(sweep, g, frame, &point, reference, renderer, &mut row)?;
                         rows.push(row);
                         progress(SweepEvent::Done {
                             done: rows.len(),
@@ -289,45 +336,71 @@ pub fn run(
     Ok(rows)
 }
 
-/// What one point renders: a scene at a size, and the reference image if there is one.
+/// What one point renders: a scene at a size.
 struct Point<'a> {
     scene: &'a Scene,
     gpu: &'a SceneGpu,
     size: FrameSize,
-    reference: Option<&'a [[f32; 4]]>,
 }
 
-/// Times one graph on one point (warm-up, then the sweep's frames), compares its image with
-/// the reference and fills the row.
-fn measure(
-    sweep: &Sweep,
+fn prepare(
     graph_name: &str,
     point: &Point,
     renderer: &mut Renderer,
+) -> Result<PreparedFrame, SweepError> {
+    let checked = check_graph(graph_name, renderer)?;
+    let compiled = graph::compile(checked, &point.scene.features(), point.size);
+    Ok(renderer.prepare(compiled, point.scene, point.gpu, point.size, false)?)
+}
+
+/// The time columns of one graph's row: frame and pass medians with p10–p90 over every
+/// timed frame, the range of its round medians, the warm-up and the SM clock.
+fn set_timing_columns(
+    row: &mut BenchRow,
+    sweep: &Sweep,
+    times: &timing::GraphTimes,
+    point: &timing::PointTimes,
+    renderer: &Renderer,
+) {
+    row.frame_ms = summarize(&times.frames);
+    if row.frame_ms.is_none() {
+        row.untimed = Some(if sweep.frames == 0 {
+            "the sweep sets frames: 0".into()
+        } else if !renderer.ctx.has_timestamps {
+            format!("{} has no timestamp queries", renderer.ctx.adapter_name())
+        } else {
+            "no timestamps came back".into()
+        });
+    }
+    row.pass_ms = times
+        .per_pass
+        .iter()
+        .filter_map(|(n, v)| summarize(v).map(|t: TimingSummary| (n.clone(), t)))
+        .collect();
+    let rounds = &times.round_medians;
+    if !rounds.is_empty() {
+        row.rounds = Some(rounds.len() as u32);
+        row.round_ms_min = rounds.iter().copied().reduce(f64::min);
+        row.round_ms_max = rounds.iter().copied().reduce(f64::max);
+    }
+    row.warmup_s = Some(point.warmup.as_secs_f64());
+    row.sm_mhz_start = point.clock_start.map(|c| c.mhz);
+    row.sm_mhz_end = point.clock_end.map(|c| c.mhz);
+    row.sm_mhz_max = point.clock_end.or(point.clock_start).map(|c| c.max_mhz);
+}
+
+/// Renders a timed graph's frame once more for its image and reports, compares it with the
+/// reference and fills the rest of the row.
+fn fill_row(
+    sweep: &Sweep,
+    graph_name: &str,
+    prepared: &PreparedFrame,
+    point: &Point,
+    reference: Option<&[[f32; 4]]>,
+    renderer: &mut Renderer,
     row: &mut BenchRow,
 ) -> Result<(), SweepError> {
-    let Point {
-        scene, gpu, size, ..
-    } = *point;
-    let checked = check_graph(graph_name, renderer)?;
-    let compiled = graph::compile(checked, &scene.features(), size);
-    let prepared = renderer.prepare(compiled, scene, gpu, size, false)?;
-    for _ in 0..sweep.warmup {
-        prepared.execute(renderer)?;
-    }
-    let mut frames = Vec::new();
-    let mut per_pass: Vec<(String, Vec<f64>)> = Vec::new();
-    for _ in 0..sweep.frames {
-        if let Some(times) = prepared.execute(renderer)? {
-            frames.push(times.iter().map(|t| t.1).sum::<f64>());
-            for (name, ms) in times {
-                match per_pass.iter_mut().find(|p| p.0 == name) {
-                    Some(p) => p.1.push(ms),
-                    None => per_pass.push((name, vec![ms])),
-                }
-            }
-        }
-    }
+    let Point { scene, gpu, size } = *point;
     let result = prepared.render(renderer)?;
     // Light statistics cost a frame of their own (an exact count is a brute-force pass), and
     // only forward shading gathers them.
@@ -339,21 +412,7 @@ fn measure(
     } else {
         None
     };
-    row.frame_ms = summarize(&frames);
-    if row.frame_ms.is_none() {
-        row.untimed = Some(if sweep.frames == 0 {
-            "the sweep sets frames: 0".into()
-        } else if !renderer.ctx.has_timestamps {
-            format!("{} has no timestamp queries", renderer.ctx.adapter_name())
-        } else {
-            "no timestamps came back".into()
-        });
-    }
-    row.pass_ms = per_pass
-        .iter()
-        .filter_map(|(n, v)| summarize(v).map(|t: TimingSummary| (n.clone(), t)))
-        .collect();
-    if let Some(reference) = point.reference {
+    if let Some(reference) = reference {
         let m = compare(
             reference,
             &result.image,

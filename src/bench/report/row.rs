@@ -26,6 +26,18 @@ pub struct BenchRow {
     pub frame_ms: Option<TimingSummary>,
     /// Why `frame_ms` is `None` (e.g. "the adapter has no timestamp queries").
     pub untimed: Option<String>,
+    /// Timed rounds (each ran every graph of the point in turn) and the smallest and
+    /// largest of this graph's round medians, ms: the spread between rounds.
+    pub rounds: Option<u32>,
+    pub round_ms_min: Option<f64>,
+    pub round_ms_max: Option<f64>,
+    /// Wall-clock seconds the point's warm-up took (all its graphs together).
+    pub warmup_s: Option<f64>,
+    /// The GPU's SM clock before the point's warm-up and after its last round, and its
+    /// maximum, MHz (`nvidia-smi`; `None` elsewhere).
+    pub sm_mhz_start: Option<u32>,
+    pub sm_mhz_end: Option<u32>,
+    pub sm_mhz_max: Option<u32>,
     /// GPU time of each pass over the timed frames, ms, in schedule order (empty when untimed).
     pub pass_ms: Vec<(String, TimingSummary)>,
     /// RMSE against the reference (linear).

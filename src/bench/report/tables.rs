@@ -37,7 +37,7 @@ fn opt<T: ToString>(v: Option<T>) -> String {
 /// row (first-seen order): `pass_ms:<name>` (median), `pass_ms_p10:<name>`, `pass_ms_p90:<name>`,
 /// empty where a row lacks that pass. Time columns are empty, not 0, for untimed rows; the
 /// ray-cast shadow columns (`shadow_*`, `bvh_*`) are empty for graphs without those passes.
-pub const CSV_COLUMNS: [&str; 38] = [
+pub const CSV_COLUMNS: [&str; 45] = [
     "scene",
     "technique",
     "params",
@@ -48,6 +48,13 @@ pub const CSV_COLUMNS: [&str; 38] = [
     "frame_ms_median",
     "frame_ms_p10",
     "frame_ms_p90",
+    "rounds",
+    "round_ms_min",
+    "round_ms_max",
+    "warmup_s",
+    "sm_mhz_start",
+    "sm_mhz_end",
+    "sm_mhz_max",
     "rmse",
     "max_abs",
     "max_rel",
@@ -104,6 +111,13 @@ pub fn to_csv(rows: &[BenchRow]) -> String {
             opt(t.map(|t| t.median)),
             opt(t.map(|t| t.p10)),
             opt(t.map(|t| t.p90)),
+            opt(r.rounds),
+            opt(r.round_ms_min),
+            opt(r.round_ms_max),
+            opt(r.warmup_s),
+            opt(r.sm_mhz_start),
+            opt(r.sm_mhz_end),
+            opt(r.sm_mhz_max),
             opt(r.rmse),
             opt(r.max_abs),
             opt(r.max_rel),
@@ -203,19 +217,37 @@ fn md_num(v: Option<f64>, digits: usize) -> String {
     }
 }
 
+/// "1.71–1.78 (5)": the range of the round medians and the number of rounds.
+fn round_spread(r: &BenchRow) -> String {
+    match (r.round_ms_min, r.round_ms_max, r.rounds) {
+        (Some(lo), Some(hi), Some(n)) => {
+            format!("{}–{} ({n})", md_num(Some(lo), 3), md_num(Some(hi), 3))
+        }
+        _ => "–".into(),
+    }
+}
+
+/// "1980→1980": the SM clock before the warm-up and after the last round.
+fn sm_clocks(r: &BenchRow) -> String {
+    match (r.sm_mhz_start, r.sm_mhz_end) {
+        (Some(a), Some(b)) => format!("{a}→{b}"),
+        _ => "–".into(),
+    }
+}
+
 /// The rows as GitHub-flavoured Markdown: a results table, a note when nothing was timed, then
 /// a per-pass table (median, p10–p90 per pass name) if any row has timed passes.
 pub fn to_markdown(rows: &[BenchRow]) -> String {
     let mut out = String::new();
-    out.push_str("| scene | technique | params | lights | size | adapter | median ms | p10 | p90 | RMSE | max abs | max rel | PSNR dB | FLIP | listed/exact | max/tile | overflow | NaN px | Inf px | lit px | reference |\n");
+    out.push_str("| scene | technique | params | lights | size | adapter | median ms | p10 | p90 | rounds min–max | SM MHz | RMSE | max abs | max rel | PSNR dB | FLIP | listed/exact | max/tile | overflow | NaN px | Inf px | lit px | reference |\n");
     out.push_str(
-        "|---|---|---|--:|--:|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|---|\n",
+        "|---|---|---|--:|--:|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|---|\n",
     );
     for r in rows {
         let t = r.frame_ms;
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {} | {}x{} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {}x{} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             md_cell(&r.scene),
             md_cell(&r.technique),
             md_cell(&r.params),
@@ -226,6 +258,8 @@ pub fn to_markdown(rows: &[BenchRow]) -> String {
             md_num(t.map(|t| t.median), 3),
             md_num(t.map(|t| t.p10), 3),
             md_num(t.map(|t| t.p90), 3),
+            round_spread(r),
+            sm_clocks(r),
             md_num(r.rmse, 5),
             md_num(r.max_abs, 4),
             md_num(r.max_rel, 4),
