@@ -2,7 +2,7 @@
 
 use super::{PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::{slot, ScheduledPass};
-use crate::render::draws::{depth_attachment, DrawMode, MeshDraws};
+use crate::render::draws::{depth_attachment, DrawMode, MeshDraws, MeshSet};
 use crate::render::RenderError;
 
 pub(super) struct DepthPrepass {
@@ -20,7 +20,7 @@ pub(super) fn prepare(
     let offered = cx.declared(sp)?;
     let draws =
         cx.renderer
-            .mesh_draws(cx.gpu, DrawMode::DepthOnly, sp.samples, &sp.name, &offered)?;
+            .mesh_draws(cx.gpu, DrawMode::DepthOnly, MeshSet::Opaque, sp.samples, &sp.name, &offered)?;
     Ok(DepthPrepass {
         name: sp.name.clone(),
         depth: cx.view(&sp.name, depth)?,

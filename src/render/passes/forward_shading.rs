@@ -3,7 +3,7 @@
 
 use super::{PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::{slot, ForwardShading, LightSource, ScheduledPass};
-use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws};
+use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws, MeshSet};
 use crate::render::RenderError;
 
 pub(super) struct ForwardShadingPass {
@@ -35,7 +35,7 @@ pub(super) fn prepare(
     };
     let draws = cx
         .renderer
-        .mesh_draws(cx.gpu, mode, sp.samples, &sp.name, &offered)?;
+        .mesh_draws(cx.gpu, mode, MeshSet::Opaque, sp.samples, &sp.name, &offered)?;
     Ok(ForwardShadingPass {
         name: sp.name.clone(),
         color: cx.view(&sp.name, color)?,

@@ -58,15 +58,24 @@ pub(super) fn prepare(
         &crate::gpu::structs::GpuListParams::new(&layout).buffer(&device),
     );
     offered.buffer("coarse_lists", &coarse_lists);
+    let mut d = vec![
+        ("TILE", format!("{}u", p.tile)),
+        ("CAPACITY", format!("{}u", p.capacity)),
+        ("VARIANT", format!("{}u", p.variant.code())),
+        ("COARSE", format!("{coarse}u")),
+        ("COARSE_CAPACITY", format!("{COARSE_CAPACITY}u")),
+        // Every sample of a multisampled depth bounds the tile.
+        ("SAMPLES", format!("{}u", sp.samples)),
+    ];
+    if sp.samples > 1 {
+        d.push(("MSAA", "1".into()));
+    }
+    if sp.roles.slot(slot::TRANSPARENT_DEPTH).is_some() {
+        d.push(("TRANSPARENT", "1".into()));
+    }
     let key = |state: &str| PipelineKey {
         shader: "cull/light_culling.wgsl".into(),
-        defines: defines(&[
-            ("TILE", format!("{}u", p.tile)),
-            ("CAPACITY", format!("{}u", p.capacity)),
-            ("VARIANT", format!("{}u", p.variant.code())),
-            ("COARSE", format!("{coarse}u")),
-            ("COARSE_CAPACITY", format!("{COARSE_CAPACITY}u")),
-        ]),
+        defines: defines(&d),
         virtual_code: BTreeMap::new(),
         state: state.to_string(),
     };

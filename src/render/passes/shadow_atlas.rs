@@ -8,7 +8,7 @@ use crate::graph::kinds::shadow_atlas::{
     atlas_side, view_table_bytes, ShadowAtlas, SHADOW_ATLAS, SHADOW_VIEWS, VIEW_VEC4S,
 };
 use crate::graph::{FrameSize, ResourceDesc, ScheduledPass};
-use crate::render::draws::{DrawMode, MeshDraws, ViewDraw};
+use crate::render::draws::{DrawMode, MeshDraws, MeshSet, ViewDraw};
 use crate::render::pipelines::{Pipeline, PipelineKey};
 use crate::render::report::{AtlasReport, PassReport};
 use crate::render::{RenderError, Renderer};
@@ -99,7 +99,7 @@ pub(super) fn prepare(
     };
     let draws = cx
         .renderer
-        .mesh_draws(cx.gpu, mode, 1, &sp.name, &offered)?;
+        .mesh_draws(cx.gpu, mode, MeshSet::Opaque, 1, &sp.name, &offered)?;
     let clear = tile_clear_pipeline(cx, &sp.name, format)?;
     let meshes = draws
         .meshes()
