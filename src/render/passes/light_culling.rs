@@ -22,6 +22,9 @@ pub(super) struct LightCullingPass {
     bind: wgpu::BindGroup,
     groups: [u32; 3],
     lists: wgpu::Buffer,
+    /// The header and list entries, copied out after culling: the report reads these,
+    /// since a later pass may reuse the lists' memory (aliasing) before it is read.
+    report_copy: wgpu::Buffer,
     layout: ListLayout,
 }
 
@@ -86,8 +89,15 @@ pub(super) fn prepare(
     } else {
         None
     };
+    let report_copy = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("light list entries (report)"),
+        size: 4 * layout.pool_offset_words() as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
     Ok(LightCullingPass {
         name: sp.name.clone(),
+        report_copy,
         coarse,
         pipeline,
         bind,
@@ -113,10 +123,12 @@ impl PreparedPass for LightCullingPass {
         pass.set_pipeline(&self.pipeline);
         let [x, y, z] = self.groups;
         pass.dispatch_workgroups(x, y, z);
+        drop(pass);
+        encoder.copy_buffer_to_buffer(&self.lists, 0, &self.report_copy, 0, self.report_copy.size());
     }
 
     fn report(&self, r: &Renderer) -> Result<Option<PassReport>, RenderError> {
-        let words = read_buffer(&r.ctx.device, &r.ctx.queue, &self.lists)?;
+        let words = read_buffer(&r.ctx.device, &r.ctx.queue, &self.report_copy)?;
         let words: &[u32] = bytemuck::cast_slice(&words);
         let counts = (0..self.layout.lists() as usize)
             .map(|l| {
