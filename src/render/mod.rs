@@ -24,6 +24,7 @@ pub use report::{
     AtlasReport, CullingReport, FrameResult, LightStats, PassReport, ShadowCompareReport,
     ShadowReport,
 };
+pub use device_limits::supported_sample_counts;
 pub use resources::FrameResources;
 pub use scene_gpu::{GpuBvh, GpuMesh, SceneGpu};
 

@@ -94,7 +94,7 @@ pub fn glass_scene() -> Scene {
             max: Vec3::new(8.0, 8.0, -2.0),
         },
         range: (1.5, 5.0),
-        intensity: (2.0, 8.0),
+        intensity: (4.0, 12.0),
         color: (Vec3::splat(0.3), Vec3::ONE),
         spot_cone_deg: (25.0, 45.0),
         seed: 1515,
@@ -117,6 +117,8 @@ pub fn glass_scene() -> Scene {
             far: 60.0,
         },
         output_size: Some((1280, 720)),
+        // A little ambient light shows the glass where no light reaches.
+        ambient: Vec3::splat(0.04),
         ..Default::default()
     }
 }
