@@ -46,8 +46,16 @@ fn samples_graph(text: &str, samples: u32, w: u32, h: u32) -> String {
 
 /// Sample counts of `counts` the adapter offers for both MSAA formats.
 fn offered(r: &lightgraph::render::Renderer, counts: &[u32]) -> Vec<u32> {
-    let depth = supported_sample_counts(wgpu::TextureFormat::Depth32Float, &r.ctx.adapter, &r.ctx.device);
-    let color = supported_sample_counts(wgpu::TextureFormat::Rgba32Float, &r.ctx.adapter, &r.ctx.device);
+    let depth = supported_sample_counts(
+        wgpu::TextureFormat::Depth32Float,
+        &r.ctx.adapter,
+        &r.ctx.device,
+    );
+    let color = supported_sample_counts(
+        wgpu::TextureFormat::Rgba32Float,
+        &r.ctx.adapter,
+        &r.ctx.device,
+    );
     counts
         .iter()
         .copied()
@@ -58,10 +66,25 @@ fn offered(r: &lightgraph::render::Renderer, counts: &[u32]) -> Vec<u32> {
 fn check_samples(scene: &Scene, culled: &str, brute: &str) {
     let mut r = renderer();
     let counts = offered(&r, &[4, 8]);
-    assert!(counts.contains(&4), "the adapter lacks 4× MSAA for Rgba32Float");
+    assert!(
+        counts.contains(&4),
+        "the adapter lacks 4× MSAA for Rgba32Float"
+    );
     for n in counts {
-        let reference = render_text(&mut r, &samples_graph(&graph_file(brute), n, W, H), scene, W, H);
-        let test = render_text(&mut r, &samples_graph(&graph_file(culled), n, W, H), scene, W, H);
+        let reference = render_text(
+            &mut r,
+            &samples_graph(&graph_file(brute), n, W, H),
+            scene,
+            W,
+            H,
+        );
+        let test = render_text(
+            &mut r,
+            &samples_graph(&graph_file(culled), n, W, H),
+            scene,
+            W,
+            H,
+        );
         assert_eq!(reference.image.len(), (n * W * H) as usize);
         let (err, at) = max_rel_diff(&test.image, &reference.image);
         let at = at as u32;
@@ -78,10 +101,24 @@ fn check_samples(scene: &Scene, culled: &str, brute: &str) {
             .chunks(n as usize)
             .filter(|s| s.iter().any(|x| x != &s[0]))
             .count();
-        assert!(edges > 20, "{culled} at {n}×: only {edges} pixels with differing samples");
-        let lit = reference.image.iter().filter(|p| p[0] + p[1] + p[2] > 0.0).count();
-        let lit_test = test.image.iter().filter(|p| p[0] + p[1] + p[2] > 0.0).count();
-        eprintln!("{} {culled} at {n}×: {lit} lit samples (culled {lit_test}), {edges} edge pixels", scene.name);
+        assert!(
+            edges > 20,
+            "{culled} at {n}×: only {edges} pixels with differing samples"
+        );
+        let lit = reference
+            .image
+            .iter()
+            .filter(|p| p[0] + p[1] + p[2] > 0.0)
+            .count();
+        let lit_test = test
+            .image
+            .iter()
+            .filter(|p| p[0] + p[1] + p[2] > 0.0)
+            .count();
+        eprintln!(
+            "{} {culled} at {n}×: {lit} lit samples (culled {lit_test}), {edges} edge pixels",
+            scene.name
+        );
         assert!(lit > 20, "{culled} at {n}×: only {lit} lit samples");
     }
 }
@@ -120,12 +157,7 @@ fn thin_bars_scene() -> Scene {
             1,
             false,
         ));
-        lights.push(Light::point(
-            Vec3::new(x, y, -z + 0.3),
-            0.6,
-            Vec3::ONE,
-            5.0,
-        ));
+        lights.push(Light::point(Vec3::new(x, y, -z + 0.3), 0.6, Vec3::ONE, 5.0));
     }
     Scene {
         name: "thin_bars".into(),
@@ -155,7 +187,11 @@ fn every_sample_equals_brute_force_msaa_on_sub_pixel_bars() {
 #[test]
 fn every_sample_equals_brute_force_msaa_with_transparency() {
     let glass = builtin::by_name("glass").unwrap();
-    check_samples(&glass, "transparent_msaa.ron", "transparent_msaa_brute_force.ron");
+    check_samples(
+        &glass,
+        "transparent_msaa.ron",
+        "transparent_msaa_brute_force.ron",
+    );
 }
 
 fn emissive(name: &str, rgb: Vec3) -> SurfaceMaterial {
@@ -171,9 +207,27 @@ fn emissive(name: &str, rgb: Vec3) -> SurfaceMaterial {
 /// weighted mean of a few flat colours, so edges are the only thing MSAA changes.
 fn flat_scene() -> Scene {
     let meshes = vec![
-        cuboid("a", Vec3::new(-3.0, -1.5, -9.0), Vec3::new(0.5, 1.0, -8.0), 0, false),
-        cuboid("b", Vec3::new(-0.7, -0.4, -6.0), Vec3::new(2.2, 2.0, -5.0), 1, false),
-        cuboid("c", Vec3::new(-2.0, -3.0, -12.0), Vec3::new(4.0, -1.0, -11.0), 2, false),
+        cuboid(
+            "a",
+            Vec3::new(-3.0, -1.5, -9.0),
+            Vec3::new(0.5, 1.0, -8.0),
+            0,
+            false,
+        ),
+        cuboid(
+            "b",
+            Vec3::new(-0.7, -0.4, -6.0),
+            Vec3::new(2.2, 2.0, -5.0),
+            1,
+            false,
+        ),
+        cuboid(
+            "c",
+            Vec3::new(-2.0, -3.0, -12.0),
+            Vec3::new(4.0, -1.0, -11.0),
+            2,
+            false,
+        ),
     ];
     Scene {
         name: "flat".into(),
@@ -208,7 +262,13 @@ fn resolved_edges_lie_between_their_neighbours() {
     let scene = flat_scene();
     let mut r = renderer();
     let resolved = render_file(&mut r, "msaa.ron", &scene, W, H);
-    let samples = render_text(&mut r, &samples_graph(&graph_file("msaa.ron"), 4, W, H), &scene, W, H);
+    let samples = render_text(
+        &mut r,
+        &samples_graph(&graph_file("msaa.ron"), 4, W, H),
+        &scene,
+        W,
+        H,
+    );
     let single = render_file(&mut r, "brute_force.ron", &scene, W, H);
     let fine = render_file(&mut r, "brute_force.ron", &scene, 2 * W, 2 * H);
     assert_eq!(resolved.image.len(), (W * H) as usize);
@@ -218,10 +278,16 @@ fn resolved_edges_lie_between_their_neighbours() {
     for y in 0..H {
         for x in 0..W {
             let p = at(&resolved.image, W, x, y);
-            let s: Vec<[f32; 4]> = (0..4).map(|k| at(&samples.image, 4 * W, 4 * x + k, y)).collect();
+            let s: Vec<[f32; 4]> = (0..4)
+                .map(|k| at(&samples.image, 4 * W, 4 * x + k, y))
+                .collect();
             for c in 0..3 {
                 let mean = s.iter().map(|v| v[c]).sum::<f32>() / 4.0;
-                assert!((p[c] - mean).abs() <= 1e-6, "({x}, {y}): resolve {} != mean {mean}", p[c]);
+                assert!(
+                    (p[c] - mean).abs() <= 1e-6,
+                    "({x}, {y}): resolve {} != mean {mean}",
+                    p[c]
+                );
             }
             let sub: Vec<[f32; 4]> = [(0, 0), (1, 0), (0, 1), (1, 1)]
                 .iter()
@@ -279,14 +345,22 @@ fn unsupported_sample_count_names_the_pass_and_the_adapters_counts() {
     let checked = graph::check_text(Path::new("msaa.ron"), &text, &ShaderLibrary::builtin())
         .expect("any power of two up to 16 validates without a device");
     let scene = random_scene(8, 1);
-    let size = FrameSize { width: 64, height: 36, lights: 8 };
+    let size = FrameSize {
+        width: 64,
+        height: 36,
+        lights: 8,
+    };
     let compiled = graph::compile(checked, &scene.features(), size);
     let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, &scene).unwrap();
     let e = match r.prepare(compiled, &scene, &gpu, size, false) {
         Ok(_) => panic!("{n}× prepared on an adapter without it"),
         Err(e) => e.to_string(),
     };
-    let counts = list.iter().map(u32::to_string).collect::<Vec<_>>().join(", ");
+    let counts = list
+        .iter()
+        .map(u32::to_string)
+        .collect::<Vec<_>>()
+        .join(", ");
     for want in [
         format!("pass '{pass}'"),
         format!("samples: {n} is not supported"),

@@ -109,7 +109,10 @@ fn opaque_lists_for_glass_differ_from_brute_force() {
     assert_ne!(wrong, graph_file("transparent.ron"));
     let culled = render_text(&mut r, &wrong, &scene, W, H);
     let (err, _) = max_rel_diff(&culled.image, &reference.image);
-    assert!(err > 1e-3, "shading glass from the opaque lists is not caught ({err:e})");
+    assert!(
+        err > 1e-3,
+        "shading glass from the opaque lists is not caught ({err:e})"
+    );
 }
 
 fn emissive_quad(name: &str, material: usize, z: f32, x0: f32) -> Mesh {
@@ -203,12 +206,19 @@ fn without_blended_meshes_the_transparency_passes_are_skipped() {
     skipped.sort();
     assert_eq!(
         skipped,
-        ["transparent_culling", "transparent_prepass", "transparent_shading"]
+        [
+            "transparent_culling",
+            "transparent_prepass",
+            "transparent_shading"
+        ]
     );
     assert_eq!(compiled.passes.len(), 3);
     let mut r = renderer();
     let plain = render_file(&mut r, "forward_plus.ron", &scene, W, H);
     let with = render_file(&mut r, "transparent.ron", &scene, W, H);
     assert_eq!(differing(&plain.image, &with.image), 0);
-    assert!(plain.image.iter().any(|p| p[0] > 0.0), "a dark frame tests nothing");
+    assert!(
+        plain.image.iter().any(|p| p[0] > 0.0),
+        "a dark frame tests nothing"
+    );
 }

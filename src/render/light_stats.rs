@@ -42,14 +42,12 @@ impl LightStatsPass {
             .passes
             .iter()
             .rposition(|p| matches!(p.kind, PassKind::ForwardShading(_)));
-        let shading = after
-            .map(|i| &graph.passes[i])
-            .ok_or_else(|| {
-                pass_error(
-                    PASS,
-                    "the graph has no ForwardShading pass to take statistics of".into(),
-                )
-            })?;
+        let shading = after.map(|i| &graph.passes[i]).ok_or_else(|| {
+            pass_error(
+                PASS,
+                "the graph has no ForwardShading pass to take statistics of".into(),
+            )
+        })?;
         let lists = shading.roles.slot(slot::LIGHT_LISTS);
         let mut d = BTreeMap::new();
         if lists.is_some() {

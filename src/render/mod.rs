@@ -16,6 +16,7 @@ mod scene_gpu;
 mod texture_fit;
 
 pub use bind::LayoutCache;
+pub use device_limits::supported_sample_counts;
 pub use frame::PreparedFrame;
 pub use materials::MaterialProgram;
 pub use pipelines::{CacheCounters, Pipeline, PipelineCache, PipelineKey};
@@ -24,7 +25,6 @@ pub use report::{
     AtlasReport, CullingReport, FrameResult, LightStats, PassReport, ShadowCompareReport,
     ShadowReport,
 };
-pub use device_limits::supported_sample_counts;
 pub use resources::FrameResources;
 pub use scene_gpu::{GpuBvh, GpuMesh, SceneGpu};
 

@@ -65,15 +65,45 @@ pub fn glass_scene() -> Scene {
     // (name, material, corner, u, v): u × v is the front face's normal.
     let quads = [
         // In front of everything, facing the camera.
-        ("glass/front", 3, Vec3::new(-2.5, 0.3, -4.0), Vec3::X * 3.5, Vec3::Y * 2.2),
+        (
+            "glass/front",
+            3,
+            Vec3::new(-2.5, 0.3, -4.0),
+            Vec3::X * 3.5,
+            Vec3::Y * 2.2,
+        ),
         // Between the boxes, seen from its back face (normal away from the camera).
-        ("glass/between", 4, Vec3::new(2.0, 0.0, -12.0), Vec3::Y * 3.0, Vec3::X * 4.0),
+        (
+            "glass/between",
+            4,
+            Vec3::new(2.0, 0.0, -12.0),
+            Vec3::Y * 3.0,
+            Vec3::X * 4.0,
+        ),
         // Behind the far box, in front of the wall: partly hidden by the box.
-        ("glass/behind", 5, Vec3::new(-1.0, 0.5, -24.0), Vec3::X * 7.0, Vec3::Y * 3.5),
+        (
+            "glass/behind",
+            5,
+            Vec3::new(-1.0, 0.5, -24.0),
+            Vec3::X * 7.0,
+            Vec3::Y * 3.5,
+        ),
         // High up against the empty sky: no opaque surface behind it.
-        ("glass/sky", 3, Vec3::new(-6.0, 5.5, -20.0), Vec3::X * 6.0, Vec3::Y * 3.0),
+        (
+            "glass/sky",
+            3,
+            Vec3::new(-6.0, 5.5, -20.0),
+            Vec3::X * 6.0,
+            Vec3::Y * 3.0,
+        ),
         // Overlapping the front quad from behind, at an angle.
-        ("glass/slant", 4, Vec3::new(-1.0, 0.0, -6.5), Vec3::new(3.0, 0.0, 1.5), Vec3::Y * 2.8),
+        (
+            "glass/slant",
+            4,
+            Vec3::new(-1.0, 0.0, -6.5),
+            Vec3::new(3.0, 0.0, 1.5),
+            Vec3::Y * 2.8,
+        ),
     ];
     let mut meshes = vec![
         floor.build(),

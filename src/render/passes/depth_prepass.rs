@@ -18,9 +18,14 @@ pub(super) fn prepare(
 ) -> Result<DepthPrepass, RenderError> {
     let depth = sp.required(slot::DEPTH);
     let offered = cx.declared(sp)?;
-    let draws =
-        cx.renderer
-            .mesh_draws(cx.gpu, DrawMode::DepthOnly, MeshSet::Opaque, sp.samples, &sp.name, &offered)?;
+    let draws = cx.renderer.mesh_draws(
+        cx.gpu,
+        DrawMode::DepthOnly,
+        MeshSet::Opaque,
+        sp.samples,
+        &sp.name,
+        &offered,
+    )?;
     Ok(DepthPrepass {
         name: sp.name.clone(),
         depth: cx.view(&sp.name, depth)?,

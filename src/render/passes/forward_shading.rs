@@ -33,9 +33,14 @@ pub(super) fn prepare(
         blend: false,
         shadows,
     };
-    let draws = cx
-        .renderer
-        .mesh_draws(cx.gpu, mode, MeshSet::Opaque, sp.samples, &sp.name, &offered)?;
+    let draws = cx.renderer.mesh_draws(
+        cx.gpu,
+        mode,
+        MeshSet::Opaque,
+        sp.samples,
+        &sp.name,
+        &offered,
+    )?;
     Ok(ForwardShadingPass {
         name: sp.name.clone(),
         color: cx.view(&sp.name, color)?,

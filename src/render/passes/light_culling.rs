@@ -124,7 +124,13 @@ impl PreparedPass for LightCullingPass {
         let [x, y, z] = self.groups;
         pass.dispatch_workgroups(x, y, z);
         drop(pass);
-        encoder.copy_buffer_to_buffer(&self.lists, 0, &self.report_copy, 0, self.report_copy.size());
+        encoder.copy_buffer_to_buffer(
+            &self.lists,
+            0,
+            &self.report_copy,
+            0,
+            self.report_copy.size(),
+        );
     }
 
     fn report(&self, r: &Renderer) -> Result<Option<PassReport>, RenderError> {
