@@ -77,7 +77,7 @@ pub(super) enum MeshSet {
     Transparent,
 }
 
-/// The meshes of a pass, sorted by material, and the pass's group-0 bind group.
+/// The meshes of a pass (opaque ones sorted by material) and the pass's group-0 bind group.
 pub(super) struct MeshDraws {
     bind: Option<wgpu::BindGroup>,
     draws: Vec<Draw>,
