@@ -8,18 +8,35 @@
 // light in every tile is what bounds culling at high light counts (memory traffic).
 // The coarse test is the same conservative test on a larger frustum and depth range,
 // so the tiles' lists are exactly those without it.
-// Defines: TILE (8 or 16), CAPACITY, VARIANT (see types.wgsl), COARSE, COARSE_CAPACITY.
+// MSAA: the depth is multisampled and every one of its SAMPLES samples bounds the tile.
+// TRANSPARENT: lists for transparent surfaces (seed 004). A sample where a transparent
+// surface lies in front of the opaque one contributes the range from the nearest
+// transparent depth to the opaque depth (the far plane over the background): every
+// visible transparent fragment lies in it. Samples without one contribute nothing.
+// Defines: TILE (8 or 16), CAPACITY, VARIANT (see types.wgsl), COARSE, COARSE_CAPACITY,
+// SAMPLES, MSAA, TRANSPARENT.
 
 #include "common/types.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
+#if MSAA
+@group(0) @binding(2) var depth: texture_depth_multisampled_2d;
+#else
 @group(0) @binding(2) var depth: texture_depth_2d;
+#endif
 @group(0) @binding(3) var<storage, read_write> light_lists: array<atomic<u32>>;
 @group(0) @binding(4) var<uniform> list_params: ListParams;
 // Per coarse tile: its light count, then up to COARSE_CAPACITY light indices ascending.
 // A count over the capacity sends its tiles back to testing every light.
 @group(0) @binding(5) var<storage, read_write> coarse_lists: array<u32>;
+#if TRANSPARENT
+#if MSAA
+@group(0) @binding(6) var transparent_depth: texture_depth_multisampled_2d;
+#else
+@group(0) @binding(6) var transparent_depth: texture_depth_2d;
+#endif
+#endif
 
 const THREADS: u32 = TILE * TILE;
 const MASK_WORDS: u32 = THREADS / 32u;
@@ -53,20 +70,49 @@ fn view_ray(pixel: vec2<f32>) -> vec3<f32> {
     return p.xyz / p.w;
 }
 
-// Folds a pixel's view depth into the workgroup's range; returns it, or -1 where the
-// pixel is outside the frame or holds no geometry.
-fn add_depth_sample(pixel: vec2<u32>) -> f32 {
+// The view-depth range sample `s` of a pixel adds to its tile (for a single-sample
+// depth, `s` is the mip level 0), or (-1, -1) where it holds nothing to light.
+fn sample_range(pixel: vec2<u32>, s: u32) -> vec2<f32> {
+    let none = vec2<f32>(-1.0);
     if (any(pixel >= frame.size)) {
-        return -1.0;
+        return none;
     }
-    let d = textureLoad(depth, pixel, 0);
+    let d = textureLoad(depth, pixel, s);
+#if TRANSPARENT
+    let t = textureLoad(transparent_depth, pixel, s);
+    // No transparent surface here, or every one is behind the opaque surface.
+    if (t >= 1.0 || t > d) {
+        return none;
+    }
+    return vec2<f32>(view_depth(t), view_depth(d));
+#else
     if (d >= 1.0) {
-        return -1.0;
+        return none;
     }
     let z = view_depth(d);
-    atomicMin(&z_min_bits, bitcast<u32>(z));
-    atomicMax(&z_max_bits, bitcast<u32>(z));
-    return z;
+    return vec2<f32>(z, z);
+#endif
+}
+
+// Folds every sample of a pixel into the workgroup's depth range.
+fn add_depth_sample(pixel: vec2<u32>) {
+    for (var s = 0u; s < SAMPLES; s++) {
+        let r = sample_range(pixel, s);
+        if (r.x >= 0.0) {
+            atomicMin(&z_min_bits, bitcast<u32>(r.x));
+            atomicMax(&z_max_bits, bitcast<u32>(r.y));
+        }
+    }
+}
+
+// The 2.5D mask's cells every sample of a pixel occupies within [lo, hi].
+fn add_depth_cells(pixel: vec2<u32>, lo: f32, hi: f32) {
+    for (var s = 0u; s < SAMPLES; s++) {
+        let r = sample_range(pixel, s);
+        if (r.x >= 0.0) {
+            atomicOr(&depth_mask, cells_between(cell_of(r.x, lo, hi), cell_of(r.y, lo, hi)));
+        }
+    }
 }
 
 // Depth cell of z in [lo, hi] for the 2.5D mask: 32 equal cells.
@@ -100,8 +146,9 @@ fn main(
     }
     workgroupBarrier();
 
-    // 1. The tile's depth range, over pixels that hold geometry.
-    let z = add_depth_sample(group.xy * TILE + lid.xy);
+    // 1. The tile's depth range, over the samples that hold geometry.
+    let pixel = group.xy * TILE + lid.xy;
+    add_depth_sample(pixel);
     workgroupBarrier();
     let tile_min = bitcast<f32>(atomicLoad(&z_min_bits));
     let tile_max = bitcast<f32>(atomicLoad(&z_max_bits));
@@ -121,8 +168,8 @@ fn main(
         if (group.z == 0u) { lo = tile_min; }
     }
     let empty = empty_tile || lo > hi;
-    if (VARIANT == VARIANT_DEPTH_MASK && z >= 0.0) {
-        atomicOr(&depth_mask, 1u << cell_of(z, tile_min, tile_max));
+    if (VARIANT == VARIANT_DEPTH_MASK && !empty_tile) {
+        add_depth_cells(pixel, tile_min, tile_max);
     }
 
     // 3. Side planes and bounding sphere of the tile's frustum slice.

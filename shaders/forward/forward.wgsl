@@ -1,6 +1,8 @@
-// Mesh draws of one material (src/render/draws.rs): the depth prepass (DEPTH_ONLY), the
-// G-buffer (GBUFFER, GBUFFER_PACKED), forward shading (SHADE, with LIGHT_LISTS for
-// culled lists) and a shadow atlas's views (DEPTH_ONLY with ATLAS_DEPTH). The material's generated code is included as <material>; ALPHA_MASK
+// Mesh draws of one material (src/render/draws.rs): the depth prepass and the
+// transparent one (DEPTH_ONLY), the G-buffer (GBUFFER, GBUFFER_PACKED), forward shading
+// of opaque and blended meshes (SHADE, with LIGHT_LISTS for culled lists; blended ones
+// return the material's alpha, blending is pipeline state), a shadow atlas's views
+// (DEPTH_ONLY with ATLAS_DEPTH); MSAA at more than one sample. The material's generated code is included as <material>; ALPHA_MASK
 // discards below the cutoff. Only SHADE binds lights: a pass binds what it declares.
 
 #include "common/types.wgsl"
@@ -58,6 +60,18 @@ struct VertexIn {
     @location(3) tangent: vec4<f32>,
 };
 
+#if MSAA
+// At the centroid of the covered samples, not the pixel centre (which may lie off the
+// triangle): the shaded point stays on the surface the samples hold, so the culled
+// lists, bounded by those samples' depths, cover it.
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) @interpolate(perspective, centroid) world: vec3<f32>,
+    @location(1) @interpolate(perspective, centroid) normal: vec3<f32>,
+    @location(2) @interpolate(perspective, centroid) uv: vec2<f32>,
+    @location(3) @interpolate(perspective, centroid) tangent: vec4<f32>,
+};
+#else
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
@@ -65,6 +79,7 @@ struct VertexOut {
     @location(2) uv: vec2<f32>,
     @location(3) tangent: vec4<f32>,
 };
+#endif
 
 @vertex
 fn vs_main(v: VertexIn, @builtin(instance_index) instance: u32) -> VertexOut {

@@ -8,7 +8,12 @@
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
 @group(0) @binding(2) var<storage, read> light_properties: array<LightProperties>;
+#if MSAA
+// Multisampled: each pixel's first sample (the level argument below is then the sample).
+@group(0) @binding(3) var depth: texture_depth_multisampled_2d;
+#else
 @group(0) @binding(3) var depth: texture_depth_2d;
+#endif
 @group(0) @binding(5) var<storage, read_write> counts: array<vec2<u32>>;
 @group(0) @binding(6) var<uniform> inv_view_proj: mat4x4<f32>;
 #if LIGHT_LISTS

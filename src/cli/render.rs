@@ -213,11 +213,16 @@ pub fn render(args: RenderArgs) -> Result<()> {
     );
     let gpu = SceneGpu::upload(&renderer.ctx.device, &renderer.ctx.queue, &scene)?;
     let stats = compiled.has_forward_shading();
+    let memory = (
+        graph::memory::by_technique(&compiled),
+        graph::memory::total_bytes(&compiled),
+    );
     let prepared = renderer.prepare(compiled, &scene, &gpu, size, stats)?;
     // The first frame builds pipelines and warms caches; report the second.
     prepared.execute(&renderer)?;
     let result = prepared.render(&renderer)?;
     report(&renderer, &scene, &graph_path, &result);
+    memory_report(&memory.0, memory.1);
     shadow_report(&scene, &gpu, &result);
     overflow_report(&result);
     match &args.out {
@@ -369,6 +374,41 @@ fn atlas_report(a: &lightgraph::render::AtlasReport) {
             a.pass,
             list.join(", "),
             if a.dropped.len() > 16 { ", ..." } else { "" }
+        );
+    }
+}
+
+/// What transparency and MSAA add to the frame's memory, resource by resource.
+fn memory_report(techniques: &[graph::memory::TechniqueMemory], total: u64) {
+    let mib = |b: u64| b as f64 / (1 << 20) as f64;
+    println!(
+        "  memory: {:.2} MiB of planned textures and buffers",
+        mib(total)
+    );
+    for t in techniques {
+        let items: Vec<String> = t
+            .items
+            .iter()
+            .map(|i| match &i.shares_with {
+                Some(other) => format!(
+                    "{} {:.2} MiB (shares {other}'s memory: +0)",
+                    i.resource,
+                    mib(i.bytes)
+                ),
+                None if i.added == i.bytes => format!("{} {:.2} MiB", i.resource, mib(i.bytes)),
+                None => format!(
+                    "{} {:.2} MiB (+{:.2} over 1 sample)",
+                    i.resource,
+                    mib(i.bytes),
+                    mib(i.added)
+                ),
+            })
+            .collect();
+        println!(
+            "  memory, {}: adds {:.2} MiB: {}",
+            t.technique,
+            mib(t.added()),
+            items.join(", ")
         );
     }
 }

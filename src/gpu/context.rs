@@ -51,10 +51,16 @@ impl GpuContext {
             })
             .await
             .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
-        let wanted =
+        let timestamps =
             wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        // MSAA of Rgba32Float targets and sample counts past 4 are the adapter's to
+        // grant (not guaranteed by WebGPU); blending transparent surfaces into them
+        // needs FLOAT32_BLENDABLE. Taken where offered; passes that need them say so.
+        let wanted = timestamps
+            | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
+            | wgpu::Features::FLOAT32_BLENDABLE;
         let features = adapter.features() & wanted;
-        let has_timestamps = features.contains(wanted);
+        let has_timestamps = features.contains(timestamps);
         let adapter_limits = adapter.limits();
         let limits = wgpu::Limits {
             max_storage_buffer_binding_size: adapter_limits.max_storage_buffer_binding_size,

@@ -8,6 +8,7 @@ mod error;
 mod fxmap;
 pub mod kinds;
 mod location;
+pub mod memory;
 pub mod model;
 mod name;
 mod order;

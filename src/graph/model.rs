@@ -6,6 +6,7 @@ pub use super::kinds::light_culling::LightCulling;
 pub use super::kinds::shadow_atlas::ShadowAtlas;
 pub use super::kinds::shadow_ray_cast::ShadowRayCast;
 pub use super::kinds::shadow_ray_jobs::ShadowRayJobs;
+pub use super::kinds::transparent_shading::TransparentShading;
 pub use super::name::Name;
 use serde::{Deserialize, Serialize};
 
@@ -282,6 +283,10 @@ pub enum PassKind {
     ShadowAtlas(ShadowAtlas),
     /// Counts (pixel, light) pairs where the atlas and ray-cast shadows disagree.
     ShadowCompare,
+    /// The nearest depth of blended meshes, for their own light lists.
+    TransparentDepth,
+    /// Blended meshes, back to front, lit two-sided over the opaque colour.
+    TransparentShading(TransparentShading),
     /// A compute shader the graph file names; bindings are matched by name.
     Compute {
         shader: String,
@@ -316,6 +321,8 @@ impl PassKind {
             PassKind::ShadowAtlas(_) => "ShadowAtlas",
             PassKind::ShadowCompare => "ShadowCompare",
             PassKind::ShadowRayCast(_) => "ShadowRayCast",
+            PassKind::TransparentDepth => "TransparentDepth",
+            PassKind::TransparentShading(_) => "TransparentShading",
             PassKind::Compute { .. } => "Compute",
             PassKind::Fullscreen { .. } => "Fullscreen",
         }

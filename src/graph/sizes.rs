@@ -25,15 +25,16 @@ pub const MAX_BUFFER_UNIT: u64 = 1 << 32;
 pub const MAX_WORKGROUPS_PER_DIMENSION: u32 = 65535;
 pub const MAX_INVOCATIONS_PER_WORKGROUP: u32 = 256;
 pub const MAX_WORKGROUP_SIZE: [u32; 3] = [256, 256, 64];
-/// Sample counts every wgpu device supports for the formats graphs use.
-pub const SAMPLE_COUNTS: [u32; 2] = [1, 4];
+/// Sample counts wgpu knows; which of them a format has on the adapter is checked at
+/// prepare (`render/device_limits.rs`).
+pub const SAMPLE_COUNTS: [u32; 5] = [1, 2, 4, 8, 16];
 
 pub fn check_resources(desc: &GraphDesc, source: &SourceText, errors: &mut Vec<GraphError>) {
     for r in &desc.resources {
         let problem = match r {
             ResourceDesc::Texture { size, samples, .. } => texture_problem(*size).or_else(|| {
                 (!SAMPLE_COUNTS.contains(samples))
-                    .then(|| format!("samples: {samples} is not supported (1 or 4)"))
+                    .then(|| format!("samples: {samples} is not supported (1, 2, 4, 8 or 16)"))
             }),
             ResourceDesc::Buffer { size, .. } => buffer_problem(*size),
             ResourceDesc::Import { .. } => None,

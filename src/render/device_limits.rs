@@ -45,6 +45,69 @@ pub fn check_plan(graph: &CompiledGraph, limits: &wgpu::Limits) -> Result<(), Re
     Ok(())
 }
 
+/// The sample counts the device offers for `format`: the adapter's own where the device
+/// has adapter-specific format features, else WebGPU's guaranteed ones.
+pub fn supported_sample_counts(
+    format: wgpu::TextureFormat,
+    adapter: &wgpu::Adapter,
+    device: &wgpu::Device,
+) -> Vec<u32> {
+    let features = device.features();
+    let flags = if features.contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES) {
+        adapter.get_texture_format_features(format).flags
+    } else {
+        format.guaranteed_format_features(features).flags
+    };
+    let mut counts = flags.supported_sample_counts();
+    if !counts.contains(&1) {
+        counts.insert(0, 1);
+    }
+    counts
+}
+
+/// Every multisampled texture against the sample counts the adapter offers for its
+/// format, naming the first pass that uses it and the counts it could have.
+pub fn check_samples(
+    graph: &CompiledGraph,
+    adapter: &wgpu::Adapter,
+    device: &wgpu::Device,
+) -> Result<(), RenderError> {
+    for r in &graph.plan.resources {
+        let PhysicalDesc::Texture {
+            format, samples, ..
+        } = graph.plan.physical[r.physical].desc
+        else {
+            continue;
+        };
+        if samples <= 1 {
+            continue;
+        }
+        let counts = supported_sample_counts(format.to_wgpu(), adapter, device);
+        if counts.contains(&samples) {
+            continue;
+        }
+        let pass = graph
+            .passes
+            .get(r.first)
+            .map_or_else(|| graph.output().to_string(), |p| p.name.to_string());
+        let list = counts
+            .iter()
+            .map(u32::to_string)
+            .collect::<Vec<_>>()
+            .join(", ");
+        return Err(RenderError::AtPass {
+            at: graph.checked.source.in_pass(&pass, &r.name),
+            pass,
+            problem: format!(
+                "resource '{}': samples: {samples} is not supported for {format:?} on this adapter ({}); it supports {list}",
+                r.name,
+                adapter.get_info().name
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// A compute dispatch's workgroup counts against the device's limit per dimension.
 pub fn check_dispatch(
     graph: &CompiledGraph,

@@ -67,7 +67,17 @@ struct Draw {
     index_count: u32,
 }
 
-/// Every opaque mesh of a pass, sorted by material, and the pass's group-0 bind group.
+/// Which of the scene's meshes a pass draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum MeshSet {
+    /// Opaque and alpha-masked meshes, sorted by material.
+    Opaque,
+    /// Blended meshes, in scene order (sorted by view depth when recorded), drawn
+    /// two-sided.
+    Transparent,
+}
+
+/// The meshes of a pass (opaque ones sorted by material) and the pass's group-0 bind group.
 pub(super) struct MeshDraws {
     bind: Option<wgpu::BindGroup>,
     draws: Vec<Draw>,
@@ -131,6 +141,7 @@ impl Renderer {
         &mut self,
         gpu: &SceneGpu,
         mode: DrawMode,
+        set: MeshSet,
         samples: u32,
         pass: &str,
         offered: &BindingSet,
@@ -146,7 +157,11 @@ impl Renderer {
             Vec<wgpu::BindGroupLayoutEntry>,
             Arc<[crate::shader::ReflectedBinding]>,
         )> = None;
-        for mesh in gpu.opaque_draws() {
+        let meshes = match set {
+            MeshSet::Opaque => gpu.opaque_draws(),
+            MeshSet::Transparent => gpu.transparent_draws(),
+        };
+        for mesh in meshes {
             let material_index = gpu.meshes[mesh].material;
             let m = &gpu.materials[material_index];
             let masked = matches!(m.alpha_mode, AlphaMode::Mask(_));
@@ -189,6 +204,11 @@ impl Renderer {
                 d.push(("ALPHA_MASK", "1".into()));
                 d.push(("ALPHA_CUTOFF", format!("{cutoff:?}")));
             }
+            // MSAA draws interpolate at the centroid: inside the triangle, so the shaded
+            // point lies within the depths culling saw (see forward.wgsl).
+            if samples > 1 {
+                d.push(("MSAA", "1".into()));
+            }
             // A prepass or G-buffer draw of an opaque, untextured material never calls the
             // material code: key it with a neutral material, so editing the material
             // rebuilds only the pipelines that shade with it.
@@ -203,14 +223,16 @@ impl Renderer {
                 defines: super::passes::defines(&d),
                 virtual_code: BTreeMap::from([("material".to_string(), code)]),
                 state: format!(
-                    "samples={samples} double_sided={} mode={mode:?}",
+                    "samples={samples} double_sided={} mode={mode:?} set={set:?}",
                     m.double_sided
                 ),
             };
             // Shadow views draw both faces (any surface occludes, as for a ray) and their
-            // triangles in spatial chunks.
+            // triangles in spatial chunks. Transparent surfaces show both faces (seed 004:
+            // shaded two-sided; the normal flips on back faces in `shading_point`).
             let shadow_view = matches!(mode, DrawMode::AtlasDepth { .. });
-            let cull_mode = (!m.double_sided && !shadow_view).then_some(wgpu::Face::Back);
+            let two_sided = m.double_sided || shadow_view || set == MeshSet::Transparent;
+            let cull_mode = (!two_sided).then_some(wgpu::Face::Back);
             let (pipeline, bindings) = self
                 .pipelines
                 .get_or_build_reflected(
@@ -454,12 +476,34 @@ impl MeshDraws {
 
     /// Draws every mesh into `pass`.
     pub fn record(&self, pass: &mut wgpu::RenderPass<'_>) {
+        self.record_in_order(pass, 0..self.draws.len());
+    }
+
+    /// The draws ordered back to front for `view` (farthest mesh centre first; ties
+    /// in scene order, so the same view always blends the same way).
+    pub fn back_to_front(&self, gpu: &SceneGpu, view: &glam::Mat4) -> Vec<usize> {
+        let depth: Vec<f32> = self
+            .draws
+            .iter()
+            .map(|d| gpu.view_depth(d.mesh, view))
+            .collect();
+        let mut order: Vec<usize> = (0..self.draws.len()).collect();
+        order.sort_by(|&a, &b| depth[b].total_cmp(&depth[a]).then(a.cmp(&b)));
+        order
+    }
+
+    /// Draws the meshes at `order` (indices into the draws) into `pass`, in that order.
+    pub fn record_in_order(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        order: impl IntoIterator<Item = usize>,
+    ) {
         if let Some(bind) = &self.bind {
             pass.set_bind_group(0, bind, &[]);
         }
         let mut current: Option<*const wgpu::RenderPipeline> = None;
-        for d in &self.draws {
-            // Draws are sorted by material: switch pipelines only when it changes.
+        for d in order.into_iter().map(|i| &self.draws[i]) {
+            // Opaque draws are sorted by material: switch pipelines only when it changes.
             d.switch_pipeline(pass, &mut current);
             d.bind_buffers(pass);
             pass.draw_indexed(0..d.index_count, 0, 0..1);

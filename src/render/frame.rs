@@ -114,6 +114,7 @@ impl Renderer {
     ) -> Result<PreparedFrame, RenderError> {
         let device = self.ctx.device.clone();
         super::device_limits::check_plan(&graph, &device.limits())?;
+        super::device_limits::check_samples(&graph, &self.ctx.adapter, &device)?;
         let resources = FrameResources::create_reusing(&device, &graph.plan, pool);
         let gpu_frame = GpuFrame::new(
             &scene.camera,
@@ -246,9 +247,9 @@ impl PreparedFrame {
         for (i, (_, pass)) in self.passes.iter().enumerate() {
             let ts = Timestamps(self.queries.as_ref().map(|(q, _)| (q, i as u32)));
             pass.record(&mut encoder, ts);
-        }
-        if let Some(stats) = &self.stats {
-            stats.record(&mut encoder);
+            if let Some(stats) = self.stats.as_ref().filter(|s| s.after == i) {
+                stats.record(&mut encoder);
+            }
         }
         if let Some((q, buf)) = &self.queries {
             encoder.resolve_query_set(q, 0..2 * self.passes.len() as u32, buf, 0);

@@ -21,6 +21,10 @@ pub(super) struct LightStatsPass {
     bind: wgpu::BindGroup,
     counts: wgpu::Buffer,
     groups: [u32; 3],
+    /// Schedule position of the shading pass it takes statistics of: it runs right
+    /// after it, while that pass's depth and lists still hold their contents (a later
+    /// pass may reuse their memory, as transparent light lists do).
+    pub after: usize,
 }
 
 impl LightStatsPass {
@@ -34,21 +38,24 @@ impl LightStatsPass {
         size: FrameSize,
     ) -> Result<Self, RenderError> {
         let device = r.ctx.device.clone();
-        let shading = graph
+        let after = graph
             .passes
             .iter()
-            .rev()
-            .find(|p| matches!(p.kind, PassKind::ForwardShading(_)))
-            .ok_or_else(|| {
-                pass_error(
-                    PASS,
-                    "the graph has no ForwardShading pass to take statistics of".into(),
-                )
-            })?;
+            .rposition(|p| matches!(p.kind, PassKind::ForwardShading(_)));
+        let shading = after.map(|i| &graph.passes[i]).ok_or_else(|| {
+            pass_error(
+                PASS,
+                "the graph has no ForwardShading pass to take statistics of".into(),
+            )
+        })?;
         let lists = shading.roles.slot(slot::LIGHT_LISTS);
         let mut d = BTreeMap::new();
         if lists.is_some() {
             d.insert("LIGHT_LISTS".to_string(), "1".to_string());
+        }
+        if shading.samples > 1 {
+            // A multisampled depth: statistics of each pixel's first sample.
+            d.insert("MSAA".to_string(), "1".to_string());
         }
         let key = PipelineKey {
             shader: "stats/light_stats.wgsl".into(),
@@ -125,6 +132,7 @@ impl LightStatsPass {
             bind,
             counts,
             groups: [size.width.div_ceil(8), size.height.div_ceil(8), 1],
+            after: after.unwrap_or_default(),
         })
     }
 

@@ -16,6 +16,7 @@ mod scene_gpu;
 mod texture_fit;
 
 pub use bind::LayoutCache;
+pub use device_limits::supported_sample_counts;
 pub use frame::PreparedFrame;
 pub use materials::MaterialProgram;
 pub use pipelines::{CacheCounters, Pipeline, PipelineCache, PipelineKey};

@@ -196,4 +196,19 @@ impl SceneGpu {
         draws.sort_by_key(|&i| self.meshes[i].material);
         draws
     }
+
+    /// Mesh indices of blended (glTF `alphaMode: BLEND`) geometry, in scene order: the
+    /// transparency passes draw these, sorted per frame by view depth.
+    pub fn transparent_draws(&self) -> Vec<usize> {
+        (0..self.meshes.len())
+            .filter(|&i| self.materials[self.meshes[i].material].alpha_mode == AlphaMode::Blend)
+            .collect()
+    }
+
+    /// Positive view-space depth of a mesh's bounds centre: the key transparent meshes are
+    /// sorted by, back to front.
+    pub fn view_depth(&self, mesh: usize, view: &glam::Mat4) -> f32 {
+        let [lo, hi] = self.meshes[mesh].bounds;
+        -view.transform_point3((lo + hi) * 0.5).z
+    }
 }

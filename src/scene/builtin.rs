@@ -7,7 +7,7 @@ use super::types::{Camera, Scene, SurfaceMaterial};
 use glam::{Quat, Vec2, Vec3};
 
 /// Names accepted by [`by_name`] (and by `builtin:` in a scene RON).
-pub const NAMES: &[&str] = &["atrium", "harada", "depth_discontinuity", "chairs"];
+pub const NAMES: &[&str] = &["atrium", "harada", "depth_discontinuity", "chairs", "glass"];
 
 /// A built-in scene by name.
 pub fn by_name(name: &str) -> Option<Scene> {
@@ -16,6 +16,7 @@ pub fn by_name(name: &str) -> Option<Scene> {
         "harada" => Some(harada()),
         "depth_discontinuity" => Some(depth_discontinuity()),
         "chairs" => Some(super::builtin_chairs::chairs()),
+        "glass" => Some(super::builtin_glass::glass_scene()),
         _ => None,
     }
 }

@@ -5,6 +5,7 @@
 
 pub mod builtin;
 pub mod builtin_chairs;
+pub mod builtin_glass;
 mod error;
 pub mod geometry;
 pub mod gltf_import;

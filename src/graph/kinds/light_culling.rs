@@ -1,5 +1,9 @@
 //! `LightCulling`: per-tile light lists from the prepass depth (Frustum, HalfZ,
 //! DepthMask, Clustered), with an optional coarse stage. Runs `shaders/cull/light_culling.wgsl`.
+//! A multisampled depth is read sample by sample. With a `transparent_depth` (a
+//! TransparentDepth pass's) the lists are for transparent surfaces: a tile spans, over
+//! its pixels that hold one, from the nearest transparent depth to the opaque depth
+//! behind it (seed 004).
 
 use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
@@ -51,14 +55,22 @@ pub const SLOTS: &[SlotSpec] = &[
         Access::Write,
         Usage::Bound,
     ),
+    SlotSpec::new(
+        slot::TRANSPARENT_DEPTH,
+        SlotType::DepthTexture,
+        Access::Read,
+        Usage::Sampled,
+    )
+    .optional(),
 ];
 
 pub fn check(p: &LightCulling, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
-    if let Some(depth) = ctx.slot(slot::DEPTH) {
-        if ctx.samples(depth) > 1 {
+    if let (Some(depth), Some(t)) = (ctx.slot(slot::DEPTH), ctx.slot(slot::TRANSPARENT_DEPTH)) {
+        let (ds, ts) = (ctx.samples(depth), ctx.samples(t));
+        if ds != ts {
             errors.push(ctx.mismatch(
-                depth,
-                "culling reads a single-sample depth texture; this one is multisampled",
+                t,
+                format!("transparent depth has {ts} sample(s) but depth '{depth}' has {ds}: culling compares them sample by sample"),
             ));
         }
     }
@@ -110,7 +122,7 @@ mod tests {
     }
 
     #[test]
-    fn lists_must_be_written_and_depth_single_sample() {
+    fn lists_must_be_written_and_depths_alike() {
         let e = errors(
             &format!(
                 r#"{PREPASS} Pass(name: "c", kind: LightCulling(tile: 16), reads: ["depth", "lg", "lists"])"#
@@ -121,10 +133,24 @@ mod tests {
             e.contains("LightCulling needs a buffer in writes (slot 'light_lists')"),
             "{e}"
         );
+        crate::graph::kinds::test_support::validate(
+            r#"Pass(name: "pre", kind: DepthPrepass, writes: ["depth4"]), Pass(name: "c", kind: LightCulling(tile: 16), reads: ["depth4", "lg"], writes: ["lists"]), Pass(name: "s", kind: ForwardShading(lights: Culled), reads: ["depth4", "lg", "lp", "lists"], writes: ["hdr4"])"#,
+            "hdr",
+        )
+        .map_err(|e| e.to_string())
+        .or_else(|e| {
+            // The graph's output is never written; the MSAA culling itself must pass.
+            assert!(!e.contains("pass 'c'"), "{e}");
+            Ok::<(), String>(())
+        })
+        .unwrap();
         let e = errors(
-            r#"Pass(name: "pre", kind: DepthPrepass, writes: ["depth4"]), Pass(name: "c", kind: LightCulling(tile: 16), reads: ["depth4", "lg"], writes: ["lists"])"#,
+            r#"Pass(name: "pre", kind: DepthPrepass, writes: ["depth4"]), Pass(name: "tp", kind: TransparentDepth, writes: ["depth"]), Pass(name: "c", kind: LightCulling(tile: 16), reads: ["depth4", "transparent_depth=depth", "lg"], writes: ["lists"])"#,
             "hdr",
         );
-        assert!(e.contains("single-sample depth"), "{e}");
+        assert!(
+            e.contains("transparent depth has 1 sample(s) but depth 'depth4' has 4"),
+            "{e}"
+        );
     }
 }

@@ -12,6 +12,8 @@ pub mod shadow_atlas;
 pub mod shadow_compare;
 pub mod shadow_ray_cast;
 pub mod shadow_ray_jobs;
+pub mod transparent_depth;
+pub mod transparent_shading;
 
 use super::error::GraphError;
 use super::model::{Name, PassDesc, PassKind, ResourceDesc, SceneResource};
@@ -27,6 +29,8 @@ pub mod slot {
     pub const LIGHT_GEOMETRY: &str = "light_geometry";
     pub const LIGHT_PROPERTIES: &str = "light_properties";
     pub const LIGHT_LISTS: &str = "light_lists";
+    /// The nearest transparent depth a culling pass bounds its tiles with.
+    pub const TRANSPARENT_DEPTH: &str = "transparent_depth";
 }
 
 /// What a slot takes.
@@ -185,6 +189,8 @@ pub fn slots(kind: &PassKind) -> Option<&'static [SlotSpec]> {
         PassKind::ShadowRayCast(_) => shadow_ray_cast::SLOTS,
         PassKind::ShadowAtlas(_) => shadow_atlas::SLOTS,
         PassKind::ShadowCompare => shadow_compare::SLOTS,
+        PassKind::TransparentDepth => transparent_depth::SLOTS,
+        PassKind::TransparentShading(_) => transparent_shading::SLOTS,
         PassKind::Compute { .. } | PassKind::Fullscreen { .. } => return None,
     })
 }
@@ -201,6 +207,8 @@ fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         PassKind::ShadowRayCast(p) => shadow_ray_cast::check(p, ctx, errors),
         PassKind::ShadowAtlas(p) => shadow_atlas::check(p, ctx, errors),
         PassKind::ShadowCompare => shadow_compare::check(ctx, errors),
+        PassKind::TransparentDepth => transparent_depth::check(ctx, errors),
+        PassKind::TransparentShading(p) => transparent_shading::check(p, ctx, errors),
         PassKind::Compute { .. } | PassKind::Fullscreen { .. } => {}
     }
 }

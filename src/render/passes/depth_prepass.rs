@@ -3,7 +3,7 @@
 use super::{PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::Name;
 use crate::graph::{slot, ScheduledPass};
-use crate::render::draws::{depth_attachment, DrawMode, MeshDraws};
+use crate::render::draws::{depth_attachment, DrawMode, MeshDraws, MeshSet};
 use crate::render::RenderError;
 
 pub(super) struct DepthPrepass {
@@ -19,9 +19,14 @@ pub(super) fn prepare(
 ) -> Result<DepthPrepass, RenderError> {
     let depth = sp.required(slot::DEPTH);
     let offered = cx.declared(sp)?;
-    let draws =
-        cx.renderer
-            .mesh_draws(cx.gpu, DrawMode::DepthOnly, sp.samples, &sp.name, &offered)?;
+    let draws = cx.renderer.mesh_draws(
+        cx.gpu,
+        DrawMode::DepthOnly,
+        MeshSet::Opaque,
+        sp.samples,
+        &sp.name,
+        &offered,
+    )?;
     Ok(DepthPrepass {
         name: sp.name.clone(),
         depth: cx.view(&sp.name, depth)?,

@@ -4,7 +4,7 @@
 use super::{PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::Name;
 use crate::graph::{slot, ForwardShading, LightSource, ScheduledPass};
-use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws};
+use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws, MeshSet};
 use crate::render::RenderError;
 
 pub(super) struct ForwardShadingPass {
@@ -34,9 +34,14 @@ pub(super) fn prepare(
         blend: false,
         shadows,
     };
-    let draws = cx
-        .renderer
-        .mesh_draws(cx.gpu, mode, sp.samples, &sp.name, &offered)?;
+    let draws = cx.renderer.mesh_draws(
+        cx.gpu,
+        mode,
+        MeshSet::Opaque,
+        sp.samples,
+        &sp.name,
+        &offered,
+    )?;
     Ok(ForwardShadingPass {
         name: sp.name.clone(),
         color: cx.view(&sp.name, color)?,

@@ -6,7 +6,7 @@ use super::{PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::g_buffer::{self as kind, G_GEOMETRIC, G_NORMAL, G_POSITION};
 use crate::graph::Name;
 use crate::graph::{slot, ScheduledPass};
-use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws};
+use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws, MeshSet};
 use crate::render::RenderError;
 
 pub(super) struct GBuffer {
@@ -36,7 +36,7 @@ pub(super) fn prepare(cx: &mut PrepareCtx, sp: &ScheduledPass) -> Result<GBuffer
     };
     let draws = cx
         .renderer
-        .mesh_draws(cx.gpu, mode, 1, &sp.name, &offered)?;
+        .mesh_draws(cx.gpu, mode, MeshSet::Opaque, 1, &sp.name, &offered)?;
     let mut targets = vec![cx.view(&sp.name, sp.required(G_POSITION))?];
     for slot in [G_NORMAL, G_GEOMETRIC] {
         if let Some(name) = sp.roles.slot(slot) {

@@ -23,6 +23,9 @@ pub(super) struct LightCullingPass {
     bind: wgpu::BindGroup,
     groups: [u32; 3],
     lists: wgpu::Buffer,
+    /// The header and list entries, copied out after culling: the report reads these,
+    /// since a later pass may reuse the lists' memory (aliasing) before it is read.
+    report_copy: wgpu::Buffer,
     layout: ListLayout,
 }
 
@@ -59,15 +62,24 @@ pub(super) fn prepare(
         &crate::gpu::structs::GpuListParams::new(&layout).buffer(&device),
     );
     offered.buffer("coarse_lists", &coarse_lists);
+    let mut d = vec![
+        ("TILE", format!("{}u", p.tile)),
+        ("CAPACITY", format!("{}u", p.capacity)),
+        ("VARIANT", format!("{}u", p.variant.code())),
+        ("COARSE", format!("{coarse}u")),
+        ("COARSE_CAPACITY", format!("{COARSE_CAPACITY}u")),
+        // Every sample of a multisampled depth bounds the tile.
+        ("SAMPLES", format!("{}u", sp.samples)),
+    ];
+    if sp.samples > 1 {
+        d.push(("MSAA", "1".into()));
+    }
+    if sp.roles.slot(slot::TRANSPARENT_DEPTH).is_some() {
+        d.push(("TRANSPARENT", "1".into()));
+    }
     let key = |state: &str| PipelineKey {
         shader: "cull/light_culling.wgsl".into(),
-        defines: defines(&[
-            ("TILE", format!("{}u", p.tile)),
-            ("CAPACITY", format!("{}u", p.capacity)),
-            ("VARIANT", format!("{}u", p.variant.code())),
-            ("COARSE", format!("{coarse}u")),
-            ("COARSE_CAPACITY", format!("{COARSE_CAPACITY}u")),
-        ]),
+        defines: defines(&d),
         virtual_code: BTreeMap::new(),
         state: state.to_string(),
     };
@@ -78,8 +90,15 @@ pub(super) fn prepare(
     } else {
         None
     };
+    let report_copy = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("light list entries (report)"),
+        size: 4 * layout.pool_offset_words() as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
     Ok(LightCullingPass {
         name: sp.name.clone(),
+        report_copy,
         coarse,
         pipeline,
         bind,
@@ -105,10 +124,18 @@ impl PreparedPass for LightCullingPass {
         pass.set_pipeline(&self.pipeline);
         let [x, y, z] = self.groups;
         pass.dispatch_workgroups(x, y, z);
+        drop(pass);
+        encoder.copy_buffer_to_buffer(
+            &self.lists,
+            0,
+            &self.report_copy,
+            0,
+            self.report_copy.size(),
+        );
     }
 
     fn report(&self, r: &Renderer) -> Result<Option<PassReport>, RenderError> {
-        let words = read_buffer(&r.ctx.device, &r.ctx.queue, &self.lists)?;
+        let words = read_buffer(&r.ctx.device, &r.ctx.queue, &self.report_copy)?;
         let words: &[u32] = bytemuck::cast_slice(&words);
         let counts = (0..self.layout.lists() as usize)
             .map(|l| {

@@ -13,6 +13,8 @@ mod shadow_atlas;
 mod shadow_compare;
 mod shadow_ray_cast;
 mod shadow_ray_jobs;
+mod transparent_depth;
+mod transparent_shading;
 
 use super::bind::{BindingSet, Bound};
 use super::pipelines::{Pipeline, PipelineKey};
@@ -54,6 +56,8 @@ pub(super) fn prepare(
         PassKind::ShadowRayCast(p) => Box::new(shadow_ray_cast::prepare(cx, sp, p)?),
         PassKind::ShadowAtlas(p) => Box::new(shadow_atlas::prepare(cx, sp, p)?),
         PassKind::ShadowCompare => Box::new(shadow_compare::prepare(cx, sp)?),
+        PassKind::TransparentDepth => Box::new(transparent_depth::prepare(cx, sp)?),
+        PassKind::TransparentShading(p) => Box::new(transparent_shading::prepare(cx, sp, p)?),
         PassKind::Compute {
             shader,
             entry,

@@ -9,7 +9,7 @@ use crate::graph::kinds::shadow_atlas::{
 };
 use crate::graph::Name;
 use crate::graph::{FrameSize, ResourceDesc, ScheduledPass};
-use crate::render::draws::{DrawMode, MeshDraws, ViewDraw};
+use crate::render::draws::{DrawMode, MeshDraws, MeshSet, ViewDraw};
 use crate::render::pipelines::{Pipeline, PipelineKey};
 use crate::render::report::{AtlasReport, PassReport};
 use crate::render::{RenderError, Renderer};
@@ -100,7 +100,7 @@ pub(super) fn prepare(
     };
     let draws = cx
         .renderer
-        .mesh_draws(cx.gpu, mode, 1, &sp.name, &offered)?;
+        .mesh_draws(cx.gpu, mode, MeshSet::Opaque, 1, &sp.name, &offered)?;
     let clear = tile_clear_pipeline(cx, &sp.name, format)?;
     let meshes = draws
         .meshes()

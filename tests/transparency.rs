@@ -1,0 +1,224 @@
+//! Transparency with its own light lists (graphs/transparent.ron): the culled image must
+//! equal the brute-force graph with the same blending order (graphs/
+//! transparent_brute_force.ron) on the built-in glass scene (quads in front of, between
+//! and behind opaque boxes, one against the sky, lights among them), for every culling
+//! variant; blended meshes are drawn back to front; without blended meshes the
+//! transparency passes are skipped and the image is exactly Forward+'s.
+//!
+//! Tolerance: 2e-6 relative (as tests/culling_exact.rs). A culled light contributes
+//! exactly zero and lists keep ascending light order, so both graphs sum the same
+//! non-zero terms in the same order, and blending happens in the same order on the same
+//! fixed-function hardware; the only slack is the shader compiler contracting a
+//! multiply-add differently in the list loop and the all-lights loop (one f32 rounding,
+//! 6e-8, per term over a few dozen terms per pixel and two blended layers).
+
+mod common;
+use common::*;
+use glam::{Vec2, Vec3, Vec4};
+use lightgraph::graph::{self, CullReason, FrameSize};
+use lightgraph::scene::builtin;
+use lightgraph::scene::{AlphaMode, Camera, Mesh, Scene, SurfaceMaterial};
+use lightgraph::shader::ShaderLibrary;
+use std::path::Path;
+
+const W: u32 = 160;
+const H: u32 = 90;
+const TOL: f32 = 2e-6;
+
+fn graph_file(name: &str) -> String {
+    std::fs::read_to_string(graph_path(name)).unwrap()
+}
+
+fn glass() -> Scene {
+    builtin::by_name("glass").expect("the built-in glass scene")
+}
+
+/// Pixels that differ between two images of one size.
+fn differing(a: &[[f32; 4]], b: &[[f32; 4]]) -> usize {
+    assert_eq!(a.len(), b.len(), "images of different sizes");
+    a.iter().zip(b).filter(|(x, y)| x != y).count()
+}
+
+#[test]
+fn culled_transparency_equals_brute_force_for_every_variant() {
+    let scene = glass();
+    assert!(scene.features().has_transparent);
+    let mut r = renderer();
+    let reference = render_file(&mut r, "transparent_brute_force.ron", &scene, W, H);
+    assert_eq!(reference.image.len(), (W * H) as usize);
+    // The glass must show: against the opaque-only frame (blended meshes skipped) it
+    // changes a large share of the pixels.
+    let opaque = render_file(&mut r, "forward_plus.ron", &scene, W, H);
+    let changed = differing(&reference.image, &opaque.image);
+    assert!(
+        changed > (W * H / 10) as usize,
+        "only {changed} pixels show glass: the scene tests nothing"
+    );
+    let text = graph_file("transparent.ron");
+    let default = "LightCulling(tile: 16, variant: Frustum, capacity: 256)";
+    assert_eq!(text.matches(default).count(), 2);
+    for (tile, variant) in [
+        (16, "Frustum"),
+        (8, "Frustum"),
+        (16, "HalfZ"),
+        (16, "DepthMask"),
+        (16, "Clustered(slices: 16)"),
+    ] {
+        let g = text.replace(
+            default,
+            &format!("LightCulling(tile: {tile}, variant: {variant}, capacity: 256)"),
+        );
+        let culled = render_text(&mut r, &g, &scene, W, H);
+        let (err, at) = max_rel_diff(&culled.image, &reference.image);
+        assert!(
+            err <= TOL,
+            "tile {tile} {variant}: error {err:e} at pixel ({}, {}) (culled {:?}, reference {:?})",
+            at as u32 % W,
+            at as u32 / W,
+            culled.image[at],
+            reference.image[at]
+        );
+        // The transparent lists are culled, not every light.
+        let t = culled
+            .culling
+            .iter()
+            .find(|c| c.pass == "transparent_culling")
+            .expect("a report of the transparent culling pass");
+        let per_tile = t.per_tile();
+        let listed: u32 = per_tile.iter().sum();
+        assert!(
+            (listed as usize) < per_tile.len() * scene.lights.len() / 4,
+            "{variant}: transparent lists hold {listed} lights over {} tiles",
+            per_tile.len()
+        );
+        assert!(listed > 0, "{variant}: transparent lists are empty");
+    }
+}
+
+/// The opaque lists are not enough for glass: shading it from them must be caught by the
+/// comparison above (this is the failure the transparent lists exist to prevent).
+#[test]
+fn opaque_lists_for_glass_differ_from_brute_force() {
+    let scene = glass();
+    let mut r = renderer();
+    let reference = render_file(&mut r, "transparent_brute_force.ron", &scene, W, H);
+    let wrong = graph_file("transparent.ron").replace(
+        r#""light_properties", "transparent_lists", "hdr"]"#,
+        r#""light_properties", "light_lists", "hdr"]"#,
+    );
+    assert_ne!(wrong, graph_file("transparent.ron"));
+    let culled = render_text(&mut r, &wrong, &scene, W, H);
+    let (err, _) = max_rel_diff(&culled.image, &reference.image);
+    assert!(
+        err > 1e-3,
+        "shading glass from the opaque lists is not caught ({err:e})"
+    );
+}
+
+fn emissive_quad(name: &str, material: usize, z: f32, x0: f32) -> Mesh {
+    let mut m = Mesh {
+        name: name.into(),
+        material,
+        ..Default::default()
+    };
+    for (a, b) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
+        m.positions.push(Vec3::new(x0 + 2.0 * a, -1.0 + 2.0 * b, z));
+        m.normals.push(Vec3::Z);
+        m.uvs.push(Vec2::new(a, b));
+        m.tangents.push(Vec4::new(1.0, 0.0, 0.0, 1.0));
+    }
+    m.indices = vec![0, 1, 2, 0, 2, 3];
+    m
+}
+
+fn emissive_glass(name: &str, rgb: Vec3) -> SurfaceMaterial {
+    SurfaceMaterial {
+        name: name.into(),
+        base_color: Vec4::new(0.0, 0.0, 0.0, 0.5),
+        emissive: rgb,
+        alpha_mode: AlphaMode::Blend,
+        ..Default::default()
+    }
+}
+
+/// Two half-transparent emissive quads that overlap, the near one first in the scene:
+/// back to front, the overlap is near × ½ + far × ¼; the scene's order would give the
+/// reverse weights.
+#[test]
+fn blended_back_to_front_whatever_the_scene_order() {
+    let scene = Scene {
+        name: "two_panes".into(),
+        meshes: vec![
+            emissive_quad("near_red", 0, -3.0, -1.5),
+            emissive_quad("far_blue", 1, -5.0, -0.5),
+        ],
+        materials: vec![
+            emissive_glass("red", Vec3::new(1.0, 0.0, 0.0)),
+            emissive_glass("blue", Vec3::new(0.0, 0.0, 1.0)),
+        ],
+        camera: Camera {
+            eye: Vec3::ZERO,
+            target: Vec3::new(0.0, 0.0, -1.0),
+            up: Vec3::Y,
+            fov_y: 60f32.to_radians(),
+            near: 0.1,
+            far: 50.0,
+        },
+        ..Default::default()
+    };
+    let mut r = renderer();
+    for graph in ["transparent_brute_force.ron", "transparent.ron"] {
+        let f = render_file(&mut r, graph, &scene, 64, 64);
+        // The frame's centre sees both quads (near x in [-1.5, 0.5], far in [-0.5, 1.5]).
+        let p = f.image[(32 * 64 + 32) as usize];
+        let want = [0.5, 0.0, 0.25];
+        for c in 0..3 {
+            assert!(
+                (p[c] - want[c]).abs() < 1e-5,
+                "{graph}: overlap {p:?}, want {want:?} (near over far)"
+            );
+        }
+    }
+}
+
+#[test]
+fn without_blended_meshes_the_transparency_passes_are_skipped() {
+    let scene = random_scene(24, 15);
+    assert!(!scene.features().has_transparent);
+    let checked = graph::check_text(
+        Path::new("transparent.ron"),
+        &graph_file("transparent.ron"),
+        &ShaderLibrary::builtin(),
+    )
+    .unwrap();
+    let size = FrameSize {
+        width: W,
+        height: H,
+        lights: scene.lights.len() as u32,
+    };
+    let compiled = graph::compile(checked, &scene.features(), size);
+    let mut skipped: Vec<&str> = compiled
+        .culled
+        .iter()
+        .filter(|c| matches!(&c.reason, CullReason::WhenFalse(f) if f == "Transparent"))
+        .map(|c| c.name.as_str())
+        .collect();
+    skipped.sort();
+    assert_eq!(
+        skipped,
+        [
+            "transparent_culling",
+            "transparent_prepass",
+            "transparent_shading"
+        ]
+    );
+    assert_eq!(compiled.passes.len(), 3);
+    let mut r = renderer();
+    let plain = render_file(&mut r, "forward_plus.ron", &scene, W, H);
+    let with = render_file(&mut r, "transparent.ron", &scene, W, H);
+    assert_eq!(differing(&plain.image, &with.image), 0);
+    assert!(
+        plain.image.iter().any(|p| p[0] > 0.0),
+        "a dark frame tests nothing"
+    );
+}
