@@ -17,6 +17,10 @@
 @group(0) @binding(3) var<storage, read> light_lists: array<u32>;
 @group(0) @binding(4) var<uniform> list_params: ListParams;
 #endif
+#if LINKED_LISTS
+@group(0) @binding(3) var<storage, read> light_lists: array<u32>;
+@group(0) @binding(4) var<uniform> link_params: LinkParams;
+#endif
 @group(0) @binding(5) var g_position: texture_2d<f32>;
 #if G_PACKED
 #include "common/octahedral.wgsl"

@@ -14,6 +14,10 @@
 @group(0) @binding(3) var<storage, read> light_lists: array<u32>;
 @group(0) @binding(4) var<uniform> list_params: ListParams;
 #endif
+#if LINKED_LISTS
+@group(0) @binding(3) var<storage, read> light_lists: array<u32>;
+@group(0) @binding(4) var<uniform> link_params: LinkParams;
+#endif
 
 #include "common/light_lists.wgsl"
 #if SHADOW_MASK

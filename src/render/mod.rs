@@ -21,7 +21,8 @@ pub use materials::MaterialProgram;
 pub use pipelines::{CacheCounters, Pipeline, PipelineCache, PipelineKey};
 pub use prepare_stats::PrepareStats;
 pub use report::{
-    AtlasReport, CullingReport, FrameResult, LightStats, PassReport, ShadowCompareReport,
+    AtlasReport, CullingReport, FrameResult, LightStats, LinkReport, PassReport,
+    ShadowCompareReport,
     ShadowReport,
 };
 pub use resources::FrameResources;

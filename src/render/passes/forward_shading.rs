@@ -2,7 +2,7 @@
 //! the prepass depth (tested, not written).
 
 use super::{PrepareCtx, PreparedPass, Timestamps};
-use crate::graph::{slot, ForwardShading, LightSource, ScheduledPass};
+use crate::graph::{slot, ForwardShading, ScheduledPass};
 use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws};
 use crate::render::RenderError;
 
@@ -22,14 +22,10 @@ pub(super) fn prepare(
     let color = sp.required(slot::COLOR);
     let depth = sp.required(slot::DEPTH);
     let mut offered = cx.declared(sp)?;
-    let culled = p.lights == LightSource::Culled;
-    if culled {
-        let params = cx.list_params(&sp.name, sp.required(slot::LIGHT_LISTS))?;
-        offered.buffer("list_params", &params);
-    }
+    let lists = cx.shading_lists(sp, p.lights, &mut offered)?;
     let shadows = cx.shading_shadows(sp, &mut offered);
     let mode = DrawMode::Shade {
-        culled,
+        lists,
         blend: false,
         shadows,
     };
