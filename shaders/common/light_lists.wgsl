@@ -1,8 +1,9 @@
 // The light loop's building block: which lights to visit for a pixel. Tile-list readers
 // call `light_range` once, then `light_at` for k in 0..count, the same for every
 // culling variant (and for all lights when LIGHT_LISTS is off). The light loop walks a
-// cursor instead (`light_first`, `light_valid`, `light_next`, `light_index`), which
-// also walks a light linked list (LINKED_LISTS), whose links are visited in order.
+// cursor instead (`light_first`, `light_valid`, `light_next`, then `light_in_span` and
+// `light_index`), which also walks a light linked list (LINKED_LISTS) in link order,
+// skipping links whose depth span misses the surface.
 
 struct LightRange {
     offset: u32,
@@ -10,43 +11,37 @@ struct LightRange {
 };
 
 #if LINKED_LISTS
+// A link of the pixel's list (LINK_END past the last), and how many links may follow:
+// the longest list the build wrote (header word 3) bounds every walk, so a lane that
+// reads no list (llvmpipe's helper lanes, a corrupted pool) cannot spin.
 struct LightCursor {
     link: u32,
-    light: u32,
+    left: u32,
 };
 
-// The first link from `link` on whose depth span `view_z` lies (LINK_END if none).
-fn link_from(link: u32, view_z: f32) -> LightCursor {
-    var l = link;
-    loop {
-        if (l == LINK_END) {
-            return LightCursor(LINK_END, 0u);
-        }
-        let w = link_params.pool_offset + LINK_WORDS * l;
-        let span = unpack2x16float(light_lists[w]);
-        if (view_z >= span.x && view_z <= span.y) {
-            return LightCursor(l, light_lists[w + 1u]);
-        }
-        l = light_lists[w + 2u];
-    }
-}
-
-// `pixel` in framebuffer coordinates, `view_z` the positive view-space depth.
+// `pixel` in framebuffer coordinates.
 fn light_first(pixel: vec2<f32>, view_z: f32) -> LightCursor {
     let p = min(vec2<u32>(pixel) / link_params.scale, vec2<u32>(link_params.width, link_params.height) - 1u);
-    return link_from(light_lists[LINK_HEADER_WORDS + p.y * link_params.width + p.x], view_z);
+    return LightCursor(light_lists[LINK_HEADER_WORDS + p.y * link_params.width + p.x], light_lists[3]);
 }
 
 fn light_valid(c: LightCursor) -> bool {
-    return c.link != LINK_END;
+    return c.link != LINK_END && c.left > 0u;
 }
 
-fn light_next(c: LightCursor, view_z: f32) -> LightCursor {
-    return link_from(light_lists[link_params.pool_offset + LINK_WORDS * c.link + 2u], view_z);
+// One load, no loop: the advance runs in loops' continuing blocks.
+fn light_next(c: LightCursor) -> LightCursor {
+    return LightCursor(light_lists[link_params.pool_offset + LINK_WORDS * c.link + 2u], c.left - 1u);
+}
+
+// Whether `view_z` (positive view depth) lies in the link's light span.
+fn light_in_span(c: LightCursor, view_z: f32) -> bool {
+    let span = unpack2x16float(light_lists[link_params.pool_offset + LINK_WORDS * c.link]);
+    return view_z >= span.x && view_z <= span.y;
 }
 
 fn light_index(c: LightCursor) -> u32 {
-    return c.light;
+    return light_lists[link_params.pool_offset + LINK_WORDS * c.link + 1u];
 }
 #else
 #if LIGHT_LISTS
@@ -103,8 +98,13 @@ fn light_valid(c: LightCursor) -> bool {
     return c.k < c.range.count;
 }
 
-fn light_next(c: LightCursor, view_z: f32) -> LightCursor {
+fn light_next(c: LightCursor) -> LightCursor {
     return LightCursor(c.range, c.k + 1u);
+}
+
+// Tile lists bound no depth span per light.
+fn light_in_span(c: LightCursor, view_z: f32) -> bool {
+    return true;
 }
 
 fn light_index(c: LightCursor) -> u32 {

@@ -9,7 +9,10 @@ fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f
     var caster = 0u;
     let pixel_index = u32(pixel.y) * frame.size.x + u32(pixel.x);
 #endif
-    for (var c = light_first(pixel, view_z); light_valid(c); c = light_next(c, view_z)) {
+    for (var c = light_first(pixel, view_z); light_valid(c); c = light_next(c)) {
+        if (!light_in_span(c, view_z)) {
+            continue;
+        }
         let i = light_index(c);
         let props = light_properties[i];
 #if SHADOWS
