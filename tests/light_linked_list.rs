@@ -215,10 +215,12 @@ fn reduced_resolution_error_is_measured_and_memory_shrinks() {
             full_bytes = (l.head_bytes(), l.layout.pool_bytes());
             assert!(m.rmse < 1e-5, "full resolution is exact: RMSE {}", m.rmse);
         } else {
-            // An approximation, not a broken image: most of the frame's light is there.
+            // An approximation, not a broken image: measured 0.002, 0.009 and 0.019 at
+            // 1/2, 1/4 and 1/8; a walk that reads the wrong list pixel gives about 0.2.
+            let bound = 0.01 * scale as f64;
             assert!(
-                flip < 0.2,
-                "scale {scale}: FLIP {flip} is far from brute force"
+                flip < bound,
+                "scale {scale}: FLIP {flip} is over {bound}, far from brute force"
             );
             // W and H are multiples of 8: heads and pool are exactly 1/scale².
             let s2 = (scale * scale) as u64;
