@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # Writes the light linked list benchmark's graph variants into benches/graphs/: forward
-# and deferred at 1/1, 1/4 and 1/8 resolution, with the pool sized for 1920x1080 at up to
-# 16,384 lights (links_per_pixel 96 at 1/1: 759 MiB of 12-byte links, the most a
-# 4 GiB binding holds with room; 512 at 1/4 and 1024 at 1/8, where a list pixel covers 16
-# and 64 output pixels), and forward at 1/8 testing every light instead of the tile
-# lists (the build without culling). Run from the repository root.
+# and deferred at 1/1, 1/4 and 1/8 resolution, with pools for 1920x1080 at up to 16,384
+# lights: links_per_pixel 64 at 1/1 (1,518.75 MiB of 12-byte links, under a 2 GiB
+# binding), 512 at 1/4 (759.38 MiB) and 1024 at 1/8 (379.69 MiB), where a list pixel
+# covers 16 and 64 output pixels; and forward at 1/8 testing every light instead of the
+# tile lists (the build without culling). A pool that fills is counted and reported.
+# Run from the repository root.
 set -euo pipefail
 out=benches/graphs
-links() { case $1 in 1) echo 96 ;; 4) echo 512 ;; 8) echo 1024 ;; esac; }
+links() { case $1 in 1) echo 64 ;; 4) echo 512 ;; 8) echo 1024 ;; esac; }
 for scale in 1 4 8; do
     params="LightLinkedList(scale: $scale, links_per_pixel: $(links $scale))"
     sed -e "s/LightLinkedList(scale: 1, links_per_pixel: 32)/$params/" \
