@@ -232,3 +232,70 @@ fn reduced_resolution_error_is_measured_and_memory_shrinks() {
         }
     }
 }
+
+/// What preparing `text` for `scene` says, for graphs that validate but cannot run.
+fn prepare_error(r: &mut Renderer, text: &str, scene: &Scene) -> String {
+    use lightgraph::graph::{self, FrameSize};
+    use lightgraph::render::SceneGpu;
+    use lightgraph::shader::ShaderLibrary;
+    let checked = graph::check_text(std::path::Path::new("<test>"), text, &ShaderLibrary::builtin())
+        .expect("valid graph");
+    let size = FrameSize {
+        width: W,
+        height: H,
+        lights: scene.lights.len() as u32,
+    };
+    let compiled = graph::compile(checked, &scene.features(), size);
+    let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, scene).expect("materials");
+    match r.prepare(compiled, scene, &gpu, size, false) {
+        Ok(_) => panic!("expected a prepare error"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn tile_lists_of_several_lists_a_tile_and_tile_list_readers_are_refused_by_name() {
+    let mut r = renderer();
+    let scene = random_scene(20, 7);
+    let half_z = graph("light_linked_list.ron", 4, 32, true).replace(
+        "LightCulling(tile: 16, variant: Frustum, capacity: 256)",
+        "LightCulling(tile: 16, variant: HalfZ, capacity: 256)",
+    );
+    let e = prepare_error(&mut r, &half_z, &scene);
+    assert!(
+        e.contains("light_linked_list") && e.contains("has 2 lists a tile (HalfZ)"),
+        "{e}"
+    );
+    // Ray-cast shadow jobs number the lights of tile lists: a linked list is refused.
+    let text = std::fs::read_to_string(graph_path("raycast_shadows.ron"))
+        .unwrap()
+        .replace("            when: Some(ShadowCasters),\n", "")
+        .replace(
+            r#"        Buffer(name: "shadow_jobs", size: Auto),"#,
+            r#"        Buffer(name: "shadow_jobs", size: Auto),
+        Buffer(name: "light_links", size: Auto),"#,
+        )
+        .replace(
+            r#"        Pass(
+            name: "shadow_gbuffer","#,
+            r#"        Pass(
+            name: "light_linked_list",
+            kind: LightLinkedList(scale: 1),
+            reads: ["depth", "light_geometry", "light_lists"],
+            writes: ["light_links"],
+        ),
+        Pass(
+            name: "shadow_gbuffer","#,
+        )
+        .replace(
+            r#"reads: ["g_position", "g_geometric", "light_geometry", "light_properties", "light_lists"],"#,
+            r#"reads: ["g_position", "g_geometric", "light_geometry", "light_properties", "light_lists=light_links"],"#,
+        );
+    assert!(text.contains("light_lists=light_links"), "raycast_shadows.ron changed");
+    let e = prepare_error(&mut r, &text, &scene);
+    assert!(
+        e.contains("shadow_ray_jobs")
+            && e.contains("'light_links' holds light linked lists; this pass reads the tile lists"),
+        "{e}"
+    );
+}
