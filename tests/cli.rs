@@ -198,7 +198,11 @@ fn render_reports_the_link_pool_and_its_overflow() {
         let (out, err) = text(&o);
         assert!(o.status.success(), "{out}\n{err}");
         let scale = if overflow { 4 } else { 1 };
-        let line = format!("light_linked_list: {}x{} list pixels (1/{scale} per side)", 64 / scale, 36 / scale);
+        let line = format!(
+            "light_linked_list: {}x{} list pixels (1/{scale} per side)",
+            64 / scale,
+            36 / scale
+        );
         assert!(out.contains(&line) && out.contains(" MiB ("), "{out}");
         assert_eq!(
             out.contains("WARNING: the link pool of 144 overflowed"),

@@ -170,7 +170,11 @@ fn a_full_pool_is_counted_and_loses_lights() {
     let l = &out.links[0];
     assert_eq!(l.layout.pool, (W * H) as u64);
     assert_eq!(l.links_wanted, wanted, "the lists want the same links");
-    assert_eq!(l.links(), l.layout.pool, "the pool is filled to the last link");
+    assert_eq!(
+        l.links(),
+        l.layout.pool,
+        "the pool is filled to the last link"
+    );
     assert_eq!(l.links_dropped, wanted - l.layout.pool);
     assert!(l.overflow_pixels > 0 && l.overflow_pixels <= (W * H) as u64);
     assert!(l.longest_list > 1);
@@ -238,8 +242,12 @@ fn prepare_error(r: &mut Renderer, text: &str, scene: &Scene) -> String {
     use lightgraph::graph::{self, FrameSize};
     use lightgraph::render::SceneGpu;
     use lightgraph::shader::ShaderLibrary;
-    let checked = graph::check_text(std::path::Path::new("<test>"), text, &ShaderLibrary::builtin())
-        .expect("valid graph");
+    let checked = graph::check_text(
+        std::path::Path::new("<test>"),
+        text,
+        &ShaderLibrary::builtin(),
+    )
+    .expect("valid graph");
     let size = FrameSize {
         width: W,
         height: H,
@@ -291,7 +299,10 @@ fn tile_lists_of_several_lists_a_tile_and_tile_list_readers_are_refused_by_name(
             r#"reads: ["g_position", "g_geometric", "light_geometry", "light_properties", "light_lists"],"#,
             r#"reads: ["g_position", "g_geometric", "light_geometry", "light_properties", "light_lists=light_links"],"#,
         );
-    assert!(text.contains("light_lists=light_links"), "raycast_shadows.ron changed");
+    assert!(
+        text.contains("light_lists=light_links"),
+        "raycast_shadows.ron changed"
+    );
     let e = prepare_error(&mut r, &text, &scene);
     assert!(
         e.contains("shadow_ray_jobs")

@@ -50,7 +50,11 @@ impl LightStatsPass {
         let links = lists.and_then(|l| graph.plan.link_layout(l));
         let mut d = BTreeMap::new();
         if lists.is_some() {
-            let define = if links.is_some() { "LINKED_LISTS" } else { "LIGHT_LISTS" };
+            let define = if links.is_some() {
+                "LINKED_LISTS"
+            } else {
+                "LIGHT_LISTS"
+            };
             d.insert(define.to_string(), "1".to_string());
         }
         let key = PipelineKey {

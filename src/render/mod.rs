@@ -22,8 +22,7 @@ pub use pipelines::{CacheCounters, Pipeline, PipelineCache, PipelineKey};
 pub use prepare_stats::PrepareStats;
 pub use report::{
     AtlasReport, CullingReport, FrameResult, LightStats, LinkReport, PassReport,
-    ShadowCompareReport,
-    ShadowReport,
+    ShadowCompareReport, ShadowReport,
 };
 pub use resources::FrameResources;
 pub use scene_gpu::{GpuBvh, GpuMesh, SceneGpu};

@@ -190,6 +190,9 @@ mod tests {
         // The seed's 8-byte links: 7.91 MiB; ours are 12 bytes.
         assert!((mib(l.pool * 8) - 7.91).abs() < 0.005);
         assert!((mib(l.pool_bytes()) - 11.87).abs() < 0.005);
-        assert_eq!(l.bytes(), 4 * LinkLayout::HEADER_WORDS + 4 * 240 * 135 + l.pool_bytes());
+        assert_eq!(
+            l.bytes(),
+            4 * LinkLayout::HEADER_WORDS + 4 * 240 * 135 + l.pool_bytes()
+        );
     }
 }

@@ -236,7 +236,10 @@ impl PrepareCtx<'_> {
         let lists = sp.required(crate::graph::slot::LIGHT_LISTS);
         if let Some(links) = self.graph.plan.link_layout(lists) {
             let params = GpuLinkParams::new(&links).ok_or_else(|| {
-                pass_error(&sp.name, format!("'{lists}': the link pool is past what u32 link indices address"))
+                pass_error(
+                    &sp.name,
+                    format!("'{lists}': the link pool is past what u32 link indices address"),
+                )
             })?;
             offered.buffer("link_params", &params.buffer(&self.renderer.ctx.device));
             return Ok(ShadeLists::Links);
