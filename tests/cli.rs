@@ -199,7 +199,7 @@ fn render_reports_the_link_pool_and_its_overflow() {
         assert!(o.status.success(), "{out}\n{err}");
         let scale = if overflow { 4 } else { 1 };
         let line = format!(
-            "light_linked_list: {}x{} list pixels (1/{scale} per side)",
+            "linked_list_build: {}x{} list pixels (1/{scale} per side)",
             64 / scale,
             36 / scale
         );

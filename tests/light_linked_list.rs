@@ -271,7 +271,7 @@ fn tile_lists_of_several_lists_a_tile_and_tile_list_readers_are_refused_by_name(
     );
     let e = prepare_error(&mut r, &half_z, &scene);
     assert!(
-        e.contains("light_linked_list") && e.contains("has 2 lists a tile (HalfZ)"),
+        e.contains("pass 'linked_list_build'") && e.contains("has 2 lists a tile (HalfZ)"),
         "{e}"
     );
     // Ray-cast shadow jobs number the lights of tile lists: a linked list is refused.
