@@ -4,8 +4,9 @@
 // fragment work (GH100) this is where the lighting throughput is.
 // With G_PACKED the G-buffer is one texture: view depth, octahedral normal, material;
 // the position is rebuilt on the pixel's view ray.
-// Defines: MATERIAL_INDEX, LIGHT_LISTS, G_PACKED, SHADOWS with SHADOW_MASK (ray-cast
-// shadows from shadow/shadow_ray_cast.wgsl) or SHADOW_ATLAS (a ShadowAtlas pass's maps).
+// Defines: MATERIAL_INDEX, LIGHT_LISTS (tile lists) or LINKED_LISTS (a light linked
+// list), G_PACKED, SHADOWS with SHADOW_MASK (ray-cast shadows from
+// shadow/shadow_ray_cast.wgsl) or SHADOW_ATLAS (a ShadowAtlas pass's maps).
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"

@@ -1,6 +1,6 @@
 // Mesh draws of one material (src/render/draws.rs): the depth prepass (DEPTH_ONLY), the
 // G-buffer (GBUFFER, GBUFFER_PACKED), forward shading (SHADE, with LIGHT_LISTS for
-// culled lists) and a shadow atlas's views (DEPTH_ONLY with ATLAS_DEPTH). The material's generated code is included as <material>; ALPHA_MASK
+// tile lists or LINKED_LISTS for a light linked list) and a shadow atlas's views (DEPTH_ONLY with ATLAS_DEPTH). The material's generated code is included as <material>; ALPHA_MASK
 // discards below the cutoff. Only SHADE binds lights: a pass binds what it declares.
 
 #include "common/types.wgsl"
