@@ -167,3 +167,47 @@ fn csv_fields(line: &str) -> Vec<String> {
     fields.push(field);
     fields
 }
+
+#[test]
+fn render_reports_the_link_pool_and_its_overflow() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let graph = root.join("graphs/light_linked_list_deferred.ron");
+    let small = dir.path().join("small_pool.ron");
+    std::fs::write(
+        &small,
+        std::fs::read_to_string(&graph).unwrap().replace(
+            "LightLinkedList(scale: 1, links_per_pixel: 32)",
+            "LightLinkedList(scale: 4, links_per_pixel: 1)",
+        ),
+    )
+    .unwrap();
+    for (g, overflow) in [(graph, false), (small, true)] {
+        let o = lightgraph(
+            dir.path(),
+            &[
+                "render",
+                "--graph",
+                g.to_str().unwrap(),
+                "--width",
+                "64",
+                "--height",
+                "36",
+            ],
+        );
+        let (out, err) = text(&o);
+        assert!(o.status.success(), "{out}\n{err}");
+        let scale = if overflow { 4 } else { 1 };
+        let line = format!(
+            "linked_list_build: {}x{} list pixels (1/{scale} per side)",
+            64 / scale,
+            36 / scale
+        );
+        assert!(out.contains(&line) && out.contains(" MiB ("), "{out}");
+        assert_eq!(
+            out.contains("WARNING: the link pool of 144 overflowed"),
+            overflow,
+            "{out}"
+        );
+    }
+}

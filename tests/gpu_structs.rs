@@ -88,3 +88,12 @@ fn list_params_match() {
         ]
     );
 }
+
+#[test]
+fn link_params_match() {
+    check!(
+        GpuLinkParams,
+        "LinkParams",
+        [scale, width, height, pool_offset, pool, _pad0, _pad1, _pad2]
+    );
+}

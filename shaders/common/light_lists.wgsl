@@ -1,12 +1,49 @@
-// The light loop's building block: which lights to visit for a pixel. Material shaders
+// The light loop's building block: which lights to visit for a pixel. Tile-list readers
 // call `light_range` once, then `light_at` for k in 0..count, the same for every
-// culling variant (and for all lights when LIGHT_LISTS is off).
+// culling variant (and for all lights when LIGHT_LISTS is off). The light loop walks a
+// cursor instead (`light_first`, `light_valid`, `light_next`, then `light_in_span` and
+// `light_index`), which also walks a light linked list (LINKED_LISTS) in link order,
+// skipping links whose depth span misses the surface.
 
 struct LightRange {
     offset: u32,
     count: u32,
 };
 
+#if LINKED_LISTS
+// A link of the pixel's list (LINK_END past the last), and how many links may follow:
+// the longest list the build wrote (header word 3) bounds every walk, so a lane that
+// reads no list (llvmpipe's helper lanes, a corrupted pool) cannot spin.
+struct LightCursor {
+    link: u32,
+    left: u32,
+};
+
+// `pixel` in framebuffer coordinates.
+fn light_first(pixel: vec2<f32>, view_z: f32) -> LightCursor {
+    let p = min(vec2<u32>(pixel) / link_params.scale, vec2<u32>(link_params.width, link_params.height) - 1u);
+    return LightCursor(light_lists[LINK_HEADER_WORDS + p.y * link_params.width + p.x], light_lists[3]);
+}
+
+fn light_valid(c: LightCursor) -> bool {
+    return c.link != LINK_END && c.left > 0u;
+}
+
+// One load, no loop: the advance runs in loops' continuing blocks.
+fn light_next(c: LightCursor) -> LightCursor {
+    return LightCursor(light_lists[link_params.pool_offset + LINK_WORDS * c.link + 2u], c.left - 1u);
+}
+
+// Whether `view_z` (positive view depth) lies in the link's light span.
+fn light_in_span(c: LightCursor, view_z: f32) -> bool {
+    let span = unpack2x16float(light_lists[link_params.pool_offset + LINK_WORDS * c.link]);
+    return view_z >= span.x && view_z <= span.y;
+}
+
+fn light_index(c: LightCursor) -> u32 {
+    return light_lists[link_params.pool_offset + LINK_WORDS * c.link + 1u];
+}
+#else
 #if LIGHT_LISTS
 fn list_entry(list: u32) -> LightRange {
     let e = HEADER_WORDS + ENTRY_WORDS * list;
@@ -45,5 +82,32 @@ fn light_range(pixel: vec2<f32>, view_z: f32) -> LightRange {
 
 fn light_at(r: LightRange, k: u32) -> u32 {
     return k;
+}
+#endif
+
+struct LightCursor {
+    range: LightRange,
+    k: u32,
+};
+
+fn light_first(pixel: vec2<f32>, view_z: f32) -> LightCursor {
+    return LightCursor(light_range(pixel, view_z), 0u);
+}
+
+fn light_valid(c: LightCursor) -> bool {
+    return c.k < c.range.count;
+}
+
+fn light_next(c: LightCursor) -> LightCursor {
+    return LightCursor(c.range, c.k + 1u);
+}
+
+// Tile lists bound no depth span per light.
+fn light_in_span(c: LightCursor, view_z: f32) -> bool {
+    return true;
+}
+
+fn light_index(c: LightCursor) -> u32 {
+    return light_at(c.range, c.k);
 }
 #endif

@@ -4,14 +4,16 @@
 // `pixel` is the framebuffer position, `view_z` the positive view-space depth.
 fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f32) -> vec3<f32> {
     var color = material_emission(m) + frame.ambient.rgb * material_eval(m, p.normal);
-    let range = light_range(pixel, view_z);
 #if SHADOWS
     // Casters are numbered before the material mask is applied, as job creation does.
     var caster = 0u;
     let pixel_index = u32(pixel.y) * frame.size.x + u32(pixel.x);
 #endif
-    for (var k = 0u; k < range.count; k++) {
-        let i = light_at(range, k);
+    for (var c = light_first(pixel, view_z); light_valid(c); c = light_next(c)) {
+        if (!light_in_span(c, view_z)) {
+            continue;
+        }
+        let i = light_index(c);
         let props = light_properties[i];
 #if SHADOWS
         let g = light_geometry[i];

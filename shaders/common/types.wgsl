@@ -48,6 +48,26 @@ struct ListParams {
     _pad0: u32,
 };
 
+// How a LightLinkedList pass laid out its links (see LinkLayout in
+// src/graph/kinds/light_linked_list.rs).
+struct LinkParams {
+    // Output pixels per list-pixel side.
+    scale: u32,
+    // List pixels per side.
+    width: u32,
+    height: u32,
+    // Words before the first link, and links the pool holds.
+    pool_offset: u32,
+    pool: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+};
+
+const LINK_HEADER_WORDS: u32 = 4u;
+const LINK_WORDS: u32 = 3u;
+const LINK_END: u32 = 0xffffffffu;
+
 const VARIANT_FRUSTUM: u32 = 0u;
 const VARIANT_HALF_Z: u32 = 1u;
 const VARIANT_DEPTH_MASK: u32 = 2u;

@@ -4,8 +4,9 @@
 // fragment work (GH100) this is where the lighting throughput is.
 // With G_PACKED the G-buffer is one texture: view depth, octahedral normal, material;
 // the position is rebuilt on the pixel's view ray.
-// Defines: MATERIAL_INDEX, LIGHT_LISTS, G_PACKED, SHADOWS with SHADOW_MASK (ray-cast
-// shadows from shadow/shadow_ray_cast.wgsl) or SHADOW_ATLAS (a ShadowAtlas pass's maps).
+// Defines: MATERIAL_INDEX, LIGHT_LISTS (tile lists) or LINKED_LISTS (a light linked
+// list), G_PACKED, SHADOWS with SHADOW_MASK (ray-cast shadows from
+// shadow/shadow_ray_cast.wgsl) or SHADOW_ATLAS (a ShadowAtlas pass's maps).
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"
@@ -16,6 +17,10 @@
 #if LIGHT_LISTS
 @group(0) @binding(3) var<storage, read> light_lists: array<u32>;
 @group(0) @binding(4) var<uniform> list_params: ListParams;
+#endif
+#if LINKED_LISTS
+@group(0) @binding(3) var<storage, read> light_lists: array<u32>;
+@group(0) @binding(4) var<uniform> link_params: LinkParams;
 #endif
 @group(0) @binding(5) var g_position: texture_2d<f32>;
 #if G_PACKED

@@ -1,8 +1,9 @@
 // Mesh draws of one material (src/render/draws.rs): the depth prepass and the
 // transparent one (DEPTH_ONLY), the G-buffer (GBUFFER, GBUFFER_PACKED), forward shading
-// of opaque and blended meshes (SHADE, with LIGHT_LISTS for culled lists; blended ones
-// return the material's alpha, blending is pipeline state), a shadow atlas's views
-// (DEPTH_ONLY with ATLAS_DEPTH); MSAA at more than one sample. The material's generated code is included as <material>; ALPHA_MASK
+// of opaque and blended meshes (SHADE, with LIGHT_LISTS for tile lists or LINKED_LISTS for
+// a light linked list; blended ones return the material's alpha, blending is pipeline
+// state), a shadow atlas's views (DEPTH_ONLY with ATLAS_DEPTH); MSAA at more than one
+// sample. The material's generated code is included as <material>; ALPHA_MASK
 // discards below the cutoff. Only SHADE binds lights: a pass binds what it declares.
 
 #include "common/types.wgsl"
@@ -15,6 +16,10 @@
 #if LIGHT_LISTS
 @group(0) @binding(3) var<storage, read> light_lists: array<u32>;
 @group(0) @binding(4) var<uniform> list_params: ListParams;
+#endif
+#if LINKED_LISTS
+@group(0) @binding(3) var<storage, read> light_lists: array<u32>;
+@group(0) @binding(4) var<uniform> link_params: LinkParams;
 #endif
 
 #include "common/light_lists.wgsl"

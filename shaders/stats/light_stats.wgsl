@@ -20,6 +20,10 @@
 @group(0) @binding(7) var<storage, read> light_lists: array<u32>;
 @group(0) @binding(4) var<uniform> list_params: ListParams;
 #endif
+#if LINKED_LISTS
+@group(0) @binding(7) var<storage, read> light_lists: array<u32>;
+@group(0) @binding(4) var<uniform> link_params: LinkParams;
+#endif
 
 #include "common/light_lists.wgsl"
 
@@ -40,7 +44,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let h = inv_view_proj * vec4<f32>(ndc, d, 1.0);
     let world = h.xyz / h.w;
     let view_z = -(frame.view * vec4<f32>(world, 1.0)).z;
-    let listed = light_range(pixel, view_z).count;
+    var listed = 0u;
+    for (var c = light_first(pixel, view_z); light_valid(c); c = light_next(c)) {
+        if (!light_in_span(c, view_z)) {
+            continue;
+        }
+        listed += 1u;
+    }
     var exact = 0u;
     for (var i = 0u; i < frame.light_count; i++) {
         let inc = incident_light(light_geometry[i], light_properties[i], world);

@@ -443,6 +443,12 @@ fn fill_row(
     }
     set_shadow_columns(row, &prepared.graph, gpu, &result.shadows);
     set_atlas_columns(row, &result);
+    if let Some(l) = result.links.first() {
+        row.link_mib = Some(l.bytes() as f64 / MIB);
+        row.links_per_list_pixel = Some(l.links() as f64 / l.layout.pixels().max(1) as f64);
+        row.link_scale = Some(l.layout.scale);
+        row.links_dropped = Some(l.links_dropped);
+    }
     Ok(())
 }
 

@@ -254,6 +254,36 @@ pub fn render(args: RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// A light linked list pass: its resolution, pool and memory, and any overflow.
+fn link_report(l: &lightgraph::render::LinkReport) {
+    let mib = |b: u64| b as f64 / (1024.0 * 1024.0);
+    let pixels = l.layout.pixels().max(1) as f64;
+    println!(
+        "  {}: {}x{} list pixels (1/{} per side), {} links ({:.2} a list pixel, longest list {}), pool of {} links: {:.2} MiB ({:.2} MiB links of 12 bytes, {:.2} MiB heads)",
+        l.pass,
+        l.layout.width,
+        l.layout.height,
+        l.layout.scale,
+        l.links(),
+        l.links() as f64 / pixels,
+        l.longest_list,
+        l.layout.pool,
+        mib(l.bytes()),
+        mib(l.layout.pool_bytes()),
+        mib(l.head_bytes()),
+    );
+    if l.links_dropped > 0 {
+        println!(
+            "  WARNING: the link pool of {} overflowed: {} links dropped in {} list pixels (wanted {}): those lights are missing there; raise links_per_pixel to at least {:.0}",
+            l.layout.pool,
+            l.links_dropped,
+            l.overflow_pixels,
+            l.links_wanted,
+            (l.links_wanted as f64 / pixels).ceil()
+        );
+    }
+}
+
 /// Pixels whose shading overflowed f32 (a light very bright for its distance on a
 /// sharp lobe): counted, never clamped, so the user sees where.
 fn overflow_report(result: &FrameResult) {
@@ -451,6 +481,9 @@ fn report(r: &Renderer, scene: &Scene, graph: &Path, result: &FrameResult) {
                 c.overflowed_lists, c.layout.capacity, c.longest_list
             );
         }
+    }
+    for l in &result.links {
+        link_report(l);
     }
     if let Some(s) = &result.light_stats {
         println!(

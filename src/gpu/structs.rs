@@ -106,6 +106,53 @@ impl GpuListParams {
     }
 }
 
+/// How a LightLinkedList pass laid out its links; see
+/// [`crate::graph::kinds::light_linked_list::LinkLayout`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuLinkParams {
+    pub scale: u32,
+    pub width: u32,
+    pub height: u32,
+    pub pool_offset: u32,
+    pub pool: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
+}
+
+impl GpuLinkParams {
+    /// `None` where the pool is past what a u32 link index addresses.
+    pub fn new(layout: &crate::graph::kinds::light_linked_list::LinkLayout) -> Option<Self> {
+        let words = layout.pool_offset_words()
+            + crate::graph::kinds::light_linked_list::LinkLayout::LINK_WORDS * layout.pool;
+        // Link indices and word offsets are u32 in the shaders; LINK_END is u32::MAX.
+        if words >= u32::MAX as u64 {
+            return None;
+        }
+        Some(Self {
+            scale: layout.scale,
+            width: layout.width,
+            height: layout.height,
+            pool_offset: layout.pool_offset_words() as u32,
+            pool: layout.pool as u32,
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
+        })
+    }
+
+    /// A uniform buffer holding these parameters.
+    pub fn buffer(&self, device: &wgpu::Device) -> wgpu::Buffer {
+        use wgpu::util::DeviceExt;
+        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("link params"),
+            contents: bytemuck::bytes_of(self),
+            usage: wgpu::BufferUsages::UNIFORM,
+        })
+    }
+}
+
 /// Splits lights into the two GPU arrays.
 pub fn light_buffers(lights: &[Light]) -> (Vec<GpuLightGeometry>, Vec<GpuLightProperties>) {
     lights

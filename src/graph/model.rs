@@ -3,6 +3,7 @@
 pub use super::kinds::deferred_shading::DeferredShading;
 pub use super::kinds::forward_shading::ForwardShading;
 pub use super::kinds::light_culling::LightCulling;
+pub use super::kinds::light_linked_list::LightLinkedList;
 pub use super::kinds::shadow_atlas::ShadowAtlas;
 pub use super::kinds::shadow_ray_cast::ShadowRayCast;
 pub use super::kinds::shadow_ray_jobs::ShadowRayJobs;
@@ -240,7 +241,7 @@ pub enum LightSource {
     /// Every light at every pixel: the reference.
     #[default]
     AllLights,
-    /// The lists written by a `LightCulling` pass (read as a buffer).
+    /// The lists written by a `LightCulling` or `LightLinkedList` pass (read as a buffer).
     Culled,
 }
 
@@ -269,6 +270,8 @@ pub enum PassKind {
     DepthPrepass,
     /// Tiled light culling against the prepass depth.
     LightCulling(LightCulling),
+    /// Per-pixel light linked lists (seed 001) at full or reduced resolution.
+    LightLinkedList(LightLinkedList),
     /// Forward shading of the scene's materials through the light loop.
     ForwardShading(ForwardShading),
     /// Geometry into a G-buffer: a depth texture and one packed or two Rgba32Float textures.
@@ -314,6 +317,7 @@ impl PassKind {
         match self {
             PassKind::DepthPrepass => "DepthPrepass",
             PassKind::LightCulling(_) => "LightCulling",
+            PassKind::LightLinkedList(_) => "LightLinkedList",
             PassKind::ForwardShading(_) => "ForwardShading",
             PassKind::GBuffer => "GBuffer",
             PassKind::DeferredShading(_) => "DeferredShading",

@@ -69,6 +69,16 @@ impl ResourcePlan {
             _ => None,
         }
     }
+    /// The linked-list layout of a planned buffer a LightLinkedList pass writes.
+    pub fn link_layout(
+        &self,
+        name: &str,
+    ) -> Option<crate::graph::kinds::light_linked_list::LinkLayout> {
+        match self.get(name)?.layout? {
+            BufferLayout::LightLinks(l) => Some(l),
+            _ => None,
+        }
+    }
 }
 
 /// Sizes the plan needs from outside the graph.

@@ -28,7 +28,7 @@ pub(super) enum DrawMode {
         geometric: bool,
     },
     Shade {
-        culled: bool,
+        lists: super::passes::ShadeLists,
         blend: bool,
         shadows: Shadows,
     },
@@ -190,13 +190,9 @@ impl Renderer {
                         d.push(("GBUFFER_GEOMETRIC", "1".into()));
                     }
                 }
-                DrawMode::Shade {
-                    culled, shadows, ..
-                } => {
+                DrawMode::Shade { lists, shadows, .. } => {
                     d.push(("SHADE", "1".into()));
-                    if culled {
-                        d.push(("LIGHT_LISTS", "1".into()));
-                    }
+                    d.extend(lists.define());
                     d.extend(shadow_defines(shadows));
                 }
             }

@@ -8,7 +8,7 @@ use super::report::LightStats;
 use super::scene_gpu::SceneGpu;
 use super::{RenderError, Renderer};
 use crate::gpu::readback::read_buffer;
-use crate::gpu::structs::{GpuFrame, GpuListParams};
+use crate::gpu::structs::{GpuFrame, GpuLinkParams, GpuListParams};
 use crate::graph::{slot, CompiledGraph, FrameSize, PassKind};
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -49,9 +49,16 @@ impl LightStatsPass {
             )
         })?;
         let lists = shading.roles.slot(slot::LIGHT_LISTS);
+        // Tile lists or a light linked list, as the planned buffer's layout says.
+        let links = lists.and_then(|l| graph.plan.link_layout(l));
         let mut d = BTreeMap::new();
         if lists.is_some() {
-            d.insert("LIGHT_LISTS".to_string(), "1".to_string());
+            let define = if links.is_some() {
+                "LINKED_LISTS"
+            } else {
+                "LIGHT_LISTS"
+            };
+            d.insert(define.to_string(), "1".to_string());
         }
         if shading.samples > 1 {
             // A multisampled depth: statistics of each pixel's first sample.
@@ -109,14 +116,22 @@ impl LightStatsPass {
         set.buffer("counts", &counts);
         set.buffer("inv_view_proj", &inv);
         if let Some(lists) = lists {
-            let layout = plan.list_layout(lists).ok_or_else(|| missing(lists))?;
             set.buffer(
                 "light_lists",
                 resources
                     .buffer(plan, lists)
                     .ok_or_else(|| missing(lists))?,
             );
-            set.buffer("list_params", &GpuListParams::new(&layout).buffer(&device));
+            match links {
+                Some(links) => {
+                    let params = GpuLinkParams::new(&links).ok_or_else(|| missing(lists))?;
+                    set.buffer("link_params", &params.buffer(&device));
+                }
+                None => {
+                    let layout = plan.list_layout(lists).ok_or_else(|| missing(lists))?;
+                    set.buffer("list_params", &GpuListParams::new(&layout).buffer(&device));
+                }
+            }
         }
         let bind = set
             .bind(

@@ -22,8 +22,8 @@ pub use materials::MaterialProgram;
 pub use pipelines::{CacheCounters, Pipeline, PipelineCache, PipelineKey};
 pub use prepare_stats::PrepareStats;
 pub use report::{
-    AtlasReport, CullingReport, FrameResult, LightStats, PassReport, ShadowCompareReport,
-    ShadowReport,
+    AtlasReport, CullingReport, FrameResult, LightStats, LinkReport, PassReport,
+    ShadowCompareReport, ShadowReport,
 };
 pub use resources::FrameResources;
 pub use scene_gpu::{GpuBvh, GpuMesh, SceneGpu};

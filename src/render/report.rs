@@ -25,6 +25,35 @@ impl CullingReport {
     }
 }
 
+/// Per light linked list pass: what its pool held this frame.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LinkReport {
+    pub pass: String,
+    pub layout: crate::graph::kinds::light_linked_list::LinkLayout,
+    /// Links the list pixels wanted (kept plus dropped).
+    pub links_wanted: u64,
+    /// Links past the pool: those lights are missing from their pixels.
+    pub links_dropped: u64,
+    /// List pixels that lost at least one link.
+    pub overflow_pixels: u64,
+    /// The longest list a pixel wanted.
+    pub longest_list: u32,
+}
+
+impl LinkReport {
+    /// Links kept in the pool.
+    pub fn links(&self) -> u64 {
+        self.links_wanted - self.links_dropped
+    }
+    /// Bytes of the heads and of the whole buffer (header, heads, pool).
+    pub fn head_bytes(&self) -> u64 {
+        self.layout.head_bytes()
+    }
+    pub fn bytes(&self) -> u64 {
+        self.layout.bytes()
+    }
+}
+
 /// Per-pixel light statistics over pixels that hold geometry.
 #[derive(Clone, Debug, Default)]
 pub struct LightStats {
@@ -152,6 +181,7 @@ pub enum PassReport {
     Shadow(ShadowReport),
     Atlas(AtlasReport),
     ShadowCompare(ShadowCompareReport),
+    Links(LinkReport),
 }
 
 pub struct FrameResult {
@@ -162,6 +192,7 @@ pub struct FrameResult {
     /// GPU milliseconds per pass, when the adapter has timestamp queries.
     pub pass_ms: Option<Vec<(String, f64)>>,
     pub culling: Vec<CullingReport>,
+    pub links: Vec<LinkReport>,
     pub shadows: Vec<ShadowReport>,
     pub atlases: Vec<AtlasReport>,
     pub shadow_compare: Vec<ShadowCompareReport>,

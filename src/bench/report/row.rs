@@ -95,6 +95,13 @@ pub struct BenchRow {
     pub shadow_pairs: Option<u64>,
     pub pair_error_pcf5: Option<f64>,
     pub pair_error_2x2: Option<f64>,
+    /// Light linked lists: heads and link pool, MiB.
+    pub link_mib: Option<f64>,
+    /// Links kept per list pixel, and the resolution divisor (1, 4, 8).
+    pub links_per_list_pixel: Option<f64>,
+    pub link_scale: Option<u32>,
+    /// Links past the pool (those lights are missing at their pixels).
+    pub links_dropped: Option<u64>,
 }
 
 impl BenchRow {

@@ -37,7 +37,7 @@ fn opt<T: ToString>(v: Option<T>) -> String {
 /// row (first-seen order): `pass_ms:<name>` (median), `pass_ms_p10:<name>`, `pass_ms_p90:<name>`,
 /// empty where a row lacks that pass. Time columns are empty, not 0, for untimed rows; the
 /// ray-cast shadow columns (`shadow_*`, `bvh_*`) are empty for graphs without those passes.
-pub const CSV_COLUMNS: [&str; 45] = [
+pub const CSV_COLUMNS: [&str; 49] = [
     "scene",
     "technique",
     "params",
@@ -83,6 +83,10 @@ pub const CSV_COLUMNS: [&str; 45] = [
     "shadow_pairs",
     "pair_error_pcf5",
     "pair_error_2x2",
+    "link_mib",
+    "links_per_list_pixel",
+    "link_scale",
+    "links_dropped",
 ];
 
 /// The rows as CSV (RFC 4180 quoting; floats in Rust's shortest round-trip form, `inf` for an
@@ -146,6 +150,10 @@ pub fn to_csv(rows: &[BenchRow]) -> String {
             opt(r.shadow_pairs),
             opt(r.pair_error_pcf5),
             opt(r.pair_error_2x2),
+            opt(r.link_mib),
+            opt(r.links_per_list_pixel),
+            opt(r.link_scale),
+            opt(r.links_dropped),
         ];
         for p in &passes {
             let t = pass_ms(r, p);
@@ -276,6 +284,7 @@ pub fn to_markdown(rows: &[BenchRow]) -> String {
     }
     shadow_markdown(&mut out, rows);
     atlas_markdown(&mut out, rows);
+    links_markdown(&mut out, rows);
     if let Some(reason) = untimed_reason(rows).filter(|_| !rows.is_empty()) {
         let _ = writeln!(
             out,
@@ -399,6 +408,38 @@ fn atlas_markdown(out: &mut String, rows: &[BenchRow]) {
     }
 }
 
+/// The light linked list table, if some row ran a LightLinkedList pass.
+fn links_markdown(out: &mut String, rows: &[BenchRow]) {
+    if !rows.iter().any(|r| r.link_mib.is_some()) {
+        return;
+    }
+    out.push_str(
+        "\nLight linked lists (scale: output pixels per list-pixel side; dropped links are \
+         lights missing at their pixels):\n\n\
+         | scene | technique | lights | size | scale | MiB | links / list pixel | dropped | frame ms | RMSE | max abs | FLIP |\n\
+         |---|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n",
+    );
+    for r in rows.iter().filter(|r| r.link_mib.is_some()) {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {}x{} | 1/{} | {} | {} | {} | {} | {} | {} | {} |",
+            md_cell(&r.scene),
+            md_cell(&r.technique),
+            r.light_count,
+            r.width,
+            r.height,
+            r.link_scale.unwrap_or(1),
+            md_num(r.link_mib, 2),
+            md_num(r.links_per_list_pixel, 1),
+            r.links_dropped.map_or("–".into(), |n| n.to_string()),
+            md_num(r.frame_ms.map(|t| t.median), 3),
+            md_num(r.rmse, 6),
+            md_num(r.max_abs, 4),
+            md_num(r.flip_mean, 5),
+        );
+    }
+}
+
 /// Write [`to_csv`] to `path` (creating the parent directory).
 pub fn write_csv(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(), ReportError> {
     write_file(path.as_ref(), &to_csv(rows))
@@ -438,15 +479,15 @@ mod tests {
         let csv = to_csv(&[plain.clone(), shadowed.clone()]);
         let lines: Vec<&str> = csv.lines().collect();
         assert!(lines[0].ends_with(
-            ",passes_ms_total,reference,shadow_rays,shadow_rays_per_s,shadow_jobs_dropped,shadow_overflow_pixels,shadow_buffers_mib,bvh_mib,bvh_build_ms,atlas_mib,atlas_shadowed,atlas_dropped,atlas_views,shadow_pairs,pair_error_pcf5,pair_error_2x2"
+            ",passes_ms_total,reference,shadow_rays,shadow_rays_per_s,shadow_jobs_dropped,shadow_overflow_pixels,shadow_buffers_mib,bvh_mib,bvh_build_ms,atlas_mib,atlas_shadowed,atlas_dropped,atlas_views,shadow_pairs,pair_error_pcf5,pair_error_2x2,link_mib,links_per_list_pixel,link_scale,links_dropped"
         ));
         assert!(
-            lines[1].ends_with(",0,,brute_force,,,,,,,,,,,,,,"),
+            lines[1].ends_with(",0,,brute_force,,,,,,,,,,,,,,,,,,"),
             "{}",
             lines[1]
         );
         assert!(
-            lines[2].ends_with(",raycast_shadows_naive,16,2500000000,0,1,1.5,20.4,180,,,,,,,"),
+            lines[2].ends_with(",raycast_shadows_naive,16,2500000000,0,1,1.5,20.4,180,,,,,,,,,,,"),
             "{}",
             lines[2]
         );

@@ -8,6 +8,7 @@ pub mod depth_prepass;
 pub mod forward_shading;
 pub mod g_buffer;
 pub mod light_culling;
+pub mod light_linked_list;
 pub mod shadow_atlas;
 pub mod shadow_compare;
 pub mod shadow_ray_cast;
@@ -126,6 +127,8 @@ impl SlotSpec {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BufferLayout {
     LightLists(ListLayout),
+    /// Per-pixel light linked lists: heads and the link pool.
+    LightLinks(light_linked_list::LinkLayout),
     /// Ray-cast shadow jobs: a header and room for `capacity` jobs.
     ShadowJobs {
         capacity: u64,
@@ -146,6 +149,7 @@ impl BufferLayout {
     pub fn bytes(&self) -> u64 {
         match self {
             BufferLayout::LightLists(l) => l.bytes(),
+            BufferLayout::LightLinks(l) => l.bytes(),
             BufferLayout::ShadowJobs { capacity } => shadow_ray_jobs::job_buffer_bytes(*capacity),
             BufferLayout::ShadowMask { pixels } => 4 * shadow_ray_jobs::MASK_WORDS * pixels,
             BufferLayout::ShadowViews {
@@ -182,6 +186,7 @@ pub fn slots(kind: &PassKind) -> Option<&'static [SlotSpec]> {
     Some(match kind {
         PassKind::DepthPrepass => depth_prepass::SLOTS,
         PassKind::LightCulling(_) => light_culling::SLOTS,
+        PassKind::LightLinkedList(_) => light_linked_list::SLOTS,
         PassKind::ForwardShading(_) => forward_shading::SLOTS,
         PassKind::GBuffer => g_buffer::SLOTS,
         PassKind::DeferredShading(_) => deferred_shading::SLOTS,
@@ -200,6 +205,7 @@ fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     match &ctx.pass.kind {
         PassKind::DepthPrepass => depth_prepass::check(ctx, errors),
         PassKind::LightCulling(p) => light_culling::check(p, ctx, errors),
+        PassKind::LightLinkedList(p) => light_linked_list::check(p, ctx, errors),
         PassKind::ForwardShading(p) => forward_shading::check(p, ctx, errors),
         PassKind::GBuffer => g_buffer::check(ctx, errors),
         PassKind::DeferredShading(p) => deferred_shading::check(p, ctx, errors),
@@ -219,6 +225,9 @@ pub fn buffer_layout(kind: &PassKind, slot: &str, frame: FrameSize) -> Option<Bu
         PassKind::LightCulling(p) if slot == slot::LIGHT_LISTS => Some(BufferLayout::LightLists(
             p.list_layout(frame.width, frame.height),
         )),
+        PassKind::LightLinkedList(p) if slot == light_linked_list::LIGHT_LINKS => Some(
+            BufferLayout::LightLinks(p.link_layout(frame.width, frame.height)),
+        ),
         PassKind::ShadowRayJobs(p) if slot == shadow_ray_jobs::SHADOW_JOBS => {
             Some(BufferLayout::ShadowJobs {
                 capacity: p.capacity(frame.width, frame.height),
@@ -505,8 +514,9 @@ pub fn check_light_source(
 ) {
     use super::model::LightSource;
     match (lights, ctx.slot(slot::LIGHT_LISTS)) {
-        (LightSource::Culled, None) => errors
-            .push(ctx.bad("lights: Culled needs the culling pass's light-list buffer in reads")),
+        (LightSource::Culled, None) => errors.push(ctx.bad(
+            "lights: Culled needs the light-list buffer of a LightCulling or LightLinkedList pass in reads",
+        )),
         (LightSource::AllLights, Some(name)) => {
             errors.push(ctx.mismatch(name, "lights: AllLights reads no light lists"))
         }
@@ -544,6 +554,7 @@ pub(crate) mod test_support {
         Import(name: "bn", from: BvhNodes),
         Import(name: "bt", from: BvhTriangles),
         Buffer(name: "lists"),
+        Buffer(name: "links"),
         Import(name: "geometry", from: Geometry),
         Import(name: "lg", from: LightGeometry),
         Import(name: "lp", from: LightProperties),

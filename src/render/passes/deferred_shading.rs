@@ -4,7 +4,7 @@
 use super::{defines, pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::g_buffer::G_NORMAL;
 use crate::graph::Name;
-use crate::graph::{slot, DeferredShading, LightSource, ScheduledPass};
+use crate::graph::{DeferredShading, ScheduledPass};
 use crate::render::pipelines::PipelineKey;
 use crate::render::RenderError;
 use std::collections::BTreeMap;
@@ -22,14 +22,10 @@ pub(super) fn prepare(
     sp: &ScheduledPass,
     p: &DeferredShading,
 ) -> Result<DeferredShadingPass, RenderError> {
-    let culled = p.lights == LightSource::Culled;
     // Without a normals texture the G-buffer is the packed one.
     let packed = sp.roles.slot(G_NORMAL).is_none();
     let mut offered = cx.declared(sp)?;
-    if culled {
-        let params = cx.list_params(&sp.name, sp.required(slot::LIGHT_LISTS))?;
-        offered.buffer("list_params", &params);
-    }
+    let lists = cx.shading_lists(sp, p.lights, &mut offered)?;
     let shadows = cx.shading_shadows(sp, &mut offered);
     let mut pipelines = Vec::new();
     let mut bind = None;
@@ -44,9 +40,7 @@ pub(super) fn prepare(
         if packed {
             d.push(("G_PACKED", "1".into()));
         }
-        if culled {
-            d.push(("LIGHT_LISTS", "1".into()));
-        }
+        d.extend(lists.define());
         d.extend(crate::render::draws::shadow_defines(shadows));
         let key = PipelineKey {
             shader: "deferred/deferred_shading.wgsl".into(),

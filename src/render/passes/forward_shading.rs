@@ -3,7 +3,7 @@
 
 use super::{PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::Name;
-use crate::graph::{slot, ForwardShading, LightSource, ScheduledPass};
+use crate::graph::{slot, ForwardShading, ScheduledPass};
 use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws, MeshSet};
 use crate::render::RenderError;
 
@@ -23,14 +23,10 @@ pub(super) fn prepare(
     let color = sp.required(slot::COLOR);
     let depth = sp.required(slot::DEPTH);
     let mut offered = cx.declared(sp)?;
-    let culled = p.lights == LightSource::Culled;
-    if culled {
-        let params = cx.list_params(&sp.name, sp.required(slot::LIGHT_LISTS))?;
-        offered.buffer("list_params", &params);
-    }
+    let lists = cx.shading_lists(sp, p.lights, &mut offered)?;
     let shadows = cx.shading_shadows(sp, &mut offered);
     let mode = DrawMode::Shade {
-        culled,
+        lists,
         blend: false,
         shadows,
     };

@@ -9,6 +9,7 @@ mod forward_shading;
 mod fullscreen;
 mod g_buffer;
 pub(super) mod light_culling;
+mod light_linked_list;
 mod shadow_atlas;
 mod shadow_compare;
 mod shadow_ray_cast;
@@ -22,7 +23,7 @@ use super::report::PassReport;
 use super::resources::FrameResources;
 use super::scene_gpu::SceneGpu;
 use super::{RenderError, Renderer};
-use crate::gpu::structs::GpuListParams;
+use crate::gpu::structs::{GpuLinkParams, GpuListParams};
 use crate::graph::{
     CompiledGraph, FrameSize, PassKind, ResourceDesc, SceneResource, ScheduledPass,
 };
@@ -49,6 +50,7 @@ pub(super) fn prepare(
     Ok(match &sp.kind {
         PassKind::DepthPrepass => Box::new(depth_prepass::prepare(cx, sp)?),
         PassKind::LightCulling(p) => Box::new(light_culling::prepare(cx, sp, p)?),
+        PassKind::LightLinkedList(p) => Box::new(light_linked_list::prepare(cx, sp, p)?),
         PassKind::ForwardShading(p) => Box::new(forward_shading::prepare(cx, sp, p)?),
         PassKind::GBuffer => Box::new(g_buffer::prepare(cx, sp)?),
         PassKind::DeferredShading(p) => Box::new(deferred_shading::prepare(cx, sp, p)?),
@@ -67,6 +69,27 @@ pub(super) fn prepare(
             Box::new(fullscreen::prepare(cx, sp, shader, entry)?)
         }
     })
+}
+
+/// Which lights a shading pass visits at a pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ShadeLists {
+    AllLights,
+    /// A LightCulling pass's tile lists.
+    Tiles,
+    /// A LightLinkedList pass's per-pixel links.
+    Links,
+}
+
+impl ShadeLists {
+    /// The shader define that selects the walk in `common/light_lists.wgsl`.
+    pub fn define(self) -> Option<(&'static str, String)> {
+        match self {
+            ShadeLists::AllLights => None,
+            ShadeLists::Tiles => Some(("LIGHT_LISTS", "1".into())),
+            ShadeLists::Links => Some(("LINKED_LISTS", "1".into())),
+        }
+    }
 }
 
 /// The timestamp query pair around one pass, when the adapter has timestamps.
@@ -193,12 +216,40 @@ impl PrepareCtx<'_> {
     /// the planned buffer by the culling pass declared to write it).
     pub fn list_params(&self, pass: &str, lists: &str) -> Result<wgpu::Buffer, RenderError> {
         let layout = self.graph.plan.list_layout(lists).ok_or_else(|| {
-            pass_error(
-                pass,
-                format!("no LightCulling pass is declared to write '{lists}'"),
-            )
+            let problem = if self.graph.plan.link_layout(lists).is_some() {
+                format!("'{lists}' holds light linked lists; this pass reads the tile lists of a LightCulling pass")
+            } else {
+                format!("no LightCulling pass is declared to write '{lists}'")
+            };
+            pass_error(pass, problem)
         })?;
         Ok(GpuListParams::new(&layout).buffer(&self.renderer.ctx.device))
+    }
+
+    /// The lists a shading pass walks for `lights`, with the uniform that describes them
+    /// offered (`list_params` for tile lists, `link_params` for linked lists).
+    pub fn shading_lists(
+        &self,
+        sp: &ScheduledPass,
+        lights: crate::graph::LightSource,
+        offered: &mut BindingSet,
+    ) -> Result<ShadeLists, RenderError> {
+        if lights == crate::graph::LightSource::AllLights {
+            return Ok(ShadeLists::AllLights);
+        }
+        let lists = sp.required(crate::graph::slot::LIGHT_LISTS);
+        if let Some(links) = self.graph.plan.link_layout(lists) {
+            let params = GpuLinkParams::new(&links).ok_or_else(|| {
+                pass_error(
+                    &sp.name,
+                    format!("'{lists}': the link pool is past what u32 link indices address"),
+                )
+            })?;
+            offered.buffer("link_params", &params.buffer(&self.renderer.ctx.device));
+            return Ok(ShadeLists::Links);
+        }
+        offered.buffer("list_params", &self.list_params(&sp.name, lists)?);
+        Ok(ShadeLists::Tiles)
     }
 
     /// A compute pipeline whose group-0 layout is made from its own reflected bindings,

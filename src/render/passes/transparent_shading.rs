@@ -5,7 +5,7 @@
 
 use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::Name;
-use crate::graph::{slot, LightSource, ScheduledPass, TransparentShading};
+use crate::graph::{slot, ScheduledPass, TransparentShading};
 use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws, MeshSet};
 use crate::render::scene_gpu::SceneGpu;
 use crate::render::{RenderError, Renderer};
@@ -41,13 +41,9 @@ pub(super) fn prepare(
         ));
     }
     let mut offered = cx.declared(sp)?;
-    let culled = p.lights == LightSource::Culled;
-    if culled {
-        let params = cx.list_params(&sp.name, sp.required(slot::LIGHT_LISTS))?;
-        offered.buffer("list_params", &params);
-    }
+    let lists = cx.shading_lists(sp, p.lights, &mut offered)?;
     let mode = DrawMode::Shade {
-        culled,
+        lists,
         blend: true,
         shadows: crate::graph::kinds::forward_shading::Shadows::None,
     };

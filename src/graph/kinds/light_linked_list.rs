@@ -1,0 +1,198 @@
+//! `LightLinkedList`: per-pixel linked lists of the lights whose volume a pixel's view
+//! ray crosses in front of the scene (seed 001), at 1/1, 1/2, 1/4 or 1/8 of the output
+//! per side. Built in compute from a LightCulling pass's tile lists (or from every
+//! light); runs `shaders/cull/light_linked_list.wgsl`.
+
+use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
+use crate::graph::error::GraphError;
+use serde::{Deserialize, Serialize};
+
+/// `LightLinkedList(scale: 8, links_per_pixel: 32)`.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
+#[serde(deny_unknown_fields)]
+pub struct LightLinkedList {
+    /// Output pixels per list-pixel side: 1 (full resolution), 2, 4 or 8.
+    pub scale: u32,
+    /// The link pool, as links per list pixel on average (the seed's table assumes 32);
+    /// links past it are dropped, counted and reported.
+    #[serde(default = "default_links_per_pixel")]
+    pub links_per_pixel: u32,
+}
+
+fn default_links_per_pixel() -> u32 {
+    32
+}
+
+/// The slot it writes (the WGSL binding name).
+pub const LIGHT_LINKS: &str = "light_links";
+
+impl LightLinkedList {
+    pub fn link_layout(&self, width: u32, height: u32) -> LinkLayout {
+        let scale = self.scale.max(1);
+        let (w, h) = (width.div_ceil(scale), height.div_ceil(scale));
+        LinkLayout {
+            scale,
+            width: w,
+            height: h,
+            pool: w as u64 * h as u64 * self.links_per_pixel as u64,
+        }
+    }
+}
+
+/// Layout of a light linked list buffer, shared with `shaders/common/light_lists.wgsl`:
+/// a header of 4 u32 (links wanted, links dropped, pixels that lost a link, longest
+/// list wanted), a head link per list pixel, then the pool of 12-byte links: the near
+/// and far view depth as two f16 (rounded outwards), the light index, the next link.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LinkLayout {
+    pub scale: u32,
+    /// List pixels per side.
+    pub width: u32,
+    pub height: u32,
+    /// Links the pool holds.
+    pub pool: u64,
+}
+
+impl LinkLayout {
+    pub const HEADER_WORDS: u64 = 4;
+    pub const LINK_WORDS: u64 = 3;
+    pub fn pixels(&self) -> u64 {
+        self.width as u64 * self.height as u64
+    }
+    pub fn pool_offset_words(&self) -> u64 {
+        Self::HEADER_WORDS + self.pixels()
+    }
+    pub fn head_bytes(&self) -> u64 {
+        4 * self.pixels()
+    }
+    pub fn pool_bytes(&self) -> u64 {
+        4 * Self::LINK_WORDS * self.pool
+    }
+    pub fn bytes(&self) -> u64 {
+        4 * Self::HEADER_WORDS + self.head_bytes() + self.pool_bytes()
+    }
+}
+
+pub const SLOTS: &[SlotSpec] = &[
+    SlotSpec::new(
+        slot::DEPTH,
+        SlotType::DepthTexture,
+        Access::Read,
+        Usage::Sampled,
+    ),
+    super::LIGHT_GEOMETRY_READ,
+    // A LightCulling pass's tile lists: only their lights are tested (else every light).
+    SlotSpec::new(
+        slot::LIGHT_LISTS,
+        SlotType::Buffer,
+        Access::Read,
+        Usage::Bound,
+    )
+    .optional(),
+    SlotSpec::new(LIGHT_LINKS, SlotType::Buffer, Access::Write, Usage::Bound),
+];
+
+/// Scales whose list pixels tile a 8- or 16-pixel culling tile exactly, so each list
+/// pixel reads one tile's list.
+pub const SCALES: [u32; 4] = [1, 2, 4, 8];
+/// Most links a list pixel may reserve on average (the pool must stay addressable by
+/// a u32 word index at 8192² / 64).
+pub const MAX_LINKS_PER_PIXEL: u32 = 1024;
+
+pub fn check(p: &LightLinkedList, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+    if let Some(depth) = ctx.slot(slot::DEPTH) {
+        if ctx.samples(depth) > 1 {
+            errors.push(ctx.mismatch(
+                depth,
+                "the light linked list reads a single-sample depth texture; this one is multisampled",
+            ));
+        }
+    }
+    if !SCALES.contains(&p.scale) {
+        errors.push(ctx.bad(format!(
+            "scale {} is not supported (1, 2, 4 or 8 output pixels per list pixel side)",
+            p.scale
+        )));
+    }
+    if p.links_per_pixel == 0 || p.links_per_pixel > MAX_LINKS_PER_PIXEL {
+        errors.push(ctx.bad(format!(
+            "links_per_pixel {} must be in 1..={MAX_LINKS_PER_PIXEL}",
+            p.links_per_pixel
+        )));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::graph::kinds::test_support::{errors, validate};
+
+    const PREPASS: &str =
+        r#"Pass(name: "pre", kind: DepthPrepass, reads: ["geometry"], writes: ["depth"]),"#;
+    const CULL: &str = r#"Pass(name: "c", kind: LightCulling(tile: 16), reads: ["depth", "lg"], writes: ["lists"]),"#;
+
+    #[test]
+    fn checks_parameters() {
+        let e = errors(
+            &format!(
+                r#"{PREPASS} Pass(name: "l", kind: LightLinkedList(scale: 3, links_per_pixel: 0), reads: ["depth", "lg"], writes: ["links"])"#
+            ),
+            "hdr",
+        );
+        for want in ["scale 3", "links_per_pixel 0"] {
+            assert!(e.contains(want), "{want}: {e}");
+        }
+    }
+
+    #[test]
+    fn links_written_from_depth_with_or_without_tile_lists() {
+        validate(
+            &format!(
+                r#"{PREPASS} {CULL} Pass(name: "l", kind: LightLinkedList(scale: 4), reads: ["depth", "lg", "lists"], writes: ["links"]), Pass(name: "s", kind: ForwardShading(lights: Culled), reads: ["depth", "lg", "lp", "links"], writes: ["hdr"])"#
+            ),
+            "hdr",
+        )
+        .unwrap();
+        validate(
+            &format!(
+                r#"{PREPASS} Pass(name: "l", kind: LightLinkedList(scale: 1), reads: ["depth", "lg"], writes: ["links"]), Pass(name: "s", kind: ForwardShading(lights: Culled), reads: ["depth", "lg", "lp", "links"], writes: ["hdr"])"#
+            ),
+            "hdr",
+        )
+        .unwrap();
+        let e = errors(
+            &format!(
+                r#"{PREPASS} Pass(name: "l", kind: LightLinkedList(scale: 8), reads: ["depth", "lg"])"#
+            ),
+            "hdr",
+        );
+        assert!(
+            e.contains("LightLinkedList needs a buffer in writes (slot 'light_links')"),
+            "{e}"
+        );
+        let e = errors(
+            r#"Pass(name: "pre", kind: DepthPrepass, writes: ["depth4"]), Pass(name: "l", kind: LightLinkedList(scale: 8), reads: ["depth4", "lg"], writes: ["links"])"#,
+            "hdr",
+        );
+        assert!(e.contains("single-sample depth"), "{e}");
+    }
+
+    #[test]
+    fn memory_matches_the_seed_table_at_8_bytes_and_costs_half_again_at_12() {
+        use super::{LightLinkedList, LinkLayout};
+        let l = LightLinkedList {
+            scale: 8,
+            links_per_pixel: 32,
+        }
+        .link_layout(1920, 1080);
+        // 240 × 135 list pixels, 32 links each.
+        assert_eq!((l.width, l.height, l.pool), (240, 135, 240 * 135 * 32));
+        let mib = |b: u64| b as f64 / (1024.0 * 1024.0);
+        // The seed's 8-byte links: 7.91 MiB; ours are 12 bytes.
+        assert!((mib(l.pool * 8) - 7.91).abs() < 0.005);
+        assert!((mib(l.pool_bytes()) - 11.87).abs() < 0.005);
+        assert_eq!(
+            l.bytes(),
+            4 * LinkLayout::HEADER_WORDS + 4 * 240 * 135 + l.pool_bytes()
+        );
+    }
+}
