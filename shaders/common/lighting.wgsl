@@ -4,6 +4,11 @@
 // Distances below 1 cm are clamped so a surface at a light's centre stays finite.
 const MIN_DISTANCE_SQ: f32 = 1e-4;
 
+// A virtual point light (VplSpawn): a cosine-weighted hemisphere about `direction`
+// (the surface it sits on emits like a Lambertian patch); `cos_inner` holds its distance
+// clamp, below which 1/d² stops growing; culled as a 90° spot light.
+const LIGHT_VPL: u32 = 4u;
+
 fn range_window(dist_sq: f32, range: f32) -> f32 {
     let r = dist_sq / (range * range);
     return clamp(1.0 - r * r, 0.0, 1.0);
@@ -33,6 +38,11 @@ fn incident_light(g: LightGeometry, p: LightProperties, pos: vec3<f32>) -> Incid
     let window = range_window(dist_sq, g.range);
     if (window <= 0.0) {
         out.radiance = vec3<f32>(0.0);
+        return out;
+    }
+    if ((p.flags & LIGHT_VPL) != 0u) {
+        let lobe = max(dot(g.direction, -out.dir), 0.0);
+        out.radiance = p.color * (lobe * window / max(dist_sq, p.cos_inner * p.cos_inner));
         return out;
     }
     let falloff = window / max(dist_sq, MIN_DISTANCE_SQ);

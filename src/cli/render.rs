@@ -298,6 +298,14 @@ fn shadow_report(scene: &Scene, gpu: &SceneGpu, result: &FrameResult) {
     for a in &result.atlases {
         atlas_report(a);
     }
+    for v in &result.vpls {
+        for line in v.lines() {
+            match line.strip_prefix("warning: ") {
+                Some(w) => eprintln!("warning: {w}"),
+                None => println!("  {line}"),
+            }
+        }
+    }
     for c in &result.shadow_compare {
         println!(
             "  {}: {} (pixel, light) pairs; the atlas disagrees with the rays on {:.3}% (5×5 PCF) and {:.3}% (2×2), {:.2}% in a 5×5 penumbra",

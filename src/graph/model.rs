@@ -3,9 +3,11 @@
 pub use super::kinds::deferred_shading::DeferredShading;
 pub use super::kinds::forward_shading::ForwardShading;
 pub use super::kinds::light_culling::LightCulling;
+pub use super::kinds::reflective_shadow_maps::ReflectiveShadowMaps;
 pub use super::kinds::shadow_atlas::ShadowAtlas;
 pub use super::kinds::shadow_ray_cast::ShadowRayCast;
 pub use super::kinds::shadow_ray_jobs::ShadowRayJobs;
+pub use super::kinds::vpl_spawn::VplSpawn;
 use serde::{Deserialize, Serialize};
 
 /// A whole graph file (`graphs/*.ron`).
@@ -277,6 +279,10 @@ pub enum PassKind {
     ShadowAtlas(ShadowAtlas),
     /// Counts (pixel, light) pairs where the atlas and ray-cast shadows disagree.
     ShadowCompare,
+    /// Reflective shadow maps of every indirect light (depth, normal, flux, position).
+    ReflectiveShadowMaps(ReflectiveShadowMaps),
+    /// Virtual point lights from the reflective shadow maps, appended to the lights.
+    VplSpawn(VplSpawn),
     /// A compute shader the graph file names; bindings are matched by name.
     Compute {
         shader: String,
@@ -311,6 +317,8 @@ impl PassKind {
             PassKind::ShadowAtlas(_) => "ShadowAtlas",
             PassKind::ShadowCompare => "ShadowCompare",
             PassKind::ShadowRayCast(_) => "ShadowRayCast",
+            PassKind::ReflectiveShadowMaps(_) => "ReflectiveShadowMaps",
+            PassKind::VplSpawn(_) => "VplSpawn",
             PassKind::Compute { .. } => "Compute",
             PassKind::Fullscreen { .. } => "Fullscreen",
         }

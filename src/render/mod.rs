@@ -22,7 +22,7 @@ pub use pipelines::{CacheCounters, Pipeline, PipelineCache, PipelineKey};
 pub use prepare_stats::PrepareStats;
 pub use report::{
     AtlasReport, CullingReport, FrameResult, LightStats, PassReport, ShadowCompareReport,
-    ShadowReport,
+    ShadowReport, VplReport,
 };
 pub use resources::FrameResources;
 pub use scene_gpu::{GpuBvh, GpuMesh, SceneGpu};
