@@ -223,7 +223,12 @@ fn fs_rsm(in: VertexOut) -> RsmOut {
         discard;
     }
 #endif
-    let inc = incident_light(g, light_properties[info.z], in.world);
+    let props = light_properties[info.z];
+    var inc = incident_light(g, props, in.world);
+    // A surface the light does not light reflects none of it.
+    if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
+        inc.radiance = vec3<f32>(0.0);
+    }
     let dist_sq = dot(to_light, to_light);
     let c = max(dot(axis, -inc.dir), 0.0);
     let flux = material_diffuse(m) * inc.radiance * (dist_sq * texel_solid_angle * c * c * c);

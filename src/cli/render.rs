@@ -270,6 +270,15 @@ fn overflow_report(result: &FrameResult) {
 
 /// What ray-cast shadows cast this frame: casters, rays, drops, memory, the BVH.
 fn shadow_report(scene: &Scene, gpu: &SceneGpu, result: &FrameResult) {
+    // Virtual lights: what was spawned, and what found no room (never silent).
+    for v in &result.vpls {
+        for line in v.lines() {
+            match line.strip_prefix("warning: ") {
+                Some(w) => eprintln!("warning: {w}"),
+                None => println!("  {line}"),
+            }
+        }
+    }
     let casters = scene
         .lights
         .iter()
@@ -297,14 +306,6 @@ fn shadow_report(scene: &Scene, gpu: &SceneGpu, result: &FrameResult) {
     }
     for a in &result.atlases {
         atlas_report(a);
-    }
-    for v in &result.vpls {
-        for line in v.lines() {
-            match line.strip_prefix("warning: ") {
-                Some(w) => eprintln!("warning: {w}"),
-                None => println!("  {line}"),
-            }
-        }
     }
     for c in &result.shadow_compare {
         println!(
