@@ -46,9 +46,15 @@ fn render(r: &mut Renderer, text: &str, scene: &Scene, w: u32, h: u32) -> Frame 
         lights: scene.lights.len() as u32,
     };
     let compiled = graph::compile(checked, &scene.features(), size);
-    let passes = compiled.pass_names().iter().map(|s| s.to_string()).collect();
+    let passes = compiled
+        .pass_names()
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
     let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, scene).expect("materials");
-    let prepared = r.prepare(compiled, scene, &gpu, size, false).expect("prepare");
+    let prepared = r
+        .prepare(compiled, scene, &gpu, size, false)
+        .expect("prepare");
     let result = prepared.render(r).expect("render");
     Frame {
         prepared,
@@ -68,7 +74,10 @@ fn redness(image: &[[f32; 4]], scene: &Scene, w: u32, h: u32, at: &[Vec3]) -> f3
         let py = ((1.0 - ndc.y) * 0.5 * h as f32) as i32;
         for dy in -1..=1 {
             for dx in -1..=1 {
-                let (x, y) = ((px + dx).clamp(0, w as i32 - 1), (py + dy).clamp(0, h as i32 - 1));
+                let (x, y) = (
+                    (px + dx).clamp(0, w as i32 - 1),
+                    (py + dy).clamp(0, h as i32 - 1),
+                );
                 let v = image[(y as u32 * w + x as u32) as usize];
                 r += v[0];
                 g += v[1];
@@ -100,8 +109,14 @@ fn vpls_bleed_the_red_wall_onto_the_floor_and_direct_light_does_not() {
     // The floor is one material, so its colour cancels: direct light alone leaves the two
     // sides within 1% (measured 1.0000001); the red wall's VPLs make its side at least 8%
     // redder than the green wall's (measured 1.131 on lavapipe, n = 4: 96 VPLs).
-    assert!((direct - 1.0).abs() < 0.01, "direct light only: red/green side {direct}");
-    assert!(vpl > 1.08, "with VPLs: red/green side {vpl} (direct only {direct})");
+    assert!(
+        (direct - 1.0).abs() < 0.01,
+        "direct light only: red/green side {direct}"
+    );
+    assert!(
+        vpl > 1.08,
+        "with VPLs: red/green side {vpl} (direct only {direct})"
+    );
 }
 
 #[test]
@@ -115,10 +130,7 @@ fn vpl_flux_sums_to_the_flux_the_maps_captured() {
     assert_eq!(v.dropped, 0);
     assert!(v.spawned > 100, "{v:?}");
     let texels = f.prepared.read_texture(&own, "rsm_flux").unwrap();
-    let captured: f64 = texels
-        .iter()
-        .map(|t| (t[0] + t[1] + t[2]) as f64)
-        .sum();
+    let captured: f64 = texels.iter().map(|t| (t[0] + t[1] + t[2]) as f64).sum();
     let props = f.prepared.read_buffer(&own, "light_properties").unwrap();
     let words: &[f32] = bytemuck::cast_slice(&props);
     let lights = s.lights.len();
@@ -131,7 +143,10 @@ fn vpl_flux_sums_to_the_flux_the_maps_captured() {
     }
     let rel = (spawned - captured).abs() / captured;
     assert!(captured > 0.0);
-    assert!(rel < 1e-3, "VPLs carry {spawned}, the maps captured {captured} (rel {rel})");
+    assert!(
+        rel < 1e-3,
+        "VPLs carry {spawned}, the maps captured {captured} (rel {rel})"
+    );
 }
 
 #[test]
@@ -141,7 +156,8 @@ fn a_full_room_drops_the_lowest_flux_vpls_and_counts_them() {
     let mut own = renderer();
     let all = render(&mut own, &graph_text("indirect_vpl.ron"), &s, w, h);
     let room = 40;
-    let text = graph_text("indirect_vpl.ron").replace("max_vpls: 16384", &format!("max_vpls: {room}"));
+    let text =
+        graph_text("indirect_vpl.ron").replace("max_vpls: 16384", &format!("max_vpls: {room}"));
     let full = render(&mut own, &text, &s, w, h);
     let (a, f) = (&all.result.vpls[0], &full.result.vpls[0]);
     assert_eq!(a.dropped, 0);
@@ -163,7 +179,9 @@ fn a_full_room_drops_the_lowest_flux_vpls_and_counts_them() {
     // Exactly the brightest `room` of them survive.
     assert_eq!(kept, every[..room as usize].to_vec());
     // And render warns (the CLI prints this line).
-    assert!(f.lines().iter().any(|l| l.contains("40 VPLs dropped") || l.contains(&format!("{} VPLs dropped", f.dropped))));
+    assert!(f.lines().iter().any(
+        |l| l.contains("40 VPLs dropped") || l.contains(&format!("{} VPLs dropped", f.dropped))
+    ));
 }
 
 #[test]
@@ -174,7 +192,11 @@ fn a_scene_without_indirect_lights_runs_no_rsm_pass_and_renders_as_forward_plus(
     assert!(!s.features().has_indirect_lights);
     let mut r = renderer();
     let vpl = render(&mut r, &graph_text("indirect_vpl.ron"), &s, w, h);
-    assert!(!vpl.passes.iter().any(|p| p == "rsm" || p == "vpl_spawn"), "{:?}", vpl.passes);
+    assert!(
+        !vpl.passes.iter().any(|p| p == "rsm" || p == "vpl_spawn"),
+        "{:?}",
+        vpl.passes
+    );
     assert!(vpl.result.vpls.is_empty());
     let plain = render(&mut r, &graph_text("forward_plus.ron"), &s, w, h);
     assert_eq!(vpl.result.image, plain.result.image);
@@ -189,7 +211,10 @@ fn vpls_are_culled_like_any_light_the_culled_image_equals_every_light() {
     let s = cornell(4);
     let text = graph_text("indirect_vpl.ron");
     let brute = text
-        .replace("ForwardShading(lights: Culled)", "ForwardShading(lights: AllLights)")
+        .replace(
+            "ForwardShading(lights: Culled)",
+            "ForwardShading(lights: AllLights)",
+        )
         .replace(
             r#"reads: ["geometry", "depth", "light_geometry", "light_properties", "light_lists"],"#,
             r#"reads: ["geometry", "depth", "light_geometry", "light_properties"],"#,
@@ -200,7 +225,10 @@ fn vpls_are_culled_like_any_light_the_culled_image_equals_every_light() {
     let all = render(&mut r, &brute, &s, w, h);
     assert_eq!(culled.result.culling[0].overflowed_lists, 0);
     let (d, at) = common::max_rel_diff(&culled.result.image, &all.result.image);
-    assert!(d < 1e-5, "culled and all-lights VPL images differ by {d} at {at}");
+    assert!(
+        d < 1e-5,
+        "culled and all-lights VPL images differ by {d} at {at}"
+    );
     // The VPLs did light something: the two differ from the direct-only frame.
     let direct = render(&mut r, &graph_text("forward_plus.ron"), &s, w, h);
     let (d, _) = common::max_rel_diff(&culled.result.image, &direct.result.image);

@@ -24,6 +24,7 @@ struct Row {
     dropped: u32,
     overflowed_lists: u32,
     rel_mse: f64,
+    energy: f64,
     frame_ms: Option<f64>,
     pass_ms: Vec<Option<f64>>,
 }
@@ -100,7 +101,10 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
             .filter(|&i| base.lights[i].flags & light_flags::INDIRECT != 0)
             .collect();
         if indirect.is_empty() {
-            bail!("{}: no light is marked indirect: true", scene_path.display());
+            bail!(
+                "{}: no light is marked indirect: true",
+                scene_path.display()
+            );
         }
         let t = std::time::Instant::now();
         let reference = OneBounce::new(&base)?.image(w, h, args.samples);
@@ -112,7 +116,7 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
         let (direct, _) = frame(&mut renderer, &direct_path, &base, w, h, 1)?;
         let _ = writeln!(
             md,
-            "## {} ({} indirect lights; reference {reference_s:.1} s on the CPU)\n\n| n | VPLs | dropped | lists overflowed (timed graph) | rel. MSE | VPL passes (ms) | rsm | spawn | culling | shading |\n|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|",
+            "## {} ({} indirect lights; reference {reference_s:.1} s on the CPU)\n\n| n | VPLs | dropped | lists overflowed (timed graph) | rel. MSE | Σvpl/Σref | VPL passes (ms) | rsm | spawn | culling | shading |\n|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|",
             base.name,
             indirect.len()
         );
@@ -130,7 +134,11 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
                 .first()
                 .with_context(|| format!("{} ran no VplSpawn pass", graph_path.display()))?;
             let (measured, _) = frame(&mut renderer, &error_path, &scene, w, h, 0)?;
-            let e = relative_mse(&indirect_part(&measured.image, &direct.image), &reference);
+            let vpl_image = indirect_part(&measured.image, &direct.image);
+            let e = relative_mse(&vpl_image, &reference);
+            // Total indirect light of the VPL image over the reference's: bias, apart from noise.
+            let total = |v: &[glam::Vec3]| v.iter().map(|p| (p.x + p.y + p.z) as f64).sum::<f64>();
+            let energy = total(&vpl_image) / total(&reference).max(1e-30);
             let overflowed_lists: u32 = result.culling.iter().map(|c| c.overflowed_lists).sum();
             let pass_ms: Vec<Option<f64>> = PASSES
                 .iter()
@@ -157,7 +165,7 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
             let ms = |x: Option<f64>| x.map_or("–".to_string(), |x| format!("{x:.3}"));
             let _ = writeln!(
                 md,
-                "| {n} | {} | {} | {overflowed_lists} | {e:.4} | {} | {} | {} | {} | {} |",
+                "| {n} | {} | {} | {overflowed_lists} | {e:.4} | {energy:.3} | {} | {} | {} | {} | {} |",
                 v.spawned,
                 v.dropped,
                 ms(frame_ms),
@@ -167,7 +175,7 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
                 ms(pass_ms[3])
             );
             println!(
-                "{} n={n}: {} VPLs ({} dropped, {overflowed_lists} lists overflowed), relative MSE {e:.4}, VPL passes {} ms",
+                "{} n={n}: {} VPLs ({} dropped, {overflowed_lists} lists overflowed), relative MSE {e:.4}, energy {energy:.3} of the reference's, VPL passes {} ms",
                 base.name,
                 v.spawned,
                 v.dropped,
@@ -180,6 +188,7 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
                 dropped: v.dropped,
                 overflowed_lists,
                 rel_mse: e,
+                energy,
                 frame_ms,
                 pass_ms,
             });
@@ -187,21 +196,26 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
         md.push('\n');
     }
     let mut csv = String::from(
-        "scene,n,vpls,dropped,overflowed_lists,rel_mse,vpl_passes_ms,rsm_ms,spawn_ms,culling_ms,shading_ms\n",
+        "scene,n,vpls,dropped,overflowed_lists,rel_mse,energy_ratio,vpl_passes_ms,rsm_ms,spawn_ms,culling_ms,shading_ms\n",
     );
     let opt = |x: Option<f64>| x.map_or(String::new(), |x| format!("{x:.4}"));
     for r in &rows {
         let _ = writeln!(
             csv,
-            "{},{},{},{},{},{:.6},{},{}",
+            "{},{},{},{},{},{:.6},{:.4},{},{}",
             r.scene,
             r.n,
             r.vpls,
             r.dropped,
             r.overflowed_lists,
             r.rel_mse,
+            r.energy,
             opt(r.frame_ms),
-            r.pass_ms.iter().map(|x| opt(*x)).collect::<Vec<_>>().join(",")
+            r.pass_ms
+                .iter()
+                .map(|x| opt(*x))
+                .collect::<Vec<_>>()
+                .join(",")
         );
     }
     std::fs::write(args.out.join("results.csv"), csv)?;
@@ -210,7 +224,10 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
     for r in rows.iter().filter(|r| r.frame_ms.is_some()) {
         match series.iter_mut().find(|(s, _)| *s == r.scene) {
             Some((_, pts)) => pts.push((r.rel_mse, r.frame_ms.unwrap_or(0.0))),
-            None => series.push((r.scene.clone(), vec![(r.rel_mse, r.frame_ms.unwrap_or(0.0))])),
+            None => series.push((
+                r.scene.clone(),
+                vec![(r.rel_mse, r.frame_ms.unwrap_or(0.0))],
+            )),
         }
     }
     if series.is_empty() {

@@ -6,8 +6,8 @@
 //! pass (`material::reference::eval`), the VPL controls' intensity scale and receiver
 //! mask applied; no range window or distance clamp (those are the VPLs' approximations).
 
-use crate::material::reference::{self as brdf, Surface};
 use crate::material::model::Lobe;
+use crate::material::reference::{self as brdf, Surface};
 use crate::material::Material;
 use crate::scene::{light_flags, Light, LightShape, Scene};
 use crate::shadow::ShadowBvh;
@@ -61,7 +61,9 @@ impl<'a> OneBounce<'a> {
                 let mut diffuse = Vec3::ZERO;
                 for layer in &material.desc().layers {
                     for lobe in &layer.lobes {
-                        if let Lobe::Lambert { color, weight } | Lobe::OrenNayar { color, weight, .. } = lobe {
+                        if let Lobe::Lambert { color, weight }
+                        | Lobe::OrenNayar { color, weight, .. } = lobe
+                        {
                             let c = brdf::color(color, &at);
                             diffuse += Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32) * *weight;
                         }
@@ -126,8 +128,18 @@ impl<'a> OneBounce<'a> {
                     let q = s.cross(e1);
                     let v = dir.dot(q) / det;
                     let t = e2.dot(q) / det;
-                    if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0 && t < best.as_ref().map_or(t_max, |h| h.t) {
-                        best = Some(Hit { t, id: tri.id, u, v });
+                    if u >= 0.0
+                        && v >= 0.0
+                        && u + v <= 1.0
+                        && t > 0.0
+                        && t < best.as_ref().map_or(t_max, |h| h.t)
+                    {
+                        best = Some(Hit {
+                            t,
+                            id: tri.id,
+                            u,
+                            v,
+                        });
                     }
                 }
             } else {
@@ -149,14 +161,23 @@ impl<'a> OneBounce<'a> {
             .cross(mesh.positions[c] - mesh.positions[a])
             .normalize_or_zero();
         let ng = if ng.dot(dir) > 0.0 { -ng } else { ng };
-        let n = match (mesh.normals.get(a), mesh.normals.get(b), mesh.normals.get(c)) {
+        let n = match (
+            mesh.normals.get(a),
+            mesh.normals.get(b),
+            mesh.normals.get(c),
+        ) {
             (Some(&na), Some(&nb), Some(&nc)) => {
                 (na * (1.0 - h.u - h.v) + nb * h.u + nc * h.v).normalize_or(ng)
             }
             _ => ng,
         };
         let n = if n.dot(ng) < 0.0 { -n } else { n };
-        (p, n, ng, mesh.material.min(self.materials.len().saturating_sub(1)))
+        (
+            p,
+            n,
+            ng,
+            mesh.material.min(self.materials.len().saturating_sub(1)),
+        )
     }
 
     /// Direct light of indirect light `l` reflected diffusely at y, as radiance.
@@ -193,7 +214,10 @@ impl<'a> OneBounce<'a> {
             return Vec3::ZERO;
         }
         let eps = 1e-4 * y.abs().max_element().max(1.0);
-        if self.bvh.occluded(y + ng * eps, dir, dist_sq.sqrt() - 2.0 * eps) {
+        if self
+            .bvh
+            .occluded(y + ng * eps, dir, dist_sq.sqrt() - 2.0 * eps)
+        {
             return Vec3::ZERO;
         }
         let radiance = l.color * l.intensity * (window * spot / dist_sq.max(1e-4));

@@ -68,7 +68,11 @@ pub fn light_views(l: &Light) -> Vec<(Mat4, Vec3, f32)> {
             outer_angle,
             ..
         } if outer_angle <= 60f32.to_radians() => {
-            vec![view(direction.normalize_or_zero(), Vec3::Y, outer_angle.max(1e-3))]
+            vec![view(
+                direction.normalize_or_zero(),
+                Vec3::Y,
+                outer_angle.max(1e-3),
+            )]
         }
         _ => FACES
             .iter()
@@ -102,8 +106,9 @@ pub fn layout(scene: &Scene, tile: u32, width: u32, height: u32, max_lights: u32
             continue;
         }
         if out.lights >= max_lights {
-            out.dropped
-                .push(drop(format!("over max_lights {max_lights} indirect lights")));
+            out.dropped.push(drop(format!(
+                "over max_lights {max_lights} indirect lights"
+            )));
             continue;
         }
         if out.views.len() + views.len() > cells as usize {
@@ -135,7 +140,13 @@ pub fn layout(scene: &Scene, tile: u32, width: u32, height: u32, max_lights: u32
 
 /// The view table the map and spawn shaders read (`VIEW_VEC4S` vec4 a view after a
 /// header of (views, tile, width, height)), as u32 words.
-pub fn view_table(layout: &RsmLayout, tile: u32, width: u32, height: u32, max_views: u64) -> Vec<[u32; 4]> {
+pub fn view_table(
+    layout: &RsmLayout,
+    tile: u32,
+    width: u32,
+    height: u32,
+    max_views: u64,
+) -> Vec<[u32; 4]> {
     use crate::graph::kinds::reflective_shadow_maps::VIEW_VEC4S;
     let mut t = vec![[0u32; 4]; 1 + (VIEW_VEC4S * max_views) as usize];
     t[0] = [layout.views.len() as u32, tile, width, height];

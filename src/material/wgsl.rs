@@ -299,7 +299,9 @@ pub fn generate(m: &Material, opts: &WgslOptions) -> String {
     o.push_str("    return acc * min(cos_l, 1.0);\n}\n\n");
     // What a reflective shadow map bounces: the diffuse lobes' colour (specular lobes are
     // not bounced), summed over layers.
-    o.push_str("fn material_diffuse(m: MaterialSample) -> vec3<f32> {\n    var acc = vec3<f32>(0.0);\n");
+    o.push_str(
+        "fn material_diffuse(m: MaterialSample) -> vec3<f32> {\n    var acc = vec3<f32>(0.0);\n",
+    );
     for (i, layer) in desc.layers.iter().enumerate() {
         for (j, lobe) in layer.lobes.iter().enumerate() {
             if matches!(lobe, Lobe::Lambert { .. } | Lobe::OrenNayar { .. }) {

@@ -170,24 +170,24 @@ pub struct VplReport {
 impl VplReport {
     pub fn lines(&self) -> Vec<String> {
         let v = self;
-    let mut lines = vec![format!(
+        let mut lines = vec![format!(
         "{}: {} indirect lights, {} map views, {} VPLs spawned of {} candidates with flux ({} blocks); room {}",
         v.pass, v.lights, v.views, v.spawned, v.with_flux, v.candidates, v.room
     )];
-    if v.dropped > 0 {
-        lines.push(format!(
-            "warning: {}: {} VPLs dropped (lowest flux first): max_vpls {} is full",
-            v.pass, v.dropped, v.room
-        ));
+        if v.dropped > 0 {
+            lines.push(format!(
+                "warning: {}: {} VPLs dropped (lowest flux first): max_vpls {} is full",
+                v.pass, v.dropped, v.room
+            ));
+        }
+        for crate::indirect::rsm_views::DroppedRsmLight { light, reason } in &v.dropped_lights {
+            lines.push(format!(
+                "warning: {}: indirect light {light} spawns no VPLs: {reason}",
+                v.pass
+            ));
+        }
+        lines
     }
-    for crate::indirect::rsm_views::DroppedRsmLight { light, reason } in &v.dropped_lights {
-        lines.push(format!(
-            "warning: {}: indirect light {light} spawns no VPLs: {reason}",
-            v.pass
-        ));
-    }
-    lines
-}
 }
 
 /// What a pass counted on the GPU (or decided on the CPU for this frame).

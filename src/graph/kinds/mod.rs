@@ -173,7 +173,9 @@ impl BufferLayout {
             BufferLayout::ShadowJobs { capacity } => shadow_ray_jobs::job_buffer_bytes(*capacity),
             BufferLayout::ShadowMask { pixels } => 4 * shadow_ray_jobs::MASK_WORDS * pixels,
             BufferLayout::Lights { lights, stride } => (*lights).max(1) * stride,
-            BufferLayout::RsmViews { max_views } => reflective_shadow_maps::view_table_bytes(*max_views),
+            BufferLayout::RsmViews { max_views } => {
+                reflective_shadow_maps::view_table_bytes(*max_views)
+            }
             BufferLayout::ShadowViews {
                 lights, max_views, ..
             } => shadow_atlas::view_table_bytes(*lights, *max_views),

@@ -166,7 +166,10 @@ mod tests {
         let e = errors(&PASSES.replace("RSM", "tile: 512"), "hdr");
         assert!(e.contains("not a whole number of 512-texel tiles"), "{e}");
         let e = errors(
-            &PASSES.replace("RSM", "").replace("\"rsm_flux\", \"rsm_position\", \"rsm_views\"]", "\"small\", \"rsm_position\", \"rsm_views\"]"),
+            &PASSES.replace("RSM", "").replace(
+                "\"rsm_flux\", \"rsm_position\", \"rsm_views\"]",
+                "\"small\", \"rsm_position\", \"rsm_views\"]",
+            ),
             "hdr",
         );
         assert!(e.contains("fixed size"), "{e}");

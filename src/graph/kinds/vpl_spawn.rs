@@ -76,10 +76,7 @@ pub const SLOTS: &[SlotSpec] = &[
 
 pub fn check(p: &VplSpawn, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     if !(1..=MAX_VPLS).contains(&p.max_vpls) {
-        errors.push(ctx.bad(format!(
-            "max_vpls {} must be in 1..={MAX_VPLS}",
-            p.max_vpls
-        )));
+        errors.push(ctx.bad(format!("max_vpls {} must be in 1..={MAX_VPLS}", p.max_vpls)));
     }
     for s in [RSM_NORMAL, RSM_FLUX, RSM_POSITION] {
         if let Some(name) = ctx.slot(s) {
@@ -108,6 +105,9 @@ mod tests {
             r#"Pass(name: "v", kind: VplSpawn(), reads: ["rsm_normal", "rsm_flux", "small", "rsm_views", "lg", "lp"], writes: ["light_geometry", "light_properties"])"#,
             "hdr",
         );
-        assert!(e.contains("slot 'rsm_position' takes a single-sample Rgba32Float"), "{e}");
+        assert!(
+            e.contains("slot 'rsm_position' takes a single-sample Rgba32Float"),
+            "{e}"
+        );
     }
 }

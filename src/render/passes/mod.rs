@@ -56,9 +56,7 @@ pub(super) fn prepare(
         PassKind::ShadowRayCast(p) => Box::new(shadow_ray_cast::prepare(cx, sp, p)?),
         PassKind::ShadowAtlas(p) => Box::new(shadow_atlas::prepare(cx, sp, p)?),
         PassKind::ShadowCompare => Box::new(shadow_compare::prepare(cx, sp)?),
-        PassKind::ReflectiveShadowMaps(p) => {
-            Box::new(reflective_shadow_maps::prepare(cx, sp, p)?)
-        }
+        PassKind::ReflectiveShadowMaps(p) => Box::new(reflective_shadow_maps::prepare(cx, sp, p)?),
         PassKind::VplSpawn(p) => Box::new(vpl_spawn::prepare(cx, sp, p)?),
         PassKind::Compute {
             shader,
@@ -160,14 +158,20 @@ impl PrepareCtx<'_> {
     fn scene_lights_instead(&self, slot: &str, name: &str) -> Option<Bound> {
         use crate::graph::slot::{LIGHT_GEOMETRY, LIGHT_PROPERTIES};
         let is_buffer = matches!(
-            self.graph.checked.desc.resources.iter().find(|r| r.name() == name),
+            self.graph
+                .checked
+                .desc
+                .resources
+                .iter()
+                .find(|r| r.name() == name),
             Some(ResourceDesc::Buffer { .. })
         );
-        let written = self
-            .graph
-            .passes
-            .iter()
-            .any(|p| self.graph.checked.desc.passes[p.index].writes.iter().any(|w| w == name));
+        let written = self.graph.passes.iter().any(|p| {
+            self.graph.checked.desc.passes[p.index]
+                .writes
+                .iter()
+                .any(|w| w == name)
+        });
         if !is_buffer || written {
             return None;
         }

@@ -84,7 +84,11 @@ pub(super) fn prepare(
         tile: p.tile,
         origins: l.views.iter().map(|v| (v.x, v.y)).collect(),
         depth: target(RSM_DEPTH)?,
-        targets: [target(RSM_NORMAL)?, target(RSM_FLUX)?, target(RSM_POSITION)?],
+        targets: [
+            target(RSM_NORMAL)?,
+            target(RSM_FLUX)?,
+            target(RSM_POSITION)?,
+        ],
         views,
         staging,
         table_bytes,

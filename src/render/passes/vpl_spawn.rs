@@ -141,7 +141,8 @@ pub(super) fn prepare(
 }
 
 /// Where the frame uniform keeps the light count.
-const LIGHT_COUNT_OFFSET: u64 = std::mem::offset_of!(crate::gpu::structs::GpuFrame, light_count) as u64;
+const LIGHT_COUNT_OFFSET: u64 =
+    std::mem::offset_of!(crate::gpu::structs::GpuFrame, light_count) as u64;
 
 impl PreparedPass for VplSpawnPass {
     fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
@@ -172,4 +173,3 @@ impl PreparedPass for VplSpawnPass {
         Ok(Some(PassReport::Vpl(report)))
     }
 }
-
