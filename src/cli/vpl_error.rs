@@ -29,6 +29,9 @@ struct Row {
     pass_ms: Vec<Option<f64>>,
 }
 
+/// One frame's GPU time per pass (ms).
+type PassTimes = Vec<(String, f64)>;
+
 fn median(mut v: Vec<f64>) -> Option<f64> {
     if v.is_empty() {
         return None;
@@ -44,7 +47,7 @@ fn frame(
     w: u32,
     h: u32,
     frames: u32,
-) -> Result<(lightgraph::render::FrameResult, Vec<Vec<(String, f64)>>)> {
+) -> Result<(lightgraph::render::FrameResult, Vec<PassTimes>)> {
     let checked = assets::check_graph(graph_path, &ShaderLibrary::builtin())?;
     let size = FrameSize {
         width: w,

@@ -98,7 +98,7 @@ pub fn layout(scene: &Scene, tile: u32, width: u32, height: u32, max_lights: u32
             light: i as u32,
             reason,
         };
-        if controls.n > tile || tile % controls.n != 0 {
+        if controls.n == 0 || controls.n > tile || !tile.is_multiple_of(controls.n) {
             out.dropped.push(drop(format!(
                 "vpl n {} does not divide the {tile}-texel RSM tile",
                 controls.n

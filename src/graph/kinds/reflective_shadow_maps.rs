@@ -125,7 +125,12 @@ pub fn check(p: &ReflectiveShadowMaps, ctx: &KindCtx, errors: &mut Vec<GraphErro
                 if slot != RSM_DEPTH && format != TextureFormat::Rgba32Float {
                     errors.push(ctx.mismatch(name, format!("slot '{slot}' takes an Rgba32Float texture")));
                 }
-                if w % p.tile != 0 || h % p.tile != 0 || w < p.tile || h < p.tile {
+                if p.tile == 0
+                    || !w.is_multiple_of(p.tile)
+                    || !h.is_multiple_of(p.tile)
+                    || w < p.tile
+                    || h < p.tile
+                {
                     errors.push(ctx.mismatch(
                         name,
                         format!("{w}×{h} is not a whole number of {}-texel tiles", p.tile),
@@ -161,6 +166,7 @@ mod tests {
     #[test]
     fn checks_parameters_and_textures() {
         let e = errors(&PASSES.replace("RSM", "tile: 24, max_lights: 0"), "hdr");
+        assert!(errors(&PASSES.replace("RSM", "tile: 0"), "hdr").contains("tile 0 must be"));
         assert!(e.contains("tile 24 must be a power of two"), "{e}");
         assert!(e.contains("max_lights 0 must be in 1..=4096"), "{e}");
         let e = errors(&PASSES.replace("RSM", "tile: 512"), "hdr");
