@@ -283,12 +283,22 @@ impl<'a> OneBounce<'a> {
         sum / samples as f32
     }
 
-    /// The whole indirect image, row-major.
+    /// The whole indirect image, row-major, rows shared among the machine's cores.
     pub fn image(&self, width: u32, height: u32, samples: u32) -> Vec<Vec3> {
-        (0..height)
-            .flat_map(|y| (0..width).map(move |x| (x, y)))
-            .map(|(x, y)| self.pixel(x, y, width, height, samples))
-            .collect()
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let mut out = vec![Vec3::ZERO; (width * height) as usize];
+        let rows_each = (height as usize).div_ceil(threads).max(1);
+        std::thread::scope(|s| {
+            for (chunk, rows) in out.chunks_mut(rows_each * width as usize).enumerate() {
+                s.spawn(move || {
+                    for (k, p) in rows.iter_mut().enumerate() {
+                        let y = (chunk * rows_each + k / width as usize) as u32;
+                        *p = self.pixel(k as u32 % width, y, width, height, samples);
+                    }
+                });
+            }
+        });
+        out
     }
 }
 
