@@ -110,16 +110,34 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
             );
         }
         let t = std::time::Instant::now();
-        let reference = OneBounce::new(&base)?.image(w, h, args.samples);
+        let tracer = OneBounce::new(&base)?;
+        let reference = tracer.image(w, h, args.samples);
         let reference_s = t.elapsed().as_secs_f64();
+        // Its own noise: half the relative MSE between it and an independent estimate
+        // (the two differ by twice one's variance); a VPL image's relative MSE includes it.
+        let noise = relative_mse(&tracer.image_seeded(w, h, args.samples, 1), &reference) / 2.0;
         eprintln!(
-            "{}: reference ({} samples) in {reference_s:.1} s",
+            "{}: reference ({} samples) in {reference_s:.1} s, its noise {noise:.4} (relative MSE)",
             base.name, args.samples
         );
         let (direct, _) = frame(&mut renderer, &direct_path, &base, w, h, 1)?;
+        let to_rgb = |v: &[glam::Vec3]| {
+            v.iter()
+                .map(|p| p.max(glam::Vec3::ZERO).to_array())
+                .collect::<Vec<[f32; 3]>>()
+        };
+        // The indirect images, two stops up (they are dim beside direct light).
+        let tonemap = lightgraph::bench::Tonemap::new(2.0, lightgraph::bench::ToneCurve::Reinhard);
+        lightgraph::bench::write_png_tonemapped(
+            args.out.join(format!("{}_reference.png", base.name)),
+            &to_rgb(&reference),
+            w,
+            h,
+            &tonemap,
+        )?;
         let _ = writeln!(
             md,
-            "## {} ({} indirect lights; reference {reference_s:.1} s on the CPU)\n\n| n | VPLs | dropped | lists overflowed (timed graph) | rel. MSE | Σvpl/Σref | VPL passes (ms) | rsm | spawn | culling | shading |\n|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|",
+            "## {} ({} indirect lights; reference {reference_s:.1} s on the CPU; its own noise: relative MSE {noise:.4})\n\n| n | VPLs | dropped | lists overflowed (timed graph) | rel. MSE | Σvpl/Σref | VPL passes (ms) | rsm | spawn | culling | shading |\n|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|",
             base.name,
             indirect.len()
         );
@@ -139,6 +157,13 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
             let (measured, _) = frame(&mut renderer, &error_path, &scene, w, h, 0)?;
             let vpl_image = indirect_part(&measured.image, &direct.image);
             let e = relative_mse(&vpl_image, &reference);
+            lightgraph::bench::write_png_tonemapped(
+                args.out.join(format!("{}_vpl_n{n}.png", base.name)),
+                &to_rgb(&vpl_image),
+                w,
+                h,
+                &tonemap,
+            )?;
             // Total indirect light of the VPL image over the reference's: bias, apart from noise.
             let total = |v: &[glam::Vec3]| v.iter().map(|p| (p.x + p.y + p.z) as f64).sum::<f64>();
             let energy = total(&vpl_image) / total(&reference).max(1e-30);

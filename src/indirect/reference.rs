@@ -227,6 +227,19 @@ impl<'a> OneBounce<'a> {
     /// Indirect radiance towards the camera at pixel (px, py) of a `width`×`height`
     /// frame, with `samples` cosine-weighted bounce rays.
     pub fn pixel(&self, px: u32, py: u32, width: u32, height: u32, samples: u32) -> Vec3 {
+        self.pixel_seeded(px, py, width, height, samples, 0)
+    }
+
+    /// [`Self::pixel`] with its random numbers drawn from `seed`'s sequence.
+    pub fn pixel_seeded(
+        &self,
+        px: u32,
+        py: u32,
+        width: u32,
+        height: u32,
+        samples: u32,
+        seed: u64,
+    ) -> Vec3 {
         let cam = &self.scene.camera;
         let inv: Mat4 = (cam.projection(width as f32 / height as f32) * cam.view()).inverse();
         let ndc = glam::Vec2::new(
@@ -244,7 +257,8 @@ impl<'a> OneBounce<'a> {
         let (t, b) = n.any_orthonormal_pair();
         let eps = 1e-4 * x.abs().max_element().max(1.0);
         let side = (samples as f32).sqrt().ceil() as u32;
-        let mut rng = (px as u64) << 32 ^ py as u64 ^ 0x9e37_79b9_7f4a_7c15;
+        let mut rng = ((px as u64) << 32 ^ py as u64 ^ 0x9e37_79b9_7f4a_7c15)
+            .wrapping_add(seed.wrapping_mul(0xd1b5_4a32_d192_ed03));
         let mut sum = Vec3::ZERO;
         let to64 = |a: Vec3| [a.x as f64, a.y as f64, a.z as f64];
         for k in 0..samples {
@@ -285,6 +299,12 @@ impl<'a> OneBounce<'a> {
 
     /// The whole indirect image, row-major, rows shared among the machine's cores.
     pub fn image(&self, width: u32, height: u32, samples: u32) -> Vec<Vec3> {
+        self.image_seeded(width, height, samples, 0)
+    }
+
+    /// [`Self::image`] with another random sequence: two seeds give independent estimates,
+    /// whose difference measures the reference's own noise.
+    pub fn image_seeded(&self, width: u32, height: u32, samples: u32, seed: u64) -> Vec<Vec3> {
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
         let mut out = vec![Vec3::ZERO; (width * height) as usize];
         let rows_each = (height as usize).div_ceil(threads).max(1);
@@ -293,7 +313,7 @@ impl<'a> OneBounce<'a> {
                 s.spawn(move || {
                     for (k, p) in rows.iter_mut().enumerate() {
                         let y = (chunk * rows_each + k / width as usize) as u32;
-                        *p = self.pixel(k as u32 % width, y, width, height, samples);
+                        *p = self.pixel_seeded(k as u32 % width, y, width, height, samples, seed);
                     }
                 });
             }
