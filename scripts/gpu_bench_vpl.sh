@@ -3,8 +3,8 @@
 #  1. the indirect_vpl sweep: the built-in atrium (1,024 lights) at 1920x1080 with 1, 8
 #     and 32 indirect spot lights of 256 VPLs each, per-pass GPU medians of 20 frames for
 #     the maps (rsm), the spawn (vpl_spawn), culling and shading, and Forward+ without
-#     VPLs on the same scenes;
-#  2. single renders of those scenes through graphs/indirect_vpl.ron (PNG, and render's
+#     VPLs on the same scenes; tiled deferred with and without VPLs likewise;
+#  2. single renders of those scenes through both VPL graphs (PNG, and render's
 #     VPL and culling lines: spawned, dropped, lists overflowed);
 #  3. the error sweep `lightgraph vpl-error`: the Cornell box and the atrium at 1920x1080,
 #     n = 4, 8, 16, 32 (N² = 16 ... 1024 VPLs a view) against the CPU path-traced bounce
@@ -23,8 +23,10 @@ lg=./.gpu/lightgraph
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv > "$out/gpu.txt" 2>&1
 for k in 1 8 32; do
     s=benches/scenes/atrium_indirect_$k.ron
-    $lg render --scene "$s" --graph graphs/indirect_vpl.ron --out "$out/atrium_indirect_$k.png" \
-        > "$out/render_atrium_indirect_$k.txt" 2>&1
+    for g in indirect_vpl tiled_deferred_indirect_vpl; do
+        $lg render --scene "$s" --graph graphs/$g.ron --out "$out/atrium_indirect_${k}_$g.png" \
+            > "$out/render_atrium_indirect_${k}_$g.txt" 2>&1
+    done
 done
 timeout 200 $lg bench --sweep benches/sweeps/indirect_vpl.ron --out "$out/indirect_vpl" > "$out/indirect_vpl.log" 2>&1
 timeout 330 $lg vpl-error --scene scenes/cornell_indirect.ron scenes/atrium_indirect.ron \
