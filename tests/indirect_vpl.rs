@@ -336,11 +336,23 @@ fn tiled_deferred_with_vpls_agrees_with_forward_plus() {
     let s = cornell(4);
     let mut r = renderer();
     let forward = render(&mut r, &graph_text("indirect_vpl.ron"), &s, w, h);
-    let deferred = render(&mut r, &graph_text("tiled_deferred_indirect_vpl.ron"), &s, w, h);
-    assert_eq!(deferred.result.vpls[0].spawned, forward.result.vpls[0].spawned);
+    let deferred = render(
+        &mut r,
+        &graph_text("tiled_deferred_indirect_vpl.ron"),
+        &s,
+        w,
+        h,
+    );
+    assert_eq!(
+        deferred.result.vpls[0].spawned,
+        forward.result.vpls[0].spawned
+    );
     assert!(deferred.result.vpls[0].spawned > 0);
     // Same lights, lists and light loop; the G-buffer's interpolated position differs from
     // the forward pass's by float rounding only (measured 3.4e-8 RMSE at 160×120).
     let (d, at) = common::max_rel_diff(&deferred.result.image, &forward.result.image);
-    assert!(d < 1e-4, "deferred and Forward+ VPL frames differ by {d} at {at}");
+    assert!(
+        d < 1e-4,
+        "deferred and Forward+ VPL frames differ by {d} at {at}"
+    );
 }
