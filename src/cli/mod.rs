@@ -125,9 +125,10 @@ pub struct VplErrorArgs {
     /// graphs/forward_plus.ron).
     #[arg(long)]
     pub direct: Option<PathBuf>,
-    /// Output size.
+    /// Output width.
     #[arg(long, default_value_t = 160)]
     pub width: u32,
+    /// Output height.
     #[arg(long, default_value_t = 120)]
     pub height: u32,
     /// VPLs per side of each map view (N² = 16, 64, 256, 1024 VPLs a view).

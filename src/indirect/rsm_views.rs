@@ -165,3 +165,92 @@ pub fn view_table(
     }
     t
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::light_flags::INDIRECT;
+
+    fn scene(lights: &[(LightShape, u32)]) -> Scene {
+        let mut s = Scene::default();
+        for (i, (shape, n)) in lights.iter().enumerate() {
+            let mut l = Light::point(Vec3::ZERO, 5.0, Vec3::ONE, 1.0);
+            l.shape = *shape;
+            l.flags = INDIRECT;
+            s.lights.push(l);
+            s.vpl_controls.insert(
+                i as u32,
+                VplControls {
+                    n: *n,
+                    ..Default::default()
+                },
+            );
+        }
+        // A light that is not indirect gets no views.
+        s.lights.push(Light::point(Vec3::ONE, 5.0, Vec3::ONE, 1.0));
+        s
+    }
+
+    const SPOT: LightShape = LightShape::Spot {
+        direction: Vec3::NEG_Y,
+        inner_angle: 0.3,
+        outer_angle: 0.6,
+    };
+
+    #[test]
+    fn spots_take_one_tile_points_six_and_a_full_atlas_drops_with_its_reason() {
+        // 64×64 of 32-texel tiles: four tiles.
+        let s = scene(&[(SPOT, 8), (LightShape::Point, 4), (SPOT, 2), (SPOT, 32)]);
+        let l = layout(&s, 32, 64, 64, 64);
+        // The spot fits, the point light's six views do not, the next spots fill the rest.
+        assert_eq!(
+            l.views.iter().map(|v| v.light).collect::<Vec<_>>(),
+            [0, 2, 3]
+        );
+        assert_eq!(l.dropped.len(), 1);
+        assert_eq!(l.dropped[0].light, 1);
+        assert!(
+            l.dropped[0]
+                .reason
+                .contains("tiles are full (6 views wanted)"),
+            "{:?}",
+            l.dropped
+        );
+        assert_eq!(l.candidates, 64 + 4 + 1024);
+        assert_eq!(l.views[1].first_candidate, 64);
+        assert_eq!(
+            (l.views[1].x, l.views[1].y, l.views[2].x, l.views[2].y),
+            (32, 0, 0, 32)
+        );
+        let l = layout(&s, 32, 512, 512, 1);
+        assert_eq!(l.lights, 1);
+        assert!(l.dropped.iter().all(|d| d.reason.contains("max_lights 1")));
+        let l = layout(&s, 16, 512, 512, 64);
+        assert!(l
+            .dropped
+            .iter()
+            .any(|d| d.light == 3 && d.reason.contains("does not divide")));
+    }
+
+    #[test]
+    fn a_point_lights_six_faces_cover_every_direction_once() {
+        let l = Light::point(Vec3::new(1.0, 2.0, 3.0), 10.0, Vec3::ONE, 1.0);
+        let views = light_views(&l);
+        assert_eq!(views.len(), 6);
+        for d in [
+            Vec3::X,
+            Vec3::new(0.3, -0.9, 0.2).normalize(),
+            Vec3::new(-0.5, 0.5, 0.7).normalize(),
+        ] {
+            let inside = views
+                .iter()
+                .filter(|(vp, _, _)| {
+                    let c = *vp * (l.position + d * 2.0).extend(1.0);
+                    let n = c.truncate() / c.w;
+                    c.w > 0.0 && n.x.abs() <= 1.0 && n.y.abs() <= 1.0 && (0.0..=1.0).contains(&n.z)
+                })
+                .count();
+            assert!(inside >= 1, "{d} seen by {inside} faces");
+        }
+    }
+}
