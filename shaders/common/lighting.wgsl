@@ -4,11 +4,6 @@
 // Distances below 1 cm are clamped so a surface at a light's centre stays finite.
 const MIN_DISTANCE_SQ: f32 = 1e-4;
 
-// A virtual point light (VplSpawn): a cosine-weighted hemisphere about `direction`
-// (the surface it sits on emits like a Lambertian patch); `cos_inner` holds its distance
-// clamp, below which 1/d² stops growing; culled as a 90° spot light.
-const LIGHT_VPL: u32 = 4u;
-
 fn range_window(dist_sq: f32, range: f32) -> f32 {
     let r = dist_sq / (range * range);
     return clamp(1.0 - r * r, 0.0, 1.0);
@@ -49,3 +44,8 @@ fn incident_light(g: LightGeometry, p: LightProperties, pos: vec3<f32>) -> Incid
     out.radiance = p.color * (falloff * spot_factor(g, p, out.dir));
     return out;
 }
+
+// A virtual point light (VplSpawn): a cosine-weighted hemisphere about `direction`
+// (the surface it sits on emits like a Lambertian patch); `cos_inner` holds its distance
+// clamp, below which 1/d² stops growing; culled as a 90° spot light.
+const LIGHT_VPL: u32 = 4u;
