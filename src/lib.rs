@@ -9,6 +9,7 @@ pub mod file_kind;
 pub mod files;
 pub mod gpu;
 pub mod graph;
+pub mod indirect;
 pub mod material;
 pub mod reload;
 pub mod render;

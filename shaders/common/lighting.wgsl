@@ -35,7 +35,17 @@ fn incident_light(g: LightGeometry, p: LightProperties, pos: vec3<f32>) -> Incid
         out.radiance = vec3<f32>(0.0);
         return out;
     }
+    if ((p.flags & LIGHT_VPL) != 0u) {
+        let lobe = max(dot(g.direction, -out.dir), 0.0);
+        out.radiance = p.color * (lobe * window / max(dist_sq, p.cos_inner * p.cos_inner));
+        return out;
+    }
     let falloff = window / max(dist_sq, MIN_DISTANCE_SQ);
     out.radiance = p.color * (falloff * spot_factor(g, p, out.dir));
     return out;
 }
+
+// A virtual point light (VplSpawn): a cosine-weighted hemisphere about `direction`
+// (the surface it sits on emits like a Lambertian patch); `cos_inner` holds its distance
+// clamp, below which 1/d² stops growing; culled as a 90° spot light.
+const LIGHT_VPL: u32 = 4u;

@@ -44,6 +44,13 @@
 // A ShadowAtlas pass: the instance index is the view (see common/shadows.wgsl).
 @group(0) @binding(8) var<storage, read> shadow_views: array<vec4<f32>>;
 #endif
+#if RSM
+// A ReflectiveShadowMaps pass: the instance index is the view (src/indirect/rsm_views.rs).
+@group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
+@group(0) @binding(2) var<storage, read> light_properties: array<LightProperties>;
+@group(0) @binding(11) var<storage, read> rsm_views: array<vec4<f32>>;
+const RSM_VIEW_VEC4S: u32 = 8u;
+#endif
 
 struct ShadingPoint {
     position: vec3<f32>,
@@ -83,6 +90,9 @@ struct VertexOut {
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
     @location(3) tangent: vec4<f32>,
+#if RSM
+    @location(4) @interpolate(flat) view: u32,
+#endif
 };
 #endif
 
@@ -94,8 +104,15 @@ fn vs_main(v: VertexIn, @builtin(instance_index) instance: u32) -> VertexOut {
     let view_proj = mat4x4<f32>(shadow_views[b], shadow_views[b + 1u], shadow_views[b + 2u], shadow_views[b + 3u]);
     out.clip = view_proj * vec4<f32>(v.position, 1.0);
 #else
+#if RSM
+    let b = 1u + RSM_VIEW_VEC4S * instance;
+    let view_proj = mat4x4<f32>(rsm_views[b], rsm_views[b + 1u], rsm_views[b + 2u], rsm_views[b + 3u]);
+    out.clip = view_proj * vec4<f32>(v.position, 1.0);
+    out.view = instance;
+#else
     // The prepass and the shading pass run this same code, so depths match exactly.
     out.clip = frame.view_proj * vec4<f32>(v.position, 1.0);
+#endif
 #endif
     out.world = v.position;
     out.normal = v.normal;
@@ -194,6 +211,48 @@ fn fs_depth(in: VertexOut, @builtin(front_facing) front: bool) {
         discard;
     }
 #endif
+}
+#endif
+
+#if RSM
+// What a texel of an indirect light's map reflects: the flux the light sends through the
+// texel (intensity × its solid angle, whatever the surface's slope), times the diffuse
+// albedo; the normal faces the light.
+struct RsmOut {
+    @location(0) normal: vec4<f32>,
+    @location(1) flux: vec4<f32>,
+    @location(2) position: vec4<f32>,
+};
+
+@fragment
+fn fs_rsm(in: VertexOut) -> RsmOut {
+    let b = 1u + RSM_VIEW_VEC4S * in.view;
+    let info = bitcast<vec4<u32>>(rsm_views[b + 4u]);
+    let texel_solid_angle = rsm_views[b + 5u].x;
+    let axis = rsm_views[b + 7u].xyz;
+    let g = light_geometry[info.z];
+    let to_light = g.position - in.world;
+    var p = shading_point(in, true);
+    if (dot(p.normal, to_light) < 0.0) {
+        p.normal = -p.normal;
+    }
+    p.view = normalize(to_light);
+    let m = material_setup(p);
+#if ALPHA_MASK
+    if (material_alpha(m) < ALPHA_CUTOFF) {
+        discard;
+    }
+#endif
+    let props = light_properties[info.z];
+    var inc = incident_light(g, props, in.world);
+    // A surface the light does not light reflects none of it.
+    if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
+        inc.radiance = vec3<f32>(0.0);
+    }
+    let dist_sq = dot(to_light, to_light);
+    let c = max(dot(axis, -inc.dir), 0.0);
+    let flux = material_diffuse(m) * inc.radiance * (dist_sq * texel_solid_angle * c * c * c);
+    return RsmOut(vec4<f32>(p.normal, 1.0), vec4<f32>(flux, 1.0), vec4<f32>(in.world, 1.0));
 }
 #endif
 

@@ -4,6 +4,7 @@
 pub mod bench;
 pub mod live;
 pub mod render;
+pub mod vpl_error;
 
 use anyhow::{bail, Result};
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
@@ -103,6 +104,45 @@ pub enum Command {
     /// Hot-reload latency: time real shader, material and graph edits from the file
     /// write to the new frame; write CSV and Markdown to --out.
     ReloadBench(ReloadBenchArgs),
+    /// One-bounce error of the VPL graph against a CPU path-traced bounce, for each n
+    /// (n×n VPLs a map view), with the GPU time of the VPL passes: time against error.
+    VplError(VplErrorArgs),
+}
+
+#[derive(clap::Args)]
+pub struct VplErrorArgs {
+    /// Scene files with indirect lights (`indirect: true`).
+    #[arg(long, required = true, num_args = 1..)]
+    pub scene: Vec<PathBuf>,
+    /// The VPL graph timed (default: graphs/indirect_vpl.ron).
+    #[arg(long)]
+    pub graph: Option<PathBuf>,
+    /// The VPL graph whose image is measured: every light at every pixel, so no list
+    /// overflow adds to the error (default: benches/graphs/indirect_vpl_all_lights.ron).
+    #[arg(long)]
+    pub error_graph: Option<PathBuf>,
+    /// The same frame without VPLs, subtracted to get the indirect part (default:
+    /// graphs/forward_plus.ron).
+    #[arg(long)]
+    pub direct: Option<PathBuf>,
+    /// Output width.
+    #[arg(long, default_value_t = 160)]
+    pub width: u32,
+    /// Output height.
+    #[arg(long, default_value_t = 120)]
+    pub height: u32,
+    /// VPLs per side of each map view (N² = 16, 64, 256, 1024 VPLs a view).
+    #[arg(long, value_delimiter = ',', default_values_t = [4u32, 8, 16, 32])]
+    pub n: Vec<u32>,
+    /// Bounce rays a pixel of the reference.
+    #[arg(long, default_value_t = 256)]
+    pub samples: u32,
+    /// Timed frames for each n (after as many warm-up frames); medians are reported.
+    #[arg(long, default_value_t = 10)]
+    pub frames: u32,
+    /// Folder for results.csv, results.md and time_vs_error.png.
+    #[arg(long)]
+    pub out: PathBuf,
 }
 
 #[derive(clap::Args)]
@@ -246,6 +286,7 @@ pub fn run() -> Result<()> {
         Some(Command::Bench { sweep, out }) => bench::run_bench(sweep.as_deref(), &out),
         Some(Command::View(args)) => live::view(args),
         Some(Command::ReloadBench(args)) => bench::reload_bench(&args),
+        Some(Command::VplError(args)) => vpl_error::run(&args),
     }
 }
 

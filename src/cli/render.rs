@@ -305,6 +305,15 @@ fn overflow_report(result: &FrameResult) {
 
 /// What ray-cast shadows cast this frame: casters, rays, drops, memory, the BVH.
 fn shadow_report(scene: &Scene, gpu: &SceneGpu, result: &FrameResult) {
+    // Virtual lights: what was spawned, and what found no room (never silent).
+    for v in &result.vpls {
+        for line in v.lines() {
+            match line.strip_prefix("warning: ") {
+                Some(w) => eprintln!("warning: {w}"),
+                None => println!("  {line}"),
+            }
+        }
+    }
     let casters = scene
         .lights
         .iter()

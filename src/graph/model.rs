@@ -4,10 +4,12 @@ pub use super::kinds::deferred_shading::DeferredShading;
 pub use super::kinds::forward_shading::ForwardShading;
 pub use super::kinds::light_culling::LightCulling;
 pub use super::kinds::light_linked_list::LightLinkedList;
+pub use super::kinds::reflective_shadow_maps::ReflectiveShadowMaps;
 pub use super::kinds::shadow_atlas::ShadowAtlas;
 pub use super::kinds::shadow_ray_cast::ShadowRayCast;
 pub use super::kinds::shadow_ray_jobs::ShadowRayJobs;
 pub use super::kinds::transparent_shading::TransparentShading;
+pub use super::kinds::vpl_spawn::VplSpawn;
 pub use super::name::Name;
 use serde::{Deserialize, Serialize};
 
@@ -290,6 +292,10 @@ pub enum PassKind {
     TransparentDepth,
     /// Blended meshes, back to front, lit two-sided over the opaque colour.
     TransparentShading(TransparentShading),
+    /// Reflective shadow maps of every indirect light (depth, normal, flux, position).
+    ReflectiveShadowMaps(ReflectiveShadowMaps),
+    /// Virtual point lights from the reflective shadow maps, appended to the lights.
+    VplSpawn(VplSpawn),
     /// A compute shader the graph file names; bindings are matched by name.
     Compute {
         shader: String,
@@ -327,6 +333,8 @@ impl PassKind {
             PassKind::ShadowRayCast(_) => "ShadowRayCast",
             PassKind::TransparentDepth => "TransparentDepth",
             PassKind::TransparentShading(_) => "TransparentShading",
+            PassKind::ReflectiveShadowMaps(_) => "ReflectiveShadowMaps",
+            PassKind::VplSpawn(_) => "VplSpawn",
             PassKind::Compute { .. } => "Compute",
             PassKind::Fullscreen { .. } => "Fullscreen",
         }

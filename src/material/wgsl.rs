@@ -297,6 +297,19 @@ pub fn generate(m: &Material, opts: &WgslOptions) -> String {
         }
     }
     o.push_str("    return acc * min(cos_l, 1.0);\n}\n\n");
+    // What a reflective shadow map bounces: the diffuse lobes' colour (specular lobes are
+    // not bounced), summed over layers.
+    o.push_str(
+        "fn material_diffuse(m: MaterialSample) -> vec3<f32> {\n    var acc = vec3<f32>(0.0);\n",
+    );
+    for (i, layer) in desc.layers.iter().enumerate() {
+        for (j, lobe) in layer.lobes.iter().enumerate() {
+            if matches!(lobe, Lobe::Lambert { .. } | Lobe::OrenNayar { .. }) {
+                let _ = writeln!(o, "    acc += m.c{i}_{j} * {};", lit(lobe.weight()));
+            }
+        }
+    }
+    o.push_str("    return acc;\n}\n\n");
     o.push_str("fn material_emission(m: MaterialSample) -> vec3<f32> {\n    return m.emission;\n}\n\nfn material_alpha(m: MaterialSample) -> f32 {\n    return m.alpha;\n}\n\n// Ambient occlusion for the renderer's ambient/indirect term; material_eval ignores it.\nfn material_occlusion(m: MaterialSample) -> f32 {\n    return m.occlusion;\n}\n");
     o
 }

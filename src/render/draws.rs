@@ -40,12 +40,15 @@ pub(super) enum DrawMode {
         /// `f32::to_bits` of the slope-scaled bias (the mode is a pipeline key).
         slope_bias_bits: u32,
     },
+    /// Reflective shadow maps' views: normal, flux and position targets over depth, the
+    /// view from the instance index, both faces.
+    Rsm,
 }
 
 impl DrawMode {
     fn writes_depth(self) -> bool {
         match self {
-            DrawMode::DepthOnly | DrawMode::AtlasDepth { .. } => true,
+            DrawMode::DepthOnly | DrawMode::AtlasDepth { .. } | DrawMode::Rsm => true,
             DrawMode::GBuffer { writes_depth, .. } => writes_depth,
             DrawMode::Shade { .. } => false,
         }
@@ -172,6 +175,7 @@ impl Renderer {
                     d.push(("DEPTH_ONLY", "1".into()));
                     d.push(("ATLAS_DEPTH", "1".into()));
                 }
+                DrawMode::Rsm => d.push(("RSM", "1".into())),
                 DrawMode::GBuffer {
                     packed,
                     normals,
@@ -208,7 +212,7 @@ impl Renderer {
             // A prepass or G-buffer draw of an opaque, untextured material never calls the
             // material code: key it with a neutral material, so editing the material
             // rebuilds only the pipelines that shade with it.
-            let shading = matches!(mode, DrawMode::Shade { .. });
+            let shading = matches!(mode, DrawMode::Shade { .. } | DrawMode::Rsm);
             let material_unused = !masked && !shading && m.textures.is_none();
             let code = match neutral_material_wgsl() {
                 Some(neutral) if material_unused => neutral.to_string(),
@@ -227,7 +231,10 @@ impl Renderer {
             // triangles in spatial chunks. Transparent surfaces show both faces (seed 004:
             // shaded two-sided; the normal flips on back faces in `shading_point`).
             let shadow_view = matches!(mode, DrawMode::AtlasDepth { .. });
-            let two_sided = m.double_sided || shadow_view || set == MeshSet::Transparent;
+            let two_sided = m.double_sided
+                || shadow_view
+                || set == MeshSet::Transparent
+                || mode == DrawMode::Rsm;
             let cull_mode = (!two_sided).then_some(wgpu::Face::Back);
             let (pipeline, bindings) = self
                 .pipelines
@@ -337,6 +344,7 @@ fn build_pipeline(
         ),
         DrawMode::Shade { .. } => ("fs_main", 1),
         DrawMode::AtlasDepth { .. } => ("fs_depth", 0),
+        DrawMode::Rsm => ("fs_rsm", 3),
     };
     let blend = match mode {
         DrawMode::Shade { blend: true, .. } => Some(wgpu::BlendState::ALPHA_BLENDING),
@@ -466,6 +474,24 @@ impl MeshDraws {
                     bound = Some(draw);
                 }
                 pass.draw_indexed(first..first + count, 0, instance..instance + 1);
+            }
+        }
+    }
+
+    /// Draws every mesh into each `tile`-texel viewport at `origins`, with the view's
+    /// index as the instance (reflective shadow maps: a few small views, no culling).
+    pub fn record_tiles(&self, pass: &mut wgpu::RenderPass<'_>, origins: &[(u32, u32)], tile: u32) {
+        if let Some(bind) = &self.bind {
+            pass.set_bind_group(0, bind, &[]);
+        }
+        let mut current: Option<*const wgpu::RenderPipeline> = None;
+        for d in &self.draws {
+            d.switch_pipeline(pass, &mut current);
+            d.bind_buffers(pass);
+            for (v, &(x, y)) in origins.iter().enumerate() {
+                pass.set_viewport(x as f32, y as f32, tile as f32, tile as f32, 0.0, 1.0);
+                pass.set_scissor_rect(x, y, tile, tile);
+                pass.draw_indexed(0..d.index_count, 0, v as u32..v as u32 + 1);
             }
         }
     }

@@ -281,7 +281,7 @@ impl PreparedFrame {
         let pass_ms = self.execute(r)?;
         let image = read_rgba32f(&r.ctx.device, &r.ctx.queue, self.output_texture())?;
         let (mut culling, mut shadows, mut atlases) = (Vec::new(), Vec::new(), Vec::new());
-        let (mut shadow_compare, mut links) = (Vec::new(), Vec::new());
+        let (mut shadow_compare, mut links, mut vpls) = (Vec::new(), Vec::new(), Vec::new());
         for report in self.pass_reports(r)? {
             match report {
                 PassReport::Culling(c) => culling.push(c),
@@ -289,6 +289,7 @@ impl PreparedFrame {
                 PassReport::Atlas(a) => atlases.push(a),
                 PassReport::ShadowCompare(c) => shadow_compare.push(c),
                 PassReport::Links(l) => links.push(l),
+                PassReport::Vpl(v) => vpls.push(v),
             }
         }
         let light_stats = self.read_light_stats(r)?;
@@ -302,6 +303,7 @@ impl PreparedFrame {
             shadows,
             atlases,
             shadow_compare,
+            vpls,
             light_stats,
         })
     }

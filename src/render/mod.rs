@@ -23,7 +23,7 @@ pub use pipelines::{CacheCounters, Pipeline, PipelineCache, PipelineKey};
 pub use prepare_stats::PrepareStats;
 pub use report::{
     AtlasReport, CullingReport, FrameResult, LightStats, LinkReport, PassReport,
-    ShadowCompareReport, ShadowReport,
+    ShadowCompareReport, ShadowReport, VplReport,
 };
 pub use resources::FrameResources;
 pub use scene_gpu::{GpuBvh, GpuMesh, SceneGpu};

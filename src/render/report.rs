@@ -174,6 +174,51 @@ impl ShadowCompareReport {
     }
 }
 
+/// Per VplSpawn pass: the virtual lights this frame made, kept and dropped.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VplReport {
+    pub pass: String,
+    /// Indirect lights with map views, and their views.
+    pub lights: u32,
+    pub views: u32,
+    /// Indirect lights that got no views (atlas full, n not dividing the tile...).
+    pub dropped_lights: Vec<crate::indirect::rsm_views::DroppedRsmLight>,
+    /// n² over every view, and those whose block captured any flux.
+    pub candidates: u32,
+    pub with_flux: u32,
+    /// Appended after the scene's lights, and dropped (lowest flux first) for want of room.
+    pub spawned: u32,
+    pub dropped: u32,
+    /// Room for VPLs (the graph's max_vpls).
+    pub room: u32,
+    /// The scene's lights, before the VPLs.
+    pub scene_lights: u32,
+}
+
+/// The report's lines for `render` (a full room or a dropped light is a warning).
+impl VplReport {
+    pub fn lines(&self) -> Vec<String> {
+        let v = self;
+        let mut lines = vec![format!(
+        "{}: {} indirect lights, {} map views, {} VPLs spawned of {} candidates with flux ({} blocks); room {}",
+        v.pass, v.lights, v.views, v.spawned, v.with_flux, v.candidates, v.room
+    )];
+        if v.dropped > 0 {
+            lines.push(format!(
+                "warning: {}: {} VPLs dropped (lowest flux first): max_vpls {} is full",
+                v.pass, v.dropped, v.room
+            ));
+        }
+        for crate::indirect::rsm_views::DroppedRsmLight { light, reason } in &v.dropped_lights {
+            lines.push(format!(
+                "warning: {}: indirect light {light} spawns no VPLs: {reason}",
+                v.pass
+            ));
+        }
+        lines
+    }
+}
+
 /// What a pass counted on the GPU (or decided on the CPU for this frame).
 #[derive(Clone, Debug)]
 pub enum PassReport {
@@ -182,6 +227,7 @@ pub enum PassReport {
     Atlas(AtlasReport),
     ShadowCompare(ShadowCompareReport),
     Links(LinkReport),
+    Vpl(VplReport),
 }
 
 pub struct FrameResult {
@@ -196,5 +242,6 @@ pub struct FrameResult {
     pub shadows: Vec<ShadowReport>,
     pub atlases: Vec<AtlasReport>,
     pub shadow_compare: Vec<ShadowCompareReport>,
+    pub vpls: Vec<VplReport>,
     pub light_stats: Option<LightStats>,
 }

@@ -15,9 +15,11 @@ mod model_budget;
 pub mod ranges;
 pub mod scene_file;
 mod types;
+pub mod vpl;
 
 pub use error::SceneError;
 pub use types::*;
+pub use vpl::VplControls;
 
 use std::path::Path;
 

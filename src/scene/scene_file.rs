@@ -186,6 +186,9 @@ pub struct LightSpec {
     pub casts_shadow: bool,
     #[serde(default)]
     pub indirect: bool,
+    /// Art controls of the light's virtual point lights (only with `indirect: true`).
+    #[serde(default)]
+    pub vpl: Option<super::VplControls>,
     #[serde(default = "all")]
     pub material_mask: u32,
 }
@@ -413,6 +416,18 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
         }
         let light = l.to_light();
         check_light(&light).map_err(|m| SceneError::invalid(file, &element, m))?;
+        if let Some(vpl) = &l.vpl {
+            if !l.indirect {
+                return Err(SceneError::invalid(
+                    file,
+                    &element,
+                    "vpl controls need indirect: true (only indirect lights spawn VPLs)",
+                ));
+            }
+            vpl.check()
+                .map_err(|m| SceneError::invalid(file, &element, m))?;
+            scene.vpl_controls.insert(scene.lights.len() as u32, *vpl);
+        }
         scene.lights.push(light);
     }
 

@@ -97,6 +97,8 @@ pub enum LightShape {
 pub mod light_flags {
     pub const CASTS_SHADOW: u32 = 1;
     pub const INDIRECT: u32 = 2;
+    /// A virtual point light spawned on the GPU (`LIGHT_VPL` in lighting.wgsl).
+    pub const VPL: u32 = 4;
 }
 
 /// A punctual light with a finite range (KHR_lights_punctual semantics: intensity in
@@ -213,9 +215,20 @@ pub struct Scene {
     pub source_path: Option<std::path::PathBuf>,
     /// How the ray-cast shadow BVH is built (scene files: `shadow_bvh: Medium`).
     pub shadow_bvh: crate::shadow::bvh::BuildQuality,
+    /// Art controls of indirect lights, by light index (lights marked indirect without
+    /// an entry use [`super::VplControls::default`]).
+    pub vpl_controls: std::collections::BTreeMap<u32, super::VplControls>,
 }
 
 impl Scene {
+    /// The VPL controls of light `i` (the defaults when the scene names none).
+    pub fn vpl(&self, i: usize) -> super::VplControls {
+        self.vpl_controls
+            .get(&(i as u32))
+            .copied()
+            .unwrap_or_default()
+    }
+
     pub fn features(&self) -> SceneFeatures {
         let uses = |f: &dyn Fn(&SurfaceMaterial) -> bool| {
             self.meshes

@@ -12,7 +12,7 @@ mod plots;
 mod row;
 mod tables;
 
-pub use plots::{plot_time_vs_error, plot_time_vs_lights, PLOT_SIZE};
+pub use plots::{plot_time_vs_error, plot_time_vs_error_points, plot_time_vs_lights, PLOT_SIZE};
 pub use row::{summarize, BenchRow, TimingSummary};
 pub use tables::{
     non_finite_csv, to_csv, to_markdown, untimed_reason, write_csv, write_markdown, CSV_COLUMNS,

@@ -220,6 +220,24 @@ pub fn plot_time_vs_error(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(
     )
 }
 
+/// Time (y, ms) against error (x) for labelled (error, ms) series: the VPL error sweep.
+pub fn plot_time_vs_error_points(
+    path: impl AsRef<Path>,
+    title: &str,
+    x_desc: &str,
+    series: &[(String, Vec<(f64, f64)>)],
+) -> Result<(), ReportError> {
+    let series: Series = series
+        .iter()
+        .map(|(name, pts)| {
+            let mut p: Vec<Point> = pts.iter().map(|&(e, t)| (e, t, t, t)).collect();
+            p.sort_by(|a, b| a.0.total_cmp(&b.0));
+            (name.clone(), p)
+        })
+        .collect();
+    render_plot(path.as_ref(), title, x_desc, true, &series)
+}
+
 #[cfg(test)]
 mod tests {
     use super::axis_label;

@@ -9,12 +9,14 @@ pub mod forward_shading;
 pub mod g_buffer;
 pub mod light_culling;
 pub mod light_linked_list;
+pub mod reflective_shadow_maps;
 pub mod shadow_atlas;
 pub mod shadow_compare;
 pub mod shadow_ray_cast;
 pub mod shadow_ray_jobs;
 pub mod transparent_depth;
 pub mod transparent_shading;
+pub mod vpl_spawn;
 
 use super::error::GraphError;
 use super::model::{Name, PassDesc, PassKind, ResourceDesc, SceneResource};
@@ -42,6 +44,9 @@ pub enum SlotType {
     ColorTexture,
     Buffer,
     Import(SceneResource),
+    /// A light array: the scene's import, or (by name only) a buffer a `VplSpawn` pass
+    /// wrote with the scene's lights and its virtual lights after them.
+    Lights(SceneResource),
 }
 
 impl SlotType {
@@ -51,6 +56,19 @@ impl SlotType {
             SlotType::ColorTexture => "a colour texture".into(),
             SlotType::Buffer => "a buffer".into(),
             SlotType::Import(from) => format!("an Import of {from:?}"),
+            SlotType::Lights(from) => {
+                format!("an Import of {from:?} (or a VplSpawn pass's buffer, by name)")
+            }
+        }
+    }
+    /// Whether a resource of type `ty` fills a slot of this type; `by_name`: the
+    /// resource is named after the slot (or names it).
+    fn takes(self, ty: SlotType, by_name: bool) -> bool {
+        match self {
+            SlotType::Lights(from) => {
+                ty == SlotType::Import(from) || (by_name && ty == SlotType::Buffer)
+            }
+            _ => self == ty,
         }
     }
 }
@@ -137,6 +155,16 @@ pub enum BufferLayout {
     ShadowMask {
         pixels: u64,
     },
+    /// A light array with room for `lights` entries of `stride` bytes (scene lights and
+    /// virtual lights after them).
+    Lights {
+        lights: u64,
+        stride: u64,
+    },
+    /// A reflective shadow map's view table.
+    RsmViews {
+        max_views: u64,
+    },
     /// A shadow atlas's view table, and how shading filters the atlas.
     ShadowViews {
         lights: u32,
@@ -152,6 +180,10 @@ impl BufferLayout {
             BufferLayout::LightLinks(l) => l.bytes(),
             BufferLayout::ShadowJobs { capacity } => shadow_ray_jobs::job_buffer_bytes(*capacity),
             BufferLayout::ShadowMask { pixels } => 4 * shadow_ray_jobs::MASK_WORDS * pixels,
+            BufferLayout::Lights { lights, stride } => (*lights).max(1) * stride,
+            BufferLayout::RsmViews { max_views } => {
+                reflective_shadow_maps::view_table_bytes(*max_views)
+            }
             BufferLayout::ShadowViews {
                 lights, max_views, ..
             } => shadow_atlas::view_table_bytes(*lights, *max_views),
@@ -170,13 +202,13 @@ pub const GEOMETRY_READ: SlotSpec = SlotSpec::new(
 .optional();
 pub const LIGHT_GEOMETRY_READ: SlotSpec = SlotSpec::new(
     slot::LIGHT_GEOMETRY,
-    SlotType::Import(SceneResource::LightGeometry),
+    SlotType::Lights(SceneResource::LightGeometry),
     Access::Read,
     Usage::Bound,
 );
 pub const LIGHT_PROPERTIES_READ: SlotSpec = SlotSpec::new(
     slot::LIGHT_PROPERTIES,
-    SlotType::Import(SceneResource::LightProperties),
+    SlotType::Lights(SceneResource::LightProperties),
     Access::Read,
     Usage::Bound,
 );
@@ -196,6 +228,8 @@ pub fn slots(kind: &PassKind) -> Option<&'static [SlotSpec]> {
         PassKind::ShadowCompare => shadow_compare::SLOTS,
         PassKind::TransparentDepth => transparent_depth::SLOTS,
         PassKind::TransparentShading(_) => transparent_shading::SLOTS,
+        PassKind::ReflectiveShadowMaps(_) => reflective_shadow_maps::SLOTS,
+        PassKind::VplSpawn(_) => vpl_spawn::SLOTS,
         PassKind::Compute { .. } | PassKind::Fullscreen { .. } => return None,
     })
 }
@@ -215,6 +249,8 @@ fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         PassKind::ShadowCompare => shadow_compare::check(ctx, errors),
         PassKind::TransparentDepth => transparent_depth::check(ctx, errors),
         PassKind::TransparentShading(p) => transparent_shading::check(p, ctx, errors),
+        PassKind::ReflectiveShadowMaps(p) => reflective_shadow_maps::check(p, ctx, errors),
+        PassKind::VplSpawn(p) => vpl_spawn::check(p, ctx, errors),
         PassKind::Compute { .. } | PassKind::Fullscreen { .. } => {}
     }
 }
@@ -236,6 +272,17 @@ pub fn buffer_layout(kind: &PassKind, slot: &str, frame: FrameSize) -> Option<Bu
         PassKind::ShadowRayJobs(_) if slot == shadow_ray_jobs::SHADOW_MASK => {
             Some(BufferLayout::ShadowMask {
                 pixels: frame.width as u64 * frame.height as u64,
+            })
+        }
+        PassKind::VplSpawn(p) if slot == slot::LIGHT_GEOMETRY || slot == slot::LIGHT_PROPERTIES => {
+            Some(BufferLayout::Lights {
+                lights: frame.lights as u64 + p.max_vpls as u64,
+                stride: 32,
+            })
+        }
+        PassKind::ReflectiveShadowMaps(p) if slot == reflective_shadow_maps::RSM_VIEWS => {
+            Some(BufferLayout::RsmViews {
+                max_views: p.max_views(),
             })
         }
         PassKind::ShadowAtlas(p) if slot == shadow_atlas::SHADOW_VIEWS => {
@@ -332,7 +379,7 @@ pub(crate) fn resolve(
     let named_like = |name: &str, ty: SlotType, write: bool| {
         specs
             .iter()
-            .any(|s| s.name == name && s.ty == ty && s.access.allows(write))
+            .any(|s| s.name == name && s.ty.takes(ty, true) && s.access.allows(write))
     };
     // Each resource's slot type, looked up once for both rounds.
     let typed: Vec<(bool, &Name, SlotType)> = [(false, &pass.reads), (true, &pass.writes)]
@@ -365,7 +412,7 @@ pub(crate) fn resolve(
                         ));
                         continue;
                     }
-                    Some(s) if s.ty != ty || !s.access.allows(write) => {
+                    Some(s) if !s.ty.takes(ty, true) || !s.access.allows(write) => {
                         errors.push(ctx.mismatch(
                             pass,
                             name,
@@ -380,7 +427,9 @@ pub(crate) fn resolve(
                     Some(s) => s,
                 },
                 None => match specs.iter().find(|s| {
-                    s.ty == ty && s.access.allows(write) && !roles.slots.contains_key(s.name)
+                    s.ty.takes(ty, false)
+                        && s.access.allows(write)
+                        && !roles.slots.contains_key(s.name)
                 }) {
                     Some(s) => s,
                     None => {
@@ -551,6 +600,13 @@ pub(crate) mod test_support {
         Buffer(name: "jobs"),
         Buffer(name: "mask"),
         Buffer(name: "small_buf", size: Bytes(16)),
+        Texture(name: "rsm_depth", format: Depth32Float, size: Fixed(256, 256)),
+        Texture(name: "rsm_normal", format: Rgba32Float, size: Fixed(256, 256)),
+        Texture(name: "rsm_flux", format: Rgba32Float, size: Fixed(256, 256)),
+        Texture(name: "rsm_position", format: Rgba32Float, size: Fixed(256, 256)),
+        Buffer(name: "rsm_views"),
+        Buffer(name: "light_geometry"),
+        Buffer(name: "light_properties"),
         Import(name: "bn", from: BvhNodes),
         Import(name: "bt", from: BvhTriangles),
         Buffer(name: "lists"),

@@ -10,12 +10,14 @@ mod fullscreen;
 mod g_buffer;
 pub(super) mod light_culling;
 mod light_linked_list;
+mod reflective_shadow_maps;
 mod shadow_atlas;
 mod shadow_compare;
 mod shadow_ray_cast;
 mod shadow_ray_jobs;
 mod transparent_depth;
 mod transparent_shading;
+pub mod vpl_spawn;
 
 use super::bind::{BindingSet, Bound};
 use super::pipelines::{Pipeline, PipelineKey};
@@ -60,6 +62,8 @@ pub(super) fn prepare(
         PassKind::ShadowCompare => Box::new(shadow_compare::prepare(cx, sp)?),
         PassKind::TransparentDepth => Box::new(transparent_depth::prepare(cx, sp)?),
         PassKind::TransparentShading(p) => Box::new(transparent_shading::prepare(cx, sp, p)?),
+        PassKind::ReflectiveShadowMaps(p) => Box::new(reflective_shadow_maps::prepare(cx, sp, p)?),
+        PassKind::VplSpawn(p) => Box::new(vpl_spawn::prepare(cx, sp, p)?),
         PassKind::Compute {
             shader,
             entry,
@@ -175,13 +179,45 @@ impl PrepareCtx<'_> {
         }))
     }
 
+    /// A light slot filled by a buffer no scheduled pass writes (its `VplSpawn` pass was
+    /// culled: `when: IndirectLights` on a scene without them) reads the scene's own
+    /// light array, so the frame is exactly the graph without VPLs.
+    fn scene_lights_instead(&self, slot: &str, name: &str) -> Option<Bound> {
+        use crate::graph::slot::{LIGHT_GEOMETRY, LIGHT_PROPERTIES};
+        let is_buffer = matches!(
+            self.graph
+                .checked
+                .desc
+                .resources
+                .iter()
+                .find(|r| r.name() == name),
+            Some(ResourceDesc::Buffer { .. })
+        );
+        let written = self.graph.passes.iter().any(|p| {
+            self.graph.checked.desc.passes[p.index]
+                .writes
+                .iter()
+                .any(|w| w == name)
+        });
+        if !is_buffer || written {
+            return None;
+        }
+        match slot {
+            LIGHT_GEOMETRY => Some(Bound::Buffer(self.gpu.light_geometry.clone())),
+            LIGHT_PROPERTIES => Some(Bound::Buffer(self.gpu.light_properties.clone())),
+            _ => None,
+        }
+    }
+
     /// What a pass may bind: the frame uniform and, under their slot names (built-in
     /// kinds) or their own names (generic kinds), exactly the resources it declared.
     pub fn declared(&self, sp: &ScheduledPass) -> Result<BindingSet, RenderError> {
         let mut set = BindingSet::default();
         set.buffer("frame", self.frame_uniform);
         for (slot, name) in &sp.roles.slots {
-            if let Some(b) = self.bound(&sp.name, name)? {
+            if let Some(b) = self.scene_lights_instead(slot, name) {
+                set.offer(slot, b);
+            } else if let Some(b) = self.bound(&sp.name, name)? {
                 set.offer(slot, b);
             }
         }

@@ -1,0 +1,273 @@
+//! `vpl-error`: for each n, the VPL image's indirect part (the all-lights VPL graph's
+//! frame minus the frame without VPLs) against the CPU path-traced bounce
+//! (`indirect::reference`): relative MSE; and the median GPU time of the passes the VPLs
+//! cost in the culled graph (maps, spawn, culling, shading) over `frames` frames, with
+//! its list overflows. Writes results.csv, results.md, time_vs_error.png.
+
+use super::{render::load_scene, VplErrorArgs};
+use anyhow::{bail, Context, Result};
+use lightgraph::graph::{self, FrameSize};
+use lightgraph::indirect::reference::{indirect_part, relative_mse, OneBounce};
+use lightgraph::render::{Renderer, SceneGpu};
+use lightgraph::scene::{light_flags, Scene};
+use lightgraph::shader::{assets, ShaderLibrary};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Passes whose GPU time the table reports (by the names graphs/indirect_vpl.ron uses).
+const PASSES: [&str; 4] = ["rsm", "vpl_spawn", "light_culling", "forward_shading"];
+
+struct Row {
+    scene: String,
+    n: u32,
+    vpls: u32,
+    dropped: u32,
+    overflowed_lists: u32,
+    rel_mse: f64,
+    energy: f64,
+    frame_ms: Option<f64>,
+    pass_ms: Vec<Option<f64>>,
+}
+
+/// One frame's GPU time per pass (ms).
+type PassTimes = Vec<(String, f64)>;
+
+fn median(mut v: Vec<f64>) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    Some(v[v.len() / 2])
+}
+
+fn frame(
+    r: &mut Renderer,
+    graph_path: &Path,
+    scene: &Scene,
+    w: u32,
+    h: u32,
+    frames: u32,
+) -> Result<(lightgraph::render::FrameResult, Vec<PassTimes>)> {
+    let checked = assets::check_graph(graph_path, &ShaderLibrary::builtin())?;
+    let size = FrameSize {
+        width: w,
+        height: h,
+        lights: scene.lights.len() as u32,
+    };
+    let compiled = graph::compile(checked, &scene.features(), size);
+    let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, scene)?;
+    let prepared = r.prepare(compiled, scene, &gpu, size, false)?;
+    for _ in 0..frames {
+        prepared.execute(r)?;
+    }
+    let mut times = Vec::new();
+    for _ in 0..frames {
+        if let Some(t) = prepared.execute(r)? {
+            times.push(t);
+        }
+    }
+    Ok((prepared.render(r)?, times))
+}
+
+pub fn run(args: &VplErrorArgs) -> Result<()> {
+    let graph_path = args
+        .graph
+        .clone()
+        .unwrap_or_else(|| super::project_path("graphs/indirect_vpl.ron"));
+    let error_path = args
+        .error_graph
+        .clone()
+        .unwrap_or_else(|| super::project_path("benches/graphs/indirect_vpl_all_lights.ron"));
+    let direct_path = args
+        .direct
+        .clone()
+        .unwrap_or_else(|| super::project_path("graphs/forward_plus.ron"));
+    if args.n.is_empty() || args.frames == 0 || args.samples == 0 {
+        bail!("--n, --frames and --samples need at least one");
+    }
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let mut renderer = Renderer::headless()?;
+    let (w, h) = (args.width, args.height);
+    let mut rows = Vec::new();
+    let mut md = String::from("# VPL one-bounce error against a path-traced bounce\n\n");
+    let _ = writeln!(
+        md,
+        "Adapter: {}. {w}×{h}, reference {} bounce rays a pixel. Relative MSE = Σ(vpl − ref)² / Σ ref² of the indirect part (VPL frame minus the frame without VPLs); times are GPU medians of {} frames.\n",
+        renderer.ctx.adapter_name(),
+        args.samples,
+        args.frames
+    );
+    for scene_path in &args.scene {
+        let base = load_scene(Some(scene_path))?;
+        let indirect: Vec<usize> = (0..base.lights.len())
+            .filter(|&i| base.lights[i].flags & light_flags::INDIRECT != 0)
+            .collect();
+        if indirect.is_empty() {
+            bail!(
+                "{}: no light is marked indirect: true",
+                scene_path.display()
+            );
+        }
+        let t = std::time::Instant::now();
+        let tracer = OneBounce::new(&base)?;
+        let reference = tracer.image(w, h, args.samples);
+        let reference_s = t.elapsed().as_secs_f64();
+        // Its own noise: half the relative MSE between it and an independent estimate
+        // (the two differ by twice one's variance); a VPL image's relative MSE includes it.
+        let noise = relative_mse(&tracer.image_seeded(w, h, args.samples, 1), &reference) / 2.0;
+        eprintln!(
+            "{}: reference ({} samples) in {reference_s:.1} s, its noise {noise:.4} (relative MSE)",
+            base.name, args.samples
+        );
+        let (direct, _) = frame(&mut renderer, &direct_path, &base, w, h, 1)?;
+        let to_rgb = |v: &[glam::Vec3]| {
+            v.iter()
+                .map(|p| p.max(glam::Vec3::ZERO).to_array())
+                .collect::<Vec<[f32; 3]>>()
+        };
+        // The indirect images, two stops up (they are dim beside direct light).
+        let tonemap = lightgraph::bench::Tonemap::new(2.0, lightgraph::bench::ToneCurve::Reinhard);
+        lightgraph::bench::write_png_tonemapped(
+            args.out.join(format!("{}_reference.png", base.name)),
+            &to_rgb(&reference),
+            w,
+            h,
+            &tonemap,
+        )?;
+        let _ = writeln!(
+            md,
+            "## {} ({} indirect lights; reference {reference_s:.1} s on the CPU; its own noise: relative MSE {noise:.4})\n\n| n | VPLs | dropped | lists overflowed (timed graph) | rel. MSE | Σvpl/Σref | VPL passes (ms) | rsm | spawn | culling | shading |\n|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|",
+            base.name,
+            indirect.len()
+        );
+        for &n in &args.n {
+            let mut scene = base.clone();
+            for &i in &indirect {
+                let mut c = scene.vpl(i);
+                c.n = n;
+                c.check().map_err(|m| anyhow::anyhow!("--n {n}: {m}"))?;
+                scene.vpl_controls.insert(i as u32, c);
+            }
+            let (result, times) = frame(&mut renderer, &graph_path, &scene, w, h, args.frames)?;
+            let v = result
+                .vpls
+                .first()
+                .with_context(|| format!("{} ran no VplSpawn pass", graph_path.display()))?;
+            let (measured, _) = frame(&mut renderer, &error_path, &scene, w, h, 0)?;
+            let vpl_image = indirect_part(&measured.image, &direct.image);
+            let e = relative_mse(&vpl_image, &reference);
+            lightgraph::bench::write_png_tonemapped(
+                args.out.join(format!("{}_vpl_n{n}.png", base.name)),
+                &to_rgb(&vpl_image),
+                w,
+                h,
+                &tonemap,
+            )?;
+            // Total indirect light of the VPL image over the reference's: bias, apart from noise.
+            let total = |v: &[glam::Vec3]| v.iter().map(|p| (p.x + p.y + p.z) as f64).sum::<f64>();
+            let energy = total(&vpl_image) / total(&reference).max(1e-30);
+            let overflowed_lists: u32 = result.culling.iter().map(|c| c.overflowed_lists).sum();
+            let pass_ms: Vec<Option<f64>> = PASSES
+                .iter()
+                .map(|p| {
+                    median(
+                        times
+                            .iter()
+                            .filter_map(|t| t.iter().find(|(n, _)| n == p).map(|x| x.1))
+                            .collect(),
+                    )
+                })
+                .collect();
+            let frame_ms = median(
+                times
+                    .iter()
+                    .map(|t| {
+                        t.iter()
+                            .filter(|(n, _)| PASSES.contains(&n.as_str()))
+                            .map(|x| x.1)
+                            .sum()
+                    })
+                    .collect(),
+            );
+            let ms = |x: Option<f64>| x.map_or("–".to_string(), |x| format!("{x:.3}"));
+            let _ = writeln!(
+                md,
+                "| {n} | {} | {} | {overflowed_lists} | {e:.4} | {energy:.3} | {} | {} | {} | {} | {} |",
+                v.spawned,
+                v.dropped,
+                ms(frame_ms),
+                ms(pass_ms[0]),
+                ms(pass_ms[1]),
+                ms(pass_ms[2]),
+                ms(pass_ms[3])
+            );
+            println!(
+                "{} n={n}: {} VPLs ({} dropped, {overflowed_lists} lists overflowed), relative MSE {e:.4}, energy {energy:.3} of the reference's, VPL passes {} ms",
+                base.name,
+                v.spawned,
+                v.dropped,
+                ms(frame_ms)
+            );
+            rows.push(Row {
+                scene: base.name.clone(),
+                n,
+                vpls: v.spawned,
+                dropped: v.dropped,
+                overflowed_lists,
+                rel_mse: e,
+                energy,
+                frame_ms,
+                pass_ms,
+            });
+        }
+        md.push('\n');
+    }
+    let mut csv = String::from(
+        "scene,n,vpls,dropped,overflowed_lists,rel_mse,energy_ratio,vpl_passes_ms,rsm_ms,spawn_ms,culling_ms,shading_ms\n",
+    );
+    let opt = |x: Option<f64>| x.map_or(String::new(), |x| format!("{x:.4}"));
+    for r in &rows {
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{},{:.6},{:.4},{},{}",
+            r.scene,
+            r.n,
+            r.vpls,
+            r.dropped,
+            r.overflowed_lists,
+            r.rel_mse,
+            r.energy,
+            opt(r.frame_ms),
+            r.pass_ms
+                .iter()
+                .map(|x| opt(*x))
+                .collect::<Vec<_>>()
+                .join(",")
+        );
+    }
+    std::fs::write(args.out.join("results.csv"), csv)?;
+    std::fs::write(args.out.join("results.md"), &md)?;
+    let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    for r in rows.iter().filter(|r| r.frame_ms.is_some()) {
+        match series.iter_mut().find(|(s, _)| *s == r.scene) {
+            Some((_, pts)) => pts.push((r.rel_mse, r.frame_ms.unwrap_or(0.0))),
+            None => series.push((
+                r.scene.clone(),
+                vec![(r.rel_mse, r.frame_ms.unwrap_or(0.0))],
+            )),
+        }
+    }
+    if series.is_empty() {
+        println!("no timestamp queries on this adapter: no time plot");
+    } else {
+        lightgraph::bench::report::plot_time_vs_error_points(
+            args.out.join("time_vs_error.png"),
+            "VPL passes' GPU time vs one-bounce error",
+            "relative MSE against the path-traced bounce (log)",
+            &series,
+        )?;
+    }
+    print!("{md}");
+    Ok(())
+}

@@ -1,0 +1,126 @@
+//! `ReflectiveShadowMaps`: lays out every indirect light's views (`indirect::rsm_views`),
+//! uploads the view table, and draws the scene into each view's tile in one render pass
+//! (normal, flux and position targets over depth; the view as the instance index). The
+//! layout depends only on the scene, so it is made once at prepare.
+
+use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
+use crate::graph::kinds::reflective_shadow_maps::{
+    fixed_size, ReflectiveShadowMaps, RSM_DEPTH, RSM_FLUX, RSM_NORMAL, RSM_POSITION, RSM_VIEWS,
+};
+use crate::graph::Name;
+use crate::graph::ScheduledPass;
+use crate::indirect::rsm_views::{layout, view_table, RsmLayout};
+use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws, MeshSet};
+use crate::render::RenderError;
+
+pub(super) struct RsmPass {
+    name: Name,
+    tile: u32,
+    origins: Vec<(u32, u32)>,
+    depth: wgpu::TextureView,
+    targets: [wgpu::TextureView; 3],
+    views: wgpu::Buffer,
+    staging: wgpu::Buffer,
+    table_bytes: u64,
+    draws: MeshDraws,
+}
+
+/// The maps' size and the views laid out on them, as both RSM passes compute it.
+pub(super) fn rsm_layout(
+    cx: &PrepareCtx,
+    pass: &str,
+    p: &ReflectiveShadowMaps,
+    flux: &str,
+) -> Result<(u32, u32, RsmLayout), RenderError> {
+    let desc = cx
+        .graph
+        .checked
+        .desc
+        .resources
+        .iter()
+        .find(|r| r.name() == flux);
+    let (w, h, _) = fixed_size(desc)
+        .ok_or_else(|| pass_error(pass, format!("'{flux}' is not a fixed-size texture")))?;
+    Ok((w, h, layout(cx.scene, p.tile, w, h, p.max_lights)))
+}
+
+pub(super) fn prepare(
+    cx: &mut PrepareCtx,
+    sp: &ScheduledPass,
+    p: &ReflectiveShadowMaps,
+) -> Result<RsmPass, RenderError> {
+    let (w, h, l) = rsm_layout(cx, &sp.name, p, sp.required(RSM_FLUX))?;
+    let views = cx.buffer(&sp.name, sp.required(RSM_VIEWS))?;
+    let table = view_table(&l, p.tile, w, h, p.max_views());
+    let table_bytes = (table.len() * 16) as u64;
+    if views.size() < table_bytes {
+        return Err(pass_error(
+            &sp.name,
+            format!(
+                "buffer '{}' holds {} bytes; the view table needs {table_bytes} (size: Auto)",
+                sp.required(RSM_VIEWS),
+                views.size()
+            ),
+        ));
+    }
+    let device = cx.device();
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("rsm view table (upload)"),
+        size: table_bytes,
+        usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    cx.renderer
+        .ctx
+        .queue
+        .write_buffer(&staging, 0, bytemuck::cast_slice(&table));
+    let mut offered = cx.declared(sp)?;
+    offered.buffer("rsm_views", &views);
+    let draws = cx.renderer.mesh_draws(
+        cx.gpu,
+        DrawMode::Rsm,
+        MeshSet::Opaque,
+        1,
+        &sp.name,
+        &offered,
+    )?;
+    let target = |slot: &str| cx.view(&sp.name, sp.required(slot));
+    Ok(RsmPass {
+        name: sp.name.clone(),
+        tile: p.tile,
+        origins: l.views.iter().map(|v| (v.x, v.y)).collect(),
+        depth: target(RSM_DEPTH)?,
+        targets: [
+            target(RSM_NORMAL)?,
+            target(RSM_FLUX)?,
+            target(RSM_POSITION)?,
+        ],
+        views,
+        staging,
+        table_bytes,
+        draws,
+    })
+}
+
+impl PreparedPass for RsmPass {
+    fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
+        encoder.copy_buffer_to_buffer(&self.staging, 0, &self.views, 0, self.table_bytes);
+        // The maps are small (a few MiB at most): clearing them whole costs nothing and
+        // leaves unused tiles at zero flux.
+        let clear = Some(wgpu::Color::TRANSPARENT);
+        let colors: Vec<_> = self
+            .targets
+            .iter()
+            .map(|t| Some(color_attachment(t, clear, None)))
+            .collect();
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(&self.name),
+            color_attachments: &colors,
+            depth_stencil_attachment: Some(depth_attachment(&self.depth, true)),
+            timestamp_writes: ts.render(),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        self.draws.record_tiles(&mut pass, &self.origins, self.tile);
+    }
+}
