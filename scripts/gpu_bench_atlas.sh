@@ -7,13 +7,7 @@
 # Usage from the project root after ../shared/gpu/prepare.sh target/release/lightgraph:
 #   scripts/gpu_bench_atlas.sh
 set -u
-for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig
-final="${OUT:-results}"
-out="$final/r"
-mkdir -p "$out"
-export XDG_RUNTIME_DIR=/tmp
-lg=./.gpu/lightgraph
-nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv > "$out/gpu.txt" 2>&1
+source "$(dirname "$0")/gpu_env.sh"
 for s in atrium_amd; do
     for g in graphs/shadow_atlas.ron graphs/tiled_deferred_shadow_atlas.ron graphs/raycast_shadows.ron \
              benches/graphs/shadow_atlas_vs_raycast_4096.ron; do
@@ -29,4 +23,4 @@ timeout 470 $lg bench --sweep benches/sweeps/shadow_atlas.ron --out "$out/shadow
 nvidia-smi --query-gpu=clocks.sm --format=csv >> "$out/gpu.txt" 2>&1
 cat "$out"/gpu.txt "$out"/render_*.txt
 grep -A80 "Shadow atlases" "$out/shadow_atlas/results.md"
-tar -czf "$final/results.tar.gz" -C "$final" r && rm -rf "$out"
+gpu_pack

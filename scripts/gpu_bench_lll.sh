@@ -8,13 +8,7 @@
 # Usage from the project root after ../shared/gpu/prepare.sh target/release/lightgraph:
 #   scripts/gpu_bench_lll.sh
 set -u
-for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig
-final="${OUT:-results}"
-out="$final/r"
-mkdir -p "$out"
-export XDG_RUNTIME_DIR=/tmp
-lg=./.gpu/lightgraph
-nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv > "$out/gpu.txt" 2>&1
+source "$(dirname "$0")/gpu_env.sh"
 for g in graphs/forward_plus.ron graphs/tiled_deferred.ron \
          benches/graphs/lll_forward_1.ron benches/graphs/lll_forward_4.ron benches/graphs/lll_forward_8.ron \
          benches/graphs/lll_forward_8_all_lights.ron \
@@ -27,4 +21,4 @@ nvidia-smi --query-gpu=clocks.sm --format=csv >> "$out/gpu.txt" 2>&1
 cat "$out"/gpu.txt
 grep -h "scene:\|ms$\|list pixels\|WARNING" "$out"/render_*.txt
 grep -A40 "Light linked lists" "$out/light_linked_list/results.md"
-tar -czf "$final/results.tar.gz" -C "$final" r && rm -rf "$out"
+gpu_pack

@@ -1,17 +1,11 @@
 #!/usr/bin/env bash
 # Issue 17 on the GPU machine: the headline, atrium and textured sweeps under the timing
-# method of 2026-12-02, hot-reload latency split by resolution and light count, and the
-# Bevy peer when its binary was brought (.gpu/peer_bevy). Usage from the project root after
-# ../shared/gpu/prepare.sh target/release/lightgraph [peer_bevy]:
+# method of 2026-12-02 and hot-reload latency split by resolution and light count (the Bevy
+# peer is scripts/gpu_bench_peer.sh). Usage from the project root after
+# ../shared/gpu/prepare.sh target/release/lightgraph:
 #   scripts/gpu_bench_method.sh
 set -u
-for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig
-final="${OUT:-results}"
-out="$final/r"
-mkdir -p "$out"
-export XDG_RUNTIME_DIR=/tmp
-lg=./.gpu/lightgraph
-nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv > "$out/gpu.txt" 2>&1
+source "$(dirname "$0")/gpu_env.sh"
 for s in method_headline method_atrium method_textured; do
     $lg bench --sweep benches/sweeps/$s.ron --out "$out/$s" > "$out/$s.log" 2>&1
     echo "== $s"; tail -n 4 "$out/$s.log"
@@ -22,13 +16,6 @@ for cfg in "1920 1080 3072" "1920 1080 1024" "160 90 3072" "160 90 1024"; do
     set -- $cfg
     $lg reload-bench --out "$out/reload_${1}x${2}_$3" --width "$1" --height "$2" --lights "$3" --repeats 10 > "$out/reload_${1}x${2}_$3.log" 2>&1
 done
-if [ -x .gpu/peer_bevy ]; then
-    for n in 1024 3072 16384; do
-        .gpu/peer_bevy --light-set sweep --lights $n --width 1920 --height 1080 --quiet > "$out/bevy_sweep_$n.txt" 2>&1
-    done
-    .gpu/peer_bevy --width 1920 --height 1080 --quiet > "$out/bevy_harada_3072.txt" 2>&1
-    tail -n 2 "$out"/bevy_*.txt
-fi
 for s in method_headline method_atrium method_textured; do cat "$out/$s/results.md" | head -n 30; done
 for d in "$out"/reload_*/; do echo "== $d"; sed -n 5,20p "$d/reload_latency.md"; done
-tar -czf "$final/results.tar.gz" -C "$final" r && rm -rf "$out"
+gpu_pack

@@ -9,13 +9,7 @@
 # Usage from the project root after ../shared/gpu/prepare.sh target/release/lightgraph:
 #   scripts/gpu_bench_msaa.sh        (about 8 minutes at most: every step has a timeout)
 set -u
-for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig
-final="${OUT:-results}"
-out="$final/r"
-mkdir -p "$out"
-export XDG_RUNTIME_DIR=/tmp
-lg=./.gpu/lightgraph
-nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv > "$out/gpu.txt" 2>&1
+source "$(dirname "$0")/gpu_env.sh"
 for g in forward_plus tiled_deferred msaa msaa_8x; do
     timeout 60 $lg render --scene scenes/atrium_amd.ron --graph graphs/$g.ron --out "$out/atrium_amd_$g.png" \
         > "$out/render_atrium_amd_$g.txt" 2>&1
@@ -32,4 +26,4 @@ cat "$out"/gpu.txt "$out"/render_*.txt
 for s in msaa msaa_8x transparency; do
     echo "== $s"; tail -3 "$out/$s.log"; cat "$out/$s/results.md" 2>/dev/null | head -60
 done
-tar -czf "$final/results.tar.gz" -C "$final" r && rm -rf "$out"
+gpu_pack

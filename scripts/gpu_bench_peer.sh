@@ -6,15 +6,9 @@
 #   ../shared/gpu/prepare.sh target/release/lightgraph; xz -9 -c peer_bevy > .gpu/peer_bevy.xz
 #   scripts/gpu_bench_peer.sh
 set -u
-for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig
-final="${OUT:-results}"
-out="$final/r"
-mkdir -p "$out"
-export XDG_RUNTIME_DIR=/tmp
-lg=./.gpu/lightgraph
+source "$(dirname "$0")/gpu_env.sh"
 bevy=/tmp/peer_bevy
 xz -dc .gpu/peer_bevy.xz > $bevy && chmod +x $bevy
-nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv > "$out/gpu.txt" 2>&1
 timeout 150 $lg bench --sweep benches/sweeps/peer_bevy.ron --out "$out/lightgraph_1" > "$out/lightgraph_1.log" 2>&1
 for n in 1024 3072 16384; do
     timeout 60 $bevy --light-set sweep --lights $n --width 1920 --height 1080 > "$out/bevy_$n.txt" 2>&1
@@ -25,4 +19,4 @@ nvidia-smi --query-gpu=clocks.sm --format=csv >> "$out/gpu.txt" 2>&1
 cat "$out/gpu.txt"
 for f in "$out"/bevy_*.txt; do echo "== $f"; grep -E "WARN|cluster|bevy frame" "$f" | tail -4; done
 for s in lightgraph_1 lightgraph_2; do echo "== $s"; head -n 16 "$out/$s/results.md"; done
-tar -czf "$final/results.tar.gz" -C "$final" r && rm -rf "$out"
+gpu_pack

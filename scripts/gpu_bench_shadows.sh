@@ -9,13 +9,7 @@
 # ../shared/gpu/prepare.sh target/release/lightgraph:
 #   scripts/gpu_bench_shadows.sh
 set -u
-for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig
-final="${OUT:-results}"
-out="$final/r"
-mkdir -p "$out"
-export XDG_RUNTIME_DIR=/tmp
-lg=./.gpu/lightgraph
-nvidia-smi --query-gpu=name,driver_version --format=csv > "$out/gpu.txt" 2>&1
+source "$(dirname "$0")/gpu_env.sh"
 for g in raycast_shadows tiled_deferred_raycast_shadows raycast_shadows_naive; do
     $lg render --scene scenes/chairs.ron --graph graphs/$g.ron --width 1280 --height 720 \
         --out "$out/chairs_$g.png" > "$out/render_chairs_$g.txt" 2>&1
@@ -43,4 +37,4 @@ cat "$out"/gpu.txt "$out"/bvh_quality/results.md "$out"/packed_3072/results.md "
 # The device tool brings back few files of at most 16 MiB: pack everything but the
 # EXRs (already compared above) into one archive.
 rm -f "$out"/*.exr
-tar -czf "$final/results.tar.gz" -C "$final" r && rm -rf "$out"
+gpu_pack

@@ -14,13 +14,7 @@
 # after ../shared/gpu/prepare.sh target/release/lightgraph:
 #   scripts/gpu_bench_vpl.sh
 set -u
-for f in .gl/*.deb; do dpkg -x "$f" /; done; ldconfig
-final="${OUT:-results}"
-out="$final/r"
-mkdir -p "$out"
-export XDG_RUNTIME_DIR=/tmp
-lg=./.gpu/lightgraph
-nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv > "$out/gpu.txt" 2>&1
+source "$(dirname "$0")/gpu_env.sh"
 for k in 1 8 32; do
     s=benches/scenes/atrium_indirect_$k.ron
     for g in indirect_vpl tiled_deferred_indirect_vpl; do
@@ -34,4 +28,4 @@ timeout 330 $lg vpl-error --scene scenes/cornell_indirect.ron scenes/atrium_indi
 nvidia-smi --query-gpu=clocks.sm --format=csv >> "$out/gpu.txt" 2>&1
 cat "$out"/gpu.txt "$out"/render_*.txt
 cat "$out/vpl_error/results.md"
-tar -czf "$final/results.tar.gz" -C "$final" r && rm -rf "$out"
+gpu_pack
