@@ -17,12 +17,21 @@ pub(super) fn prepare(
     cx: &mut PrepareCtx,
     sp: &ScheduledPass,
 ) -> Result<DepthPrepass, RenderError> {
+    prepare_meshes(cx, sp, MeshSet::Opaque)
+}
+
+/// The depth-only draw of one mesh set (`TransparentDepth` draws the blended one).
+pub(super) fn prepare_meshes(
+    cx: &mut PrepareCtx,
+    sp: &ScheduledPass,
+    set: MeshSet,
+) -> Result<DepthPrepass, RenderError> {
     let depth = sp.required(slot::DEPTH);
     let offered = cx.declared(sp)?;
     let draws = cx.renderer.mesh_draws(
         cx.gpu,
         DrawMode::DepthOnly,
-        MeshSet::Opaque,
+        set,
         sp.samples,
         &sp.name,
         &offered,

@@ -1,51 +1,16 @@
-//! `TransparentDepth`: every blended mesh, both faces, depth only, into its own texture.
+//! `TransparentDepth`: every blended mesh, both faces, depth only, into its own texture:
+//! the depth prepass's draw over the transparent mesh set (the nearest depth wins
+//! whatever the order, so no sorting).
 
-use super::{PrepareCtx, PreparedPass, Timestamps};
-use crate::graph::Name;
-use crate::graph::{slot, ScheduledPass};
-use crate::render::draws::{depth_attachment, DrawMode, MeshDraws, MeshSet};
+use super::depth_prepass::{self, DepthPrepass};
+use super::PrepareCtx;
+use crate::graph::ScheduledPass;
+use crate::render::draws::MeshSet;
 use crate::render::RenderError;
-
-pub(super) struct TransparentDepth {
-    name: Name,
-    depth: wgpu::TextureView,
-    clear: bool,
-    draws: MeshDraws,
-}
 
 pub(super) fn prepare(
     cx: &mut PrepareCtx,
     sp: &ScheduledPass,
-) -> Result<TransparentDepth, RenderError> {
-    let depth = sp.required(slot::DEPTH);
-    let offered = cx.declared(sp)?;
-    let draws = cx.renderer.mesh_draws(
-        cx.gpu,
-        DrawMode::DepthOnly,
-        MeshSet::Transparent,
-        sp.samples,
-        &sp.name,
-        &offered,
-    )?;
-    Ok(TransparentDepth {
-        name: sp.name.clone(),
-        depth: cx.view(&sp.name, depth)?,
-        clear: sp.clears(depth),
-        draws,
-    })
-}
-
-impl PreparedPass for TransparentDepth {
-    fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(&self.name),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(depth_attachment(&self.depth, self.clear)),
-            timestamp_writes: ts.render(),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        // The nearest depth wins whatever the order.
-        self.draws.record(&mut pass);
-    }
+) -> Result<DepthPrepass, RenderError> {
+    depth_prepass::prepare_meshes(cx, sp, MeshSet::Transparent)
 }
