@@ -12,6 +12,7 @@ pub mod progress;
 pub mod reload_latency;
 pub mod report;
 pub mod sweep;
+mod sweep_columns;
 pub mod timing;
 pub mod tonemap;
 

@@ -6,10 +6,10 @@
 use super::cases::SceneCase;
 use super::metrics::non_finite_pixels;
 use super::report::{summarize, BenchRow, TimingSummary};
-use super::timing;
 use super::{compare, CompareOptions};
-use crate::graph::{self, FrameSize, PassKind, ResourceDesc, SceneResource};
-use crate::render::{PreparedFrame, RenderError, Renderer, SceneGpu, ShadowReport};
+use super::{sweep_columns, timing};
+use crate::graph::{self, FrameSize};
+use crate::render::{PreparedFrame, RenderError, Renderer, SceneGpu};
 use crate::scene::{self, lights::RandomLights, Scene};
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -441,102 +441,10 @@ fn fill_row(
     if let Some(s) = &light_stats {
         row.listed_exact_ratio = Some(s.false_positive_ratio());
     }
-    set_shadow_columns(row, &prepared.graph, gpu, &result.shadows);
-    set_atlas_columns(row, &result);
-    if let Some(l) = result.links.first() {
-        row.link_mib = Some(l.bytes() as f64 / MIB);
-        row.links_per_list_pixel = Some(l.links() as f64 / l.layout.pixels().max(1) as f64);
-        row.link_scale = Some(l.layout.scale);
-        row.links_dropped = Some(l.links_dropped);
-    }
+    sweep_columns::set_shadow_columns(row, &prepared.graph, gpu, &result.shadows);
+    sweep_columns::set_atlas_columns(row, &result);
+    sweep_columns::set_link_columns(row, &result);
     Ok(())
-}
-
-/// The shadow atlas columns: memory, lights shadowed and dropped, views; the pair error
-/// when a ShadowCompare pass ran.
-fn set_atlas_columns(row: &mut BenchRow, result: &crate::render::FrameResult) {
-    if !result.atlases.is_empty() {
-        let a = &result.atlases;
-        row.atlas_mib = Some(
-            a.iter()
-                .map(|a| (a.atlas_bytes + a.table_bytes) as f64)
-                .sum::<f64>()
-                / MIB,
-        );
-        row.atlas_shadowed = Some(a.iter().map(|a| a.shadowed.len() as u64).sum());
-        row.atlas_dropped = Some(a.iter().map(|a| a.dropped.len() as u64).sum());
-        row.atlas_views = Some(a.iter().map(|a| a.views as u64).sum());
-    }
-    if let Some(c) = result.shadow_compare.first() {
-        row.shadow_pairs = Some(c.pairs);
-        row.pair_error_pcf5 = Some(c.error_pcf5());
-        row.pair_error_2x2 = Some(c.error_2x2());
-    }
-}
-
-const MIB: f64 = (1u64 << 20) as f64;
-
-/// The ray-cast shadow columns: rays, rays a second of the `ShadowRayCast` passes, drops and
-/// buffer memory when a `ShadowRayJobs` pass ran; the BVH's size and build time when a pass
-/// that runs reads it (the naive graph traces it in the light loop).
-fn set_shadow_columns(
-    row: &mut BenchRow,
-    graph: &graph::CompiledGraph,
-    gpu: &SceneGpu,
-    shadows: &[ShadowReport],
-) {
-    let runs = |kind: fn(&PassKind) -> bool| graph.passes.iter().filter(move |p| kind(&p.kind));
-    if runs(|k| matches!(k, PassKind::ShadowRayJobs(_)))
-        .next()
-        .is_some()
-    {
-        let rays: u64 = shadows.iter().map(ShadowReport::rays).sum();
-        row.shadow_rays = Some(rays);
-        row.shadow_jobs_dropped = Some(shadows.iter().map(|s| s.jobs_dropped).sum());
-        row.shadow_overflow_pixels = Some(shadows.iter().map(|s| s.overflow_pixels).sum());
-        row.shadow_buffers_mib = Some(
-            shadows
-                .iter()
-                .map(|s| (s.job_bytes + s.mask_bytes) as f64)
-                .sum::<f64>()
-                / MIB,
-        );
-        // Every ShadowRayCast pass's median, found by kind; `None` if any is untimed.
-        let cast_ms: Option<Vec<f64>> = runs(|k| matches!(k, PassKind::ShadowRayCast(_)))
-            .map(|p| {
-                row.pass_ms
-                    .iter()
-                    .find(|(n, _)| p.name == *n)
-                    .map(|(_, t)| t.median)
-            })
-            .collect();
-        row.shadow_rays_per_s = cast_ms
-            .map(|v| v.iter().sum::<f64>())
-            .filter(|&ms| ms > 0.0)
-            .map(|ms| rays as f64 / (ms * 1e-3));
-    }
-    let desc = &graph.checked.desc;
-    let bvh_imports: Vec<&str> = desc
-        .resources
-        .iter()
-        .filter_map(|r| match r {
-            ResourceDesc::Import {
-                name,
-                from: SceneResource::BvhNodes,
-            } => Some(name.as_str()),
-            _ => None,
-        })
-        .collect();
-    let reads_bvh = graph.passes.iter().any(|p| {
-        desc.passes[p.index]
-            .reads
-            .iter()
-            .any(|r| bvh_imports.contains(&r.as_str()))
-    });
-    if let (true, Some(bvh)) = (reads_bvh, gpu.built_bvh()) {
-        row.bvh_mib = Some(bvh.bytes() as f64 / MIB);
-        row.bvh_build_ms = Some(bvh.stats.build_time.as_secs_f64() * 1e3);
-    }
 }
 
 fn render_once(

@@ -1,6 +1,6 @@
 //! Built-in pass kinds, one file each: its parameters, its slot table and its checks.
-//! This file holds the one match from a kind to them, and the slot matching every
-//! built-in kind shares. Generic kinds (Compute, Fullscreen) bind by reflected shader
+//! This file holds the one match from a kind to them and the rows and checks several
+//! kinds share; `matching.rs` the slot matcher they all use. Generic kinds (Compute, Fullscreen) bind by reflected shader
 //! binding names instead (see `roles.rs`).
 
 pub mod deferred_shading;
@@ -9,6 +9,7 @@ pub mod forward_shading;
 pub mod g_buffer;
 pub mod light_culling;
 pub mod light_linked_list;
+mod matching;
 pub mod reflective_shadow_maps;
 pub mod shadow_atlas;
 pub mod shadow_compare;
@@ -19,9 +20,11 @@ pub mod transparent_shading;
 pub mod vpl_spawn;
 
 use super::error::GraphError;
-use super::model::{Name, PassDesc, PassKind, ResourceDesc, SceneResource};
+use super::model::{PassDesc, PassKind, ResourceDesc, SceneResource};
 use super::plan::{FrameSize, ListLayout};
 use super::roles::{PassRoles, RoleCtx};
+
+pub(crate) use matching::resolve;
 
 /// Slot names shared by several kinds; each is also the WGSL binding name the kind's
 /// shader uses for it (attachments are not bindings).
@@ -348,141 +351,6 @@ impl KindCtx<'_> {
     }
     pub fn writes(&self, name: &str) -> bool {
         self.pass.writes.iter().any(|w| w == name)
-    }
-}
-
-fn slot_type_of(ctx: &RoleCtx, name: &str) -> Option<SlotType> {
-    Some(match ctx.resources.get(name)? {
-        ResourceDesc::Texture { format, .. } if format.is_depth() => SlotType::DepthTexture,
-        ResourceDesc::Texture { .. } => SlotType::ColorTexture,
-        ResourceDesc::Buffer { .. } => SlotType::Buffer,
-        ResourceDesc::Import { from, .. } => SlotType::Import(*from),
-    })
-}
-
-/// Matches a built-in pass's declared resources to its kind's slots: by name where the
-/// declaration says `slot=resource` or the resource is named like a slot of its type,
-/// else to the first free slot of the resource's type
-/// that takes it from that list (reads or writes), in the table's order. Every resource
-/// must fill a slot and every required slot must be filled; then the kind checks.
-pub(crate) fn resolve(
-    ctx: &RoleCtx,
-    pass: &PassDesc,
-    specs: &[SlotSpec],
-) -> Result<PassRoles, Vec<GraphError>> {
-    let mut roles = PassRoles::default();
-    let mut errors = Vec::new();
-    let kind = pass.kind.label();
-    let names = || specs.iter().map(|s| s.name).collect::<Vec<_>>().join(", ");
-    // Explicit slots and resources named like a free slot of their type go first, so
-    // one that fills by type order cannot take the slot a later one is named after.
-    let named_like = |name: &str, ty: SlotType, write: bool| {
-        specs
-            .iter()
-            .any(|s| s.name == name && s.ty.takes(ty, true) && s.access.allows(write))
-    };
-    // Each resource's slot type, looked up once for both rounds.
-    let typed: Vec<(bool, &Name, SlotType)> = [(false, &pass.reads), (true, &pass.writes)]
-        .into_iter()
-        .flat_map(|(write, list)| list.iter().map(move |name| (write, name)))
-        .filter_map(|(write, name)| Some((write, name, slot_type_of(ctx, name)?)))
-        .collect(); // unknown resources are reported by validation
-    for by_name in [true, false] {
-        for &(write, name, ty) in &typed {
-            let first = pass.explicit_slot(name).is_some() || named_like(name, ty, write);
-            if first != by_name {
-                continue;
-            }
-            if write && matches!(ty, SlotType::Import(_)) {
-                continue; // a write to a read-only import, reported by validation
-            }
-            if roles.slots.values().any(|v| v == name) {
-                continue; // in reads and writes: one slot
-            }
-            let wanted = pass
-                .explicit_slot(name)
-                .or_else(|| named_like(name, ty, write).then_some(name.as_str()));
-            let spec = match wanted {
-                Some(wanted) => match specs.iter().find(|s| s.name == wanted) {
-                    None => {
-                        errors.push(ctx.mismatch(
-                            pass,
-                            name,
-                            format!("{kind} has no slot '{wanted}' (its slots: {})", names()),
-                        ));
-                        continue;
-                    }
-                    Some(s) if !s.ty.takes(ty, true) || !s.access.allows(write) => {
-                        errors.push(ctx.mismatch(
-                            pass,
-                            name,
-                            format!(
-                                "slot '{wanted}' takes {} {}",
-                                s.ty.describe(),
-                                s.access.describe()
-                            ),
-                        ));
-                        continue;
-                    }
-                    Some(s) => s,
-                },
-                None => match specs.iter().find(|s| {
-                    s.ty.takes(ty, false)
-                        && s.access.allows(write)
-                        && !roles.slots.contains_key(s.name)
-                }) {
-                    Some(s) => s,
-                    None => {
-                        let list = if write { "writes" } else { "reads" };
-                        errors.push(ctx.mismatch(
-                            pass,
-                            name,
-                            format!(
-                                "{kind} has no free slot for {} in {list} (its slots: {})",
-                                ty.describe(),
-                                names()
-                            ),
-                        ));
-                        continue;
-                    }
-                },
-            };
-            if let Some(prev) = roles.slots.insert(spec.name, name.clone()) {
-                errors.push(ctx.mismatch(
-                    pass,
-                    name,
-                    format!("slot '{}' already filled by '{prev}'", spec.name),
-                ));
-            }
-        }
-    }
-    for s in specs.iter().filter(|s| !s.optional) {
-        if !roles.slots.contains_key(s.name) {
-            errors.push(ctx.bad(
-                pass,
-                format!(
-                    "{kind} needs {} {} (slot '{}')",
-                    s.ty.describe(),
-                    s.access.describe(),
-                    s.name
-                ),
-            ));
-        }
-    }
-    if errors.is_empty() {
-        check(
-            &KindCtx {
-                roles: &roles,
-                pass,
-                graph: ctx,
-            },
-            &mut errors,
-        );
-    }
-    if errors.is_empty() {
-        Ok(roles)
-    } else {
-        Err(errors)
     }
 }
 
