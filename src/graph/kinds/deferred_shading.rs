@@ -3,7 +3,7 @@
 
 use super::g_buffer::{G_NORMAL, G_POSITION};
 use super::shadow_ray_jobs::SHADOW_MASK;
-use super::{check_light_source, slot, Access, KindCtx, SlotSpec, SlotType, Usage};
+use super::{check_light_source, Access, KindCtx, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 use crate::graph::model::LightSource;
 use serde::{Deserialize, Serialize};
@@ -35,13 +35,7 @@ pub const SLOTS: &[SlotSpec] = &[
     .optional(),
     super::LIGHT_GEOMETRY_READ,
     super::LIGHT_PROPERTIES_READ,
-    SlotSpec::new(
-        slot::LIGHT_LISTS,
-        SlotType::Buffer,
-        Access::Read,
-        Usage::Bound,
-    )
-    .optional(),
+    super::LIGHT_LISTS_READ,
     SlotSpec::new(HDR, SlotType::ColorTexture, Access::Write, Usage::Storage),
     // Ray-cast shadows: the hit mask of a ShadowRayCast pass.
     SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound).optional(),

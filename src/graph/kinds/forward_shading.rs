@@ -20,13 +20,7 @@ pub const SLOTS: &[SlotSpec] = &[
     super::GEOMETRY_READ,
     super::LIGHT_GEOMETRY_READ,
     super::LIGHT_PROPERTIES_READ,
-    SlotSpec::new(
-        slot::LIGHT_LISTS,
-        SlotType::Buffer,
-        Access::Read,
-        Usage::Bound,
-    )
-    .optional(),
+    super::LIGHT_LISTS_READ,
     SlotSpec::new(
         slot::DEPTH,
         SlotType::DepthTexture,

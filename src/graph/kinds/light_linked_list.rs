@@ -82,13 +82,7 @@ pub const SLOTS: &[SlotSpec] = &[
     ),
     super::LIGHT_GEOMETRY_READ,
     // A LightCulling pass's tile lists: only their lights are tested (else every light).
-    SlotSpec::new(
-        slot::LIGHT_LISTS,
-        SlotType::Buffer,
-        Access::Read,
-        Usage::Bound,
-    )
-    .optional(),
+    super::LIGHT_LISTS_READ,
     SlotSpec::new(LIGHT_LINKS, SlotType::Buffer, Access::Write, Usage::Bound),
 ];
 

@@ -215,6 +215,15 @@ pub const LIGHT_PROPERTIES_READ: SlotSpec = SlotSpec::new(
     Access::Read,
     Usage::Bound,
 );
+/// The tile lists of a `LightCulling` pass (or a `LightLinkedList`'s links), read by the
+/// passes that walk them; optional: without them a pass visits every light.
+pub const LIGHT_LISTS_READ: SlotSpec = SlotSpec::new(
+    slot::LIGHT_LISTS,
+    SlotType::Buffer,
+    Access::Read,
+    Usage::Bound,
+)
+.optional();
 
 /// The slot table of a built-in kind; `None` for generic kinds.
 pub fn slots(kind: &PassKind) -> Option<&'static [SlotSpec]> {
