@@ -160,27 +160,8 @@ fn random_lights() {
 
 #[test]
 fn depth_discontinuities() {
-    let mut s = random_scene(0, 3);
     // A thin near pillar in front of the far wall; lights spread through depth.
-    s.meshes.push(cuboid(
-        "pillar",
-        Vec3::new(-0.3, 0.0, 2.0),
-        Vec3::new(0.3, 6.0, 2.6),
-        1,
-        false,
-    ));
-    let mut rng = Rng(11);
-    s.lights = (0..500)
-        .map(|_| {
-            random_light(
-                &mut rng,
-                Vec3::new(-6.0, 0.0, -40.0),
-                Vec3::new(6.0, 6.0, 3.0),
-                0.5,
-                3.0,
-            )
-        })
-        .collect();
+    let mut s = pillar_scene(500);
     s.name = "depth_discontinuities".into();
     check_scene(&s, true);
 }

@@ -111,27 +111,8 @@ fn full_resolution_equals_brute_force() {
 #[test]
 fn full_resolution_equals_brute_force_at_depth_edges_and_the_near_plane() {
     let mut r = renderer();
-    let mut s = random_scene(0, 3);
     // A thin near pillar in front of the far wall; lights spread through depth.
-    s.meshes.push(cuboid(
-        "pillar",
-        Vec3::new(-0.3, 0.0, 2.0),
-        Vec3::new(0.3, 6.0, 2.6),
-        1,
-        false,
-    ));
-    let mut rng = Rng(11);
-    s.lights = (0..200)
-        .map(|_| {
-            random_light(
-                &mut rng,
-                Vec3::new(-6.0, 0.0, -40.0),
-                Vec3::new(6.0, 6.0, 3.0),
-                0.5,
-                3.0,
-            )
-        })
-        .collect();
+    let mut s = pillar_scene(200);
     // Lights around the eye: spans that start behind it (the seed's near-plane case).
     let eye = s.camera.eye;
     let fwd = (s.camera.target - eye).normalize();

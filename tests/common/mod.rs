@@ -170,6 +170,32 @@ pub fn random_light(rng: &mut Rng, lo: Vec3, hi: Vec3, rmin: f32, rmax: f32) -> 
     l
 }
 
+/// [`random_scene`]'s room with a thin near pillar in front of the far wall and `lights`
+/// random lights spread through depth: depth discontinuities in most tiles.
+pub fn pillar_scene(lights: usize) -> Scene {
+    let mut s = random_scene(0, 3);
+    s.meshes.push(cuboid(
+        "pillar",
+        Vec3::new(-0.3, 0.0, 2.0),
+        Vec3::new(0.3, 6.0, 2.6),
+        1,
+        false,
+    ));
+    let mut rng = Rng(11);
+    s.lights = (0..lights)
+        .map(|_| {
+            random_light(
+                &mut rng,
+                Vec3::new(-6.0, 0.0, -40.0),
+                Vec3::new(6.0, 6.0, 3.0),
+                0.5,
+                3.0,
+            )
+        })
+        .collect();
+    s
+}
+
 pub fn graph_path(name: &str) -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("graphs")
