@@ -116,11 +116,7 @@ pub fn check(p: &ForwardShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
 
 #[cfg(test)]
 mod tests {
-    use crate::graph::kinds::test_support::{errors, validate};
-
-    const PREPASS: &str =
-        r#"Pass(name: "pre", kind: DepthPrepass, reads: ["geometry"], writes: ["depth"]),"#;
-    const CULL: &str = r#"Pass(name: "c", kind: LightCulling(tile: 16), reads: ["depth", "lg"], writes: ["lists"]),"#;
+    use crate::graph::kinds::test_support::{errors, validate, CULL, PREPASS};
 
     #[test]
     fn culled_needs_lists_and_all_lights_takes_none() {

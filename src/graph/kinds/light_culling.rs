@@ -98,10 +98,7 @@ pub fn check(p: &LightCulling, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
 
 #[cfg(test)]
 mod tests {
-    use crate::graph::kinds::test_support::errors;
-
-    const PREPASS: &str =
-        r#"Pass(name: "pre", kind: DepthPrepass, reads: ["geometry"], writes: ["depth"]),"#;
+    use crate::graph::kinds::test_support::{errors, PREPASS};
 
     #[test]
     fn checks_parameters() {

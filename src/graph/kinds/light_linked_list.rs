@@ -118,11 +118,7 @@ pub fn check(p: &LightLinkedList, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
 
 #[cfg(test)]
 mod tests {
-    use crate::graph::kinds::test_support::{errors, validate};
-
-    const PREPASS: &str =
-        r#"Pass(name: "pre", kind: DepthPrepass, reads: ["geometry"], writes: ["depth"]),"#;
-    const CULL: &str = r#"Pass(name: "c", kind: LightCulling(tile: 16), reads: ["depth", "lg"], writes: ["lists"]),"#;
+    use crate::graph::kinds::test_support::{errors, validate, CULL, PREPASS};
 
     #[test]
     fn checks_parameters() {

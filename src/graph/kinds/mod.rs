@@ -456,6 +456,11 @@ pub(crate) mod test_support {
     use crate::graph::{check_text, GraphErrors};
     use crate::shader::ShaderLibrary;
 
+    /// The depth prepass and the tiled culling pass many kinds' tests put first.
+    pub const PREPASS: &str =
+        r#"Pass(name: "pre", kind: DepthPrepass, reads: ["geometry"], writes: ["depth"]),"#;
+    pub const CULL: &str = r#"Pass(name: "c", kind: LightCulling(tile: 16), reads: ["depth", "lg"], writes: ["lists"]),"#;
+
     /// A graph with the usual resources and `passes` (RON text), validated.
     pub fn validate(passes: &str, output: &str) -> Result<(), GraphErrors> {
         let text = format!(
