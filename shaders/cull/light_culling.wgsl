@@ -17,6 +17,7 @@
 // SAMPLES, MSAA, TRANSPARENT.
 
 #include "common/types.wgsl"
+#include "common/view_space.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
@@ -55,20 +56,6 @@ const COARSE_STRIDE: u32 = COARSE_CAPACITY + 1u;
 // 1e-4 of the distance: a thousand times the rounding it covers, and still far below
 // a tile's width at any distance (a 64-pixel coarse tile spans ~5e-2 of it at 60°).
 const COARSE_REACH: f32 = 1e-4;
-
-// Positive view-space distance along -z of a depth-buffer value.
-fn view_depth(d: f32) -> f32 {
-    let p = frame.inv_proj * vec4<f32>(0.0, 0.0, d, 1.0);
-    return -p.z / p.w;
-}
-
-// View-space point on the far plane through a framebuffer position.
-fn view_ray(pixel: vec2<f32>) -> vec3<f32> {
-    let size = vec2<f32>(frame.size);
-    let ndc = vec2<f32>(pixel.x / size.x * 2.0 - 1.0, 1.0 - pixel.y / size.y * 2.0);
-    let p = frame.inv_proj * vec4<f32>(ndc, 1.0, 1.0);
-    return p.xyz / p.w;
-}
 
 // The view-depth range sample `s` of a pixel adds to its tile (for a single-sample
 // depth, `s` is the mip level 0), or (-1, -1) where it holds nothing to light.

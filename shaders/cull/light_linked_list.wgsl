@@ -14,6 +14,7 @@
 // Defines: SCALE (1, 2, 4 or 8), LIGHT_LISTS.
 
 #include "common/types.wgsl"
+#include "common/view_space.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
@@ -32,20 +33,6 @@ var<workgroup> group_base: u32;
 
 // Largest finite f16.
 const F16_MAX: f32 = 65504.0;
-
-// Positive view-space distance along -z of a depth-buffer value.
-fn view_depth(d: f32) -> f32 {
-    let p = frame.inv_proj * vec4<f32>(0.0, 0.0, d, 1.0);
-    return -p.z / p.w;
-}
-
-// View-space point on the far plane through a framebuffer position.
-fn view_ray(pixel: vec2<f32>) -> vec3<f32> {
-    let size = vec2<f32>(frame.size);
-    let ndc = vec2<f32>(pixel.x / size.x * 2.0 - 1.0, 1.0 - pixel.y / size.y * 2.0);
-    let p = frame.inv_proj * vec4<f32>(ndc, 1.0, 1.0);
-    return p.xyz / p.w;
-}
 
 // f16 bits of the largest f16 at most x (x >= 0): spans only ever grow by rounding.
 fn f16_down(x: f32) -> u32 {
