@@ -383,11 +383,11 @@ fn build_pipeline(
                     _ => wgpu::TextureFormat::Depth32Float,
                 },
                 depth_write_enabled: Some(writes_depth),
-                depth_compare: Some(if writes_depth {
-                    wgpu::CompareFunction::Less
-                } else {
-                    wgpu::CompareFunction::LessEqual
-                }),
+                // LessEqual also where the draw writes depth: of two fragments at the same
+                // depth the later one wins, as in forward shading after a prepass (which
+                // tests LessEqual against it), so a G-buffer without a prepass keeps the
+                // same one of two coincident surfaces (tests/depth_ties.rs).
+                depth_compare: Some(wgpu::CompareFunction::LessEqual),
                 stencil: Default::default(),
                 bias: match mode {
                     DrawMode::AtlasDepth {
