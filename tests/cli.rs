@@ -211,3 +211,36 @@ fn render_reports_the_link_pool_and_its_overflow() {
         );
     }
 }
+
+/// `lightgraph compare A B | head -1`: the reader closes the pipe after one line; the
+/// command must end quietly (SIGPIPE), not panic on the next print.
+#[test]
+fn output_into_a_closed_pipe_ends_quietly() {
+    use std::io::Read;
+    use std::process::Stdio;
+    let dir = tempfile::tempdir().unwrap();
+    let a: Vec<[f32; 4]> = (0..64).map(|i| [i as f32 / 64.0, 0.5, 0.25, 1.0]).collect();
+    let mut b = a.clone();
+    b[3][1] = 2.0;
+    lightgraph::bench::write_exr(dir.path().join("a.exr"), &a, 8, 8).unwrap();
+    lightgraph::bench::write_exr(dir.path().join("b.exr"), &b, 8, 8).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lightgraph"))
+        .current_dir(dir.path())
+        .args(["compare", "a.exr", "b.exr"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    // Closed before the command writes anything: its first print hits a closed pipe.
+    drop(child.stdout.take());
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    child.wait().unwrap();
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(!err.contains("Broken pipe"), "{err}");
+}
