@@ -230,11 +230,12 @@ fn ron_with_gltf_model_transform_and_light_sets() {
 const BAD_RON: &[(&str, &[&str])] = &[
     (
         r#"Scene(lights: [(name: "key", position: (0, NaN, 0), range: 1, intensity: 1)])"#,
-        &["scene.ron", "lights[0] (\"key\")", "position"],
+        // Semantic errors point at the element's line and column like syntax errors.
+        &["scene.ron:1:16: lights[0] (\"key\")", "position"],
     ),
     (
         r#"Scene(lights: [(position: (0, 0, 0), range: 1, intensity: 1), (position: (0, 0, 0), range: inf, intensity: 1)])"#,
-        &["lights[1]", "range"],
+        &["scene.ron:1:63: lights[1]", "range"],
     ),
     (
         r#"Scene(lights: [(position: (0, 0, 0), range: 0, intensity: 1)])"#,
@@ -266,11 +267,11 @@ const BAD_RON: &[(&str, &[&str])] = &[
     ),
     (
         r#"Scene(builtin: "cathedral")"#,
-        &["builtin", "cathedral", "atrium"],
+        &["scene.ron:1:7: builtin", "cathedral", "atrium"],
     ),
     (
         r#"Scene(builtin: "atrium", light_sets: [Random(count: 2000000, placement: SceneBounds(), range: (1, 2), intensity: (1, 1))])"#,
-        &["light_sets[0]", "exceeds the limit"],
+        &["scene.ron:1:39: light_sets[0]", "exceeds the limit"],
     ),
     (
         r#"Scene(builtin: "atrium", light_sets: [Random(count: 10, placement: SceneBounds(), range: (2, 1), intensity: (1, 1))])"#,
@@ -286,7 +287,7 @@ const BAD_RON: &[(&str, &[&str])] = &[
     ),
     (
         r#"Scene(models: [(path: "missing.gltf")])"#,
-        &["missing.gltf", "cannot read"],
+        &["scene.ron:1:16: models[0]", "missing.gltf", "cannot read"],
     ),
     (
         r#"Scene(models: [(path: "a.obj")])"#,

@@ -22,17 +22,20 @@ pub enum SceneError {
         col: usize,
         message: String,
     },
-    /// Bad content: names the element (e.g. `mesh 0 ("box") primitive 1 accessor 3`).
-    #[error("{}: {element}: {message}", file.display())]
+    /// Bad content: names the element (e.g. `mesh 0 ("box") primitive 1 accessor 3`),
+    /// and where a scene file writes it when that is known.
+    #[error("{}{}: {element}: {message}", file.display(), at_text(at))]
     Invalid {
         file: PathBuf,
+        at: Option<(usize, usize)>,
         element: String,
         message: String,
     },
     /// A count past a safety limit.
-    #[error("{}: {element}: {what} {count} exceeds the limit of {limit}", file.display())]
+    #[error("{}{}: {element}: {what} {count} exceeds the limit of {limit}", file.display(), at_text(at))]
     Limit {
         file: PathBuf,
+        at: Option<(usize, usize)>,
         element: String,
         what: &'static str,
         count: u64,
@@ -48,6 +51,7 @@ impl SceneError {
     ) -> Self {
         SceneError::Invalid {
             file: file.into(),
+            at: None,
             element: element.to_string(),
             message: message.to_string(),
         }
@@ -60,6 +64,29 @@ impl SceneError {
         }
     }
 
+    /// The error with the line and column where the scene file `file`, whose text is
+    /// `text`, writes the element it names (when it names one of that file's).
+    pub fn located_in(mut self, file: &std::path::Path, text: &str) -> Self {
+        if let SceneError::Invalid {
+            file: f,
+            at,
+            element,
+            ..
+        }
+        | SceneError::Limit {
+            file: f,
+            at,
+            element,
+            ..
+        } = &mut self
+        {
+            if f == file && at.is_none() {
+                *at = super::locate::locate(text, element);
+            }
+        }
+        self
+    }
+
     /// The file the error is about.
     pub fn file(&self) -> &std::path::Path {
         match self {
@@ -69,4 +96,9 @@ impl SceneError {
             | SceneError::Limit { file, .. } => file,
         }
     }
+}
+
+fn at_text(at: &Option<(usize, usize)>) -> String {
+    at.map(|(line, col)| format!(":{line}:{col}"))
+        .unwrap_or_default()
 }

@@ -11,6 +11,7 @@ pub mod geometry;
 pub mod gltf_import;
 pub mod gltf_writer;
 pub mod lights;
+mod locate;
 mod model_budget;
 pub mod ranges;
 pub mod scene_file;

@@ -264,7 +264,7 @@ pub fn load_scene_file(path: &Path) -> Result<Loaded, SceneError> {
     let text = crate::files::read_text(path, crate::files::caps::RON)
         .map_err(|e| SceneError::io(path, e))?;
     let spec = parse_scene_file(&text, path)?;
-    build_scene(&spec, path)
+    build_scene(&spec, path).map_err(|e| e.located_in(path, &text))
 }
 
 fn transform_scene(scene: &mut Scene, m: Mat4) {
@@ -443,6 +443,7 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
         if total > MAX_SCENE_LIGHTS {
             return Err(SceneError::Limit {
                 file: file.to_path_buf(),
+                at: None,
                 element,
                 what: "total light count",
                 count: total,

@@ -185,6 +185,7 @@ impl Importer {
         if count > limit {
             return Err(SceneError::Limit {
                 file: self.file.clone(),
+                at: None,
                 element: element.to_string(),
                 what,
                 count,
