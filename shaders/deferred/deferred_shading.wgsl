@@ -5,7 +5,8 @@
 // With G_PACKED the G-buffer is one texture: view depth, octahedral normal, material;
 // the position is rebuilt on the pixel's view ray.
 // Defines: MATERIAL_INDEX, LIGHT_LISTS (tile lists) or LINKED_LISTS (a light linked
-// list), G_PACKED, SHADOWS with SHADOW_MASK (ray-cast shadows from
+// list), G_PACKED, G_SAMPLES (a multisampled G-buffer of that many samples: the main of
+// deferred/deferred_msaa.wgsl), SHADOWS with SHADOW_MASK (ray-cast shadows from
 // shadow/shadow_ray_cast.wgsl) or SHADOW_ATLAS (a ShadowAtlas pass's maps).
 
 #include "common/types.wgsl"
@@ -22,6 +23,13 @@
 @group(0) @binding(3) var<storage, read> light_lists: array<u32>;
 @group(0) @binding(4) var<uniform> link_params: LinkParams;
 #endif
+#if G_SAMPLES
+// A multisampled G-buffer (see deferred/deferred_msaa.wgsl): `hdr` holds partial sums
+// between the materials' dispatches.
+@group(0) @binding(5) var g_position: texture_multisampled_2d<f32>;
+@group(0) @binding(6) var g_normal: texture_multisampled_2d<f32>;
+@group(0) @binding(7) var hdr: texture_storage_2d<rgba32float, read_write>;
+#else
 @group(0) @binding(5) var g_position: texture_2d<f32>;
 #if G_PACKED
 #include "common/octahedral.wgsl"
@@ -29,6 +37,7 @@
 @group(0) @binding(6) var g_normal: texture_2d<f32>;
 #endif
 @group(0) @binding(7) var hdr: texture_storage_2d<rgba32float, write>;
+#endif
 
 #include "common/light_lists.wgsl"
 #if SHADOW_MASK
@@ -53,6 +62,10 @@ struct ShadingPoint {
 
 #include <material>
 #include "common/light_loop.wgsl"
+
+#if G_SAMPLES
+#include "deferred/deferred_msaa.wgsl"
+#else
 
 #if G_PACKED
 // The world point at view depth `view_z` on the ray through framebuffer position `pixel`.
@@ -101,3 +114,4 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let pixel = vec2<f32>(id.xy) + 0.5;
     textureStore(hdr, id.xy, vec4<f32>(shade_surface(p, m, pixel, view_z), material_alpha(m)));
 }
+#endif

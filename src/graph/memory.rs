@@ -202,4 +202,31 @@ mod tests {
         assert!(t.is_empty(), "{t:?}");
         assert!(by_technique(&compiled("forward_plus.ron", false)).is_empty());
     }
+
+    #[test]
+    fn deferred_msaa_counts_its_multisampled_g_buffer() {
+        // The depth and both G-buffer textures at 4×; the output stays single-sample and
+        // there is no multisampled colour texture (the shading pass resolves).
+        let t = by_technique(&compiled("tiled_deferred_msaa.ron", false));
+        assert_eq!(t.len(), 1, "{t:?}");
+        assert_eq!(t[0].technique, "MSAA 4×");
+        let mut items: Vec<(&str, u64, u64)> = t[0]
+            .items
+            .iter()
+            .map(|i| (i.resource.as_str(), i.bytes, i.added))
+            .collect();
+        items.sort();
+        let px = 100 * 50;
+        assert_eq!(
+            items,
+            [
+                ("depth_msaa", 4 * px * 4, 4 * px * 3),
+                ("g_normal", 16 * px * 4, 16 * px * 3),
+                ("g_position", 16 * px * 4, 16 * px * 3),
+            ]
+        );
+        let t = by_technique(&compiled("tiled_deferred_msaa_8x.ron", false));
+        assert_eq!(t[0].technique, "MSAA 8×");
+        assert_eq!(t[0].added(), (4 + 16 + 16) * px * 7);
+    }
 }

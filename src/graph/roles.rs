@@ -221,7 +221,9 @@ impl RoleCtx<'_> {
                 }
             }
             (
-                BindingKind::StorageTexture { format, writable },
+                BindingKind::StorageTexture {
+                    format, writable, ..
+                },
                 ResourceDesc::Texture {
                     format: declared,
                     samples,

@@ -34,6 +34,7 @@ pub fn validate(
     let mut errors = Vec::new();
     let (resources, passes) = names_and_duplicates(&desc, &source, &mut errors);
     let ids = check_references(&desc, &source, &resources, &passes, &mut errors);
+    check_conditions(&desc, &source, &mut errors);
     super::sizes::check_resources(&desc, &source, &mut errors);
     if !errors.is_empty() {
         // Role and order checks assume every name resolves.
@@ -212,6 +213,20 @@ fn check_references(
         }
     }
     ids
+}
+
+/// `when: Msaa` is refused: MSAA is a property of the graph (its textures' sample
+/// counts), not of the scene, so the condition would be the same for every scene.
+fn check_conditions(desc: &GraphDesc, source: &SourceText, errors: &mut Vec<GraphError>) {
+    for pass in &desc.passes {
+        if pass.when == Some(super::model::SceneFeature::Msaa) {
+            errors.push(GraphError::BadPass {
+                at: source.in_pass(&pass.name, "Msaa"),
+                pass: pass.name.to_string(),
+                problem: "when: Msaa is not a scene feature: MSAA is chosen by the graph (samples: 4 on its textures), so it would hold for every scene or none. Drop the condition, and put what only an MSAA frame needs in an MSAA graph (graphs/msaa.ron)".into(),
+            });
+        }
+    }
 }
 
 fn check_writes(

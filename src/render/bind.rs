@@ -118,11 +118,15 @@ pub(super) fn layout_entries_filtering(
                     view_dimension: D::D2,
                     multisampled: *multisampled,
                 },
-                BindingKind::StorageTexture { format, writable } => T::StorageTexture {
-                    access: if *writable {
-                        wgpu::StorageTextureAccess::WriteOnly
-                    } else {
-                        wgpu::StorageTextureAccess::ReadOnly
+                BindingKind::StorageTexture {
+                    format,
+                    writable,
+                    readable,
+                } => T::StorageTexture {
+                    access: match (*writable, *readable) {
+                        (true, true) => wgpu::StorageTextureAccess::ReadWrite,
+                        (true, false) => wgpu::StorageTextureAccess::WriteOnly,
+                        (false, _) => wgpu::StorageTextureAccess::ReadOnly,
                     },
                     format: storage_format(*format),
                     view_dimension: D::D2,

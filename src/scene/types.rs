@@ -184,7 +184,6 @@ pub struct SceneFeatures {
     pub has_indirect_lights: bool,
     pub has_spot_lights: bool,
     pub has_lights: bool,
-    pub msaa: bool,
     /// Some light is a point light.
     pub has_point_lights: bool,
     /// Some drawn material is double-sided (needs two-sided lighting / no back-face culling).
@@ -251,7 +250,6 @@ impl Scene {
                 .iter()
                 .any(|l| matches!(l.shape, LightShape::Spot { .. })),
             has_lights: !self.lights.is_empty(),
-            msaa: false,
             has_point_lights: self
                 .lights
                 .iter()

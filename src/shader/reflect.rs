@@ -17,6 +17,8 @@ pub enum BindingKind {
     StorageTexture {
         format: naga::StorageFormat,
         writable: bool,
+        /// `read_write` (with `writable`), or `read`.
+        readable: bool,
     },
     Sampler {
         comparison: bool,
@@ -54,6 +56,7 @@ pub fn reflect_bindings(module: &naga::Module) -> Vec<ReflectedBinding> {
                         ImageClass::Storage { format, access } => BindingKind::StorageTexture {
                             format,
                             writable: access.contains(StorageAccess::STORE),
+                            readable: access.contains(StorageAccess::LOAD),
                         },
                         ImageClass::External => return None,
                     },

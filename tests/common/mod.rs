@@ -2,6 +2,8 @@
 //! file on the real adapter (lavapipe on CI).
 #![allow(dead_code)]
 
+pub mod msaa;
+
 use glam::{Vec2, Vec3, Vec4};
 use lightgraph::graph::{self, FrameSize};
 use lightgraph::render::{FrameResult, Renderer, SceneGpu};

@@ -53,6 +53,35 @@ pub fn check(p: &DeferredShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         "deferred shading stores into a single-sample Rgba32Float texture",
         errors,
     );
+    check_msaa(ctx, errors);
+}
+
+/// A multisampled G-buffer (MSAA): both textures at one sample count, the two-texture
+/// layout, and no per-pixel shadow mask (its bits are per pixel, not per sample). The
+/// pass shades every distinct sample and stores their mean: the output stays single-sample.
+fn check_msaa(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+    let Some(position) = ctx.slot(G_POSITION) else {
+        return;
+    };
+    let ps = ctx.samples(position);
+    if let Some(normal) = ctx.slot(G_NORMAL) {
+        let ns = ctx.samples(normal);
+        if ns != ps {
+            errors.push(ctx.mismatch(
+                normal,
+                format!("G-buffer texture has {ns} sample(s) but '{position}' has {ps}: both are read sample by sample"),
+            ));
+        }
+    }
+    if ps > 1 {
+        super::g_buffer::check_msaa_layout(ctx, position, errors);
+        if let Some(mask) = ctx.slot(SHADOW_MASK) {
+            errors.push(ctx.mismatch(
+                mask,
+                "the ray-cast shadow mask holds one pixel's bits, not each sample's: a multisampled G-buffer is shadowed from a shadow atlas",
+            ));
+        }
+    }
 }
 
 #[cfg(test)]
@@ -91,5 +120,48 @@ mod tests {
             "hdr",
         );
         assert!(e.contains("single-sample Rgba32Float"), "{e}");
+    }
+
+    const GBUF4: &str = r#"Pass(name: "g", kind: GBuffer, reads: ["geometry"], writes: ["depth4", "pos4", "nrm4"]),"#;
+
+    #[test]
+    fn reads_a_multisampled_g_buffer_at_one_count() {
+        validate(
+            &format!(r#"{GBUF4} Pass(name: "d", kind: DeferredShading(), reads: ["pos4", "nrm4", "lg", "lp"], writes: ["hdr"])"#),
+            "hdr",
+        )
+        .unwrap();
+        // Reads of textures another pass wrote at a different count.
+        let e = errors(
+            &format!(
+                r#"{GBUF4} Pass(name: "g1", kind: GBuffer, reads: ["geometry"], writes: ["depth", "pos", "nrm"]), Pass(name: "d", kind: DeferredShading(), reads: ["pos4", "nrm", "lg", "lp"], writes: ["hdr"])"#
+            ),
+            "hdr",
+        );
+        assert!(
+            e.contains(
+                "pass 'd', resource 'nrm': G-buffer texture has 1 sample(s) but 'pos4' has 4"
+            ),
+            "{e}"
+        );
+        let e = errors(
+            &format!(
+                r#"{GBUF4} Pass(name: "d", kind: DeferredShading(), reads: ["pos4", "nrm4", "lg", "lp"], writes: ["hdr4"])"#
+            ),
+            "hdr",
+        );
+        assert!(e.contains("single-sample Rgba32Float"), "{e}");
+        let e = errors(
+            &format!(
+                r#"{GBUF4} Pass(name: "d", kind: DeferredShading(), reads: ["pos4", "lg", "lp"], writes: ["hdr"])"#
+            ),
+            "hdr",
+        );
+        assert!(
+            e.contains(
+                "pass 'd', resource 'pos4': a multisampled G-buffer is the two-texture layout"
+            ),
+            "{e}"
+        );
     }
 }

@@ -43,15 +43,50 @@ pub const SLOTS: &[SlotSpec] = &[
 ];
 
 pub fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
-    ctx.require_single_rgba32f(
-        &[G_POSITION, G_NORMAL, G_GEOMETRIC],
-        "G-buffer textures are single-sample Rgba32Float",
-        errors,
-    );
-    if let Some(depth) = ctx.slot(slot::DEPTH) {
-        if ctx.samples(depth) != 1 {
-            errors.push(ctx.mismatch(depth, "the G-buffer is single-sample"));
+    let targets = [G_POSITION, G_NORMAL, G_GEOMETRIC];
+    for s in targets {
+        if let Some(name) = ctx.slot(s) {
+            if !ctx.is_rgba32f(name) {
+                errors.push(ctx.mismatch(name, "G-buffer textures are Rgba32Float"));
+            }
         }
+    }
+    let Some(depth) = ctx.slot(slot::DEPTH) else {
+        return;
+    };
+    // MSAA: every target and the depth at one sample count (a render pass's attachments
+    // must agree), and only the two-texture layout (see check_msaa_layout).
+    let ds = ctx.samples(depth);
+    for name in targets.iter().filter_map(|s| ctx.slot(s)) {
+        let ts = ctx.samples(name);
+        if ts != ds {
+            errors.push(ctx.mismatch(
+                name,
+                format!("G-buffer texture has {ts} sample(s) but depth '{depth}' has {ds}: every G-buffer texture takes the depth's sample count"),
+            ));
+        }
+    }
+    if ds > 1 {
+        check_msaa_layout(ctx, depth, errors);
+    }
+}
+
+/// A multisampled G-buffer holds world positions and shading normals per sample: the
+/// packed layout rebuilds positions on the pixel centre's view ray, which is not where
+/// an edge sample's surface lies (MSAA interpolates at the centroid), and ray-cast
+/// shadows' jobs read a single-sample G-buffer.
+pub fn check_msaa_layout(ctx: &KindCtx, at: &str, errors: &mut Vec<GraphError>) {
+    if ctx.slot(G_NORMAL).is_none() {
+        errors.push(ctx.mismatch(
+            at,
+            "a multisampled G-buffer is the two-texture layout (g_position, g_normal): the packed one rebuilds positions on the pixel centre's ray, not at each sample's surface",
+        ));
+    }
+    if let Some(g) = ctx.slot(G_GEOMETRIC) {
+        errors.push(ctx.mismatch(
+            g,
+            "ray-cast shadows read a single-sample G-buffer: a multisampled one has no geometric normals",
+        ));
     }
 }
 
@@ -94,13 +129,62 @@ mod tests {
             r#"Pass(name: "g", kind: GBuffer, reads: ["geometry"], writes: ["depth", "small"])"#,
             "hdr",
         );
-        assert!(e.contains("single-sample Rgba32Float"), "{e}");
+        assert!(e.contains("G-buffer textures are Rgba32Float"), "{e}");
         let e = errors(
             r#"Pass(name: "g", kind: GBuffer, reads: ["geometry", "lg"], writes: ["depth", "pos"])"#,
             "pos",
         );
         assert!(
             e.contains("GBuffer has no free slot for an Import of LightGeometry"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn msaa_targets_take_the_depths_samples_and_two_textures() {
+        // The G-buffer pass writes `targets`; a deferred pass reads its colour textures.
+        let graph = |targets: &str, reads: &str| {
+            format!(
+                r#"Pass(name: "g", kind: GBuffer, reads: ["geometry"], writes: [{targets}]), Pass(name: "d", kind: DeferredShading(), reads: [{reads}, "lg", "lp"], writes: ["hdr"])"#
+            )
+        };
+        validate(
+            &graph(r#""depth4", "pos4", "nrm4""#, r#""pos4", "nrm4""#),
+            "hdr",
+        )
+        .unwrap();
+        let e = errors(
+            &graph(r#""depth4", "pos4", "nrm""#, r#""pos4", "nrm""#),
+            "hdr",
+        );
+        assert!(
+            e.contains("pass 'g', resource 'nrm': G-buffer texture has 1 sample(s) but depth 'depth4' has 4"),
+            "{e}"
+        );
+        let e = errors(
+            &graph(r#""depth", "pos4", "nrm4""#, r#""pos4", "nrm4""#),
+            "hdr",
+        );
+        assert!(
+            e.contains("pass 'g', resource 'pos4': G-buffer texture has 4 sample(s) but depth 'depth' has 1"),
+            "{e}"
+        );
+        let e = errors(&graph(r#""depth4", "pos4""#, r#""pos4""#), "hdr");
+        assert!(
+            e.contains(
+                "pass 'g', resource 'depth4': a multisampled G-buffer is the two-texture layout"
+            ),
+            "{e}"
+        );
+        let e = errors(
+            &graph(
+                r#""depth4", "pos4", "nrm4", "g_geometric=hdr4""#,
+                r#""pos4", "nrm4""#,
+            ),
+            "hdr",
+        );
+        assert!(
+            e.contains("resource 'hdr4': ray-cast shadows read a single-sample G-buffer"),
             "{e}"
         );
     }

@@ -348,6 +348,16 @@ impl KindCtx<'_> {
             }
         }
     }
+    /// Whether the texture is Rgba32Float, at any sample count.
+    pub fn is_rgba32f(&self, name: &str) -> bool {
+        matches!(
+            self.graph.resources.get(name),
+            Some(ResourceDesc::Texture {
+                format: super::model::TextureFormat::Rgba32Float,
+                ..
+            })
+        )
+    }
     pub fn is_single_rgba32f(&self, name: &str) -> bool {
         matches!(
             self.graph.resources.get(name),
@@ -473,6 +483,8 @@ pub(crate) mod test_support {
         Texture(name: "hdr4", format: Rgba32Float, samples: 4),
         Texture(name: "pos", format: Rgba32Float),
         Texture(name: "nrm", format: Rgba32Float),
+        Texture(name: "pos4", format: Rgba32Float, samples: 4),
+        Texture(name: "nrm4", format: Rgba32Float, samples: 4),
         Texture(name: "small", format: Rgba8Unorm),
         Texture(name: "geo", format: Rgba32Float),
         Texture(name: "atlas", format: Depth32Float, size: Fixed(2048, 2048)),

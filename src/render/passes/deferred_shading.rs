@@ -1,7 +1,9 @@
 //! `DeferredShading`: one compute dispatch per material over the frame, reading the
-//! G-buffer and storing lit colour.
+//! G-buffer and storing lit colour; from a multisampled G-buffer, the mean of every
+//! sample's colour (shaders/deferred/deferred_msaa.wgsl).
 
 use super::{defines, pass_error, PrepareCtx, PreparedPass, Timestamps};
+use crate::graph::kinds::deferred_shading::HDR;
 use crate::graph::kinds::g_buffer::G_NORMAL;
 use crate::graph::Name;
 use crate::graph::{DeferredShading, ScheduledPass};
@@ -27,6 +29,32 @@ pub(super) fn prepare(
     let mut offered = cx.declared(sp)?;
     let lists = cx.shading_lists(sp, p.lights, &mut offered)?;
     let shadows = cx.shading_shadows(sp, &mut offered);
+    // A multisampled G-buffer: every distinct sample shaded, the mean stored. Pixels whose
+    // samples hold several materials sum over the materials' dispatches in `hdr`, which
+    // each reads back (read-write storage; the MSAA formats already need the adapter's
+    // format features).
+    let msaa = sp.samples > 1;
+    if msaa {
+        let flags = cx
+            .renderer
+            .ctx
+            .adapter
+            .get_texture_format_features(wgpu::TextureFormat::Rgba32Float)
+            .flags;
+        let features = cx.device().features();
+        if !features.contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES)
+            || !flags.contains(wgpu::TextureFormatFeatureFlags::STORAGE_READ_WRITE)
+        {
+            return Err(pass_error(
+                &sp.name,
+                format!(
+                    "a multisampled G-buffer needs read-write storage of Rgba32Float for '{}' (samples of several materials are summed there), which this adapter ({}) lacks",
+                    sp.required(HDR),
+                    cx.renderer.ctx.adapter.get_info().name
+                ),
+            ));
+        }
+    }
     let mut pipelines = Vec::new();
     let mut bind = None;
     for (index, m) in cx.gpu.materials.iter().enumerate() {
@@ -39,6 +67,9 @@ pub(super) fn prepare(
         let mut d = vec![("MATERIAL_INDEX", index.to_string())];
         if packed {
             d.push(("G_PACKED", "1".into()));
+        }
+        if msaa {
+            d.push(("G_SAMPLES", sp.samples.to_string()));
         }
         d.extend(lists.define());
         d.extend(crate::render::draws::shadow_defines(shadows));

@@ -1,6 +1,7 @@
 //! `GBuffer`: every opaque mesh into one packed or two Rgba32Float textures. After a
 //! depth prepass it loads that depth and only tests against it, so each pixel is
-//! written once instead of once per overlapping surface.
+//! written once instead of once per overlapping surface. Multisampled, it draws at the
+//! targets' sample count with centroid inputs, as MSAA forward shading does.
 
 use super::{PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::g_buffer::{self as kind, G_GEOMETRIC, G_NORMAL, G_POSITION};
@@ -34,9 +35,14 @@ pub(super) fn prepare(cx: &mut PrepareCtx, sp: &ScheduledPass) -> Result<GBuffer
         normals: sp.roles.slot(G_NORMAL).is_some(),
         geometric,
     };
-    let draws = cx
-        .renderer
-        .mesh_draws(cx.gpu, mode, MeshSet::Opaque, 1, &sp.name, &offered)?;
+    let draws = cx.renderer.mesh_draws(
+        cx.gpu,
+        mode,
+        MeshSet::Opaque,
+        sp.samples,
+        &sp.name,
+        &offered,
+    )?;
     let mut targets = vec![cx.view(&sp.name, sp.required(G_POSITION))?];
     for slot in [G_NORMAL, G_GEOMETRIC] {
         if let Some(name) = sp.roles.slot(slot) {
