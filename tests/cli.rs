@@ -244,3 +244,35 @@ fn output_into_a_closed_pipe_ends_quietly() {
     assert!(!err.contains("panicked"), "{err}");
     assert!(!err.contains("Broken pipe"), "{err}");
 }
+
+/// A graph whose only writer of the output is skipped by `when:` for this scene: a clear
+/// error naming the graph line and the pass, not a panic (it was an `expect` in render).
+#[test]
+fn output_without_a_running_writer_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let graph = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("graphs/forward_plus.ron"),
+    )
+    .unwrap()
+    .replace(
+        "            writes: [\"hdr\"],\n",
+        "            writes: [\"hdr\"],\n            when: Some(Transparent),\n",
+    );
+    assert!(graph.contains("when: Some(Transparent)"));
+    std::fs::write(dir.path().join("g.ron"), graph).unwrap();
+    let o = lightgraph(
+        dir.path(),
+        &[
+            "render", "--graph", "g.ron", "--width", "32", "--height", "18", "--out", "x.png",
+        ],
+    );
+    let (_, err) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(
+        err.contains("g.ron:31:")
+            && err.contains("pass 'forward_shading': output 'hdr' has no writer in this scene")
+            && err.contains("when: Transparent is false"),
+        "{err}"
+    );
+}

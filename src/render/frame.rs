@@ -113,6 +113,7 @@ impl Renderer {
         pool: Option<&FrameResources>,
     ) -> Result<PreparedFrame, RenderError> {
         let device = self.ctx.device.clone();
+        check_output_written(&graph)?;
         super::device_limits::check_plan(&graph, &device.limits())?;
         super::device_limits::check_samples(&graph, &self.ctx.adapter, &device)?;
         let resources = FrameResources::create_reusing(&device, &graph.plan, pool);
@@ -308,7 +309,8 @@ impl PreparedFrame {
         })
     }
 
-    /// The graph's output texture (Rgba32Float; sampled by the viewer).
+    /// The graph's output texture (Rgba32Float; sampled by the viewer). Planned for every
+    /// prepared frame: [`check_output_written`].
     pub fn output_texture(&self) -> &wgpu::Texture {
         self.resources
             .texture(&self.graph.plan, self.graph.output())
@@ -422,4 +424,48 @@ impl PreparedFrame {
             pass.set_view(r, camera);
         }
     }
+}
+
+/// The output must have a writer that runs for this scene: where `when:` skipped every
+/// pass that writes it, nothing would plan it (and a black image would say nothing).
+fn check_output_written(graph: &CompiledGraph) -> Result<(), RenderError> {
+    let output = graph.output();
+    if graph.plan.resources.iter().any(|r| &*r.name == output) {
+        return Ok(());
+    }
+    let skipped: Vec<String> = graph
+        .culled
+        .iter()
+        .filter(|c| {
+            graph
+                .checked
+                .desc
+                .passes
+                .iter()
+                .any(|p| p.name == c.name && p.writes.iter().any(|w| &**w == output))
+        })
+        .map(|c| match &c.reason {
+            crate::graph::CullReason::WhenFalse(feature) => {
+                format!("'{}' (when: {feature} is false for this scene)", c.name)
+            }
+            crate::graph::CullReason::Unreachable => format!("'{}'", c.name),
+        })
+        .collect();
+    let pass = graph
+        .culled
+        .iter()
+        .find(|c| {
+            skipped
+                .iter()
+                .any(|s| s.starts_with(&format!("'{}'", c.name)))
+        })
+        .map_or_else(|| output.to_string(), |c| c.name.to_string());
+    Err(RenderError::AtPass {
+        at: graph.checked.source.in_pass(&pass, output),
+        pass,
+        problem: format!(
+            "output '{output}' has no writer in this scene: its writers {} are skipped",
+            skipped.join(", ")
+        ),
+    })
 }
