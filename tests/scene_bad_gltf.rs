@@ -37,7 +37,8 @@ const CORPUS: &[(&str, Expect)] = &[
     (
         "index_past_vertex_count.gltf",
         Error(&[
-            "mesh 0 (\"tri\") primitive 0 indices accessor 1",
+            // Semantic errors carry the JSON line and column of the element they name.
+            "index_past_vertex_count.gltf:39:3: mesh 0 (\"tri\") primitive 0 indices accessor 1",
             "index 2 is 7, past the vertex count 3",
         ]),
     ),
@@ -75,9 +76,15 @@ const CORPUS: &[(&str, Expect)] = &[
     ),
     (
         "dangling_accessor_reference.gltf",
-        Error(&["glTF validation", "meshes[0].primitives[0].attributes"]),
+        Error(&[
+            "dangling_accessor_reference.gltf:26:7: glTF validation",
+            "meshes[0].primitives[0].attributes",
+        ]),
     ),
-    ("node_cycle.gltf", Error(&["node", "cycle"])),
+    (
+        "node_cycle.gltf",
+        Error(&["node_cycle.gltf:20:3: node 1", "cycle"]),
+    ),
     (
         "node_instance_explosion.gltf",
         Error(&["node instance count", "exceeds the limit"]),
@@ -88,7 +95,10 @@ const CORPUS: &[(&str, Expect)] = &[
     ),
     (
         "light_negative_range.gltf",
-        Error(&["light 0 (\"lamp\")", "range"]),
+        Error(&[
+            "light_negative_range.gltf:67:5: light 0 (\"lamp\")",
+            "range",
+        ]),
     ),
     (
         "light_infinite_intensity.gltf",

@@ -66,23 +66,31 @@ impl SceneError {
 
     /// The error with the line and column where the scene file `file`, whose text is
     /// `text`, writes the element it names (when it names one of that file's).
-    pub fn located_in(mut self, file: &std::path::Path, text: &str) -> Self {
-        if let SceneError::Invalid {
-            file: f,
-            at,
-            element,
-            ..
-        }
-        | SceneError::Limit {
-            file: f,
-            at,
-            element,
-            ..
-        } = &mut self
-        {
-            if f == file && at.is_none() {
-                *at = super::locate::locate(text, element);
-            }
+    pub fn located_in(self, file: &std::path::Path, text: &str) -> Self {
+        self.located_by(file, |element, _| super::locate::locate(text, element))
+    }
+
+    /// The error with the line and column `find(element, message)` gives, for an element
+    /// of `file` not yet located.
+    pub(crate) fn located_by(
+        mut self,
+        file: &std::path::Path,
+        find: impl Fn(&str, &str) -> Option<(usize, usize)>,
+    ) -> Self {
+        match &mut self {
+            SceneError::Invalid {
+                file: f,
+                at,
+                element,
+                message,
+            } if f == file && at.is_none() => *at = find(element, message),
+            SceneError::Limit {
+                file: f,
+                at,
+                element,
+                ..
+            } if f == file && at.is_none() => *at = find(element, ""),
+            _ => {}
         }
         self
     }

@@ -20,6 +20,7 @@ mod encoding;
 mod images;
 pub mod instancing;
 mod lights;
+mod locate;
 mod materials;
 mod mesh;
 mod morph;
@@ -106,6 +107,28 @@ pub fn import_gltf_slice(
 }
 
 fn import_slice_inner(
+    bytes: &[u8],
+    base_dir: &Path,
+    file: &Path,
+    limits: &ImportLimits,
+) -> Result<(Loaded, bool, instancing::Expansion), SceneError> {
+    import_unlocated(bytes, base_dir, file, limits).map_err(|e| {
+        // Semantic errors of a .gltf point at its JSON text (a .glb's chunk is binary).
+        let text = std::str::from_utf8(bytes).ok();
+        match text.filter(|t| {
+            t.trim_start_matches('\u{feff}')
+                .trim_start()
+                .starts_with('{')
+        }) {
+            Some(text) => e.located_by(file, |element, message| {
+                locate::locate(text, element, message)
+            }),
+            None => e,
+        }
+    })
+}
+
+fn import_unlocated(
     bytes: &[u8],
     base_dir: &Path,
     file: &Path,
