@@ -12,20 +12,23 @@
 #     (results.md, results.csv, time_vs_error.png).
 # Results are packed into $OUT/results.tar.gz (or results/). Usage from the project root
 # after ../shared/gpu/prepare.sh target/release/lightgraph:
-#   scripts/gpu_bench_vpl.sh
+#   scripts/gpu_bench_vpl.sh          all three
+#   scripts/gpu_bench_vpl.sh error    only the error sweep (3.; about 3 minutes on an H200)
 set -u
 source "$(dirname "$0")/gpu_env.sh"
-for k in 1 8 32; do
+only_error=false
+[ "${1:-}" = error ] && only_error=true
+$only_error || for k in 1 8 32; do
     s=benches/scenes/atrium_indirect_$k.ron
     for g in indirect_vpl tiled_deferred_indirect_vpl; do
         $lg render --scene "$s" --graph graphs/$g.ron --out "$out/atrium_indirect_${k}_$g.png" \
             > "$out/render_atrium_indirect_${k}_$g.txt" 2>&1
     done
 done
-timeout 200 $lg bench --sweep benches/sweeps/indirect_vpl.ron --out "$out/indirect_vpl" > "$out/indirect_vpl.log" 2>&1
+$only_error || timeout 200 $lg bench --sweep benches/sweeps/indirect_vpl.ron --out "$out/indirect_vpl" > "$out/indirect_vpl.log" 2>&1
 timeout 330 $lg vpl-error --scene scenes/cornell_indirect.ron scenes/atrium_indirect.ron \
     --width 1920 --height 1080 --samples 256 --frames 10 --out "$out/vpl_error" > "$out/vpl_error.log" 2>&1
 nvidia-smi --query-gpu=clocks.sm --format=csv >> "$out/gpu.txt" 2>&1
-cat "$out"/gpu.txt "$out"/render_*.txt
+cat "$out"/gpu.txt "$out"/render_*.txt 2>/dev/null
 cat "$out/vpl_error/results.md"
 gpu_pack

@@ -174,6 +174,84 @@ fn lobes_match_f64_reference() {
     }
 }
 
+/// The f32 lobes where the shading normal faces away from the eye (n·v < 0) and the light
+/// is almost straight behind the point (`back_facing`): every GGX lobe within its physical
+/// bound (see material_cpu.rs), no NaN or Inf. Without GGX's χ⁺(n·h) they reached 1e8 × it.
+#[test]
+fn ggx_lobes_stay_bounded_when_the_shading_normal_faces_away() {
+    let gpu = GpuContext::new_headless().expect("GPU (lavapipe) needed");
+    let count = 1 << 14;
+    let mut rng = Rng(0xbac9);
+    let mut input = Vec::with_capacity(count * 24);
+    let mut cases = Vec::with_capacity(count);
+    for i in 0..count {
+        let g = back_facing(&mut rng);
+        let rough = [0.0, 0.05, 0.3, 0.6, 0.7][i % 5];
+        let an = [-0.6, 0.0, 0.6][i % 3];
+        let p = [rough, an, 1.5, 0.0];
+        for x in [g.n[0], g.n[1], g.n[2], 0.0]
+            .iter()
+            .chain(&g.t)
+            .chain(&[g.v[0], g.v[1], g.v[2], 0.0])
+            .chain(&[g.l[0], g.l[1], g.l[2], 0.0])
+            .chain(&p)
+            .chain(&[1.0, 1.0, 1.0, 0.0])
+        {
+            input.push(*x as f32);
+        }
+        cases.push((g, p));
+    }
+    let wgsl = format!("{LOBE_LIBRARY}\n{LOBE_HARNESS}");
+    let out = f32s(&run_compute(
+        &gpu,
+        &wgsl,
+        &to_bytes(&input),
+        (count * 7 * 16) as u64,
+        count as u32,
+    ));
+    // lobes 2 (ggx, F0 = 1), 3 (ggx_aniso, F0 = 1), 6 (GGX at the IOR's F0: clearcoat's)
+    let mut worst = [(0.0f64, 0usize); 3];
+    for (i, (g, p)) in cases.iter().enumerate() {
+        let cos = r::dot(g.n, g.l).clamp(0.0, 1.0);
+        let a = r::alpha(p[0]);
+        let at = (a * (1.0 + p[1])).max(r::ALPHA_MIN);
+        let ab = (a * (1.0 - p[1])).max(r::ALPHA_MIN);
+        for (k, (lobe, bound)) in [
+            (2, ggx_cos_bound(a, a)),
+            (3, ggx_cos_bound(at, ab)),
+            (6, ggx_cos_bound(a, a)),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            for c in 0..3 {
+                let v = out[(i * 7 + lobe) * 4 + c] as f64;
+                assert!(v.is_finite(), "{}: {v} at {g:?} {p:?}", LOBE_NAMES[lobe]);
+                let x = v * cos / bound;
+                if x > worst[k].0 {
+                    worst[k] = (x, i);
+                }
+            }
+        }
+    }
+    println!(
+        "n·v < 0, l ≈ −v ({}): max f·cos over its bound: ggx {:.3e}, ggx_aniso {:.3e}, clearcoat {:.3e}",
+        gpu.adapter_name(),
+        worst[0].0,
+        worst[1].0,
+        worst[2].0
+    );
+    for (k, (w, i)) in worst.iter().enumerate() {
+        // 1% for the anisotropic bound's |v_t| ≥ 0.997 and f32 rounding
+        assert!(
+            *w <= 1.01,
+            "{}: f·cos is {w:e} × its bound at {:?}",
+            LOBE_NAMES[[2, 3, 6][k]],
+            cases[*i]
+        );
+    }
+}
+
 const MATERIAL_HARNESS: &str = "
 struct Sample {
     n: vec4<f32>,

@@ -1,13 +1,16 @@
 //! `vpl-error`: for each n, the VPL image's indirect part (the all-lights VPL graph's
 //! frame minus the frame without VPLs) against the CPU path-traced bounce
-//! (`indirect::reference`): relative MSE; and the median GPU time of the passes the VPLs
+//! (`indirect::reference`): relative MSE, the worst pixel's share of it and any non-finite
+//! pixels; and the median GPU time of the passes the VPLs
 //! cost in the culled graph (maps, spawn, culling, shading) over `frames` frames, with
 //! its list overflows. Writes results.csv, results.md, time_vs_error.png.
 
 use super::{render::load_scene, VplErrorArgs};
 use anyhow::{bail, Context, Result};
 use lightgraph::graph::{self, FrameSize};
-use lightgraph::indirect::reference::{indirect_part, relative_mse, OneBounce};
+use lightgraph::indirect::reference::{
+    indirect_part, relative_mse, worst_pixel, OneBounce, WorstPixel,
+};
 use lightgraph::render::{Renderer, SceneGpu};
 use lightgraph::scene::{light_flags, Scene};
 use lightgraph::shader::{assets, ShaderLibrary};
@@ -25,6 +28,7 @@ struct Row {
     overflowed_lists: u32,
     rel_mse: f64,
     energy: f64,
+    worst: WorstPixel,
     frame_ms: Option<f64>,
     pass_ms: Vec<Option<f64>>,
 }
@@ -93,7 +97,7 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
     let mut md = String::from("# VPL one-bounce error against a path-traced bounce\n\n");
     let _ = writeln!(
         md,
-        "Adapter: {}. {w}×{h}, reference {} bounce rays a pixel. Relative MSE = Σ(vpl − ref)² / Σ ref² of the indirect part (VPL frame minus the frame without VPLs); times are GPU medians of {} frames.\n",
+        "Adapter: {}. {w}×{h}, reference {} bounce rays a pixel. Relative MSE = Σ(vpl − ref)² / Σ ref² of the indirect part (VPL frame minus the frame without VPLs); the worst pixel is the one with the largest (vpl − ref)², with its share of Σ(vpl − ref)²; times are GPU medians of {} frames.\n",
         renderer.ctx.adapter_name(),
         args.samples,
         args.frames
@@ -137,7 +141,7 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
         )?;
         let _ = writeln!(
             md,
-            "## {} ({} indirect lights; reference {reference_s:.1} s on the CPU; its own noise: relative MSE {noise:.4})\n\n| n | VPLs | dropped | lists overflowed (timed graph) | rel. MSE | Σvpl/Σref | VPL passes (ms) | rsm | spawn | culling | shading |\n|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|",
+            "## {} ({} indirect lights; reference {reference_s:.1} s on the CPU; its own noise: relative MSE {noise:.4})\n\n| n | VPLs | dropped | lists overflowed (timed graph) | rel. MSE | Σvpl/Σref | worst pixel: share of the squared error (VPL / reference luminance) | VPL passes (ms) | rsm | spawn | culling | shading |\n|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|",
             base.name,
             indirect.len()
         );
@@ -157,6 +161,9 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
             let (measured, _) = frame(&mut renderer, &error_path, &scene, w, h, 0)?;
             let vpl_image = indirect_part(&measured.image, &direct.image);
             let e = relative_mse(&vpl_image, &reference);
+            let worst = worst_pixel(&vpl_image, &reference);
+            let (wx, wy) = (worst.index as u32 % w, worst.index as u32 / w);
+            let luma = |c: glam::Vec3| c.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722));
             lightgraph::bench::write_png_tonemapped(
                 args.out.join(format!("{}_vpl_n{n}.png", base.name)),
                 &to_rgb(&vpl_image),
@@ -193,9 +200,17 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
             let ms = |x: Option<f64>| x.map_or("–".to_string(), |x| format!("{x:.3}"));
             let _ = writeln!(
                 md,
-                "| {n} | {} | {} | {overflowed_lists} | {e:.4} | {energy:.3} | {} | {} | {} | {} | {} |",
+                "| {n} | {} | {} | {overflowed_lists} | {e:.4} | {energy:.3} | {:.1}% at ({wx}, {wy}) ({:.3} / {:.3}){} | {} | {} | {} | {} | {} |",
                 v.spawned,
                 v.dropped,
+                100.0 * worst.share,
+                luma(worst.value),
+                luma(worst.reference),
+                if worst.non_finite > 0 {
+                    format!("; {} non-finite pixels", worst.non_finite)
+                } else {
+                    String::new()
+                },
                 ms(frame_ms),
                 ms(pass_ms[0]),
                 ms(pass_ms[1]),
@@ -203,10 +218,14 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
                 ms(pass_ms[3])
             );
             println!(
-                "{} n={n}: {} VPLs ({} dropped, {overflowed_lists} lists overflowed), relative MSE {e:.4}, energy {energy:.3} of the reference's, VPL passes {} ms",
+                "{} n={n}: {} VPLs ({} dropped, {overflowed_lists} lists overflowed), relative MSE {e:.4}, energy {energy:.3} of the reference's, worst pixel ({wx}, {wy}) {:.1}% of the squared error (VPL {:.3}, reference {:.3}), {} non-finite pixels, VPL passes {} ms",
                 base.name,
                 v.spawned,
                 v.dropped,
+                100.0 * worst.share,
+                luma(worst.value),
+                luma(worst.reference),
+                worst.non_finite,
                 ms(frame_ms)
             );
             rows.push(Row {
@@ -217,6 +236,7 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
                 overflowed_lists,
                 rel_mse: e,
                 energy,
+                worst,
                 frame_ms,
                 pass_ms,
             });
@@ -224,13 +244,13 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
         md.push('\n');
     }
     let mut csv = String::from(
-        "scene,n,vpls,dropped,overflowed_lists,rel_mse,energy_ratio,vpl_passes_ms,rsm_ms,spawn_ms,culling_ms,shading_ms\n",
+        "scene,n,vpls,dropped,overflowed_lists,rel_mse,energy_ratio,worst_pixel,worst_share,non_finite,vpl_passes_ms,rsm_ms,spawn_ms,culling_ms,shading_ms\n",
     );
     let opt = |x: Option<f64>| x.map_or(String::new(), |x| format!("{x:.4}"));
     for r in &rows {
         let _ = writeln!(
             csv,
-            "{},{},{},{},{},{:.6},{:.4},{},{}",
+            "{},{},{},{},{},{:.6},{:.4},{},{:.6},{},{},{}",
             r.scene,
             r.n,
             r.vpls,
@@ -238,6 +258,9 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
             r.overflowed_lists,
             r.rel_mse,
             r.energy,
+            r.worst.index,
+            r.worst.share,
+            r.worst.non_finite,
             opt(r.frame_ms),
             r.pass_ms
                 .iter()

@@ -36,6 +36,17 @@ pub struct OneBounce<'a> {
     lights: Vec<(usize, Light)>,
 }
 
+/// A camera ray's first hit: position, shading normal and geometric normal (both facing
+/// the camera), the direction to the eye, and the scene's material index.
+#[derive(Clone, Copy, Debug)]
+pub struct Primary {
+    pub x: Vec3,
+    pub n: Vec3,
+    pub ng: Vec3,
+    pub v: Vec3,
+    pub m: usize,
+}
+
 struct Hit {
     t: f32,
     id: u32,
@@ -224,6 +235,27 @@ impl<'a> OneBounce<'a> {
         mat.diffuse / std::f32::consts::PI * radiance * cos
     }
 
+    /// The camera ray's first hit at pixel (px, py) of a `width`×`height` frame.
+    pub fn primary(&self, px: u32, py: u32, width: u32, height: u32) -> Option<Primary> {
+        let cam = &self.scene.camera;
+        let inv: Mat4 = (cam.projection(width as f32 / height as f32) * cam.view()).inverse();
+        let ndc = glam::Vec2::new(
+            (px as f32 + 0.5) / width as f32 * 2.0 - 1.0,
+            1.0 - (py as f32 + 0.5) / height as f32 * 2.0,
+        );
+        let far = inv * Vec4::new(ndc.x, ndc.y, 1.0, 1.0);
+        let dir = (far.truncate() / far.w - cam.eye).normalize();
+        let h = self.closest(cam.eye, dir, f32::MAX)?;
+        let (x, n, ng, m) = self.surface(cam.eye, dir, &h);
+        Some(Primary {
+            x,
+            n,
+            ng,
+            v: -dir,
+            m,
+        })
+    }
+
     /// Indirect radiance towards the camera at pixel (px, py) of a `width`×`height`
     /// frame, with `samples` cosine-weighted bounce rays.
     pub fn pixel(&self, px: u32, py: u32, width: u32, height: u32, samples: u32) -> Vec3 {
@@ -240,20 +272,10 @@ impl<'a> OneBounce<'a> {
         samples: u32,
         seed: u64,
     ) -> Vec3 {
-        let cam = &self.scene.camera;
-        let inv: Mat4 = (cam.projection(width as f32 / height as f32) * cam.view()).inverse();
-        let ndc = glam::Vec2::new(
-            (px as f32 + 0.5) / width as f32 * 2.0 - 1.0,
-            1.0 - (py as f32 + 0.5) / height as f32 * 2.0,
-        );
-        let far = inv * Vec4::new(ndc.x, ndc.y, 1.0, 1.0);
-        let dir = (far.truncate() / far.w - cam.eye).normalize();
-        let Some(h) = self.closest(cam.eye, dir, f32::MAX) else {
+        let Some(Primary { x, n, ng, v, m }) = self.primary(px, py, width, height) else {
             return Vec3::ZERO;
         };
-        let (x, n, ng, m) = self.surface(cam.eye, dir, &h);
         let receiver = &self.materials[m];
-        let v = -dir;
         let (t, b) = n.any_orthonormal_pair();
         let eps = 1e-4 * x.abs().max_element().max(1.0);
         let side = (samples as f32).sqrt().ceil() as u32;
@@ -341,10 +363,62 @@ pub fn relative_mse(a: &[Vec3], b: &[Vec3]) -> f64 {
     num / den.max(1e-30)
 }
 
+/// Where `a`'s squared error against `b` sits: its worst pixel and that pixel's share of
+/// Σ (a − b)², and how many of `a`'s pixels are not finite. One pixel holding most of the
+/// error is a defect (a singularity), not the approximation's spread-out error.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct WorstPixel {
+    pub index: usize,
+    pub value: Vec3,
+    pub reference: Vec3,
+    /// Its (a − b)² over Σ (a − b)²
+    pub share: f64,
+    pub non_finite: usize,
+}
+
+pub fn worst_pixel(a: &[Vec3], b: &[Vec3]) -> WorstPixel {
+    let mut w = WorstPixel::default();
+    let (mut total, mut worst) = (0.0f64, -1.0f64);
+    for (i, (x, y)) in a.iter().zip(b).enumerate() {
+        if !x.is_finite() {
+            w.non_finite += 1;
+            continue;
+        }
+        let e = (*x - *y).length_squared() as f64;
+        total += e;
+        if e > worst {
+            (worst, w.index, w.value, w.reference) = (e, i, *x, *y);
+        }
+    }
+    w.share = worst.max(0.0) / total.max(1e-30);
+    w
+}
+
 /// The indirect part of a VPL frame: it minus the same frame without VPLs.
 pub fn indirect_part(with: &[[f32; 4]], without: &[[f32; 4]]) -> Vec<Vec3> {
     with.iter()
         .zip(without)
         .map(|(a, b)| Vec3::new(a[0] - b[0], a[1] - b[1], a[2] - b[2]))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn worst_pixel_finds_the_pixel_holding_the_error_and_counts_non_finite_ones() {
+        let b = vec![Vec3::ONE; 4];
+        let a = vec![
+            Vec3::ONE * 1.1,
+            Vec3::ONE * 4.0,
+            Vec3::splat(f32::NAN),
+            Vec3::ONE,
+        ];
+        let w = worst_pixel(&a, &b);
+        assert_eq!((w.index, w.non_finite), (1, 1));
+        assert_eq!(w.value, Vec3::ONE * 4.0);
+        // 27 of 27.03
+        assert!((w.share - 27.0 / 27.03).abs() < 1e-6, "{}", w.share);
+    }
 }

@@ -103,7 +103,12 @@ pub fn schlick(f0: V3, vh: f64) -> V3 {
     ]
 }
 
+/// GGX D with its χ⁺(n·h): zero for a half vector below the horizon (`nh` is n·h clamped
+/// to [0, 1]); see `lg_d_ggx`.
 pub fn d_ggx(nh: f64, s2: f64, a: f64) -> f64 {
+    if nh <= 0.0 {
+        return 0.0;
+    }
     let x = s2 + nh * nh * a * a;
     let r = a / x;
     r * r * INV_PI
@@ -133,6 +138,10 @@ pub fn ggx_aniso(f0: V3, a: f64, anisotropy: f64, t: V3, b: V3, v: V3, l: V3, d:
     let at = (a * (1.0 + an)).max(ALPHA_MIN);
     let ab = (a * (1.0 - an)).max(ALPHA_MIN);
     let a2 = at * ab;
+    // χ⁺(n·h), as in d_ggx
+    if d.nh <= 0.0 {
+        return [0.0; 3];
+    }
     let w = [ab * dot(t, d.h), at * dot(b, d.h), a2 * d.nh];
     let w2 = a2 / dot(w, w);
     let dist = a2 * w2 * w2 * INV_PI;

@@ -277,3 +277,32 @@ pub fn f32s(bytes: &[u8]) -> Vec<f32> {
 pub fn to_bytes(xs: &[f32]) -> Vec<u8> {
     xs.iter().flat_map(|x| x.to_le_bytes()).collect()
 }
+
+/// A view just behind the shading normal's horizon (n·v = −c < 0: the silhouettes of
+/// smooth-shaded meshes, where interpolated normals turn away from the eye) and a light
+/// nearly opposite it (l ≈ −v − k n, 0 < k < c, so n·l > 0): h = normalize(l + v) then
+/// lies below the horizon, where GGX's D is zero (its χ⁺(n·h)).
+pub fn back_facing(rng: &mut Rng) -> Geo {
+    let n = rng.unit();
+    let c = rng.pick(&[1e-4, 1e-3, 3e-3, 1e-2, 0.05]) * rng.range(0.5, 1.5);
+    let v = around(n, -c, rng.range(0.0, std::f64::consts::TAU));
+    let k = c * rng.range(0.05, 0.95);
+    // off the exact line by up to a fraction of c (exactly on it: l + v ∥ −n)
+    let tau = sc(rng.unit(), c * rng.pick(&[0.0, 1e-3, 1e-2, 0.1, 0.5]));
+    let l = norm(add(add(sc(v, -1.0), sc(n, -k)), tau));
+    let t0 = rng.unit();
+    let t = f32v(norm(add(t0, sc(n, -dot(n, t0)))));
+    Geo {
+        n: f32v(n),
+        t: [t[0], t[1], t[2], 1.0],
+        v: f32v(v),
+        l: f32v(l),
+    }
+}
+
+/// The most a GGX lobe with F ≤ 1 can reflect, f·cos θl, for α_t, α_b ≤ 1: D ≤ 1/(π α_t α_b)
+/// and V·cos θl ≤ 1/(2 min(α_t, α_b)) (Smith's Λ_v ≥ min α for views above the horizon),
+/// both wherever n·h > 0.
+pub fn ggx_cos_bound(at: f64, ab: f64) -> f64 {
+    1.0 / (2.0 * std::f64::consts::PI * at * ab * at.min(ab))
+}
