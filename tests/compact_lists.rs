@@ -13,8 +13,9 @@
 //! A bound smaller than the lists want cuts the last lists in list order, fills the
 //! index array to its last word, and is counted (lists cut, indices wanted) and reported.
 //! `mutations_are_caught` runs these checks on deliberately broken copies of the culling
-//! shader (scan off by one, block carry dropped, bound ignored, fill out of order) and
-//! requires each check to fail, so none of them passes vacuously.
+//! shader (scan off by one, the block scan's carry dropped from its total or its offsets,
+//! bound ignored, fill out of order, count short) and requires each check to fail, so
+//! none of them passes vacuously.
 
 mod common;
 use common::*;
