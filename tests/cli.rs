@@ -168,6 +168,18 @@ fn csv_fields(line: &str) -> Vec<String> {
     fields
 }
 
+/// `render --graph GRAPH --width 64 --height 36 EXTRA...` in `dir`, which must succeed:
+/// its standard output.
+fn render_64x36(dir: &Path, graph: &Path, extra: &[&str]) -> String {
+    let mut args = vec!["render", "--graph", graph.to_str().unwrap()];
+    args.extend(["--width", "64", "--height", "36"]);
+    args.extend(extra);
+    let o = lightgraph(dir, &args);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{out}\n{err}");
+    out
+}
+
 #[test]
 fn render_reports_the_link_pool_and_its_overflow() {
     let dir = tempfile::tempdir().unwrap();
@@ -183,20 +195,7 @@ fn render_reports_the_link_pool_and_its_overflow() {
     )
     .unwrap();
     for (g, overflow) in [(graph, false), (small, true)] {
-        let o = lightgraph(
-            dir.path(),
-            &[
-                "render",
-                "--graph",
-                g.to_str().unwrap(),
-                "--width",
-                "64",
-                "--height",
-                "36",
-            ],
-        );
-        let (out, err) = text(&o);
-        assert!(o.status.success(), "{out}\n{err}");
+        let out = render_64x36(dir.path(), &g, &[]);
         let scale = if overflow { 4 } else { 1 };
         let line = format!(
             "linked_list_build: {}x{} list pixels (1/{scale} per side)",
@@ -275,4 +274,38 @@ fn output_without_a_running_writer_is_an_error() {
             && err.contains("when: Transparent is false"),
         "{err}"
     );
+}
+
+#[test]
+fn render_reports_compact_lists_and_their_bound() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let graph = root.join("graphs/forward_plus.ron");
+    let scene = root.join("scenes/harada.ron");
+    let small = dir.path().join("small_bound.ron");
+    let source = std::fs::read_to_string(&graph).unwrap();
+    let shipped = "lists: Compact(max_indices: 16777216)";
+    assert_eq!(source.matches(shipped).count(), 1);
+    std::fs::write(
+        &small,
+        source.replace(shipped, "lists: Compact(max_indices: 1000)"),
+    )
+    .unwrap();
+    for (g, bound) in [(graph, 16_777_216), (small, 1000)] {
+        let out = render_64x36(dir.path(), &g, &["--scene", scene.to_str().unwrap()]);
+        // Harada's 3,072 lights at 64x36 want 4,375 indices: fixed lists of 256 overflow
+        // in six tiles, compact lists hold them all under the shipped bound.
+        assert!(out.contains("light_culling: 12 tiles x 1 lists"), "{out}");
+        let held = if bound == 1000 { 1000 } else { 4375 };
+        assert!(
+            out.contains(&format!("(compact, {held} of max_indices {bound}; ")),
+            "{out}"
+        );
+        let warning =
+            "WARNING: light_culling: the lists wanted 4375 light indices, over max_indices 1000: ";
+        assert_eq!(out.contains(warning), bound == 1000, "{out}");
+        if bound == 1000 {
+            assert!(out.contains("(max_indices: 4375 fits this frame)"), "{out}");
+        }
+    }
 }

@@ -18,17 +18,14 @@ const TILES: [u32; 2] = [8, 16];
 const W: u32 = 333;
 const H: u32 = 197;
 
-/// `coarse: None` keeps the default coarse stage (4×4 tiles).
+/// `coarse: None` keeps the default coarse stage (4×4 tiles). Fixed lists: compact
+/// lists are checked against these in tests/compact_lists.rs.
 fn graph_text(tile: u32, variant: &str, capacity: u32, coarse: Option<u32>) -> String {
     let coarse = coarse.map(|c| format!(", coarse: {c}")).unwrap_or_default();
-    std::fs::read_to_string(graph_path("forward_plus.ron"))
-        .unwrap()
-        .replace(
-            "LightCulling(tile: 16, variant: Frustum, capacity: 256)",
-            &format!(
-                "LightCulling(tile: {tile}, variant: {variant}, capacity: {capacity}{coarse})"
-            ),
-        )
+    graph_with_culling(
+        "forward_plus.ron",
+        &format!("LightCulling(tile: {tile}, variant: {variant}, capacity: {capacity}{coarse})"),
+    )
 }
 
 fn check_scene(scene: &Scene, expect_lit: bool) {

@@ -84,7 +84,7 @@ fn list_params_match() {
             capacity,
             variant,
             pool_offset,
-            _pad0
+            pool_indices
         ]
     );
 }

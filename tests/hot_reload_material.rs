@@ -204,16 +204,34 @@ fn graph_edits_keep_unchanged_resources_and_pipelines() {
     let graph = root.join("forward_plus.ron");
     let text = std::fs::read_to_string(&graph).unwrap();
 
-    // 1. One pass parameter: list capacity 256 -> 128. The list buffer changes size; depth
-    //    and hdr are the same textures as before; only the culling pass's two pipelines
-    //    (its coarse and fine stages share the module) are rebuilt.
+    // 1. One pass parameter: the compact lists' bound. The list buffer changes size;
+    //    depth and hdr are the same textures as before; no pipeline is rebuilt (the
+    //    bound is a uniform, not a define).
     let before = s.prepared().unwrap().graph.plan.physical.len();
-    std::fs::write(&graph, text.replace("capacity: 256", "capacity: 128")).unwrap();
+    let bound = "lists: Compact(max_indices: 16777216)";
+    assert_eq!(text.matches(bound).count(), 1);
+    std::fs::write(
+        &graph,
+        text.replace(bound, "lists: Compact(max_indices: 65536)"),
+    )
+    .unwrap();
     let r = reload_of(&mut s, &graph);
     r.outcome.as_ref().expect("the edited graph compiles");
     let stats = s.prepared().unwrap().stats().clone();
     println!("graph edit: {stats:?}; {r:?}");
     assert_eq!(before, 3);
+    assert_eq!((stats.resources_reused, stats.resources_created), (2, 1));
+    assert!(stats.pipelines_built.is_empty(), "{stats:?}");
+    assert!(stats.pipeline_hits >= 6, "{stats:?}");
+    // 48 lights never fill 65,536 indices: the same image.
+    assert_eq!(image(&s), first);
+
+    // 1b. Fixed lists of 128: a define changes, so only the culling pass's two pipelines
+    //     (its coarse and fine stages share the module) are built.
+    std::fs::write(&graph, text.replace(bound, "capacity: 128")).unwrap();
+    let r = reload_of(&mut s, &graph);
+    r.outcome.as_ref().expect("the edited graph compiles");
+    let stats = s.prepared().unwrap().stats().clone();
     assert_eq!((stats.resources_reused, stats.resources_created), (2, 1));
     assert_eq!(stats.pipelines_built.len(), 2, "{stats:?}");
     assert!(
@@ -223,12 +241,10 @@ fn graph_edits_keep_unchanged_resources_and_pipelines() {
             .all(|p| p.starts_with("cull/light_culling.wgsl")),
         "{stats:?}"
     );
-    assert!(stats.pipeline_hits >= 4, "{stats:?}");
-    // 48 lights never overflow 128 entries: the same image.
-    let (d, _) = max_rel_diff(&image(&s), &first);
-    assert!(d < 2e-6, "{d}");
+    // 48 lights never overflow 128 entries: the same lists, the same image.
+    assert_eq!(image(&s), first);
 
-    // 2. Back to 256: again only the list buffer is new.
+    // 2. Back to the shipped graph: again only the list buffer is new.
     std::fs::write(&graph, &text).unwrap();
     reload_of(&mut s, &graph)
         .outcome
@@ -264,7 +280,7 @@ fn graph_edits_keep_unchanged_resources_and_pipelines() {
     assert!(stats.resources_reused >= 1, "{stats:?}");
     let (d, _) = max_rel_diff(&image(&s), &first);
     assert!(d < 1e-5, "{d}");
-    std::fs::write(&graph, text.replace("capacity: 256", "capacity: 64")).unwrap();
+    std::fs::write(&graph, text.replace(bound, "capacity: 64")).unwrap();
     let r = reload_of(&mut s, &graph);
     assert!(r.rebuilt.is_empty(), "{r:?}");
     assert_eq!(s.prepared().unwrap().graph.checked.desc.name, "brute_force");

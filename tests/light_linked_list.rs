@@ -246,9 +246,9 @@ fn prepare_error(r: &mut Renderer, text: &str, scene: &Scene) -> String {
 fn tile_lists_of_several_lists_a_tile_and_tile_list_readers_are_refused_by_name() {
     let mut r = renderer();
     let scene = random_scene(20, 7);
-    let half_z = graph("light_linked_list.ron", 4, 32, true).replace(
-        "LightCulling(tile: 16, variant: Frustum, capacity: 256)",
-        "LightCulling(tile: 16, variant: HalfZ, capacity: 256)",
+    let half_z = with_culling(
+        &graph("light_linked_list.ron", 4, 32, true),
+        "LightCulling(tile: 16, variant: HalfZ)",
     );
     let e = prepare_error(&mut r, &half_z, &scene);
     assert!(

@@ -55,24 +55,31 @@ fn culled_transparency_equals_brute_force_for_every_variant() {
         "only {changed} pixels show glass: the scene tests nothing"
     );
     let text = graph_file("transparent.ron");
-    let default = "LightCulling(tile: 16, variant: Frustum, capacity: 256)";
+    let default = "LightCulling(tile: 16, variant: Frustum, lists: Compact(max_indices: 16777216))";
     assert_eq!(text.matches(default).count(), 2);
-    for (tile, variant) in [
-        (16, "Frustum"),
-        (8, "Frustum"),
-        (16, "HalfZ"),
-        (16, "DepthMask"),
-        (16, "Clustered(slices: 16)"),
+    for (tile, variant, lists) in [
+        (16, "Frustum", "lists: Compact(max_indices: 16777216)"),
+        (8, "Frustum", "lists: Compact(max_indices: 16777216)"),
+        (16, "HalfZ", "lists: Compact(max_indices: 16777216)"),
+        (16, "DepthMask", "lists: Compact(max_indices: 16777216)"),
+        (
+            16,
+            "Clustered(slices: 16)",
+            "lists: Compact(max_indices: 16777216)",
+        ),
+        // The fixed layout reads the same through the transparent pass.
+        (16, "Frustum", "capacity: 256"),
+        (16, "Clustered(slices: 16)", "capacity: 256"),
     ] {
         let g = text.replace(
             default,
-            &format!("LightCulling(tile: {tile}, variant: {variant}, capacity: 256)"),
+            &format!("LightCulling(tile: {tile}, variant: {variant}, {lists})"),
         );
         let culled = render_text(&mut r, &g, &scene, W, H);
         let (err, at) = max_rel_diff(&culled.image, &reference.image);
         assert!(
             err <= TOL,
-            "tile {tile} {variant}: error {err:e} at pixel ({}, {}) (culled {:?}, reference {:?})",
+            "tile {tile} {variant} {lists}: error {err:e} at pixel ({}, {}) (culled {:?}, reference {:?})",
             at as u32 % W,
             at as u32 / W,
             culled.image[at],

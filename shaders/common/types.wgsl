@@ -41,11 +41,13 @@ struct ListParams {
     tiles_y: u32,
     tile: u32,
     lists_per_tile: u32,
+    // Fixed lists' capacity; 0 for compact lists.
     capacity: u32,
     // 0 Frustum, 1 HalfZ, 2 DepthMask, 3 Clustered
     variant: u32,
+    // Words before the index pool, and light indices the pool holds.
     pool_offset: u32,
-    _pad0: u32,
+    pool_indices: u32,
 };
 
 // How a LightLinkedList pass laid out its links (see LinkLayout in

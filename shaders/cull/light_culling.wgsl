@@ -13,8 +13,15 @@
 // surface lies in front of the opaque one contributes the range from the nearest
 // transparent depth to the opaque depth (the far plane over the background): every
 // visible transparent fragment lies in it. Samples without one contribute nothing.
+// COMPACT: lists that never overflow (count → prefix sum → fill). `main` runs twice with
+// the same pipeline, so both runs test every light with the same machine code:
+// `cull_phase.x` 0 counts each list (entry count, depth range, block sums), 1 fills it.
+// Between them `scan_blocks` (one workgroup) and `scan_lists` (a workgroup per
+// SCAN_BLOCK lists) turn the counts into offsets in one flat index array. A list runs
+// past the array's end (`list_params.pool_indices`, the graph's max_indices) only when
+// the lists together want more: its count is cut to what fits, and the cut is counted.
 // Defines: TILE (8 or 16), CAPACITY, VARIANT (see types.wgsl), COARSE, COARSE_CAPACITY,
-// SAMPLES, MSAA, TRANSPARENT.
+// SAMPLES, MSAA, TRANSPARENT, COMPACT, SCAN_BLOCK.
 
 #include "common/types.wgsl"
 #include "common/view_space.wgsl"
@@ -38,6 +45,13 @@
 @group(0) @binding(6) var transparent_depth: texture_depth_2d;
 #endif
 #endif
+#if COMPACT
+// Per scan block of SCAN_BLOCK lists: the sum of its lists' counts (then, after
+// `scan_blocks`, the offset of its first list) and whether the sum wrapped past u32.
+@group(0) @binding(7) var<storage, read_write> list_block_sums: array<atomic<u32>>;
+// x: 0 count, 1 fill.
+@group(0) @binding(8) var<uniform> cull_phase: vec4<u32>;
+#endif
 
 const THREADS: u32 = TILE * TILE;
 const MASK_WORDS: u32 = THREADS / 32u;
@@ -47,10 +61,16 @@ var<workgroup> z_min_bits: atomic<u32>;
 var<workgroup> z_max_bits: atomic<u32>;
 var<workgroup> depth_mask: atomic<u32>;
 var<workgroup> hits: array<atomic<u32>, MASK_WORDS>;
-var<workgroup> list: array<u32, CAPACITY>;
 var<workgroup> list_len: u32;
-var<workgroup> pool_base: u32;
 var<workgroup> coarse_count: u32;
+#if COMPACT
+var<workgroup> fill_offset: u32;
+var<workgroup> fill_kept: u32;
+const PHASE_FILL: u32 = 1u;
+#else
+var<workgroup> list: array<u32, CAPACITY>;
+var<workgroup> pool_base: u32;
+#endif
 
 const COARSE_STRIDE: u32 = COARSE_CAPACITY + 1u;
 // 1e-4 of the distance: a thousand times the rounding it covers, and still far below
@@ -181,6 +201,28 @@ fn main(
             from_coarse = true;
         }
     }
+    let list_index = (group.y * list_params.tiles_x + group.x) * list_params.lists_per_tile + group.z;
+#if COMPACT
+    // The fill writes straight into the list's run of the index array (nothing while
+    // counting: `kept` 0).
+    let filling = cull_phase.x == PHASE_FILL;
+    var start = 0u;
+    var kept = 0u;
+    if (filling) {
+        if (local == 0u) {
+            let e = HEADER_WORDS + ENTRY_WORDS * list_index;
+            fill_offset = atomicLoad(&light_lists[e]);
+            fill_kept = atomicLoad(&light_lists[e + 1u]);
+        }
+        start = workgroupUniformLoad(&fill_offset);
+        kept = workgroupUniformLoad(&fill_kept);
+        // A list with no room (no lights, or all past the bound) has nothing to place.
+        if (kept == 0u) {
+            count = 0u;
+        }
+    }
+    let offset = list_params.pool_offset + start;
+#endif
     var total = 0u;
     for (var base = 0u; base < count; base += THREADS) {
         if (local < MASK_WORDS) {
@@ -201,15 +243,43 @@ fn main(
         }
         workgroupBarrier();
         let slot = total + rank_in_batch(local);
+#if COMPACT
+        if (hit && slot < kept) {
+            atomicStore(&light_lists[offset + slot], i);
+        }
+#else
         if (hit && slot < CAPACITY) {
             list[slot] = i;
         }
+#endif
         total += hits_in_batch();
         workgroupBarrier();
     }
 
+#if COMPACT
+    // 5. Counting: publish the count and depth range, add the count to the list's scan
+    //    block. Filling: check that the count found now gives the kept count the scan
+    //    wrote from the first run's count.
+    if (local == 0u) {
+        let e = HEADER_WORDS + ENTRY_WORDS * list_index;
+        if (filling) {
+            if (min(total, list_params.pool_indices - start) != kept) {
+                atomicAdd(&light_lists[3], 1u);
+            }
+        } else {
+            atomicStore(&light_lists[e + 1u], total);
+            atomicStore(&light_lists[e + 2u], bitcast<u32>(select(lo, 0.0, empty)));
+            atomicStore(&light_lists[e + 3u], bitcast<u32>(select(hi, 0.0, empty)));
+            atomicMax(&light_lists[2], total);
+            let b = 2u * (list_index / SCAN_BLOCK);
+            let before = atomicAdd(&list_block_sums[b], total);
+            if (before + total < before) {
+                atomicStore(&list_block_sums[b + 1u], 1u);
+            }
+        }
+    }
+#else
     // 5. Reserve room in the pool, publish the entry, copy the list out.
-    let list_index = (group.y * list_params.tiles_x + group.x) * list_params.lists_per_tile + group.z;
     let kept = min(total, CAPACITY);
     if (local == 0u) {
         pool_base = atomicAdd(&light_lists[0], kept);
@@ -228,6 +298,7 @@ fn main(
     for (var k = local; k < kept; k += THREADS) {
         atomicStore(&light_lists[base_word + k], list[k]);
     }
+#endif
 }
 
 // Side planes through the eye and a (coarse) tile's edges, normals pointing inwards, and
@@ -415,3 +486,115 @@ fn coarse(
         coarse_lists[base_word] = total;
     }
 }
+
+#if COMPACT
+// The prefix sum between the two runs of `main`: blocked, not decoupled look-back (WGSL
+// promises no forward progress between workgroups, so a workgroup spinning on another's
+// flag may never see it), and not one workgroup over every list (at 1920×1080 with 16
+// clusters that is 130,560 lists in one workgroup's loop). Sums saturate at u32::MAX,
+// which is associative, so a saturated total is still exact below the bound.
+const SCAN_THREADS: u32 = 256u;
+const SCAN_PER_THREAD: u32 = SCAN_BLOCK / SCAN_THREADS;
+
+var<workgroup> scan_sums: array<u32, SCAN_THREADS>;
+var<workgroup> scan_total: u32;
+
+fn add_sat(a: u32, b: u32) -> u32 {
+    let s = a + b;
+    return select(s, 0xffffffffu, s < a);
+}
+
+fn list_count() -> u32 {
+    return list_params.tiles_x * list_params.tiles_y * list_params.lists_per_tile;
+}
+
+// Exclusive prefix sum of `v` over the workgroup (Hillis–Steele), leaving the group's
+// total in `scan_total`.
+fn group_exclusive_scan(local: u32, v: u32) -> u32 {
+    scan_sums[local] = v;
+    workgroupBarrier();
+    for (var d = 1u; d < SCAN_THREADS; d *= 2u) {
+        var add = 0u;
+        if (local >= d) {
+            add = scan_sums[local - d];
+        }
+        workgroupBarrier();
+        scan_sums[local] = add_sat(scan_sums[local], add);
+        workgroupBarrier();
+    }
+    var before = 0u;
+    if (local > 0u) {
+        before = scan_sums[local - 1u];
+    }
+    if (local == SCAN_THREADS - 1u) {
+        scan_total = scan_sums[local];
+    }
+    workgroupBarrier();
+    return before;
+}
+
+// One workgroup: block sums → each block's first offset; header word 0 → the indices
+// all lists want.
+@compute @workgroup_size(SCAN_THREADS, 1, 1)
+fn scan_blocks(@builtin(local_invocation_index) local: u32) {
+    let blocks = (list_count() + SCAN_BLOCK - 1u) / SCAN_BLOCK;
+    var carry = 0u;
+    for (var base = 0u; base < blocks; base += SCAN_THREADS) {
+        let b = base + local;
+        var v = 0u;
+        if (b < blocks) {
+            v = atomicLoad(&list_block_sums[2u * b]);
+            if (atomicLoad(&list_block_sums[2u * b + 1u]) != 0u) {
+                v = 0xffffffffu;
+            }
+        }
+        let before = group_exclusive_scan(local, v);
+        if (b < blocks) {
+            atomicStore(&list_block_sums[2u * b], add_sat(carry, before));
+        }
+        carry = add_sat(carry, workgroupUniformLoad(&scan_total));
+    }
+    if (local == 0u) {
+        atomicStore(&light_lists[0], carry);
+    }
+}
+
+// A workgroup per block of SCAN_BLOCK lists, SCAN_PER_THREAD consecutive lists an
+// invocation: each list's offset and the count it keeps under the bound.
+@compute @workgroup_size(SCAN_THREADS, 1, 1)
+fn scan_lists(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    let lists = list_count();
+    let first = group.x * SCAN_BLOCK + local * SCAN_PER_THREAD;
+    var counts: array<u32, SCAN_PER_THREAD>;
+    var sum = 0u;
+    for (var j = 0u; j < SCAN_PER_THREAD; j++) {
+        let l = first + j;
+        var c = 0u;
+        if (l < lists) {
+            c = atomicLoad(&light_lists[HEADER_WORDS + ENTRY_WORDS * l + 1u]);
+        }
+        counts[j] = c;
+        sum = add_sat(sum, c);
+    }
+    let before = group_exclusive_scan(local, sum);
+    var offset = add_sat(atomicLoad(&list_block_sums[2u * group.x]), before);
+    let pool = list_params.pool_indices;
+    for (var j = 0u; j < SCAN_PER_THREAD; j++) {
+        let l = first + j;
+        if (l < lists) {
+            let start = min(offset, pool);
+            let kept = min(counts[j], pool - start);
+            let e = HEADER_WORDS + ENTRY_WORDS * l;
+            atomicStore(&light_lists[e], start);
+            atomicStore(&light_lists[e + 1u], kept);
+            if (kept < counts[j]) {
+                atomicAdd(&light_lists[1], 1u);
+            }
+        }
+        offset = add_sat(offset, counts[j]);
+    }
+}
+#endif

@@ -118,6 +118,17 @@ const SHADER_LINE: &str = "return clamp(1.0 - r * r, 0.0, 1.0);";
 const MATERIAL_MARKER: &str = "Lambert(weight: 0.65, color: (";
 const GRAPH_MARKER: &str = "capacity: ";
 
+/// The graph edit changes a fixed list capacity, a define of the culling pipelines, as
+/// in every earlier measurement: the shipped graph's compact lists (whose bound is a
+/// uniform, so editing it builds no pipeline) become fixed lists of 256 in the copy.
+fn fixed_lists(text: &str) -> String {
+    let Some(start) = text.find("lists: Compact(max_indices: ") else {
+        return text.to_string();
+    };
+    let end = start + text[start..].find(')').map_or(0, |e| e + 1);
+    format!("{}capacity: 256{}", &text[..start], &text[end..])
+}
+
 /// `text` with the number right after the first `marker` replaced by `value`.
 fn replace_number_after(text: &str, marker: &str, value: &str) -> Option<String> {
     let start = text.find(marker)? + marker.len();
@@ -225,7 +236,7 @@ pub fn run(
         ("materials/car_paint.ron", &material),
     ] {
         let (from, text) = project.read(rel).map_err(io(&project.locate(rel)))?;
-        std::fs::write(to, text).map_err(io(&from))?;
+        std::fs::write(to, fixed_lists(&text)).map_err(io(&from))?;
     }
     std::fs::write(&scene, scene_text(config.lights)).map_err(io(&scene))?;
     let targets = [
@@ -464,6 +475,12 @@ mod tests {
             "Lambert(weight: 0.65, color: (0.5499, 0.03, 0.02))"
         );
         assert!(replace_number_after(t, "absent: ", "1").is_none());
+        assert_eq!(
+            fixed_lists(
+                "LightCulling(tile: 16, variant: Frustum, lists: Compact(max_indices: 64)),"
+            ),
+            "LightCulling(tile: 16, variant: Frustum, capacity: 256),"
+        );
         assert!(replace_number_after("capacity: x", "capacity: ", "1").is_none());
     }
 

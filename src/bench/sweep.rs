@@ -436,7 +436,7 @@ fn fill_row(
     );
     if let Some(c) = result.culling.first() {
         row.max_lights_per_tile = c.per_tile().into_iter().max();
-        row.overflow_tiles = Some(c.overflowed_lists);
+        sweep_columns::set_list_columns(row, c);
     }
     if let Some(s) = &light_stats {
         row.listed_exact_ratio = Some(s.false_positive_ratio());

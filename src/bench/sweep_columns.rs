@@ -1,9 +1,9 @@
-//! The columns of a sweep row that come from a technique's own reports: ray-cast
-//! shadows, the shadow atlas, the light linked list.
+//! The columns of a sweep row that come from a technique's own reports: tile light lists,
+//! ray-cast shadows, the shadow atlas, the light linked list.
 
 use super::report::BenchRow;
 use crate::graph::{self, PassKind, ResourceDesc, SceneResource};
-use crate::render::{SceneGpu, ShadowReport};
+use crate::render::{CullingReport, SceneGpu, ShadowReport};
 
 /// The shadow atlas columns: memory, lights shadowed and dropped, views; the pair error
 /// when a ShadowCompare pass ran.
@@ -28,6 +28,21 @@ pub(super) fn set_atlas_columns(row: &mut BenchRow, result: &crate::render::Fram
 }
 
 const MIB: f64 = (1u64 << 20) as f64;
+
+/// The tile light list columns of the first culling pass: storage, memory, indices held
+/// and wanted, lists cut, fills that disagreed with their count.
+pub(super) fn set_list_columns(row: &mut BenchRow, c: &CullingReport) {
+    row.overflow_tiles = Some(c.overflowed_lists);
+    row.list_storage = Some(match c.layout.storage {
+        graph::ListStorage::Fixed { capacity } => format!("fixed:{capacity}"),
+        graph::ListStorage::Compact { max_indices } => format!("compact:{max_indices}"),
+    });
+    row.list_mib = Some(c.bytes() as f64 / MIB);
+    row.list_indices = Some(c.listed());
+    row.list_indices_wanted = c.wanted;
+    row.list_mismatched = Some(c.mismatched_lists + c.misplaced_lists);
+    row.list_pass = Some(c.pass.clone());
+}
 
 /// The ray-cast shadow columns: rays, rays a second of the `ShadowRayCast` passes, drops and
 /// buffer memory when a `ShadowRayJobs` pass ran; the BVH's size and build time when a pass

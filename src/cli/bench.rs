@@ -92,8 +92,19 @@ fn point_summary(row: &bench::BenchRow) -> String {
         }
         _ => "no reference".into(),
     };
+    // Lists that lost lights, or whose fill disagreed with their count: never silent.
+    let lists = match (row.overflow_tiles, row.list_mismatched) {
+        (Some(0) | None, Some(0) | None) => String::new(),
+        (cut, mismatched) => format!(
+            ", light lists cut {} (wanted {} indices), fills mismatched {}",
+            cut.unwrap_or(0),
+            row.list_indices_wanted
+                .map_or("?".into(), |n| n.to_string()),
+            mismatched.unwrap_or(0)
+        ),
+    };
     format!(
-        "{} {} {} lights {}x{}: {time}, {error}, NaN px {}, Inf px {}",
+        "{} {} {} lights {}x{}: {time}, {error}, NaN px {}, Inf px {}{lists}",
         row.scene,
         row.technique,
         row.light_count,

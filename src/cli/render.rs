@@ -474,21 +474,9 @@ fn report(r: &Renderer, scene: &Scene, graph: &Path, result: &FrameResult) {
         None => println!("  (this adapter has no timestamp queries: no per-pass GPU times)"),
     }
     for c in &result.culling {
-        let per_tile = c.per_tile();
-        let avg = per_tile.iter().map(|&x| x as f64).sum::<f64>() / per_tile.len().max(1) as f64;
-        println!(
-            "  {}: {} tiles x {} lists, lights per tile avg {avg:.1} max {}, longest list wanted {}",
-            c.pass,
-            c.layout.tiles_x * c.layout.tiles_y,
-            c.layout.lists_per_tile,
-            per_tile.iter().max().unwrap_or(&0),
-            c.longest_list
-        );
-        if c.overflowed_lists > 0 {
-            println!(
-                "  WARNING: {} lists overflowed their capacity of {} (worst wanted {}): lights were dropped there",
-                c.overflowed_lists, c.layout.capacity, c.longest_list
-            );
+        println!("  {}", c.summary());
+        for w in c.warnings() {
+            println!("  WARNING: {w}");
         }
     }
     for l in &result.links {

@@ -75,10 +75,12 @@ pub struct GpuListParams {
     pub tiles_y: u32,
     pub tile: u32,
     pub lists_per_tile: u32,
+    /// Fixed lists' capacity; 0 for compact lists.
     pub capacity: u32,
     pub variant: u32,
     pub pool_offset: u32,
-    pub _pad0: u32,
+    /// Light indices the pool holds (saturating at u32::MAX).
+    pub pool_indices: u32,
 }
 
 impl GpuListParams {
@@ -88,10 +90,13 @@ impl GpuListParams {
             tiles_y: layout.tiles_y,
             tile: layout.tile,
             lists_per_tile: layout.lists_per_tile,
-            capacity: layout.capacity,
+            capacity: match layout.storage {
+                crate::graph::ListStorage::Fixed { capacity } => capacity,
+                crate::graph::ListStorage::Compact { .. } => 0,
+            },
             variant: layout.variant.code(),
             pool_offset: layout.pool_offset_words(),
-            _pad0: 0,
+            pool_indices: layout.pool_indices().min(u32::MAX as u64) as u32,
         }
     }
 

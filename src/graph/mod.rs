@@ -24,7 +24,7 @@ pub use error::{GraphError, GraphErrors};
 pub use kinds::{slot, BufferLayout, SlotSpec};
 pub use location::{Location, SourceText};
 pub use model::*;
-pub use plan::{FrameSize, ListLayout, ResourcePlan};
+pub use plan::{FrameSize, ListLayout, ListStorage, ResourcePlan};
 pub use roles::{PassRoles, BUILTIN_BINDINGS};
 pub use specialise::CullReason;
 pub use validate::CheckedGraph;

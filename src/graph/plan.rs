@@ -89,9 +89,15 @@ pub struct FrameSize {
     pub lights: u32,
 }
 
-/// Layout of a culling pass's light-list buffer, shared with `shaders/cull/*.wgsl`:
-/// a header of 4 u32 (pool cursor, lists that overflowed, longest list wanted, pool
-/// overflows), then (offset, count, z_min, z_max) per list, then the index pool.
+/// Layout of a culling pass's light-list buffer, shared with `shaders/cull/*.wgsl` and
+/// every reader through `shaders/common/light_lists.wgsl`: a header of 4 u32, then
+/// (offset, count, z_min, z_max) per list, then the index pool. A list's lights are
+/// `pool[offset .. offset + count]`, in ascending light order, in both storages.
+///
+/// Header, `Fixed`: pool cursor, lists cut at the capacity, longest list wanted, unused.
+/// Header, `Compact`: indices all lists wanted (saturating at u32::MAX), lists cut at
+/// the bound, longest list wanted, lists whose fill found other lights than their count
+/// (0 unless the two dispatches disagree; counted so it is never silent).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ListLayout {
     /// Pixels per tile side.
@@ -100,14 +106,31 @@ pub struct ListLayout {
     pub tiles_x: u32,
     pub tiles_y: u32,
     pub lists_per_tile: u32,
-    pub capacity: u32,
+    pub storage: ListStorage,
+}
+
+/// How a culling pass stores its lists: room for `capacity` lights in every list, or
+/// one flat array of at most `max_indices` for all lists together, filled by count →
+/// prefix sum → fill.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ListStorage {
+    Fixed { capacity: u32 },
+    Compact { max_indices: u32 },
 }
 
 impl ListLayout {
     pub const HEADER_WORDS: u32 = 4;
     /// Words per list entry: offset, count, and the view-depth range it covers (f32 bits).
     pub const ENTRY_WORDS: u32 = 4;
-    pub fn new(tile: u32, variant: CullVariant, capacity: u32, width: u32, height: u32) -> Self {
+    /// Lists per workgroup of the compact layout's scan (256 invocations × 4 lists).
+    pub const SCAN_BLOCK: u32 = 1024;
+    pub fn new(
+        tile: u32,
+        variant: CullVariant,
+        storage: ListStorage,
+        width: u32,
+        height: u32,
+    ) -> Self {
         Self {
             tile,
             variant,
@@ -118,7 +141,7 @@ impl ListLayout {
                 CullVariant::Clustered { slices } => slices,
                 CullVariant::Frustum | CullVariant::DepthMask => 1,
             },
-            capacity,
+            storage,
         }
     }
     pub fn lists(&self) -> u32 {
@@ -127,10 +150,25 @@ impl ListLayout {
     pub fn pool_offset_words(&self) -> u32 {
         Self::HEADER_WORDS + Self::ENTRY_WORDS * self.lists()
     }
-    /// The pool holds every list at full capacity, so only a list longer than the
-    /// capacity can overflow (counted, never silent).
+    /// Light indices the pool holds: every list at full capacity (so only a list longer
+    /// than the capacity can overflow), or the compact bound for all lists together.
+    pub fn pool_indices(&self) -> u64 {
+        match self.storage {
+            ListStorage::Fixed { capacity } => self.lists() as u64 * capacity as u64,
+            ListStorage::Compact { max_indices } => max_indices as u64,
+        }
+    }
+    /// Scan blocks of the compact layout (0 for fixed lists).
+    pub fn scan_blocks(&self) -> u32 {
+        match self.storage {
+            ListStorage::Fixed { .. } => 0,
+            ListStorage::Compact { .. } => self.lists().div_ceil(Self::SCAN_BLOCK),
+        }
+    }
+    /// The whole buffer: header, entries and pool. Overflow of any list is counted,
+    /// never silent.
     pub fn bytes(&self) -> u64 {
-        4 * (self.pool_offset_words() as u64 + self.lists() as u64 * self.capacity as u64)
+        4 * (self.pool_offset_words() as u64 + self.pool_indices())
     }
 }
 
@@ -373,11 +411,23 @@ mod tests {
 
     #[test]
     fn list_layout_counts_partial_tiles() {
-        let l = ListLayout::new(16, CullVariant::Frustum, 256, 333, 197);
+        let fixed = |capacity| ListStorage::Fixed { capacity };
+        let l = ListLayout::new(16, CullVariant::Frustum, fixed(256), 333, 197);
         assert_eq!((l.tiles_x, l.tiles_y), (21, 13));
         assert_eq!(l.lists(), 273);
-        let h = ListLayout::new(8, CullVariant::HalfZ, 64, 16, 16);
+        let h = ListLayout::new(8, CullVariant::HalfZ, fixed(64), 16, 16);
         assert_eq!(h.lists(), 8);
         assert_eq!(h.bytes(), 4 * (4 + 32 + 8 * 64));
+        assert_eq!(h.scan_blocks(), 0);
+    }
+
+    #[test]
+    fn compact_lists_are_bounded_by_the_graph_alone() {
+        let compact = ListStorage::Compact { max_indices: 5000 };
+        let c = ListLayout::new(8, CullVariant::Clustered { slices: 16 }, compact, 333, 197);
+        assert_eq!(c.lists(), 42 * 25 * 16);
+        // Header, one entry a list, then exactly the bound: no per-list room.
+        assert_eq!(c.bytes(), 4 * (4 + 4 * 16_800 + 5000));
+        assert_eq!(c.scan_blocks(), 17);
     }
 }

@@ -1,16 +1,27 @@
 //! What a frame returns: the image, per-pass GPU times, culling reports, statistics.
 
-use crate::graph::ListLayout;
+use crate::graph::{ListLayout, ListStorage};
 
 /// Per culling pass: what its lists held this frame.
 #[derive(Clone, Debug)]
 pub struct CullingReport {
     pub pass: String,
     pub layout: ListLayout,
-    /// Lists (tiles, halves or clusters) that wanted more lights than the capacity.
+    /// Lists (tiles, halves or clusters) that lost lights: past the capacity (fixed
+    /// lists), or past the end of the index array (compact lists).
     pub overflowed_lists: u32,
-    /// The longest list wanted (before clamping to the capacity).
+    /// The longest list wanted (before any cut).
     pub longest_list: u32,
+    /// Compact lists: the indices all lists wanted together (what `max_indices` must
+    /// hold for this frame; saturates at u32::MAX). `None` for fixed lists.
+    pub wanted: Option<u64>,
+    /// Compact lists whose fill found other lights than their count: 0 unless the two
+    /// runs of the culling shader disagree (a driver or shader bug; never silent).
+    pub mismatched_lists: u32,
+    /// Compact lists whose offset is not the sum of the kept counts before them (the
+    /// prefix sum checked on the CPU from the entries read back): 0 unless the scan is
+    /// wrong.
+    pub misplaced_lists: u32,
     /// Kept count of every list, `lists_per_tile` consecutive entries per tile.
     pub counts: Vec<u32>,
 }
@@ -22,6 +33,67 @@ impl CullingReport {
             .chunks(self.layout.lists_per_tile as usize)
             .map(|c| c.iter().sum())
             .collect()
+    }
+    /// Light indices the lists hold.
+    pub fn listed(&self) -> u64 {
+        self.counts.iter().map(|&c| c as u64).sum()
+    }
+    /// The bytes of the list buffer: header, entries, index pool.
+    pub fn bytes(&self) -> u64 {
+        self.layout.bytes()
+    }
+    /// One line on the lists' size and memory, e.g. for `render` and the viewer.
+    pub fn summary(&self) -> String {
+        let per_tile = self.per_tile();
+        let avg = per_tile.iter().map(|&x| x as f64).sum::<f64>() / per_tile.len().max(1) as f64;
+        let storage = match self.layout.storage {
+            ListStorage::Fixed { capacity } => format!("fixed, capacity {capacity}"),
+            ListStorage::Compact { max_indices } => {
+                format!("compact, {} of max_indices {max_indices}", self.listed())
+            }
+        };
+        format!(
+            "{}: {} tiles x {} lists, lights per tile avg {avg:.1} max {}, longest list wanted {} ({storage}; {:.2} MiB)",
+            self.pass,
+            self.layout.tiles_x * self.layout.tiles_y,
+            self.layout.lists_per_tile,
+            per_tile.iter().max().unwrap_or(&0),
+            self.longest_list,
+            self.bytes() as f64 / (1u64 << 20) as f64,
+        )
+    }
+    /// What went wrong this frame, one line each: lights dropped from lists, or a fill
+    /// that disagreed with its count. Empty when every list holds exactly its lights.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut w = Vec::new();
+        if self.overflowed_lists > 0 {
+            w.push(match self.layout.storage {
+                ListStorage::Compact { max_indices } => {
+                    let wanted = self.wanted.unwrap_or_default();
+                    format!(
+                        "{}: the lists wanted {wanted} light indices, over max_indices {max_indices}: {} lists lost lights (max_indices: {wanted} fits this frame)",
+                        self.pass, self.overflowed_lists
+                    )
+                }
+                ListStorage::Fixed { capacity } => format!(
+                    "{} lists overflowed their capacity of {capacity} (worst wanted {}): lights were dropped there",
+                    self.overflowed_lists, self.longest_list
+                ),
+            });
+        }
+        if self.mismatched_lists > 0 {
+            w.push(format!(
+                "{}: {} compact lists found other lights when filled than when counted: those lists are wrong",
+                self.pass, self.mismatched_lists
+            ));
+        }
+        if self.misplaced_lists > 0 {
+            w.push(format!(
+                "{}: {} compact lists start elsewhere than after the lists before them: the prefix sum is wrong",
+                self.pass, self.misplaced_lists
+            ));
+        }
+        w
     }
 }
 

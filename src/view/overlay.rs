@@ -121,10 +121,10 @@ impl Overlay {
 
     fn light_statistics(&self, ui: &mut egui::Ui, info: &FrameInfo) {
         for c in &info.culling {
-            ui.label(format!(
-                "{}: longest list {} (capacity {}), {} lists overflowed",
-                c.pass, c.longest_list, c.layout.capacity, c.overflowed_lists
-            ));
+            ui.label(c.summary());
+            for w in c.warnings() {
+                ui.colored_label(egui::Color32::YELLOW, w);
+            }
         }
         if let Some(s) = &info.light_stats {
             ui.label(format!(

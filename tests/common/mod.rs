@@ -198,6 +198,34 @@ pub fn pillar_scene(lights: usize) -> Scene {
     s
 }
 
+/// `graph_text` with its (first) `LightCulling(...)` kind replaced by `kind`, whatever
+/// parameters the file gives it.
+pub fn with_culling(graph_text: &str, kind: &str) -> String {
+    let start = graph_text
+        .find("LightCulling(")
+        .expect("the graph has a LightCulling pass");
+    let mut depth = 0;
+    for (i, c) in graph_text[start..].char_indices() {
+        match c {
+            '(' => depth += 1,
+            ')' => {
+                depth -= 1;
+                if depth == 0 {
+                    let end = start + i + 1;
+                    return format!("{}{kind}{}", &graph_text[..start], &graph_text[end..]);
+                }
+            }
+            _ => {}
+        }
+    }
+    panic!("unbalanced LightCulling(...)")
+}
+
+/// The graph file `name` with its culling pass's kind replaced by `kind`.
+pub fn graph_with_culling(name: &str, kind: &str) -> String {
+    with_culling(&std::fs::read_to_string(graph_path(name)).unwrap(), kind)
+}
+
 pub fn graph_path(name: &str) -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("graphs")

@@ -55,8 +55,21 @@ pub struct BenchRow {
     pub listed_exact_ratio: Option<f64>,
     /// Largest per-tile light count.
     pub max_lights_per_tile: Option<u32>,
-    /// Tiles whose list overflowed.
+    /// Lists (tiles, halves, clusters) that lost lights: past a fixed capacity, or past
+    /// the end of a compact index array.
     pub overflow_tiles: Option<u32>,
+    /// The first culling pass's lists: `fixed:CAPACITY` or `compact:MAX_INDICES`.
+    pub list_storage: Option<String>,
+    /// Their buffer (header, entries, index pool), MiB.
+    pub list_mib: Option<f64>,
+    /// Light indices the lists hold, and (compact lists) the indices they wanted.
+    pub list_indices: Option<u64>,
+    pub list_indices_wanted: Option<u64>,
+    /// Compact lists whose fill disagreed with their count, or whose offset is not the
+    /// sum of the counts before them (0 unless something is wrong).
+    pub list_mismatched: Option<u32>,
+    /// The culling pass's name, to find its time in `pass_ms`.
+    pub list_pass: Option<String>,
     /// Pixels of the output with a NaN channel.
     pub nan_pixels: Option<u64>,
     /// Pixels of the output with an infinite channel and no NaN.

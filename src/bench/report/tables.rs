@@ -37,7 +37,7 @@ fn opt<T: ToString>(v: Option<T>) -> String {
 /// row (first-seen order): `pass_ms:<name>` (median), `pass_ms_p10:<name>`, `pass_ms_p90:<name>`,
 /// empty where a row lacks that pass. Time columns are empty, not 0, for untimed rows; the
 /// ray-cast shadow columns (`shadow_*`, `bvh_*`) are empty for graphs without those passes.
-pub const CSV_COLUMNS: [&str; 49] = [
+pub const CSV_COLUMNS: [&str; 54] = [
     "scene",
     "technique",
     "params",
@@ -63,6 +63,11 @@ pub const CSV_COLUMNS: [&str; 49] = [
     "listed_exact_ratio",
     "max_lights_per_tile",
     "overflow_tiles",
+    "list_storage",
+    "list_mib",
+    "list_indices",
+    "list_indices_wanted",
+    "list_mismatched",
     "nan_pixels",
     "inf_pixels",
     "lit_pixels",
@@ -130,6 +135,11 @@ pub fn to_csv(rows: &[BenchRow]) -> String {
             opt(r.listed_exact_ratio),
             opt(r.max_lights_per_tile),
             opt(r.overflow_tiles),
+            csv_field(r.list_storage.as_deref().unwrap_or_default()),
+            opt(r.list_mib),
+            opt(r.list_indices),
+            opt(r.list_indices_wanted),
+            opt(r.list_mismatched),
             opt(r.nan_pixels),
             opt(r.inf_pixels),
             opt(r.lit_pixels),
@@ -282,6 +292,7 @@ pub fn to_markdown(rows: &[BenchRow]) -> String {
             md_cell(r.reference.as_deref().unwrap_or("–")),
         );
     }
+    lists_markdown(&mut out, rows);
     shadow_markdown(&mut out, rows);
     atlas_markdown(&mut out, rows);
     links_markdown(&mut out, rows);
@@ -404,6 +415,46 @@ fn atlas_markdown(out: &mut String, rows: &[BenchRow]) {
             pct(r.pair_error_2x2),
             md_num(r.rmse, 6),
             md_num(r.flip_mean, 5),
+        );
+    }
+}
+
+/// The tile light list table, if some row's graph culls lights: storage, memory, indices
+/// held and wanted, lists cut, the culling pass's time and the error it leaves.
+fn lists_markdown(out: &mut String, rows: &[BenchRow]) {
+    if !rows.iter().any(|r| r.list_mib.is_some()) {
+        return;
+    }
+    out.push_str(
+        "\nTile light lists (cut: lists that lost lights, past a fixed capacity or a compact \
+         max_indices; wanted: the indices compact lists asked for):\n\n\
+         | scene | technique | lights | size | storage | MiB | indices | wanted | cut | mismatched | culling ms | frame ms | RMSE | max rel |\n\
+         |---|---|--:|--:|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n",
+    );
+    for r in rows.iter().filter(|r| r.list_mib.is_some()) {
+        let culling = r
+            .list_pass
+            .as_deref()
+            .and_then(|p| r.pass_ms.iter().find(|(n, _)| n == p))
+            .map(|(_, t)| t.median);
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {}x{} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            md_cell(&r.scene),
+            md_cell(&r.technique),
+            r.light_count,
+            r.width,
+            r.height,
+            md_cell(r.list_storage.as_deref().unwrap_or("–")),
+            md_num(r.list_mib, 2),
+            opt(r.list_indices),
+            r.list_indices_wanted.map_or("–".into(), |n| n.to_string()),
+            opt(r.overflow_tiles),
+            opt(r.list_mismatched),
+            md_num(culling, 3),
+            md_num(r.frame_ms.map(|t| t.median), 3),
+            md_num(r.rmse, 6),
+            md_num(r.max_rel, 4),
         );
     }
 }

@@ -4,14 +4,21 @@
 //! TransparentDepth pass's) the lists are for transparent surfaces: a tile spans, over
 //! its pixels that hold one, from the nearest transparent depth to the opaque depth
 //! behind it (seed 004).
+//!
+//! Two list layouts (`lists:`), read alike through `shaders/common/light_lists.wgsl`:
+//! `Fixed` gives every list room for `capacity` lights (a longer list is cut, counted
+//! and reported); `Compact(max_indices)` counts every list, prefix-sums the counts and
+//! fills one flat index array, so each list holds exactly its lights, and only the
+//! total is bounded (past `max_indices` the last lists are cut, counted and reported).
 
 use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 use crate::graph::model::CullVariant;
-use crate::graph::plan::ListLayout;
+use crate::graph::plan::{ListLayout, ListStorage};
 use serde::{Deserialize, Serialize};
 
-/// `LightCulling(tile: 16, variant: Frustum, capacity: 256, coarse: 4)`.
+/// `LightCulling(tile: 16, variant: Frustum, capacity: 256, coarse: 4)` or
+/// `LightCulling(tile: 16, variant: Frustum, lists: Compact(max_indices: 16777216))`.
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
 #[serde(deny_unknown_fields)]
 pub struct LightCulling {
@@ -19,25 +26,64 @@ pub struct LightCulling {
     pub tile: u32,
     #[serde(default)]
     pub variant: CullVariant,
-    /// Most lights a tile (or a half, or a cluster) can list.
-    #[serde(default = "default_capacity")]
-    pub capacity: u32,
+    /// How the lists are stored: `Fixed` (the default) or `Compact(max_indices: N)`.
+    #[serde(default)]
+    pub lists: ListMode,
+    /// `Fixed` lists: most lights a tile (or a half, or a cluster) can list (default
+    /// 256). Written as a plain number; `None` where the graph gives none.
+    #[serde(
+        default,
+        deserialize_with = "plain_some",
+        serialize_with = "plain_or_default",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub capacity: Option<u32>,
     /// Tiles per side of a coarse tile culled first: fine tiles then test only
     /// their coarse tile's lights instead of every light. 0 or 1 turns it off.
     #[serde(default = "default_coarse")]
     pub coarse: u32,
 }
 
-fn default_capacity() -> u32 {
-    256
+/// How a culling pass stores its lists.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
+pub enum ListMode {
+    /// Room for `capacity` lights in every list: one pass, lists cut at the capacity.
+    #[default]
+    Fixed,
+    /// Count → prefix sum → fill: every list holds exactly its lights, in one flat array
+    /// of at most `max_indices` light indices (4 bytes each) for all lists together.
+    Compact { max_indices: u32 },
 }
+
+pub const DEFAULT_CAPACITY: u32 = 256;
+/// Largest `max_indices`: the index array's words stay addressable by u32 with room
+/// for the header and entries.
+pub const MAX_INDICES_LIMIT: u32 = 1 << 30;
+
 fn default_coarse() -> u32 {
     4
 }
 
+fn plain_some<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
+    u32::deserialize(d).map(Some)
+}
+
+fn plain_or_default<S: serde::Serializer>(v: &Option<u32>, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_u32(v.unwrap_or(DEFAULT_CAPACITY))
+}
+
 impl LightCulling {
+    /// Where the lists live: the graph's `lists` and `capacity` together.
+    pub fn storage(&self) -> ListStorage {
+        match self.lists {
+            ListMode::Fixed => ListStorage::Fixed {
+                capacity: self.capacity.unwrap_or(DEFAULT_CAPACITY),
+            },
+            ListMode::Compact { max_indices } => ListStorage::Compact { max_indices },
+        }
+    }
     pub fn list_layout(&self, width: u32, height: u32) -> ListLayout {
-        ListLayout::new(self.tile, self.variant, self.capacity, width, height)
+        ListLayout::new(self.tile, self.variant, self.storage(), width, height)
     }
 }
 
@@ -80,8 +126,21 @@ pub fn check(p: &LightCulling, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
             p.tile
         )));
     }
-    if p.capacity == 0 || p.capacity > 4096 {
-        errors.push(ctx.bad(format!("capacity {} must be in 1..=4096", p.capacity)));
+    match (p.lists, p.capacity) {
+        (ListMode::Fixed, Some(c)) if c == 0 || c > 4096 => {
+            errors.push(ctx.bad(format!("capacity {c} must be in 1..=4096")));
+        }
+        (ListMode::Compact { .. }, Some(c)) => errors.push(ctx.bad(format!(
+            "capacity {c} is for lists: Fixed; Compact lists have no per-list capacity (their total is max_indices)"
+        ))),
+        (ListMode::Compact { max_indices }, None)
+            if max_indices == 0 || max_indices > MAX_INDICES_LIMIT =>
+        {
+            errors.push(ctx.bad(format!(
+                "max_indices {max_indices} must be in 1..={MAX_INDICES_LIMIT}"
+            )));
+        }
+        _ => {}
     }
     if p.coarse > 16 {
         errors.push(ctx.bad(format!(
@@ -116,6 +175,48 @@ mod tests {
         ] {
             assert!(e.contains(want), "{want}: {e}");
         }
+    }
+
+    #[test]
+    fn compact_lists_take_a_bound_and_no_capacity() {
+        let cull = |kind: &str| {
+            errors(
+                &format!(
+                    r#"{PREPASS} Pass(name: "c", kind: {kind}, reads: ["depth", "lg"], writes: ["lists"])"#
+                ),
+                "hdr",
+            )
+        };
+        let e = cull("LightCulling(tile: 16, lists: Compact(max_indices: 64), capacity: 256)");
+        assert!(e.contains("capacity 256 is for lists: Fixed"), "{e}");
+        let e = cull("LightCulling(tile: 16, lists: Compact(max_indices: 0))");
+        assert!(e.contains("max_indices 0 must be in 1..=1073741824"), "{e}");
+        let e = cull("LightCulling(tile: 16, lists: Compact(max_indices: 1073741825))");
+        assert!(e.contains("max_indices 1073741825"), "{e}");
+        crate::graph::kinds::test_support::validate(
+            &format!(
+                r#"{PREPASS} Pass(name: "c", kind: LightCulling(tile: 16, lists: Compact(max_indices: 1024)), reads: ["depth", "lg"], writes: ["lists"])"#
+            ),
+            "hdr",
+        )
+        .expect("compact lists with a bound and no capacity are valid");
+    }
+
+    #[test]
+    fn storage_follows_lists_and_capacity() {
+        use super::{LightCulling, ListMode};
+        use crate::graph::plan::ListStorage;
+        let text = |t: &str| ron::from_str::<LightCulling>(t).unwrap();
+        let fixed = text("(tile: 16, capacity: 64)");
+        assert_eq!(fixed.storage(), ListStorage::Fixed { capacity: 64 });
+        let default = text("(tile: 16)");
+        assert_eq!(default.storage(), ListStorage::Fixed { capacity: 256 });
+        let compact = text("(tile: 8, lists: Compact(max_indices: 4096))");
+        assert_eq!(compact.lists, ListMode::Compact { max_indices: 4096 });
+        assert_eq!(
+            compact.storage(),
+            ListStorage::Compact { max_indices: 4096 }
+        );
     }
 
     #[test]

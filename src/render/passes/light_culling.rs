@@ -1,10 +1,11 @@
 //! `LightCulling`: per-tile light lists, with an optional coarse stage first in the same
-//! compute pass; reports each frame's overflows and longest list.
+//! compute pass; reports each frame's overflows and longest list. Compact lists run
+//! count → scan → fill in that pass too (see `shaders/cull/light_culling.wgsl`).
 
 use super::{defines, PrepareCtx, PreparedPass, Timestamps};
 use crate::gpu::readback::read_buffer;
 use crate::graph::Name;
-use crate::graph::{slot, LightCulling, ListLayout, ScheduledPass};
+use crate::graph::{slot, LightCulling, ListLayout, ListStorage, ScheduledPass};
 use crate::render::pipelines::PipelineKey;
 use crate::render::report::{CullingReport, PassReport};
 use crate::render::{RenderError, Renderer};
@@ -22,11 +23,23 @@ pub(super) struct LightCullingPass {
     pipeline: Arc<wgpu::ComputePipeline>,
     bind: wgpu::BindGroup,
     groups: [u32; 3],
+    /// Compact lists: the scan between the two runs of `pipeline`.
+    compact: Option<Compact>,
     lists: wgpu::Buffer,
     /// The header and list entries, copied out after culling: the report reads these,
     /// since a later pass may reuse the lists' memory (aliasing) before it is read.
     report_copy: wgpu::Buffer,
     layout: ListLayout,
+}
+
+/// What compact lists add: the fill's bind group (the same pipeline as the count, with
+/// `cull_phase` 1), the two scan pipelines and the block sums they share.
+struct Compact {
+    fill: wgpu::BindGroup,
+    scan_blocks: Arc<wgpu::ComputePipeline>,
+    scan_lists: Arc<wgpu::ComputePipeline>,
+    block_sums: wgpu::Buffer,
+    blocks: u32,
 }
 
 pub(super) fn prepare(
@@ -64,7 +77,6 @@ pub(super) fn prepare(
     offered.buffer("coarse_lists", &coarse_lists);
     let mut d = vec![
         ("TILE", format!("{}u", p.tile)),
-        ("CAPACITY", format!("{}u", p.capacity)),
         ("VARIANT", format!("{}u", p.variant.code())),
         ("COARSE", format!("{coarse}u")),
         ("COARSE_CAPACITY", format!("{COARSE_CAPACITY}u")),
@@ -77,6 +89,45 @@ pub(super) fn prepare(
     if sp.roles.slot(slot::TRANSPARENT_DEPTH).is_some() {
         d.push(("TRANSPARENT", "1".into()));
     }
+    let blocks = layout.scan_blocks();
+    if let ListStorage::Fixed { capacity } = layout.storage {
+        d.push(("CAPACITY", format!("{capacity}u")));
+    } else {
+        d.push(("COMPACT", "1".into()));
+        d.push(("SCAN_BLOCK", format!("{}u", ListLayout::SCAN_BLOCK)));
+        // One workgroup per block in x.
+        let max = device.limits().max_compute_workgroups_per_dimension;
+        if blocks > max {
+            return Err(super::pass_error(
+                &sp.name,
+                format!(
+                    "{} lists need {blocks} scan workgroups, over the device's {max}: use larger tiles or fewer clusters",
+                    layout.lists()
+                ),
+            ));
+        }
+    }
+    // Compact lists: a (sum, wrapped) pair per scan block, and the phase uniforms.
+    let phase = |p: u32| {
+        use wgpu::util::DeviceExt;
+        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("cull phase"),
+            contents: bytemuck::cast_slice(&[p, 0u32, 0, 0]),
+            usage: wgpu::BufferUsages::UNIFORM,
+        })
+    };
+    let block_sums = (blocks > 0).then(|| {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("light list block sums"),
+            size: 8 * blocks as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    });
+    if let Some(b) = &block_sums {
+        offered.buffer("list_block_sums", b);
+        offered.buffer("cull_phase", &phase(0));
+    }
     let key = |state: &str| PipelineKey {
         shader: "cull/light_culling.wgsl".into(),
         defines: defines(&d),
@@ -84,6 +135,24 @@ pub(super) fn prepare(
         state: state.to_string(),
     };
     let (pipeline, bind) = cx.compute_pipeline(&sp.name, key(""), "main", &offered)?;
+    let compact = if let Some(block_sums) = block_sums {
+        // The same pipeline (a cache hit) bound with the fill phase.
+        offered.buffer("cull_phase", &phase(1));
+        let (_, fill) = cx.compute_pipeline(&sp.name, key(""), "main", &offered)?;
+        let (scan_blocks, _) =
+            cx.compute_pipeline(&sp.name, key("scan_blocks"), "scan_blocks", &offered)?;
+        let (scan_lists, _) =
+            cx.compute_pipeline(&sp.name, key("scan_lists"), "scan_lists", &offered)?;
+        Some(Compact {
+            fill,
+            scan_blocks,
+            scan_lists,
+            block_sums,
+            blocks,
+        })
+    } else {
+        None
+    };
     let coarse = if coarse > 1 {
         let (pipeline, _) = cx.compute_pipeline(&sp.name, key("coarse"), "coarse", &offered)?;
         Some((pipeline, coarse_groups))
@@ -103,6 +172,7 @@ pub(super) fn prepare(
         pipeline,
         bind,
         groups: [layout.tiles_x, layout.tiles_y, layout.lists_per_tile],
+        compact,
         lists,
         layout,
     })
@@ -110,8 +180,11 @@ pub(super) fn prepare(
 
 impl PreparedPass for LightCullingPass {
     fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
-        // Header words (pool cursor and overflow counters) start at zero.
+        // Header words (pool cursor or wanted total, and counters) start at zero.
         encoder.clear_buffer(&self.lists, 0, Some(16));
+        if let Some(c) = &self.compact {
+            encoder.clear_buffer(&c.block_sums, 0, None);
+        }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some(&self.name),
             timestamp_writes: ts.compute(),
@@ -124,6 +197,17 @@ impl PreparedPass for LightCullingPass {
         pass.set_pipeline(&self.pipeline);
         let [x, y, z] = self.groups;
         pass.dispatch_workgroups(x, y, z);
+        if let Some(c) = &self.compact {
+            // Count (above), scan, fill. Each dispatch sees the previous one's writes:
+            // wgpu puts a barrier between dispatches that use a buffer read-write.
+            pass.set_pipeline(&c.scan_blocks);
+            pass.dispatch_workgroups(1, 1, 1);
+            pass.set_pipeline(&c.scan_lists);
+            pass.dispatch_workgroups(c.blocks, 1, 1);
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &c.fill, &[]);
+            pass.dispatch_workgroups(x, y, z);
+        }
         drop(pass);
         encoder.copy_buffer_to_buffer(
             &self.lists,
@@ -137,16 +221,32 @@ impl PreparedPass for LightCullingPass {
     fn report(&self, r: &Renderer) -> Result<Option<PassReport>, RenderError> {
         let words = read_buffer(&r.ctx.device, &r.ctx.queue, &self.report_copy)?;
         let words: &[u32] = bytemuck::cast_slice(&words);
-        let counts = (0..self.layout.lists() as usize)
-            .map(|l| {
-                words[(ListLayout::HEADER_WORDS + ListLayout::ENTRY_WORDS * l as u32 + 1) as usize]
-            })
+        let entry = |l: usize, w: u32| {
+            words[(ListLayout::HEADER_WORDS + ListLayout::ENTRY_WORDS * l as u32 + w) as usize]
+        };
+        let counts: Vec<u32> = (0..self.layout.lists() as usize)
+            .map(|l| entry(l, 1))
             .collect();
+        let compact = self.compact.is_some();
+        // Compact lists lie back to back in list order: each offset is the sum of the
+        // kept counts before it (also past the bound, where offsets stop at its end).
+        let mut misplaced_lists = 0;
+        if compact {
+            let mut running = 0u64;
+            for (l, &c) in counts.iter().enumerate() {
+                misplaced_lists += (entry(l, 0) as u64 != running) as u32;
+                running += c as u64;
+            }
+            misplaced_lists += (running > self.layout.pool_indices()) as u32;
+        }
         Ok(Some(PassReport::Culling(CullingReport {
             pass: self.name.to_string(),
             layout: self.layout,
             overflowed_lists: words[1],
             longest_list: words[2],
+            wanted: compact.then_some(words[0] as u64),
+            mismatched_lists: if compact { words[3] } else { 0 },
+            misplaced_lists,
             counts,
         })))
     }

@@ -1,0 +1,489 @@
+//! Compact light lists (`LightCulling(..., lists: Compact(max_indices: N))`): count →
+//! prefix sum → fill, so every list holds exactly its lights at any density, and only the
+//! total is bounded by the graph.
+//!
+//! Where fixed lists of 256 overflow (harada's 3,072 lights at 64×36; 3,000 random lights
+//! at 96×64), every culling variant at both tile sizes must give:
+//! - no list cut, no fill that disagrees with its count, every offset the sum of the
+//!   counts before it (checked on the CPU from the entries read back);
+//! - exactly the lists of fixed lists roomy enough not to overflow (same counts), and so
+//!   the same image to the bit (same lights, same ascending order, same shading code);
+//! - brute force's image within the culling tests' 2e-6 (see tests/culling_exact.rs).
+//!
+//! A bound smaller than the lists want cuts the last lists in list order, fills the
+//! index array to its last word, and is counted (lists cut, indices wanted) and reported.
+//! `mutations_are_caught` runs these checks on deliberately broken copies of the culling
+//! shader (scan off by one, the block scan's carry dropped from its total or its offsets,
+//! bound ignored, fill out of order, count short) and requires each check to fail, so
+//! none of them passes vacuously.
+
+mod common;
+use common::*;
+use lightgraph::render::{FrameResult, Renderer};
+use lightgraph::scene::Scene;
+use lightgraph::shader::ShaderLibrary;
+
+/// Every variant at both tile sizes.
+const ALL: [(u32, &str); 8] = [
+    (8, "Frustum"),
+    (8, "HalfZ"),
+    (8, "DepthMask"),
+    (8, "Clustered(slices: 16)"),
+    (16, "Frustum"),
+    (16, "HalfZ"),
+    (16, "DepthMask"),
+    (16, "Clustered(slices: 16)"),
+];
+const TOLERANCE: f32 = 2e-6;
+/// Room for everything these scenes want (4 MiB of indices).
+const ROOMY: u32 = 1 << 20;
+
+fn compact(tile: u32, variant: &str, max_indices: u32) -> String {
+    graph_with_culling(
+        "forward_plus.ron",
+        &format!("LightCulling(tile: {tile}, variant: {variant}, lists: Compact(max_indices: {max_indices}))"),
+    )
+}
+
+fn fixed(tile: u32, variant: &str, capacity: u32) -> String {
+    graph_with_culling(
+        "forward_plus.ron",
+        &format!("LightCulling(tile: {tile}, variant: {variant}, capacity: {capacity})"),
+    )
+}
+
+/// The worst relative error against the reference (to the pixel, or to 1e-3 of the
+/// peak for dark pixels), as in tests/culling_exact.rs.
+fn worst_error(image: &[[f32; 4]], reference: &[[f32; 4]]) -> f32 {
+    assert_eq!(image.len(), reference.len());
+    let peak = reference
+        .iter()
+        .flat_map(|p| p[..3].to_vec())
+        .fold(0.0f32, f32::max);
+    let mut worst = 0.0f32;
+    for (a, b) in image.iter().zip(reference) {
+        for ch in 0..3 {
+            let d = (a[ch] - b[ch]).abs() / b[ch].abs().max(1e-3 * peak).max(1e-30);
+            if d.is_nan() {
+                return f32::INFINITY;
+            }
+            worst = worst.max(d);
+        }
+    }
+    worst
+}
+
+/// What is wrong with one compact frame's report on its own.
+fn report_failures(what: &str, out: &FrameResult) -> Vec<String> {
+    let c = &out.culling[0];
+    let mut f = Vec::new();
+    if c.overflowed_lists != 0 || c.mismatched_lists != 0 || c.misplaced_lists != 0 {
+        f.push(format!(
+            "{what}: {} lists cut, {} fills mismatched, {} lists misplaced",
+            c.overflowed_lists, c.mismatched_lists, c.misplaced_lists
+        ));
+    }
+    if c.wanted != Some(c.listed()) {
+        f.push(format!(
+            "{what}: lists want {:?} indices but hold {}",
+            c.wanted,
+            c.listed()
+        ));
+    }
+    f
+}
+
+/// Compact lists at each (tile, variant) against roomy fixed lists and brute force;
+/// returns what is wrong (empty when everything holds).
+fn exactness_failures(
+    r: &mut Renderer,
+    scene: &Scene,
+    (w, h): (u32, u32),
+    combos: &[(u32, &str)],
+) -> Vec<String> {
+    let reference = render_file(r, "brute_force.ron", scene, w, h);
+    let mut failures = Vec::new();
+    for &(tile, variant) in combos {
+        let what = format!("{} {w}x{h} tile {tile} {variant}", scene.name);
+        let out = render_text(r, &compact(tile, variant, ROOMY), scene, w, h);
+        failures.extend(report_failures(&what, &out));
+        // Fixed lists as long as the scene has lights cannot overflow.
+        let roomy = render_text(r, &fixed(tile, variant, 4096), scene, w, h);
+        assert_eq!(roomy.culling[0].overflowed_lists, 0, "{what}: fixed 4096");
+        if out.culling[0].counts != roomy.culling[0].counts {
+            let differ = (out.culling[0].counts.iter())
+                .zip(&roomy.culling[0].counts)
+                .filter(|(a, b)| a != b)
+                .count();
+            failures.push(format!("{what}: {differ} lists differ from fixed lists"));
+        }
+        if out.image != roomy.image {
+            failures.push(format!("{what}: the image differs from fixed lists'"));
+        }
+        // The per-pixel statistics read the lists through the same include.
+        let stats = |o: &FrameResult| {
+            o.light_stats
+                .as_ref()
+                .map(|s| (s.listed_total, s.exact_total, s.max_listed))
+        };
+        if stats(&out) != stats(&roomy) || stats(&out).is_none() {
+            failures.push(format!("{what}: light statistics differ from fixed lists'"));
+        }
+        let e = worst_error(&out.image, &reference.image);
+        if e > TOLERANCE {
+            failures.push(format!("{what}: relative error {e:e} against brute force"));
+        }
+    }
+    failures
+}
+
+/// The density the fixed layout cannot hold: lists of 256 overflow in `lists` tiles, and
+/// the image is wrong there.
+fn assert_fixed_overflows(r: &mut Renderer, scene: &Scene, w: u32, h: u32, lists: u32) {
+    let out = render_text(r, &fixed(16, "Frustum", 256), scene, w, h);
+    assert_eq!(
+        out.culling[0].overflowed_lists, lists,
+        "{}: fixed lists of 256 overflow in {lists} tiles",
+        scene.name
+    );
+    let reference = render_file(r, "brute_force.ron", scene, w, h);
+    assert!(worst_error(&out.image, &reference.image) > 1e-2);
+}
+
+fn harada() -> Scene {
+    lightgraph::scene::builtin::harada()
+}
+
+#[test]
+fn harada_at_64x36_is_exact_for_every_variant() {
+    let mut r = renderer();
+    let scene = harada();
+    assert_eq!(scene.lights.len(), 3072);
+    assert_fixed_overflows(&mut r, &scene, 64, 36, 6);
+    let failures = exactness_failures(&mut r, &scene, (64, 36), &ALL);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn dense_random_lights_are_exact_for_every_variant() {
+    let mut r = renderer();
+    let scene = random_scene(3000, 23);
+    let out = render_text(&mut r, &fixed(16, "Frustum", 256), &scene, 96, 64);
+    assert!(
+        out.culling[0].overflowed_lists >= 6,
+        "the set must be dense"
+    );
+    let failures = exactness_failures(&mut r, &scene, (96, 64), &ALL);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Every other reader of tile lists where fixed lists of 256 overflow (harada at 64×36):
+/// deferred shading, the packed G-buffer's, the light linked list's build (tile lists as
+/// candidates) in both shading paths, transparent shading (the glass scene with 3,072
+/// lights); each equal to its own brute force.
+#[test]
+fn every_list_reader_takes_compact_lists() {
+    let mut r = renderer();
+    let harada = harada();
+    let (w, h) = (64, 36);
+    let forward = render_file(&mut r, "brute_force.ron", &harada, w, h);
+    let deferred = render_file(&mut r, "deferred_brute_force.ron", &harada, w, h);
+    let glass = lightgraph::bench::sweep::with_light_count(
+        &lightgraph::scene::builtin::by_name("glass").unwrap(),
+        3072,
+    );
+    let glass_reference = render_file(&mut r, "transparent_brute_force.ron", &glass, w, h);
+    let mut failures = Vec::new();
+    let mut check = |graph: &str, scene: &Scene, reference: &[[f32; 4]], tol: f32| {
+        let out = render_file(&mut r, graph, scene, w, h);
+        assert!(!out.culling.is_empty(), "{graph}: no culling report");
+        for (i, c) in out.culling.iter().enumerate() {
+            assert!(
+                matches!(
+                    c.layout.storage,
+                    lightgraph::graph::ListStorage::Compact { .. }
+                ),
+                "{graph}: ships compact lists"
+            );
+            failures.extend(report_failures(&format!("{graph} pass {i}"), &out));
+        }
+        let e = worst_error(&out.image, reference);
+        println!("{graph}: worst relative error {e:e}");
+        if e > tol {
+            failures.push(format!("{graph}: relative error {e:e}"));
+        }
+    };
+    check(
+        "tiled_deferred_prepass.ron",
+        &harada,
+        &deferred.image,
+        TOLERANCE,
+    );
+    check("tiled_deferred.ron", &harada, &deferred.image, TOLERANCE);
+    // Rebuilt positions: tests/culling_exact.rs's bound for the packed G-buffer.
+    check("tiled_deferred_packed.ron", &harada, &deferred.image, 1e-3);
+    check("light_linked_list.ron", &harada, &forward.image, TOLERANCE);
+    check(
+        "light_linked_list_deferred.ron",
+        &harada,
+        &deferred.image,
+        TOLERANCE,
+    );
+    check("transparent.ron", &glass, &glass_reference.image, TOLERANCE);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Thousands of lists (tile 8, 64 clusters at 640×480: 307,200 lists, 300 scan blocks)
+/// take both levels of the scan, the block loop included (256 blocks a round).
+fn many_lists_failures(r: &mut Renderer) -> Vec<String> {
+    let scene = random_scene(40, 29);
+    let (w, h) = (640, 480);
+    let variant = "Clustered(slices: 64)";
+    let out = render_text(r, &compact(8, variant, ROOMY), &scene, w, h);
+    assert_eq!(out.culling[0].layout.lists(), 307_200);
+    let mut f = report_failures("640x480 tile 8 64 clusters", &out);
+    let roomy = render_text(r, &fixed(8, variant, 64), &scene, w, h);
+    assert_eq!(roomy.culling[0].overflowed_lists, 0);
+    if out.culling[0].counts != roomy.culling[0].counts || out.image != roomy.image {
+        f.push("640x480: lists or image differ from fixed lists'".into());
+    }
+    f
+}
+
+#[test]
+fn hundreds_of_thousands_of_lists_scan_in_two_levels() {
+    let mut r = renderer();
+    let failures = many_lists_failures(&mut r);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// A bound of half what the lists want: what must hold when it is reached.
+fn bound_failures(r: &mut Renderer) -> Vec<String> {
+    let scene = harada();
+    let (w, h) = (64, 36);
+    let full = render_text(r, &compact(16, "Frustum", ROOMY), &scene, w, h);
+    let wanted = full.culling[0].listed();
+    let max = (wanted / 2) as u32;
+    let out = render_text(r, &compact(16, "Frustum", max), &scene, w, h);
+    let c = &out.culling[0];
+    let mut f = Vec::new();
+    if c.wanted != Some(wanted) {
+        f.push(format!("wanted {:?}, not {wanted}", c.wanted));
+    }
+    // The array fills to its last word; lists keep their start in list order, so the
+    // lists before the cut are whole, one is cut short and the rest are empty.
+    if c.listed() != max as u64 {
+        f.push(format!("{} indices held, not the bound {max}", c.listed()));
+    }
+    let whole = c
+        .counts
+        .iter()
+        .zip(&full.culling[0].counts)
+        .take_while(|(a, b)| a == b)
+        .count();
+    if whole == c.counts.len() {
+        f.push("no list was cut".into());
+        return f;
+    }
+    if c.counts[whole + 1..].iter().any(|&n| n != 0) {
+        f.push(format!("lists after the cut hold lights: {:?}", c.counts));
+    }
+    let cut_nonempty = full.culling[0].counts[whole..]
+        .iter()
+        .filter(|&&n| n > 0)
+        .count();
+    if c.overflowed_lists as usize != cut_nonempty {
+        f.push(format!(
+            "{} lists counted as cut, {cut_nonempty} lost lights",
+            c.overflowed_lists
+        ));
+    }
+    if c.mismatched_lists != 0 || c.misplaced_lists != 0 {
+        f.push(format!(
+            "{} mismatched, {} misplaced",
+            c.mismatched_lists, c.misplaced_lists
+        ));
+    }
+    let warnings = c.warnings().join("\n");
+    let expect = format!(
+        "the lists wanted {wanted} light indices, over max_indices {max}: {} lists lost lights",
+        c.overflowed_lists
+    );
+    if !warnings.contains(&expect) {
+        f.push(format!("warning missing: {warnings}"));
+    }
+    f
+}
+
+#[test]
+fn reaching_the_bound_is_counted_and_reported() {
+    let mut r = renderer();
+    let failures = bound_failures(&mut r);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The GPU sweep (benches/sweeps/compact_lists.ron) end to end at 64×36 with 3,072 lights:
+/// compact rows hold every light and equal brute force of their shading path; the fixed
+/// rows of 256 overflow and are wrong; the list columns are filled.
+#[test]
+fn the_compact_lists_sweep_runs_at_a_tiny_size() {
+    use lightgraph::bench::sweep::{self, Sweep};
+    let path = lightgraph::project_root().join("benches/sweeps/compact_lists.ron");
+    let mut plan = Sweep::load(&path).expect("the sweep parses");
+    plan.resolutions = vec![(64, 36)];
+    plan.lights = vec![3072];
+    (plan.warmup, plan.warmup_seconds, plan.frames, plan.rounds) = (1, 0.0, 1, 1);
+    let mut r = renderer();
+    let rows = sweep::run(&plan, path.parent().unwrap(), &mut r, |_| {}).expect("sweep");
+    let mut failures = Vec::new();
+    for row in rows.iter().filter(|r| r.reference.is_some()) {
+        let what = format!("{} {}", row.technique, row.light_count);
+        let storage = row.list_storage.clone().unwrap_or_default();
+        let cut = row.overflow_tiles.unwrap_or(0);
+        let (Some(mib), Some(held)) = (row.list_mib, row.list_indices) else {
+            failures.push(format!("{what}: no list columns"));
+            continue;
+        };
+        println!(
+            "{what}: {storage}, {mib:.2} MiB, {held} indices, {cut} cut, max rel {:?}",
+            row.max_rel
+        );
+        if storage.starts_with("compact:") {
+            // The packed G-buffer rebuilds positions (tests/culling_exact.rs: 1e-3 here).
+            let tolerance = if row.technique.contains("packed") {
+                1e-3
+            } else {
+                2e-6
+            };
+            let exact = row.max_rel.is_some_and(|e| e <= tolerance);
+            if cut != 0 || row.list_indices_wanted != Some(held) || !exact {
+                failures.push(format!(
+                    "{what}: compact lists cut {cut} or wrong ({:?})",
+                    row.max_rel
+                ));
+            }
+        } else if storage == "fixed:256" && (cut == 0 || row.max_rel.is_none_or(|e| e < 1e-2)) {
+            failures.push(format!("{what}: fixed lists of 256 did not overflow here"));
+        }
+    }
+    assert_eq!(rows.iter().filter(|r| r.list_storage.is_some()).count(), 9);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// A copy of the culling shader with `from` replaced by `to` (which must occur once),
+/// used through the renderer's shader library until the guard is dropped.
+struct Mutated<'a> {
+    r: &'a mut Renderer,
+    _dir: tempfile::TempDir,
+    saved: Option<ShaderLibrary>,
+}
+
+impl<'a> Mutated<'a> {
+    fn new(r: &'a mut Renderer, from: &str, to: &str) -> Self {
+        let file = "cull/light_culling.wgsl";
+        let text = ShaderLibrary::builtin().read_source(file).unwrap();
+        assert_eq!(text.matches(from).count(), 1, "mutation site: {from}");
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir_all(dir.path().join("cull")).unwrap();
+        std::fs::write(dir.path().join(file), text.replace(from, to)).unwrap();
+        let saved = std::mem::replace(&mut r.shaders, ShaderLibrary::with_builtin(dir.path()));
+        // The cache is keyed by file name and defines, not text: start from empty.
+        r.pipelines = Default::default();
+        Self {
+            r,
+            _dir: dir,
+            saved: Some(saved),
+        }
+    }
+}
+
+impl Drop for Mutated<'_> {
+    fn drop(&mut self) {
+        self.r.shaders = self.saved.take().unwrap();
+        self.r.pipelines = Default::default();
+    }
+}
+
+/// A tile size of each and a variant of one list and of many lists a tile: enough for a
+/// mutation to show (the tests above run all eight).
+const SOME: [(u32, &str); 2] = [(16, "Frustum"), (8, "Clustered(slices: 16)")];
+
+#[test]
+fn mutations_are_caught() {
+    let mut r = renderer();
+    let harada = harada();
+    let dense = random_scene(3000, 23);
+    let caught = |what: &str, f: Vec<String>| {
+        println!("{what}: {} failures, first: {:?}", f.len(), f.first());
+        assert!(!f.is_empty(), "{what} passed");
+        f
+    };
+    // Scan off by one: each invocation's offset includes its own lists.
+    {
+        let m = Mutated::new(
+            &mut r,
+            "before = scan_sums[local - 1u];",
+            "before = scan_sums[local];",
+        );
+        caught(
+            "scan off by one, harada",
+            exactness_failures(m.r, &harada, (64, 36), &SOME),
+        );
+        caught(
+            "scan off by one, dense",
+            exactness_failures(m.r, &dense, (96, 64), &SOME),
+        );
+    }
+    // The block loop's total forgets the blocks of earlier rounds.
+    {
+        let m = Mutated::new(
+            &mut r,
+            "carry = add_sat(carry, workgroupUniformLoad(&scan_total));",
+            "carry = workgroupUniformLoad(&scan_total);",
+        );
+        caught("block carry dropped", many_lists_failures(m.r));
+    }
+    // The block scan leaves out earlier rounds' total from its offsets.
+    {
+        let m = Mutated::new(
+            &mut r,
+            "atomicStore(&list_block_sums[2u * b], add_sat(carry, before));",
+            "atomicStore(&list_block_sums[2u * b], before);",
+        );
+        caught("block offsets without the carry", many_lists_failures(m.r));
+    }
+    // The scan ignores the bound: lists run past the index array.
+    {
+        let m = Mutated::new(
+            &mut r,
+            "let kept = min(counts[j], pool - start);",
+            "let kept = counts[j];",
+        );
+        caught("bound ignored", bound_failures(m.r));
+    }
+    // The fill writes each batch in reverse: the same lights, out of ascending order.
+    {
+        let m = Mutated::new(
+            &mut r,
+            "atomicStore(&light_lists[offset + slot], i);",
+            "atomicStore(&light_lists[offset + total + hits_in_batch() - 1u - rank_in_batch(local)], i);",
+        );
+        let f = caught(
+            "fill reversed",
+            exactness_failures(m.r, &harada, (64, 36), &SOME),
+        );
+        assert!(f.iter().any(|f| f.contains("image differs")), "{f:?}");
+    }
+    // The count misses the last batch of candidates: lists come out short.
+    {
+        let m = Mutated::new(
+            &mut r,
+            "atomicStore(&light_lists[e + 1u], total);",
+            "atomicStore(&light_lists[e + 1u], total - hits_in_batch());",
+        );
+        caught(
+            "count short",
+            exactness_failures(m.r, &dense, (96, 64), &SOME),
+        );
+    }
+}
