@@ -258,6 +258,11 @@ fn output_without_a_running_writer_is_an_error() {
         "            writes: [\"hdr\"],\n            when: Some(Transparent),\n",
     );
     assert!(graph.contains("when: Some(Transparent)"));
+    // The error points at the output in the skipped pass's writes.
+    let line = 1 + graph
+        .lines()
+        .position(|l| l.contains("writes: [\"hdr\"]"))
+        .unwrap();
     std::fs::write(dir.path().join("g.ron"), graph).unwrap();
     let o = lightgraph(
         dir.path(),
@@ -269,7 +274,7 @@ fn output_without_a_running_writer_is_an_error() {
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(!err.contains("panicked"), "{err}");
     assert!(
-        err.contains("g.ron:31:")
+        err.contains(&format!("g.ron:{line}:"))
             && err.contains("pass 'forward_shading': output 'hdr' has no writer in this scene")
             && err.contains("when: Transparent is false"),
         "{err}"
