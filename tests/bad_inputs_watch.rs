@@ -5,12 +5,11 @@
 
 use lightgraph::reload::{ReloadSession, SceneSource};
 use lightgraph::render::Renderer;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Duration;
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
+#[path = "common/watched_project.rs"]
+mod watched_project;
+use watched_project::{expected, ron_files, root, WatchedProject};
 
 /// The outcome of the reload that touched `file` (bounded wait).
 fn save(s: &mut ReloadSession, file: &Path, text: &[u8]) -> Result<Duration, String> {
@@ -28,52 +27,16 @@ fn save(s: &mut ReloadSession, file: &Path, text: &[u8]) -> Result<Duration, Str
     panic!("no reload of {} within 100 s", file.display());
 }
 
-/// The `// expect: ` message of a bad file, if it has one.
-fn expected(text: &str) -> Option<&str> {
-    text.trim_start_matches('\u{feff}')
-        .lines()
-        .next()?
-        .strip_prefix("// expect: ")
-}
-
-fn ron_files(dir: &Path) -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
-        .collect();
-    v.sort();
-    v
-}
-
 #[test]
 fn watch_survives_every_bad_save() {
-    let tmp = tempfile::tempdir().unwrap();
-    let t = tmp.path();
+    let project = WatchedProject::new();
+    let (graph, material, scene) = (&project.graph, &project.material, &project.scene);
     let hostile = root().join("tests/bad/hostile");
-    std::fs::create_dir_all(t.join("models")).unwrap();
-    for e in std::fs::read_dir(hostile.join("models")).unwrap() {
-        let p = e.unwrap().path();
-        std::fs::copy(&p, t.join("models").join(p.file_name().unwrap())).unwrap();
-    }
-    let good_graph = std::fs::read(root().join("graphs/forward_plus.ron")).unwrap();
-    let graph = t.join("graph.ron");
-    std::fs::write(&graph, &good_graph).unwrap();
-    let material = t.join("mat.ron");
-    let good_material = b"(name: \"plain\", layers: [(lobes: [Lambert(color: (0.5, 0.5, 0.5))])])";
-    std::fs::write(&material, good_material).unwrap();
-    let good_scene = br#"Scene(
-    models: [(path: "models/tri.gltf")],
-    material_overrides: { "tri_mat": "mat.ron" },
-    camera: LookAt(eye: (0.3, 0.3, 3), target: (0.3, 0.3, 0), fov_y_deg: 50, near: 0.1, far: 100),
-)"#;
-    let scene = t.join("scene.ron");
-    std::fs::write(&scene, good_scene).unwrap();
 
     let renderer = Renderer::headless().unwrap();
     let mut s = ReloadSession::new(
         renderer,
-        &graph,
+        graph,
         SceneSource::File(scene.clone()),
         64,
         36,
@@ -96,16 +59,16 @@ fn watch_survives_every_bad_save() {
         assert!(s.frame.is_some(), "the last good frame stays");
     };
     for bad in ron_files(&root().join("tests/bad/graphs")) {
-        check(&mut s, &graph, &bad);
+        check(&mut s, graph, &bad);
     }
-    save(&mut s, &graph, &good_graph).expect("the good graph recovers");
+    save(&mut s, graph, &project.good_graph).expect("the good graph recovers");
     for bad in ron_files(&hostile) {
-        check(&mut s, &scene, &bad);
+        check(&mut s, scene, &bad);
     }
-    save(&mut s, &scene, good_scene).expect("the good scene recovers");
+    save(&mut s, scene, &project.good_scene).expect("the good scene recovers");
     // A material saved with a texture wider than the device: scaled down, no panic.
     let wide = std::fs::read_to_string(hostile.join("wide_texture_material.ron")).unwrap();
-    save(&mut s, &material, wide.as_bytes()).expect("a too-wide texture is scaled down");
-    save(&mut s, &material, good_material).expect("the good material recovers");
+    save(&mut s, material, wide.as_bytes()).expect("a too-wide texture is scaled down");
+    save(&mut s, material, &project.good_material).expect("the good material recovers");
     assert!(failures.is_empty(), "\n{}", failures.join("\n"));
 }

@@ -6,33 +6,13 @@
 //! or an error returned from the watch loop, would end the process.)
 
 use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::sync::mpsc::{channel, Receiver};
 use std::time::{Duration, Instant};
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// The `// expect: ` message of a bad file, if it has one.
-fn expected(text: &str) -> Option<String> {
-    text.trim_start_matches('\u{feff}')
-        .lines()
-        .next()?
-        .strip_prefix("// expect: ")
-        .map(str::to_string)
-}
-
-fn ron_files(dir: &Path) -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
-        .collect();
-    v.sort();
-    v
-}
+#[path = "common/watched_project.rs"]
+mod watched_project;
+use watched_project::{expected, ron_files, root, WatchedProject};
 
 /// The running `watch` and what it has printed so far, both streams as lines.
 struct Watch {
@@ -147,29 +127,15 @@ impl Drop for Watch {
 
 #[test]
 fn the_watch_process_survives_every_bad_save() {
-    let tmp = tempfile::tempdir().unwrap();
-    let t = tmp.path();
+    let project = WatchedProject::new();
+    let t = project.dir.path();
+    let (graph, material, scene) = (&project.graph, &project.material, &project.scene);
+    let (good_graph, good_material, good_scene) = (
+        &project.good_graph,
+        &project.good_material,
+        &project.good_scene,
+    );
     let hostile = root().join("tests/bad/hostile");
-    std::fs::create_dir_all(t.join("models")).unwrap();
-    for e in std::fs::read_dir(hostile.join("models")).unwrap() {
-        let p = e.unwrap().path();
-        std::fs::copy(&p, t.join("models").join(p.file_name().unwrap())).unwrap();
-    }
-    let good_graph = std::fs::read(root().join("graphs/forward_plus.ron")).unwrap();
-    let graph = t.join("graph.ron");
-    std::fs::write(&graph, &good_graph).unwrap();
-    let material = t.join("mat.ron");
-    let good_material =
-        b"(name: \"plain\", layers: [(lobes: [Lambert(color: (0.5, 0.5, 0.5))])])".to_vec();
-    std::fs::write(&material, &good_material).unwrap();
-    let good_scene = br#"Scene(
-    models: [(path: "models/tri.gltf")],
-    material_overrides: { "tri_mat": "mat.ron" },
-    camera: LookAt(eye: (0.3, 0.3, 3), target: (0.3, 0.3, 0), fov_y_deg: 50, near: 0.1, far: 100),
-)"#
-    .to_vec();
-    let scene = t.join("scene.ron");
-    std::fs::write(&scene, &good_scene).unwrap();
     let out = t.join("out.png");
 
     let mut w = Watch::start(
@@ -198,7 +164,7 @@ fn the_watch_process_survives_every_bad_save() {
     // name in place of the bad file's).
     let mut save_bad = |w: &mut Watch, file: &Path, bad: &Path| {
         let text = std::fs::read(bad).unwrap();
-        let Some(want) = expected(&String::from_utf8_lossy(&text)) else {
+        let Some(want) = expected(&String::from_utf8_lossy(&text)).map(str::to_string) else {
             return;
         };
         let name = |p: &Path| p.file_name().unwrap().to_string_lossy().into_owned();
