@@ -205,13 +205,13 @@ fn the_watch_process_survives_every_bad_save() {
         assert_eq!(image::image_dimensions(&out).unwrap(), (64, 36));
     };
     for bad in ron_files(&root().join("tests/bad/graphs")) {
-        save_bad(&mut w, &graph, &bad);
+        save_bad(&mut w, graph, &bad);
     }
-    save_good(&mut w, &graph, &good_graph);
+    save_good(&mut w, graph, good_graph);
     for bad in ron_files(&hostile) {
-        save_bad(&mut w, &scene, &bad);
+        save_bad(&mut w, scene, &bad);
     }
-    save_good(&mut w, &scene, &good_scene);
+    save_good(&mut w, scene, good_scene);
     // 38 when written (27 graphs, 11 hostile scenes): a test that checks nothing fails.
     assert!(
         checked >= 30,
@@ -221,12 +221,12 @@ fn the_watch_process_survives_every_bad_save() {
     // A material saved with a texture wider than the device is scaled down, not fatal.
     let wide = std::fs::read_to_string(hostile.join("wide_texture_material.ron")).unwrap();
     let since = w.mark();
-    std::fs::write(&material, wide).unwrap();
+    std::fs::write(material, wide).unwrap();
     w.expect(since, "the wide texture's reload", |o, e| {
         o.contains("reloaded ") || e.contains("error (still showing")
     });
     let since = w.mark();
-    std::fs::write(&material, &good_material).unwrap();
+    std::fs::write(material, good_material).unwrap();
     w.expect(since, "the good material rendered again", |o, _| {
         o.contains("reloaded ")
     });
