@@ -40,8 +40,10 @@ fn element_path(element: &str) -> Option<Path<'_>> {
     None
 }
 
+/// RON tokens; JSON's too (a JSON number may come as several tokens, which the walkers
+/// below never count: they step by commas and brackets).
 #[derive(Debug, PartialEq)]
-enum Token<'a> {
+pub(super) enum Token<'a> {
     Open(char),
     Close,
     Comma,
@@ -52,7 +54,7 @@ enum Token<'a> {
 }
 
 /// The tokens of RON text with where each starts; comments and whitespace dropped.
-fn tokens(text: &str) -> Vec<(Token<'_>, Location)> {
+pub(super) fn tokens(text: &str) -> Vec<(Token<'_>, Location)> {
     let chars: Vec<(usize, char)> = text.char_indices().collect();
     let mut out = Vec::new();
     let (mut i, mut line, mut col) = (0, 1, 1);
@@ -188,7 +190,7 @@ pub fn locate(text: &str, element: &str) -> Option<Location> {
     let mut depth = 0usize;
     let mut k = 0;
     while k < toks.len() {
-        let (tok, loc) = &toks[k];
+        let (tok, _) = &toks[k];
         match tok {
             Token::Open(_) => depth += 1,
             Token::Close => depth = depth.saturating_sub(1),
@@ -197,11 +199,12 @@ pub fn locate(text: &str, element: &str) -> Option<Location> {
                     && *name == field
                     && matches!(toks.get(k + 1), Some((Token::Colon, _))) =>
             {
-                return match &path {
-                    Path::Field(_) => Some(*loc),
-                    Path::Index(_, n) => entry(&toks[k + 2..], *n),
-                    Path::Key(_, key) => key_of(&toks[k + 2..], key),
+                let at = match &path {
+                    Path::Field(_) => Some(k),
+                    Path::Index(_, n) => entry(&toks, k + 2, *n),
+                    Path::Key(_, key) => key_of(&toks, k + 2, key),
                 };
+                return at.map(|j| toks[j].1);
             }
             _ => {}
         }
@@ -210,13 +213,13 @@ pub fn locate(text: &str, element: &str) -> Option<Location> {
     None
 }
 
-/// The start of entry `n` of the list that `toks` starts with.
-fn entry(toks: &[(Token<'_>, Location)], n: usize) -> Option<Location> {
-    if !matches!(toks.first(), Some((Token::Open('['), _))) {
+/// The token where entry `n` of the list opening at `toks[open]` starts.
+pub(super) fn entry(toks: &[(Token<'_>, Location)], open: usize, n: usize) -> Option<usize> {
+    if !matches!(toks.get(open), Some((Token::Open('['), _))) {
         return None;
     }
     let (mut depth, mut index, mut at_start) = (0usize, 0usize, true);
-    for (tok, loc) in &toks[1..] {
+    for (j, (tok, _)) in toks.iter().enumerate().skip(open + 1) {
         if depth == 0 {
             if matches!(tok, Token::Close) {
                 return None;
@@ -227,7 +230,7 @@ fn entry(toks: &[(Token<'_>, Location)], n: usize) -> Option<Location> {
                 continue;
             }
             if at_start && index == n {
-                return Some(*loc);
+                return Some(j);
             }
             at_start = false;
         }
@@ -240,13 +243,14 @@ fn entry(toks: &[(Token<'_>, Location)], n: usize) -> Option<Location> {
     None
 }
 
-/// The key `key` of the map that `toks` starts with.
-fn key_of(toks: &[(Token<'_>, Location)], key: &str) -> Option<Location> {
-    if !matches!(toks.first(), Some((Token::Open('{'), _))) {
+/// The token of the quoted key `key` in the map (RON) or object (JSON) opening at
+/// `toks[open]`; its value starts two tokens later.
+pub(super) fn key_of(toks: &[(Token<'_>, Location)], open: usize, key: &str) -> Option<usize> {
+    if !matches!(toks.get(open), Some((Token::Open('{'), _))) {
         return None;
     }
     let mut depth = 0usize;
-    for (j, (tok, loc)) in toks.iter().enumerate().skip(1) {
+    for (j, (tok, _)) in toks.iter().enumerate().skip(open + 1) {
         match tok {
             Token::Open(_) => depth += 1,
             Token::Close if depth == 0 => return None,
@@ -254,7 +258,7 @@ fn key_of(toks: &[(Token<'_>, Location)], key: &str) -> Option<Location> {
             Token::Str(s)
                 if depth == 0 && s == key && matches!(toks.get(j + 1), Some((Token::Colon, _))) =>
             {
-                return Some(*loc)
+                return Some(j)
             }
             _ => {}
         }

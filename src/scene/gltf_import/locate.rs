@@ -2,8 +2,11 @@
 //! primitive 1 accessor 3`, `node 5`) or a glTF validation path
 //! (`meshes[0].primitives[1].indices`) to the line and column of its JSON, so semantic
 //! errors point at the text like JSON syntax errors do. serde_json's parse keeps no spans,
-//! so this walks the text's tokens. A .glb's JSON chunk is not located (its line and column
+//! so this walks the text's tokens with the scene file locator's tokenizer and walkers
+//! (JSON's syntax is within RON's). A .glb's JSON chunk is not located (its line and column
 //! would not be the file's).
+
+use crate::scene::locate::{entry, key_of, tokens, Location, Token};
 
 /// One step into the JSON document.
 #[derive(Clone, Debug, PartialEq)]
@@ -103,135 +106,31 @@ fn json_path(path: &str) -> Vec<Step> {
     steps
 }
 
-#[derive(Debug, PartialEq)]
-enum Tok {
-    Open,
-    Close,
-    Comma,
-    Colon,
-    Str(String),
-    Scalar,
-}
-
-fn tokens(text: &str) -> Vec<(Tok, (usize, usize))> {
-    let mut out = Vec::new();
-    let mut chars = text.chars().peekable();
-    let (mut line, mut col) = (1, 1);
-    let advance = |c: char, line: &mut usize, col: &mut usize| {
-        if c == '\n' {
-            *line += 1;
-            *col = 1;
-        } else {
-            *col += 1;
-        }
-    };
-    while let Some(c) = chars.next() {
-        let at = (line, col);
-        advance(c, &mut line, &mut col);
-        match c {
-            '{' | '[' => out.push((Tok::Open, at)),
-            '}' | ']' => out.push((Tok::Close, at)),
-            ',' => out.push((Tok::Comma, at)),
-            ':' => out.push((Tok::Colon, at)),
-            '"' => {
-                let mut s = String::new();
-                while let Some(c) = chars.next() {
-                    advance(c, &mut line, &mut col);
-                    match c {
-                        '"' => break,
-                        '\\' => {
-                            if let Some(e) = chars.next() {
-                                advance(e, &mut line, &mut col);
-                                s.push(e);
-                            }
-                        }
-                        c => s.push(c),
-                    }
-                }
-                out.push((Tok::Str(s), at));
-            }
-            c if c.is_whitespace() || c == '\u{feff}' => {}
-            _ => {
-                while chars
-                    .peek()
-                    .is_some_and(|c| !(c.is_whitespace() || "{}[],:\"".contains(*c)))
-                {
-                    let c = chars.next().unwrap();
-                    advance(c, &mut line, &mut col);
-                }
-                out.push((Tok::Scalar, at));
-            }
-        }
-    }
-    out
-}
-
-/// The index of the token after the value starting at `i`.
-fn skip_value(toks: &[(Tok, (usize, usize))], i: usize) -> usize {
-    if !matches!(toks.get(i), Some((Tok::Open, _))) {
-        return i + 1;
-    }
-    let mut depth = 0usize;
-    for (j, (t, _)) in toks.iter().enumerate().skip(i) {
-        match t {
-            Tok::Open => depth += 1,
-            Tok::Close => {
-                depth -= 1;
-                if depth == 0 {
-                    return j + 1;
-                }
-            }
-            _ => {}
-        }
-    }
-    toks.len()
-}
-
-/// Follows `path` from the value at token `i`; the location of the value it ends at (for
-/// an object member, its key).
-fn find(toks: &[(Tok, (usize, usize))], i: usize, path: &[Step]) -> Option<(usize, usize)> {
+/// Follows `path` from the value starting at token `i`; the location of the value it
+/// ends at (for an object member, its key).
+fn find(toks: &[(Token<'_>, Location)], i: usize, path: &[Step]) -> Option<Location> {
     let Some(step) = path.first() else {
         return toks.get(i).map(|t| t.1);
     };
-    if !matches!(toks.get(i), Some((Tok::Open, _))) {
-        return None;
-    }
-    let mut j = i + 1;
-    let mut index = 0;
-    while j < toks.len() && !matches!(toks[j].0, Tok::Close) {
-        match (step, &toks[j].0) {
-            (Step::Key(want), Tok::Str(key))
-                if matches!(toks.get(j + 1), Some((Tok::Colon, _))) =>
-            {
-                if key == want {
-                    return if path.len() == 1 {
-                        Some(toks[j].1)
-                    } else {
-                        find(toks, j + 2, &path[1..])
-                    };
-                }
-                j = skip_value(toks, j + 2);
+    match step {
+        Step::Key(key) => {
+            let k = key_of(toks, i, key)?;
+            if path.len() == 1 {
+                Some(toks[k].1)
+            } else {
+                find(toks, k + 2, &path[1..])
             }
-            (Step::Index(n), _) => {
-                if index == *n {
-                    return find(toks, j, &path[1..]);
-                }
-                index += 1;
-                j = skip_value(toks, j);
-            }
-            _ => return None,
         }
-        if matches!(toks.get(j), Some((Tok::Comma, _))) {
-            j += 1;
-        }
+        Step::Index(n) => find(toks, entry(toks, i, *n)?, &path[1..]),
     }
-    None
 }
 
 /// Where the .gltf JSON `text` writes what an error names: its element, or the
 /// validation path at the start of its message. None when the text has no such element.
-pub fn locate(text: &str, element: &str, message: &str) -> Option<(usize, usize)> {
+pub fn locate(text: &str, element: &str, message: &str) -> Option<Location> {
     let toks = tokens(text);
+    // The document is the first object (after a byte-order mark, if any).
+    let root = toks.iter().position(|t| t.0 == Token::Open('{'))?;
     let mut paths = Vec::new();
     if element == "glTF validation" {
         let path = message.split(':').next().unwrap_or("");
@@ -243,7 +142,7 @@ pub fn locate(text: &str, element: &str, message: &str) -> Option<(usize, usize)
         }
     }
     paths.extend(element_paths(element));
-    paths.iter().find_map(|p| find(&toks, 0, p))
+    paths.iter().find_map(|p| find(&toks, root, p))
 }
 
 #[cfg(test)]
