@@ -433,7 +433,7 @@ fn check_output_written(graph: &CompiledGraph) -> Result<(), RenderError> {
     if graph.plan.resources.iter().any(|r| &*r.name == output) {
         return Ok(());
     }
-    let skipped: Vec<String> = graph
+    let writers: Vec<&crate::graph::CulledPass> = graph
         .culled
         .iter()
         .filter(|c| {
@@ -444,6 +444,9 @@ fn check_output_written(graph: &CompiledGraph) -> Result<(), RenderError> {
                 .iter()
                 .any(|p| p.name == c.name && p.writes.iter().any(|w| &**w == output))
         })
+        .collect();
+    let skipped: Vec<String> = writers
+        .iter()
         .map(|c| match &c.reason {
             crate::graph::CullReason::WhenFalse(feature) => {
                 format!("'{}' (when: {feature} is false for this scene)", c.name)
@@ -451,14 +454,8 @@ fn check_output_written(graph: &CompiledGraph) -> Result<(), RenderError> {
             crate::graph::CullReason::Unreachable => format!("'{}'", c.name),
         })
         .collect();
-    let pass = graph
-        .culled
-        .iter()
-        .find(|c| {
-            skipped
-                .iter()
-                .any(|s| s.starts_with(&format!("'{}'", c.name)))
-        })
+    let pass = writers
+        .first()
         .map_or_else(|| output.to_string(), |c| c.name.to_string());
     Err(RenderError::AtPass {
         at: graph.checked.source.in_pass(&pass, output),
