@@ -14,6 +14,7 @@ mod report;
 mod resources;
 mod scene_gpu;
 mod texture_fit;
+pub mod visibility_geometry;
 
 pub use bind::LayoutCache;
 pub use device_limits::supported_sample_counts;

@@ -2,6 +2,7 @@
 //! arrays, and one material program per scene material.
 
 use super::materials::MaterialProgram;
+use super::visibility_geometry::VisibilityGeometry;
 use crate::gpu::structs::{light_buffers, GpuVertex};
 use crate::scene::{AlphaMode, Scene};
 use wgpu::util::DeviceExt;
@@ -18,6 +19,11 @@ pub struct GpuMesh {
     /// views, which cull chunk by chunk.
     pub shadow_indices: wgpu::Buffer,
     pub chunks: std::sync::Arc<[crate::shadow::chunks::Chunk]>,
+    /// This mesh's index in `Scene::meshes` (empty meshes are not uploaded).
+    pub scene_mesh: usize,
+    /// The visibility id of its first triangle (see `visibility_geometry`); 0 for
+    /// blended meshes, which no visibility buffer holds.
+    pub first_triangle: u32,
 }
 
 /// Cheap to clone (the GPU objects are shared handles): hot reload builds a changed copy
@@ -32,6 +38,9 @@ pub struct SceneGpu {
     /// The shadow BVH, built the first time a pass binds it (see [`SceneGpu::bvh`]);
     /// shared by clones of this upload.
     bvh: std::sync::Arc<std::sync::OnceLock<Result<GpuBvh, String>>>,
+    /// The opaque meshes merged for vertex fetching, built the first time a pass binds
+    /// them (see [`SceneGpu::visibility_geometry`]).
+    visibility: std::sync::Arc<std::sync::OnceLock<Result<VisibilityGeometry, String>>>,
 }
 
 /// The shadow BVH's two storage buffers and what building it found.
@@ -104,6 +113,24 @@ impl SceneGpu {
             .map_err(Clone::clone)
     }
 
+    /// The opaque meshes merged into storage buffers, or why they cannot be: built on
+    /// first use. `scene` must be the scene this was uploaded from.
+    pub fn visibility_geometry(
+        &self,
+        device: &wgpu::Device,
+        scene: &Scene,
+    ) -> Result<&VisibilityGeometry, String> {
+        self.visibility
+            .get_or_init(|| VisibilityGeometry::build(device, self, scene))
+            .as_ref()
+            .map_err(Clone::clone)
+    }
+
+    /// The merged geometry, if a pass has built it.
+    pub fn built_visibility_geometry(&self) -> Option<&VisibilityGeometry> {
+        self.visibility.get().and_then(|b| b.as_ref().ok())
+    }
+
     /// The BVH, if a pass has built it.
     pub fn built_bvh(&self) -> Option<&GpuBvh> {
         self.bvh.get().and_then(|b| b.as_ref().ok())
@@ -114,11 +141,12 @@ impl SceneGpu {
         scene: &Scene,
         materials: Vec<MaterialProgram>,
     ) -> Self {
-        let meshes = scene
+        let meshes: Vec<GpuMesh> = scene
             .meshes
             .iter()
-            .filter(|m| !m.indices.is_empty())
-            .map(|m| {
+            .enumerate()
+            .filter(|(_, m)| !m.indices.is_empty())
+            .map(|(scene_mesh, m)| {
                 let (shadow_indices, chunks) =
                     crate::shadow::chunks::chunk_triangles(&m.positions, &m.indices);
                 let vertices: Vec<GpuVertex> = (0..m.positions.len())
@@ -157,6 +185,8 @@ impl SceneGpu {
                         usage: wgpu::BufferUsages::INDEX,
                     }),
                     chunks: chunks.into(),
+                    scene_mesh,
+                    first_triangle: 0,
                 }
             })
             .collect();
@@ -176,7 +206,7 @@ impl SceneGpu {
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             })
         };
-        Self {
+        let mut gpu = Self {
             meshes,
             materials,
             light_geometry: storage("light geometry", bytemuck::cast_slice(&geometry)),
@@ -184,7 +214,16 @@ impl SceneGpu {
             light_count: scene.lights.len() as u32,
             // A new upload (hot reload of geometry) builds its own when first bound.
             bvh: Default::default(),
+            visibility: Default::default(),
+        };
+        // Visibility ids: opaque triangles numbered in draw order.
+        let mut next = 0u32;
+        for mesh in gpu.opaque_draws() {
+            let m = &mut gpu.meshes[mesh];
+            m.first_triangle = next;
+            next = next.saturating_add(m.index_count / 3);
         }
+        gpu
     }
 
     /// Mesh indices to draw for opaque and alpha-masked geometry, sorted by material so
