@@ -56,9 +56,15 @@ impl GpuContext {
         // MSAA of Rgba32Float targets and sample counts past 4 are the adapter's to
         // grant (not guaranteed by WebGPU); blending transparent surfaces into them
         // needs FLOAT32_BLENDABLE. Taken where offered; passes that need them say so.
+        // The visibility buffer's prepass writes triangle ids (PRIMITIVE_INDEX); the
+        // compute rasterizer resolves depth with 64-bit atomic min (SHADER_INT64 and
+        // SHADER_INT64_ATOMIC_MIN_MAX). Where missing, those passes say so.
         let wanted = timestamps
             | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
-            | wgpu::Features::FLOAT32_BLENDABLE;
+            | wgpu::Features::FLOAT32_BLENDABLE
+            | wgpu::Features::PRIMITIVE_INDEX
+            | wgpu::Features::SHADER_INT64
+            | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX;
         let features = adapter.features() & wanted;
         let has_timestamps = features.contains(timestamps);
         let adapter_limits = adapter.limits();
