@@ -25,11 +25,23 @@ impl Expansion {
     }
 }
 
-/// The expansion of the scene the importer walks; `None` if the reachable nodes form a
-/// cycle (the walk reports it, naming the node).
+/// What the reachable node graph is: a DAG and its expansion, or a cycle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum NodeGraph {
+    Acyclic(Expansion),
+    /// Node `parent` lists `child` among its children, and `child` leads back to `parent`.
+    Cycle {
+        parent: usize,
+        child: usize,
+    },
+}
+
+/// The expansion of the scene the importer walks, or a cycle among its reachable nodes:
+/// both found in time linear in nodes and edges, so a cyclic graph of shared children is
+/// refused at once rather than after walking a million paths into it.
 /// An accessor over `max_accessor` elements counts none here: reading it is refused with
 /// its own message.
-pub(super) fn expansion(root: &Root, max_accessor: u64) -> Option<Expansion> {
+pub(super) fn expansion(root: &Root, max_accessor: u64) -> NodeGraph {
     let n = root.nodes.len();
     let children = |i: usize| {
         root.nodes[i]
@@ -98,14 +110,63 @@ pub(super) fn expansion(root: &Root, max_accessor: u64) -> Option<Expansion> {
             }
         }
     }
-    (done == reachable.iter().filter(|&&r| r).count()).then_some(total)
+    if done == reachable.iter().filter(|&&r| r).count() {
+        return NodeGraph::Acyclic(total);
+    }
+    // Kahn's order stopped short: a back edge of a depth-first search names the cycle.
+    let mut state = vec![0u8; n]; // 0 unvisited, 1 on the path, 2 finished
+    for &r in &roots {
+        if state[r] != 0 {
+            continue;
+        }
+        state[r] = 1;
+        let mut path: Vec<(usize, Vec<usize>)> = vec![(r, children(r).collect())];
+        while let Some((node, pending)) = path.last_mut() {
+            let node = *node;
+            match pending.pop() {
+                Some(c) if state[c] == 1 => {
+                    return NodeGraph::Cycle {
+                        parent: node,
+                        child: c,
+                    }
+                }
+                Some(c) if state[c] == 0 => {
+                    state[c] = 1;
+                    path.push((c, children(c).collect()));
+                }
+                Some(_) => {}
+                None => {
+                    state[node] = 2;
+                    path.pop();
+                }
+            }
+        }
+    }
+    // Not reached (the search covers every node Kahn's order left), but never a panic.
+    let stuck = (0..n)
+        .find(|&i| reachable[i] && indegree[i] > 0)
+        .unwrap_or(0);
+    NodeGraph::Cycle {
+        parent: stuck,
+        child: stuck,
+    }
 }
 
 impl super::Importer {
     /// Refuses a document whose expansion is past the limits, before any buffer is read.
     pub(super) fn check_expansion(&mut self, root: &Root) -> Result<(), SceneError> {
-        let Some(e) = expansion(root, self.limits.max_accessor_count) else {
-            return Ok(()); // a cycle: the walk names the node
+        let e = match expansion(root, self.limits.max_accessor_count) {
+            NodeGraph::Acyclic(e) => e,
+            NodeGraph::Cycle { parent, child } => {
+                let name = |i: usize| root.nodes[i].name.as_deref();
+                return Err(self.err(
+                    super::named("node", parent, name(parent)),
+                    format!(
+                        "node hierarchy contains a cycle: its child {} leads back to it",
+                        super::named("node", child, name(child))
+                    ),
+                ));
+            }
         };
         let l = self.limits;
         self.limit(
@@ -174,13 +235,41 @@ mod tests {
         gltf::json::deserialize::from_str(&json).unwrap()
     }
 
+    fn acyclic(g: NodeGraph) -> Expansion {
+        match g {
+            NodeGraph::Acyclic(e) => e,
+            other => panic!("expected a DAG, got {other:?}"),
+        }
+    }
+
     #[test]
     fn counts_every_path_to_a_node() {
-        let e = expansion(&diamond(3), u64::MAX).unwrap();
+        let e = acyclic(expansion(&diamond(3), u64::MAX));
         // Level 0: node 0 once (node 1 is unreachable); level 1: 1 + 1; level 2: 2 + 2.
         assert_eq!(e.node_instances, 1 + 2 + 4);
         assert_eq!((e.primitives, e.triangles), (4, 4));
-        let e = expansion(&diamond(40), 1 << 20).unwrap();
+        let e = acyclic(expansion(&diamond(40), 1 << 20));
         assert_eq!(e.triangles, 1 << 39);
+    }
+
+    /// A cycle at the bottom of 40 levels of shared children (2^40 paths into it) is
+    /// named by its closing edge without walking the paths (the fuzzer's slow input).
+    #[test]
+    fn names_a_cycle_under_shared_children_at_once() {
+        let mut root = diamond(40);
+        let last = root.nodes.len() - 1;
+        root.nodes[last].children = Some(vec![gltf::json::Index::new(2)]);
+        let start = std::time::Instant::now();
+        let NodeGraph::Cycle { parent, child } = expansion(&root, 1 << 20) else {
+            panic!("the cycle was not found");
+        };
+        // Any edge closing the cycle will do: it must be a real child edge on it.
+        let kids = root.nodes[parent].children.as_ref().unwrap();
+        assert!(kids.iter().any(|c| c.value() == child));
+        assert!(
+            parent >= 2 && child >= 2,
+            "{parent} -> {child} is not on the cycle"
+        );
+        assert!(start.elapsed().as_secs_f32() < 1.0);
     }
 }
