@@ -29,30 +29,58 @@ const GRAPHS: [&str; 5] = [
     "visibility_buffer_brute_force.ron",
 ];
 
-/// Worst channel error relative to max(|reference|, 1e-3 of the frame's peak), as in
-/// culling_exact.rs (NaN counts as the worst), and where.
-fn worst_rel(out: &[[f32; 4]], reference: &[[f32; 4]]) -> (f32, usize) {
+/// Each pixel's worst channel error relative to max(|reference|, 1e-3 of the frame's
+/// peak), as in culling_exact.rs (NaN counts as infinite).
+fn rel_errors(out: &[[f32; 4]], reference: &[[f32; 4]]) -> Vec<f32> {
     assert_eq!(out.len(), reference.len(), "image sizes");
     assert!(!reference.is_empty(), "empty image");
     let peak = reference
         .iter()
         .flat_map(|p| p[..3].to_vec())
         .fold(0.0f32, f32::max);
-    let mut worst = (0.0f32, 0usize);
-    for (i, (a, b)) in out.iter().zip(reference).enumerate() {
-        for ch in 0..3 {
-            let d = (a[ch] - b[ch]).abs() / b[ch].abs().max(1e-3 * peak).max(1e-30);
-            if d.is_nan() || d > worst.0 {
-                worst = (if d.is_nan() { f32::INFINITY } else { d }, i);
-            }
-        }
-    }
-    worst
+    out.iter()
+        .zip(reference)
+        .map(|(a, b)| {
+            (0..3)
+                .map(|ch| {
+                    let d = (a[ch] - b[ch]).abs() / b[ch].abs().max(1e-3 * peak).max(1e-30);
+                    if d.is_nan() {
+                        f32::INFINITY
+                    } else {
+                        d
+                    }
+                })
+                .fold(0.0, f32::max)
+        })
+        .collect()
+}
+
+/// The worst relative error and where.
+fn worst_rel(out: &[[f32; 4]], reference: &[[f32; 4]]) -> (f32, usize) {
+    rel_errors(out, reference)
+        .into_iter()
+        .enumerate()
+        .fold((0.0, 0), |w, (i, d)| if d > w.0 { (d, i) } else { w })
+}
+
+/// The relative error 99.9% of pixels stay within.
+fn p999(out: &[[f32; 4]], reference: &[[f32; 4]]) -> f32 {
+    let mut e = rel_errors(out, reference);
+    e.sort_by(f32::total_cmp);
+    e[e.len() - 1 - e.len() / 1000]
+}
+
+/// Bounds on the relative error against the reference: the worst pixel, and the 99.9th
+/// percentile (which a systematic error anywhere in the frame breaks).
+#[derive(Clone, Copy)]
+struct Bound {
+    worst: f32,
+    p999: f32,
 }
 
 /// Renders `scene` through every visibility graph and `reference`, and returns the
 /// failures above `bound` (printing every graph's worst error).
-fn check_graphs(scene: &Scene, reference: &str, bound: f32) -> Vec<String> {
+fn check_graphs(scene: &Scene, reference: &str, bound: Bound) -> Vec<String> {
     let mut r = renderer();
     let expected = render_file(&mut r, reference, scene, W, H);
     let lit = expected
@@ -69,10 +97,14 @@ fn check_graphs(scene: &Scene, reference: &str, bound: f32) -> Vec<String> {
             "{graph}: lists overflowed"
         );
         let (d, i) = worst_rel(&out.image, &expected.image);
-        println!("{:28} {graph:36} worst {d:.3e}", scene.name);
-        if d > bound {
+        let p = p999(&out.image, &expected.image);
+        println!(
+            "{:24} {graph:36} worst {d:.3e}, 99.9% within {p:.3e}",
+            scene.name
+        );
+        if d > bound.worst || p > bound.p999 {
             failures.push(format!(
-                "{} {graph}: relative error {d:e} at ({}, {}): {:?} vs {:?}",
+                "{} {graph}: 99.9% within {p:e}, worst {d:e} at ({}, {}): {:?} vs {:?}",
                 scene.name,
                 i as u32 % W,
                 i as u32 / W,
@@ -84,10 +116,19 @@ fn check_graphs(scene: &Scene, reference: &str, bound: f32) -> Vec<String> {
     failures
 }
 
-/// Against forward brute force on the culling tests' scenes (untextured Lambert, lit
-/// by hundreds of point and spot lights). Measured on lavapipe at 333x197 (2026-12-02):
-/// see BOUND_LAMBERT.
-const BOUND_LAMBERT: f32 = 1e-4;
+/// Against forward brute force on the culling tests' scenes (untextured Lambert, lit by
+/// hundreds of point and spot lights). Measured on lavapipe at 333x197 (2026-12-02), the
+/// same for all five graphs: worst 1.40e-3 (random301), 3.36e-4 (depth_discontinuities),
+/// 3.46e-4 (camera_inside), 1.24e-3 (random1100); 99.9% of pixels within 3.2e-5, 4.8e-5,
+/// 7.5e-5 and 6.1e-5.
+/// Why not ~1e-6: the rebuilt point and the rasterizer's interpolated one are each a few
+/// f32 ulps of world coordinates up to 40 m (~1e-5 m) from the true point, and a light a
+/// few centimetres from a surface turns that into 2·δ/d of its radiance (1/d² falloff).
+/// The bounds are about twice the worst.
+const BOUND_LAMBERT: Bound = Bound {
+    worst: 3e-3,
+    p999: 1.5e-4,
+};
 
 #[test]
 fn every_visibility_graph_matches_brute_force_on_the_culling_scenes() {
@@ -217,8 +258,16 @@ fn textured_scene() -> Scene {
 }
 
 /// Textured, normal-mapped, glossy, masked and back-facing surfaces against forward
-/// brute force. Measured on lavapipe at 333x197 (2026-12-02): see BOUND_TEXTURED.
-const BOUND_TEXTURED: f32 = 1e-3;
+/// brute force. Measured on lavapipe at 333x197 (2026-12-02): worst 8.54e-3 at one pixel
+/// of the normal-mapped floor (1.9e-4 without the normal map), 99.9% within 2.9e-5.
+/// The outlier is the texture unit's: llvmpipe (like D3D-class GPUs) filters with 8-bit
+/// sub-texel weights, so a uv that differs in its last bits can land one 1/256-texel step
+/// away; on a steep normal map (0.15 a texel) lit at a grazing angle that is a few
+/// percent of n·l. The 99.9th percentile shows the systematic error stays ~3e-5.
+const BOUND_TEXTURED: Bound = Bound {
+    worst: 1.5e-2,
+    p999: 1e-4,
+};
 
 #[test]
 fn textured_masked_and_double_sided_materials_match_brute_force() {
@@ -274,7 +323,14 @@ fn textured_gltf_matches_forward_plus() {
         s.add_headlight_if_unlit();
         let reference = render_file(&mut r, "forward_plus.ron", &s, W, H);
         let out = render_file(&mut r, "visibility_buffer.ron", &s, W, H);
-        let m = compare(&reference.image, &out.image, W, H, &CompareOptions::default()).unwrap();
+        let m = compare(
+            &reference.image,
+            &out.image,
+            W,
+            H,
+            &CompareOptions::default(),
+        )
+        .unwrap();
         let flip = m.flip_mean.unwrap();
         let (d, _) = worst_rel(&out.image, &reference.image);
         println!(
@@ -283,15 +339,19 @@ fn textured_gltf_matches_forward_plus() {
             m.rmse,
             m.bad_pixels
         );
-        if flip > FLIP_BOUND || d > BOUND_TEXTURED || m.bad_pixels > 0 {
+        if flip > FLIP_BOUND || d > GLTF_WORST || m.bad_pixels > 0 {
             bad.push(format!("{}: {m}", path.display()));
         }
     }
     assert!(bad.is_empty(), "{}", bad.join("\n"));
 }
 
-/// FLIP mean bound for the glTF comparison (measured: see textured_gltf_matches_forward_plus).
-const FLIP_BOUND: f64 = 1e-4;
+/// The glTF comparison's bounds. Measured on lavapipe at 333x197 (2026-12-02): the
+/// Cornell box (untextured) FLIP mean 0, worst relative 5.1e-6; BoxTextured FLIP mean
+/// 6.5e-6, worst relative 1.5e-3 (8-bit filter weights, as in BOUND_TEXTURED); no pixel
+/// over the metric's 1e-3 threshold. Bounds a few times the measured.
+const FLIP_BOUND: f64 = 5e-5;
+const GLTF_WORST: f32 = 5e-3;
 
 /// The ids and the depth of a visibility pass next to a depth prepass, read through
 /// `shaders/visibility/ids_and_depth.wgsl`: x the visibility depth, y the prepass depth,
@@ -385,10 +445,22 @@ fn ids_cover_exactly_the_prepass_depth_and_name_the_triangle_there() {
                 ));
             }
         }
-        println!("{}: {covered} pixels with ids, {checked} checked against their triangle", s.name);
-        assert!(covered > (W * H / 2) as usize, "{}: only {covered} covered", s.name);
+        println!(
+            "{}: {covered} pixels with ids, {checked} checked against their triangle",
+            s.name
+        );
+        assert!(
+            covered > (W * H / 2) as usize,
+            "{}: only {covered} covered",
+            s.name
+        );
         let n = errors.len();
         errors.truncate(10);
-        assert!(n == 0, "{}: {n} errors, first: {}", s.name, errors.join("\n"));
+        assert!(
+            n == 0,
+            "{}: {n} errors, first: {}",
+            s.name,
+            errors.join("\n")
+        );
     }
 }
