@@ -89,6 +89,8 @@ const GRAPHS: &[&str] = &[
     "tiled_deferred.ron",
     "tiled_deferred_depth_mask.ron",
     "light_linked_list_deferred.ron",
+    "visibility_buffer.ron",
+    "visibility_buffer_brute_force.ron",
 ];
 
 #[test]
@@ -110,7 +112,15 @@ fn coincident_double_sided_surfaces_resolve_alike_in_every_path() {
             // The same surface at every pixel leaves only summation order and the
             // G-buffer's reconstruction (packed: 5.2e-3 worst on shipped scenes, see
             // packed_gbuffer.rs); the other square's colour differs by ~1 of the peak.
-            let bound = if graph.contains("packed") { 1e-2 } else { 2e-5 };
+            // The visibility buffer rebuilds the point from the triangle (measured 9.8e-7 here;
+            // up to ~1e-4 of the peak elsewhere: visibility_buffer.rs).
+            let bound = if graph.contains("packed") {
+                1e-2
+            } else if graph.starts_with("visibility") {
+                1e-4
+            } else {
+                2e-5
+            };
             assert!(
                 worst <= bound,
                 "{graph} (second square faces the camera: {second_faces_camera}): pixel {at} \

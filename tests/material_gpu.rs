@@ -285,6 +285,7 @@ fn check_material(gpu: &GpuContext, m: &Material, count: usize, seed: u64) -> f6
     let code = m
         .wgsl_with(&WgslOptions {
             sample_level_zero: true,
+            ..Default::default()
         })
         .expect("valid WGSL");
     let wgsl = format!("{SHADING_POINT_WGSL}\n{code}\n{MATERIAL_HARNESS}");
@@ -546,6 +547,7 @@ fn textured_gltf_matches_f64_reference() {
     let code = m
         .wgsl_with(&WgslOptions {
             sample_level_zero: true,
+            ..Default::default()
         })
         .unwrap();
     let wgsl = format!("{SHADING_POINT_WGSL}\n{code}\n{TEXTURED_HARNESS}");

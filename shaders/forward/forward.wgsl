@@ -5,7 +5,11 @@
 // state), a shadow atlas's views (DEPTH_ONLY with ATLAS_DEPTH); MSAA at more than one
 // sample. The material's generated code is included as <material>; ALPHA_MASK
 // discards below the cutoff. Only SHADE binds lights: a pass binds what it declares.
+// VISIBILITY writes each fragment's triangle id (the visibility buffer).
 
+#if VISIBILITY
+enable primitive_index;
+#endif
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"
 
@@ -93,6 +97,10 @@ struct VertexOut {
 #if RSM
     @location(4) @interpolate(flat) view: u32,
 #endif
+#if VISIBILITY
+    // The mesh's first triangle id, passed as the instance index.
+    @location(4) @interpolate(flat) first_triangle: u32,
+#endif
 };
 #endif
 
@@ -118,6 +126,9 @@ fn vs_main(v: VertexIn, @builtin(instance_index) instance: u32) -> VertexOut {
     out.normal = v.normal;
     out.uv = v.uv;
     out.tangent = v.tangent;
+#if VISIBILITY
+    out.first_triangle = instance;
+#endif
     return out;
 }
 
@@ -211,6 +222,25 @@ fn fs_depth(in: VertexOut, @builtin(front_facing) front: bool) {
         discard;
     }
 #endif
+}
+#endif
+
+#if VISIBILITY
+// The visibility buffer: the id of the triangle drawn here, the mesh's first id plus the
+// primitive index within the draw (src/render/visibility_geometry.rs).
+@fragment
+fn fs_visibility(
+    in: VertexOut,
+    @builtin(front_facing) front: bool,
+    @builtin(primitive_index) primitive: u32,
+) -> @location(0) u32 {
+#if ALPHA_MASK
+    let m = material_setup(shading_point(in, front));
+    if (material_alpha(m) < ALPHA_CUTOFF) {
+        discard;
+    }
+#endif
+    return in.first_triangle + primitive;
 }
 #endif
 

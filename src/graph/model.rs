@@ -9,6 +9,7 @@ pub use super::kinds::shadow_atlas::ShadowAtlas;
 pub use super::kinds::shadow_ray_cast::ShadowRayCast;
 pub use super::kinds::shadow_ray_jobs::ShadowRayJobs;
 pub use super::kinds::transparent_shading::TransparentShading;
+pub use super::kinds::visibility_shading::VisibilityShading;
 pub use super::kinds::vpl_spawn::VplSpawn;
 pub use super::name::Name;
 use serde::{Deserialize, Serialize};
@@ -142,6 +143,13 @@ pub enum SceneResource {
     BvhNodes,
     /// The shadow BVH's triangles, in the order its leaves name them.
     BvhTriangles,
+    /// Opaque meshes merged for vertex fetching (`render::visibility_geometry`): 12
+    /// floats a vertex, world space.
+    Vertices,
+    /// Three merged-vertex indices a triangle; a visibility id indexes it.
+    Triangles,
+    /// Each material's `[first, end)` triangle ids.
+    MaterialTriangles,
 }
 
 /// A scene feature a pass can be conditional on (`when:`).
@@ -299,6 +307,10 @@ pub enum PassKind {
     ReflectiveShadowMaps(ReflectiveShadowMaps),
     /// Virtual point lights from the reflective shadow maps, appended to the lights.
     VplSpawn(VplSpawn),
+    /// Depth and a 32-bit triangle id per pixel (R32Uint) for every opaque mesh.
+    VisibilityBuffer,
+    /// Every material shaded in compute from the visibility buffer's triangle ids.
+    VisibilityShading(VisibilityShading),
     /// A compute shader the graph file names; bindings are matched by name.
     Compute {
         shader: String,
@@ -338,6 +350,8 @@ impl PassKind {
             PassKind::TransparentShading(_) => "TransparentShading",
             PassKind::ReflectiveShadowMaps(_) => "ReflectiveShadowMaps",
             PassKind::VplSpawn(_) => "VplSpawn",
+            PassKind::VisibilityBuffer => "VisibilityBuffer",
+            PassKind::VisibilityShading(_) => "VisibilityShading",
             PassKind::Compute { .. } => "Compute",
             PassKind::Fullscreen { .. } => "Fullscreen",
         }

@@ -186,7 +186,7 @@ impl RoleCtx<'_> {
             }
             (BindingKind::Uniform, ResourceDesc::Buffer { .. }) => None,
             (
-                BindingKind::SampledTexture { multisampled },
+                BindingKind::SampledTexture { multisampled, .. },
                 ResourceDesc::Texture {
                     format, samples, ..
                 },

@@ -27,6 +27,12 @@ pub struct WgslOptions {
     /// Sample textures with `textureSampleLevel(.., 0.0)` instead of `textureSample`, so the
     /// code also works outside fragment shaders (compute tests, ray-cast passes).
     pub sample_level_zero: bool,
+    /// Sample with `textureSampleGrad(.., material_uv_ddx, material_uv_ddy)`: module-scope
+    /// private variables (declared here) that the including shader sets before
+    /// `material_setup` to the uv's screen derivatives (compute shading of a visibility
+    /// buffer, where implicit derivatives do not exist). Takes precedence over
+    /// `sample_level_zero`.
+    pub sample_grad: bool,
 }
 
 fn lit(x: f32) -> String {
@@ -126,6 +132,9 @@ pub fn generate(m: &Material, opts: &WgslOptions) -> String {
                 s.binding, s.name
             );
         }
+        if opts.sample_grad {
+            o.push_str("// The uv's derivatives along x and y, set by the shader before material_setup.\nvar<private> material_uv_ddx: vec2<f32>;\nvar<private> material_uv_ddy: vec2<f32>;\n");
+        }
         o.push('\n');
     }
     let _ = writeln!(o, "const MATERIAL_TYPE_BIT: u32 = {}u;", desc.type_bit);
@@ -163,7 +172,9 @@ pub fn generate(m: &Material, opts: &WgslOptions) -> String {
         "fn material_setup(p: ShadingPoint) -> MaterialSample {\n    var m: MaterialSample;\n",
     );
     for (i, _) in slots.iter().enumerate() {
-        let sample = if opts.sample_level_zero {
+        let sample = if opts.sample_grad {
+            format!("textureSampleGrad(material_tex{i}, material_sampler, p.uv, material_uv_ddx, material_uv_ddy)")
+        } else if opts.sample_level_zero {
             format!("textureSampleLevel(material_tex{i}, material_sampler, p.uv, 0.0)")
         } else {
             format!("textureSample(material_tex{i}, material_sampler, p.uv)")

@@ -106,9 +106,13 @@ pub(super) fn layout_entries_filtering(
                     has_dynamic_offset: false,
                     min_binding_size: None,
                 },
-                BindingKind::SampledTexture { multisampled } => T::Texture {
-                    sample_type: wgpu::TextureSampleType::Float {
-                        filterable: filtering,
+                BindingKind::SampledTexture { multisampled, kind } => T::Texture {
+                    sample_type: match kind {
+                        naga::ScalarKind::Uint => wgpu::TextureSampleType::Uint,
+                        naga::ScalarKind::Sint => wgpu::TextureSampleType::Sint,
+                        _ => wgpu::TextureSampleType::Float {
+                            filterable: filtering,
+                        },
                     },
                     view_dimension: D::D2,
                     multisampled: *multisampled,

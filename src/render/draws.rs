@@ -43,13 +43,20 @@ pub(super) enum DrawMode {
     /// Reflective shadow maps' views: normal, flux and position targets over depth, the
     /// view from the instance index, both faces.
     Rsm,
+    /// A visibility buffer: each fragment's triangle id into one R32Uint target. The
+    /// mesh's first id is the instance index (`first_triangle..first_triangle + 1`).
+    Visibility {
+        writes_depth: bool,
+    },
 }
 
 impl DrawMode {
     fn writes_depth(self) -> bool {
         match self {
             DrawMode::DepthOnly | DrawMode::AtlasDepth { .. } | DrawMode::Rsm => true,
-            DrawMode::GBuffer { writes_depth, .. } => writes_depth,
+            DrawMode::GBuffer { writes_depth, .. } | DrawMode::Visibility { writes_depth } => {
+                writes_depth
+            }
             DrawMode::Shade { .. } => false,
         }
     }
@@ -68,6 +75,8 @@ struct Draw {
     vertices: wgpu::Buffer,
     indices: wgpu::Buffer,
     index_count: u32,
+    /// The instance drawn: the mesh's first triangle id for visibility draws, else 0.
+    instance: u32,
 }
 
 /// Which of the scene's meshes a pass draws.
@@ -120,21 +129,17 @@ pub(super) fn shadow_defines(shadows: Shadows) -> Vec<(&'static str, String)> {
     }
 }
 /// The bind group the generated material code declares its textures in.
-const MATERIAL_GROUP: u32 = 2;
+pub(super) const MATERIAL_GROUP: u32 = 2;
 
 /// The material's texture layout, from the composed shader's reflection (None when the
 /// material declares no textures).
-fn material_layout(
+pub(super) fn material_layout(
     layouts: &super::bind::LayoutCache,
     device: &wgpu::Device,
     bindings: &[crate::shader::ReflectedBinding],
+    stages: wgpu::ShaderStages,
 ) -> Option<Arc<wgpu::BindGroupLayout>> {
-    let entries = super::bind::layout_entries_filtering(
-        bindings,
-        MATERIAL_GROUP,
-        wgpu::ShaderStages::FRAGMENT,
-        true,
-    );
+    let entries = super::bind::layout_entries_filtering(bindings, MATERIAL_GROUP, stages, true);
     (!entries.is_empty()).then(|| layouts.get(device, entries))
 }
 
@@ -176,6 +181,7 @@ impl Renderer {
                     d.push(("ATLAS_DEPTH", "1".into()));
                 }
                 DrawMode::Rsm => d.push(("RSM", "1".into())),
+                DrawMode::Visibility { .. } => d.push(("VISIBILITY", "1".into())),
                 DrawMode::GBuffer {
                     packed,
                     normals,
@@ -243,7 +249,12 @@ impl Renderer {
                     key,
                     |_, module, bindings| {
                         let bgl = layouts.get(&device, layout_entries(bindings, 0, vf));
-                        let material = material_layout(&layouts, &device, bindings);
+                        let material = material_layout(
+                            &layouts,
+                            &device,
+                            bindings,
+                            wgpu::ShaderStages::FRAGMENT,
+                        );
                         let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                             label: Some(pass),
                             bind_group_layouts: &[Some(&bgl), None, material.as_deref()],
@@ -276,7 +287,10 @@ impl Renderer {
                 }
                 Some(_) => {}
             }
-            let material = match (&m.textures, material_layout(&layouts, &device, &bindings)) {
+            let material = match (
+                &m.textures,
+                material_layout(&layouts, &device, &bindings, wgpu::ShaderStages::FRAGMENT),
+            ) {
                 (Some(textures), Some(layout)) => {
                     if let std::collections::hash_map::Entry::Vacant(e) =
                         material_groups.entry(material_index)
@@ -305,6 +319,10 @@ impl Renderer {
                     gm.indices.clone()
                 },
                 index_count: gm.index_count,
+                instance: match mode {
+                    DrawMode::Visibility { .. } => gm.first_triangle,
+                    _ => 0,
+                },
             });
         }
         let bind = match group0 {
@@ -345,13 +363,17 @@ fn build_pipeline(
         DrawMode::Shade { .. } => ("fs_main", 1),
         DrawMode::AtlasDepth { .. } => ("fs_depth", 0),
         DrawMode::Rsm => ("fs_rsm", 3),
+        DrawMode::Visibility { .. } => ("fs_visibility", 1),
     };
     let blend = match mode {
         DrawMode::Shade { blend: true, .. } => Some(wgpu::BlendState::ALPHA_BLENDING),
         _ => None,
     };
     let target = Some(wgpu::ColorTargetState {
-        format: wgpu::TextureFormat::Rgba32Float,
+        format: match mode {
+            DrawMode::Visibility { .. } => wgpu::TextureFormat::R32Uint,
+            _ => wgpu::TextureFormat::Rgba32Float,
+        },
         blend,
         write_mask: wgpu::ColorWrites::ALL,
     });
@@ -528,7 +550,7 @@ impl MeshDraws {
             // Opaque draws are sorted by material: switch pipelines only when it changes.
             d.switch_pipeline(pass, &mut current);
             d.bind_buffers(pass);
-            pass.draw_indexed(0..d.index_count, 0, 0..1);
+            pass.draw_indexed(0..d.index_count, 0, d.instance..d.instance + 1);
         }
     }
 }

@@ -13,6 +13,9 @@ pub struct MaterialProgram {
     pub name: String,
     /// Generated WGSL, included as `<material>`.
     pub wgsl: String,
+    /// The same for compute shaders (textures sampled with explicit derivatives, see
+    /// `WgslOptions::sample_grad`); None when `wgsl` has no textures, so serves as is.
+    pub compute_wgsl: Option<String>,
     pub alpha_mode: AlphaMode,
     pub double_sided: bool,
     /// Group 2's sampler and textures by binding name; None without textures.
@@ -20,6 +23,11 @@ pub struct MaterialProgram {
 }
 
 impl MaterialProgram {
+    /// The material code a compute shader includes.
+    pub fn wgsl_for_compute(&self) -> &str {
+        self.compute_wgsl.as_deref().unwrap_or(&self.wgsl)
+    }
+
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -29,6 +37,14 @@ impl MaterialProgram {
     ) -> Result<Self, MaterialError> {
         let wgsl = material.wgsl()?;
         let slots = material.texture_slots();
+        let compute_wgsl = if slots.is_empty() {
+            None
+        } else {
+            Some(material.wgsl_with(&crate::material::WgslOptions {
+                sample_grad: true,
+                ..Default::default()
+            })?)
+        };
         // Offered by the names the generated WGSL declares (`material_sampler`,
         // `material_tex{i}`); the layout comes from reflecting the composed shader.
         let textures = if slots.is_empty() {
@@ -91,6 +107,7 @@ impl MaterialProgram {
         Ok(Self {
             name: material.name().to_string(),
             wgsl,
+            compute_wgsl,
             alpha_mode,
             double_sided,
             textures,

@@ -211,6 +211,10 @@ impl ShaderLibrary {
                 } else {
                     return Err(directive_error(n, format!("malformed #include {rest}")));
                 }
+            } else if active && trimmed.starts_with("enable ") {
+                // WGSL wants directives before every declaration, the defines' constants
+                // included: moved to the top (its origin with it).
+                out.hoist_line(line, path, n);
             } else if active {
                 out.push_line(line, path, n);
             } else {
@@ -234,6 +238,11 @@ fn is_set(defines: &BTreeMap<String, String>, name: &str) -> bool {
 }
 
 impl Composed {
+    fn hoist_line(&mut self, line: &str, file: &Path, n: usize) {
+        self.text.insert_str(0, &format!("{line}\n"));
+        self.origin.insert(0, (file.to_path_buf(), n));
+    }
+
     fn push_line(&mut self, line: &str, file: &Path, n: usize) {
         self.text.push_str(line);
         self.text.push('\n');

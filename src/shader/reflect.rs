@@ -10,6 +10,8 @@ pub enum BindingKind {
     /// `texture_2d<f32>` and friends; `multisampled` for `texture_multisampled_2d`.
     SampledTexture {
         multisampled: bool,
+        /// `f32`, `u32` (visibility ids) or `i32` texels.
+        kind: naga::ScalarKind,
     },
     DepthTexture {
         multisampled: bool,
@@ -47,8 +49,9 @@ pub fn reflect_bindings(module: &naga::Module) -> Vec<ReflectedBinding> {
                 },
                 AddressSpace::Handle => match &module.types[var.ty].inner {
                     TypeInner::Image { class, .. } => match *class {
-                        ImageClass::Sampled { multi, .. } => BindingKind::SampledTexture {
+                        ImageClass::Sampled { multi, kind } => BindingKind::SampledTexture {
                             multisampled: multi,
+                            kind,
                         },
                         ImageClass::Depth { multi } => BindingKind::DepthTexture {
                             multisampled: multi,

@@ -17,6 +17,8 @@ pub mod shadow_ray_cast;
 pub mod shadow_ray_jobs;
 pub mod transparent_depth;
 pub mod transparent_shading;
+pub mod visibility_buffer;
+pub mod visibility_shading;
 pub mod vpl_spawn;
 
 use super::error::GraphError;
@@ -242,6 +244,8 @@ pub fn slots(kind: &PassKind) -> Option<&'static [SlotSpec]> {
         PassKind::TransparentShading(_) => transparent_shading::SLOTS,
         PassKind::ReflectiveShadowMaps(_) => reflective_shadow_maps::SLOTS,
         PassKind::VplSpawn(_) => vpl_spawn::SLOTS,
+        PassKind::VisibilityBuffer => visibility_buffer::SLOTS,
+        PassKind::VisibilityShading(_) => visibility_shading::SLOTS,
         PassKind::Compute { .. } | PassKind::Fullscreen { .. } => return None,
     })
 }
@@ -263,6 +267,8 @@ fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         PassKind::TransparentShading(p) => transparent_shading::check(p, ctx, errors),
         PassKind::ReflectiveShadowMaps(p) => reflective_shadow_maps::check(p, ctx, errors),
         PassKind::VplSpawn(p) => vpl_spawn::check(p, ctx, errors),
+        PassKind::VisibilityBuffer => visibility_buffer::check(ctx, errors),
+        PassKind::VisibilityShading(p) => visibility_shading::check(p, ctx, errors),
         PassKind::Compute { .. } | PassKind::Fullscreen { .. } => {}
     }
 }
@@ -503,6 +509,11 @@ pub(crate) mod test_support {
         Buffer(name: "light_properties"),
         Import(name: "bn", from: BvhNodes),
         Import(name: "bt", from: BvhTriangles),
+        Texture(name: "vis", format: R32Uint),
+        Texture(name: "vis4", format: R32Uint, samples: 4),
+        Import(name: "vertices", from: Vertices),
+        Import(name: "triangles", from: Triangles),
+        Import(name: "material_triangles", from: MaterialTriangles),
         Buffer(name: "lists"),
         Buffer(name: "links"),
         Import(name: "geometry", from: Geometry),

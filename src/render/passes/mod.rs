@@ -17,6 +17,8 @@ mod shadow_ray_cast;
 mod shadow_ray_jobs;
 mod transparent_depth;
 mod transparent_shading;
+mod visibility_buffer;
+mod visibility_shading;
 pub mod vpl_spawn;
 
 use super::bind::{BindingSet, Bound};
@@ -64,6 +66,8 @@ pub(super) fn prepare(
         PassKind::TransparentShading(p) => Box::new(transparent_shading::prepare(cx, sp, p)?),
         PassKind::ReflectiveShadowMaps(p) => Box::new(reflective_shadow_maps::prepare(cx, sp, p)?),
         PassKind::VplSpawn(p) => Box::new(vpl_spawn::prepare(cx, sp, p)?),
+        PassKind::VisibilityBuffer => Box::new(visibility_buffer::prepare(cx, sp)?),
+        PassKind::VisibilityShading(p) => Box::new(visibility_shading::prepare(cx, sp, p)?),
         PassKind::Compute {
             shader,
             entry,
@@ -155,6 +159,16 @@ impl PrepareCtx<'_> {
             .map_err(|m| pass_error(pass, m))
     }
 
+    /// The opaque meshes merged for vertex fetching, built on the first pass that binds them.
+    fn merged(
+        &self,
+        pass: &str,
+    ) -> Result<&super::visibility_geometry::VisibilityGeometry, RenderError> {
+        self.gpu
+            .visibility_geometry(&self.renderer.ctx.device, self.scene)
+            .map_err(|m| pass_error(pass, m))
+    }
+
     /// A declared resource as something to bind: scene imports, planned buffers and
     /// textures. `None` for scene geometry (drawn, never bound).
     fn bound(&self, pass: &str, name: &str) -> Result<Option<Bound>, RenderError> {
@@ -172,6 +186,11 @@ impl PrepareCtx<'_> {
                 SceneResource::Geometry => return Ok(None),
                 SceneResource::BvhNodes => Bound::Buffer(self.bvh(pass)?.nodes.clone()),
                 SceneResource::BvhTriangles => Bound::Buffer(self.bvh(pass)?.triangles.clone()),
+                SceneResource::Vertices => Bound::Buffer(self.merged(pass)?.vertices.clone()),
+                SceneResource::Triangles => Bound::Buffer(self.merged(pass)?.triangles.clone()),
+                SceneResource::MaterialTriangles => {
+                    Bound::Buffer(self.merged(pass)?.material_triangles.clone())
+                }
             },
             Some(ResourceDesc::Buffer { .. }) => Bound::Buffer(self.buffer(pass, name)?),
             Some(ResourceDesc::Texture { .. }) => Bound::View(self.view(pass, name)?),
@@ -297,6 +316,28 @@ impl PrepareCtx<'_> {
         entry: &str,
         offered: &BindingSet,
     ) -> Result<(Arc<wgpu::ComputePipeline>, wgpu::BindGroup), RenderError> {
+        self.compute_pipeline_with_material(pass, key, entry, offered, None)
+            .map(|(pipeline, bind, _)| (pipeline, bind))
+    }
+
+    /// [`Self::compute_pipeline`] whose shader includes material code: the material's
+    /// textures (`material`) bound in group 2 as mesh draws bind them, if it declares any.
+    pub fn compute_pipeline_with_material(
+        &mut self,
+        pass: &str,
+        key: PipelineKey,
+        entry: &str,
+        offered: &BindingSet,
+        material: Option<&BindingSet>,
+    ) -> Result<
+        (
+            Arc<wgpu::ComputePipeline>,
+            wgpu::BindGroup,
+            Option<wgpu::BindGroup>,
+        ),
+        RenderError,
+    > {
+        use super::draws::{material_layout, MATERIAL_GROUP};
         let device = self.device();
         let layouts = self.renderer.layouts.clone();
         let compute = wgpu::ShaderStages::COMPUTE;
@@ -309,9 +350,14 @@ impl PrepareCtx<'_> {
                 |_, module, bindings| {
                     let bgl =
                         layouts.get(&device, super::bind::layout_entries(bindings, 0, compute));
+                    let textures = material_layout(&layouts, &device, bindings, compute);
+                    let groups = match &textures {
+                        Some(t) => vec![Some(&*bgl), None, Some(&**t)],
+                        None => vec![Some(&*bgl)],
+                    };
                     let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                         label: Some(pass),
-                        bind_group_layouts: &[Some(&bgl)],
+                        bind_group_layouts: &groups,
                         immediate_size: 0,
                     });
                     Pipeline::compute(&device, pass, Some(&pl), &module, entry)
@@ -329,7 +375,23 @@ impl PrepareCtx<'_> {
         let bind = offered
             .bind(&device, pass, &bgl, &bindings, 0)
             .map_err(|m| pass_error(pass, m))?;
-        Ok((pipeline, bind))
+        let textures = match (
+            material,
+            material_layout(&layouts, &device, &bindings, compute),
+        ) {
+            (Some(set), Some(layout)) => Some(
+                set.bind(&device, pass, &layout, &bindings, MATERIAL_GROUP)
+                    .map_err(|m| pass_error(pass, m))?,
+            ),
+            (None, Some(_)) => {
+                return Err(pass_error(
+                    pass,
+                    "the shader declares material textures but the material has none".into(),
+                ))
+            }
+            _ => None,
+        };
+        Ok((pipeline, bind, textures))
     }
 }
 

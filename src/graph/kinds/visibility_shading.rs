@@ -1,0 +1,119 @@
+//! `VisibilityShading`: every material shaded in a compute shader from a visibility
+//! buffer, one dispatch per material: each pixel whose triangle id lies in the material's
+//! range fetches the triangle, rebuilds its attributes at the pixel centre and runs the
+//! light loop. Runs `shaders/visibility/visibility_shading.wgsl`.
+
+use super::deferred_shading::HDR;
+use super::shadow_ray_jobs::SHADOW_MASK;
+use super::visibility_buffer::VISIBILITY;
+use super::{check_light_source, Access, KindCtx, SlotSpec, SlotType, Usage};
+use crate::graph::error::GraphError;
+use crate::graph::model::{LightSource, SceneResource};
+use serde::{Deserialize, Serialize};
+
+/// `VisibilityShading(lights: Culled)`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
+#[serde(deny_unknown_fields)]
+pub struct VisibilityShading {
+    #[serde(default)]
+    pub lights: LightSource,
+}
+
+pub const VERTICES: &str = "vertices";
+pub const TRIANGLES: &str = "triangles";
+pub const MATERIAL_TRIANGLES: &str = "material_triangles";
+
+const fn import(name: &'static str, from: SceneResource) -> SlotSpec {
+    SlotSpec::new(name, SlotType::Import(from), Access::Read, Usage::Bound)
+}
+
+pub const SLOTS: &[SlotSpec] = &[
+    SlotSpec::new(
+        VISIBILITY,
+        SlotType::ColorTexture,
+        Access::Read,
+        Usage::Sampled,
+    ),
+    import(VERTICES, SceneResource::Vertices),
+    import(TRIANGLES, SceneResource::Triangles),
+    import(MATERIAL_TRIANGLES, SceneResource::MaterialTriangles),
+    super::LIGHT_GEOMETRY_READ,
+    super::LIGHT_PROPERTIES_READ,
+    super::LIGHT_LISTS_READ,
+    SlotSpec::new(HDR, SlotType::ColorTexture, Access::Write, Usage::Storage),
+    // Taken only to refuse them by name (see `check`).
+    SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound).optional(),
+    super::SHADOW_ATLAS_READ,
+    super::SHADOW_VIEWS_READ,
+];
+
+pub fn check(p: &VisibilityShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+    check_light_source(ctx, p.lights, errors);
+    super::visibility_buffer::check_ids(ctx, errors);
+    ctx.require_single_rgba32f(
+        &[HDR],
+        "visibility shading stores into a single-sample Rgba32Float texture",
+        errors,
+    );
+    let shadows = [
+        SHADOW_MASK,
+        super::shadow_atlas::SHADOW_ATLAS,
+        super::shadow_atlas::SHADOW_VIEWS,
+    ];
+    for name in shadows.iter().filter_map(|s| ctx.slot(s)) {
+        errors.push(ctx.mismatch(
+            name,
+            "visibility shading does not shadow its lights yet: use a G-buffer or forward graph for shadows",
+        ));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::graph::kinds::test_support::{errors, validate, PREPASS};
+
+    const VIS: &str = r#"Pass(name: "v", kind: VisibilityBuffer, reads: ["geometry"], writes: ["depth", "vis"]),"#;
+    const READS: &str = r#""vis", "vertices", "triangles", "material_triangles", "lg", "lp""#;
+
+    #[test]
+    fn reads_ids_and_the_merged_geometry() {
+        validate(
+            &format!(r#"{VIS} Pass(name: "s", kind: VisibilityShading(), reads: [{READS}], writes: ["hdr"])"#),
+            "hdr",
+        )
+        .unwrap();
+        let e = errors(
+            &format!(
+                r#"{VIS} Pass(name: "s", kind: VisibilityShading(), reads: ["vis", "vertices", "lg", "lp"], writes: ["hdr"])"#
+            ),
+            "hdr",
+        );
+        assert!(
+            e.contains(
+                "VisibilityShading needs an Import of Triangles in reads (slot 'triangles')"
+            ),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn refuses_shadows_and_multisampled_ids() {
+        let e = errors(
+            &format!(
+                r#"{VIS} {PREPASS} Pass(name: "s", kind: VisibilityShading(), reads: [{READS}, "mask"], writes: ["hdr"])"#
+            ),
+            "hdr",
+        );
+        assert!(
+            e.contains("resource 'mask': visibility shading does not shadow its lights yet"),
+            "{e}"
+        );
+        let e = errors(
+            &format!(
+                r#"{VIS} Pass(name: "s", kind: VisibilityShading(), reads: [{READS}], writes: ["hdr4"])"#
+            ),
+            "hdr",
+        );
+        assert!(e.contains("single-sample Rgba32Float"), "{e}");
+    }
+}
