@@ -142,6 +142,12 @@ pub enum SceneResource {
     BvhNodes,
     /// The shadow BVH's triangles, in the order its leaves name them.
     BvhTriangles,
+    /// Opaque meshes' vertices merged into one array (`src/render/visibility_geometry.rs`).
+    Vertices,
+    /// Opaque meshes' triangles (three merged vertex indices each); a triangle's id is its index.
+    Triangles,
+    /// Each material's `[first, end)` range of triangle ids.
+    MaterialTriangles,
 }
 
 /// A scene feature a pass can be conditional on (`when:`).
@@ -299,6 +305,9 @@ pub enum PassKind {
     ReflectiveShadowMaps(ReflectiveShadowMaps),
     /// Virtual point lights from the reflective shadow maps, appended to the lights.
     VplSpawn(VplSpawn),
+    /// Opaque triangles rasterized in compute (64-bit atomic min per pixel) into a depth
+    /// texture and an R32Uint triangle-id visibility texture.
+    ComputeRaster,
     /// A compute shader the graph file names; bindings are matched by name.
     Compute {
         shader: String,
@@ -338,6 +347,7 @@ impl PassKind {
             PassKind::TransparentShading(_) => "TransparentShading",
             PassKind::ReflectiveShadowMaps(_) => "ReflectiveShadowMaps",
             PassKind::VplSpawn(_) => "VplSpawn",
+            PassKind::ComputeRaster => "ComputeRaster",
             PassKind::Compute { .. } => "Compute",
             PassKind::Fullscreen { .. } => "Fullscreen",
         }

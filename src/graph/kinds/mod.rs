@@ -3,6 +3,7 @@
 //! kinds share; `matching.rs` the slot matcher they all use. Generic kinds (Compute, Fullscreen) bind by reflected shader
 //! binding names instead (see `roles.rs`).
 
+pub mod compute_raster;
 pub mod deferred_shading;
 pub mod depth_prepass;
 pub mod forward_shading;
@@ -242,6 +243,7 @@ pub fn slots(kind: &PassKind) -> Option<&'static [SlotSpec]> {
         PassKind::TransparentShading(_) => transparent_shading::SLOTS,
         PassKind::ReflectiveShadowMaps(_) => reflective_shadow_maps::SLOTS,
         PassKind::VplSpawn(_) => vpl_spawn::SLOTS,
+        PassKind::ComputeRaster => compute_raster::SLOTS,
         PassKind::Compute { .. } | PassKind::Fullscreen { .. } => return None,
     })
 }
@@ -263,6 +265,7 @@ fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         PassKind::TransparentShading(p) => transparent_shading::check(p, ctx, errors),
         PassKind::ReflectiveShadowMaps(p) => reflective_shadow_maps::check(p, ctx, errors),
         PassKind::VplSpawn(p) => vpl_spawn::check(p, ctx, errors),
+        PassKind::ComputeRaster => compute_raster::check(ctx, errors),
         PassKind::Compute { .. } | PassKind::Fullscreen { .. } => {}
     }
 }
@@ -503,6 +506,11 @@ pub(crate) mod test_support {
         Buffer(name: "light_properties"),
         Import(name: "bn", from: BvhNodes),
         Import(name: "bt", from: BvhTriangles),
+        Import(name: "vertices", from: Vertices),
+        Import(name: "triangles", from: Triangles),
+        Import(name: "material_triangles", from: MaterialTriangles),
+        Texture(name: "visibility", format: R32Uint),
+        Texture(name: "ids4", format: R32Uint, samples: 4),
         Buffer(name: "lists"),
         Buffer(name: "links"),
         Import(name: "geometry", from: Geometry),

@@ -3,6 +3,7 @@
 //! This file holds the one match from a compiled pass to its prepared form.
 
 mod compute;
+mod compute_raster;
 mod deferred_shading;
 mod depth_prepass;
 mod forward_shading;
@@ -64,6 +65,7 @@ pub(super) fn prepare(
         PassKind::TransparentShading(p) => Box::new(transparent_shading::prepare(cx, sp, p)?),
         PassKind::ReflectiveShadowMaps(p) => Box::new(reflective_shadow_maps::prepare(cx, sp, p)?),
         PassKind::VplSpawn(p) => Box::new(vpl_spawn::prepare(cx, sp, p)?),
+        PassKind::ComputeRaster => Box::new(compute_raster::prepare(cx, sp)?),
         PassKind::Compute {
             shader,
             entry,
@@ -155,6 +157,17 @@ impl PrepareCtx<'_> {
             .map_err(|m| pass_error(pass, m))
     }
 
+    /// The opaque meshes merged for passes that fetch vertices themselves, built on the
+    /// first pass that binds them.
+    fn visibility(
+        &self,
+        pass: &str,
+    ) -> Result<&super::visibility_geometry::VisibilityGeometry, RenderError> {
+        self.gpu
+            .visibility_geometry(&self.renderer.ctx.device, self.scene)
+            .map_err(|m| pass_error(pass, m))
+    }
+
     /// A declared resource as something to bind: scene imports, planned buffers and
     /// textures. `None` for scene geometry (drawn, never bound).
     fn bound(&self, pass: &str, name: &str) -> Result<Option<Bound>, RenderError> {
@@ -172,6 +185,11 @@ impl PrepareCtx<'_> {
                 SceneResource::Geometry => return Ok(None),
                 SceneResource::BvhNodes => Bound::Buffer(self.bvh(pass)?.nodes.clone()),
                 SceneResource::BvhTriangles => Bound::Buffer(self.bvh(pass)?.triangles.clone()),
+                SceneResource::Vertices => Bound::Buffer(self.visibility(pass)?.vertices.clone()),
+                SceneResource::Triangles => Bound::Buffer(self.visibility(pass)?.triangles.clone()),
+                SceneResource::MaterialTriangles => {
+                    Bound::Buffer(self.visibility(pass)?.material_triangles.clone())
+                }
             },
             Some(ResourceDesc::Buffer { .. }) => Bound::Buffer(self.buffer(pass, name)?),
             Some(ResourceDesc::Texture { .. }) => Bound::View(self.view(pass, name)?),
