@@ -183,3 +183,48 @@ fn shipped_scenes_match_the_depth_prepass() {
         assert!(d.covered > d.pixels / 4, "{rel}: {d:?}");
     }
 }
+
+#[test]
+fn diag_atrium() {
+    let scene = load("scenes/atrium_amd.ron");
+    let px = rasterize(&scene, 333, 197);
+    let mut bad: Vec<(usize, &Pixel)> = px.iter().enumerate().filter(|(_, p)| p.id != NO_TRIANGLE && (p.cr - p.hw).abs() > 1e-6).collect();
+    bad.sort_by(|a, b| (b.1.cr - b.1.hw).abs().partial_cmp(&(a.1.cr - a.1.hw).abs()).unwrap());
+    eprintln!("{} pixels over 1e-6; near camera {:?}", bad.len(), scene.camera);
+    for (i, p) in bad.iter().take(20) {
+        eprintln!("({}, {}) cr {} hw {} id {}", i % 333, i / 333, p.cr, p.hw, p.id);
+    }
+}
+
+#[test]
+fn diag_tri() {
+    let scene = load("scenes/atrium_amd.ron");
+    let mut order: Vec<usize> = (0..scene.meshes.len()).filter(|&i| !scene.meshes[i].indices.is_empty() && scene.materials[scene.meshes[i].material].alpha_mode != AlphaMode::Blend).collect();
+    order.sort_by_key(|&i| scene.meshes[i].material);
+    let vp = scene.camera.projection(333.0 / 197.0) * scene.camera.view();
+    for want in [16061u32, 15220, 16053] {
+        let mut first = 0u32;
+        for &m in &order {
+            let mesh = &scene.meshes[m];
+            let n = mesh.indices.len() as u32 / 3;
+            if want < first + n {
+                let t = (want - first) as usize;
+                let mat = &scene.materials[mesh.material];
+                eprintln!("tri {want}: mesh {} material {} double_sided {}", mesh.name, mat.name, mat.double_sided);
+                let mut s = vec![];
+                for k in 0..3 {
+                    let p = mesh.positions[mesh.indices[3 * t + k] as usize];
+                    let c = vp * p.extend(1.0);
+                    let x = 166.5 * (c.x / c.w) + 166.5;
+                    let y = -98.5 * (c.y / c.w) + 98.5;
+                    eprintln!("  world {p:?} clip {c:?} screen ({x}, {y}, {})", c.z / c.w);
+                    s.push((x as f64, y as f64));
+                }
+                let area = (s[1].0 - s[0].0) * (s[2].1 - s[0].1) - (s[1].1 - s[0].1) * (s[2].0 - s[0].0);
+                eprintln!("  float area (y down) {area}");
+                break;
+            }
+            first += n;
+        }
+    }
+}

@@ -8,8 +8,8 @@
 // threads per listed triangle, sharing its pixels), `resolve_vs`/`resolve_fs` (a
 // full-screen draw writing the id and frag_depth).
 // Per triangle, as the hardware does: clip space with the vertex shader's own expression
-// (frame.view_proj * position), clipping against the near plane z >= 0 (and a guard band
-// of GUARD times the viewport, so fixed-point coordinates fit in 32 bits), vertices
+// (frame.view_proj * position), clipped against the near plane z >= 0 and the viewport's
+// sides (only where a vertex lies outside them), vertices
 // snapped to 1/256 pixel, back faces of single-sided materials culled (front is
 // counter-clockwise in NDC), pixel centres tested with exact 64-bit edge functions and
 // the top-left rule, depth from the triangle's plane in screen space, pixels past the
@@ -47,9 +47,10 @@ const NO_TRIANGLE: u32 = 0xffffffffu;
 // Sub-pixel bits of snapped vertex positions (as lavapipe and most GPUs).
 const SUBPIXEL: f32 = 256.0;
 const HALF_PIXEL: i32 = 128;
-// Clip-space guard band, in viewports: at most GUARD/2+1 viewport widths from the
-// centre, times 256, stays far inside i32 for viewports up to 16384.
-const GUARD: f32 = 8.0;
+// Where x and y clip: at the viewport's sides. lavapipe clips there too (and against the
+// near plane) when a triangle needs clipping: with the planes 2 viewports out instead,
+// 4 pixels of atrium_amd's near-clipped balustrade took another depth.
+const GUARD: f32 = 1.0;
 const MAX_POLY: u32 = 8u;
 
 fn flat_index(wg: vec3<u32>, groups: vec3<u32>, local: u32, size: u32) -> u32 {
@@ -113,7 +114,7 @@ fn clip_position(v: u32) -> vec4<f32> {
 }
 
 // Signed distance-like value of `c` to clip plane `k`: the near plane (z >= 0) and the
-// four guard-band planes.
+// viewport's four sides.
 fn plane_distance(c: vec4<f32>, k: u32) -> f32 {
     if (k == 0u) {
         return c.z;
@@ -154,12 +155,12 @@ fn clip_triangle(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) -> Polygon {
                 q.n++;
             }
             if ((ds >= 0.0) != (de >= 0.0)) {
-                // From the inside vertex, so the two triangles sharing an edge get the
-                // same point.
+                // From the outside vertex, so the two triangles sharing an edge get the
+                // same point (and as Mesa's clipper computes it).
                 if (ds >= 0.0) {
-                    q.v[q.n] = mix(s, e, ds / (ds - de));
+                    q.v[q.n] = e + de / (de - ds) * (s - e);
                 } else {
-                    q.v[q.n] = mix(e, s, de / (de - ds));
+                    q.v[q.n] = s + ds / (ds - de) * (e - s);
                 }
                 q.n++;
             }
@@ -175,9 +176,9 @@ fn clip_triangle(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) -> Polygon {
 
 // Framebuffer position (x right, y down, pixels) and depth, as the viewport transform.
 fn to_screen(c: vec4<f32>) -> vec3<f32> {
-    let ndc = c.xyz / c.w;
+    let ndc = c.xyz * (1.0 / c.w);
     let half = vec2<f32>(raster_params.zw) * 0.5;
-    return vec3<f32>(half.x * ndc.x + half.x, -half.y * ndc.y + half.y, ndc.z);
+    return vec3<f32>(ndc.x * half.x + half.x, ndc.y * -half.y + half.y, ndc.z);
 }
 
 fn snap(p: vec3<f32>) -> vec2<i32> {
