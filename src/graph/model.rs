@@ -311,6 +311,9 @@ pub enum PassKind {
     VisibilityBuffer,
     /// Every material shaded in compute from the visibility buffer's triangle ids.
     VisibilityShading(VisibilityShading),
+    /// Opaque triangles rasterized in compute (64-bit atomic min per pixel) into a depth
+    /// texture and an R32Uint triangle-id visibility texture.
+    ComputeRaster,
     /// A compute shader the graph file names; bindings are matched by name.
     Compute {
         shader: String,
@@ -352,6 +355,7 @@ impl PassKind {
             PassKind::VplSpawn(_) => "VplSpawn",
             PassKind::VisibilityBuffer => "VisibilityBuffer",
             PassKind::VisibilityShading(_) => "VisibilityShading",
+            PassKind::ComputeRaster => "ComputeRaster",
             PassKind::Compute { .. } => "Compute",
             PassKind::Fullscreen { .. } => "Fullscreen",
         }

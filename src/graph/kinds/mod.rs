@@ -3,6 +3,7 @@
 //! kinds share; `matching.rs` the slot matcher they all use. Generic kinds (Compute, Fullscreen) bind by reflected shader
 //! binding names instead (see `roles.rs`).
 
+pub mod compute_raster;
 pub mod deferred_shading;
 pub mod depth_prepass;
 pub mod forward_shading;
@@ -246,6 +247,7 @@ pub fn slots(kind: &PassKind) -> Option<&'static [SlotSpec]> {
         PassKind::VplSpawn(_) => vpl_spawn::SLOTS,
         PassKind::VisibilityBuffer => visibility_buffer::SLOTS,
         PassKind::VisibilityShading(_) => visibility_shading::SLOTS,
+        PassKind::ComputeRaster => compute_raster::SLOTS,
         PassKind::Compute { .. } | PassKind::Fullscreen { .. } => return None,
     })
 }
@@ -269,6 +271,7 @@ fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         PassKind::VplSpawn(p) => vpl_spawn::check(p, ctx, errors),
         PassKind::VisibilityBuffer => visibility_buffer::check(ctx, errors),
         PassKind::VisibilityShading(p) => visibility_shading::check(p, ctx, errors),
+        PassKind::ComputeRaster => compute_raster::check(ctx, errors),
         PassKind::Compute { .. } | PassKind::Fullscreen { .. } => {}
     }
 }
@@ -514,6 +517,8 @@ pub(crate) mod test_support {
         Import(name: "vertices", from: Vertices),
         Import(name: "triangles", from: Triangles),
         Import(name: "material_triangles", from: MaterialTriangles),
+        Texture(name: "visibility", format: R32Uint),
+        Texture(name: "ids4", format: R32Uint, samples: 4),
         Buffer(name: "lists"),
         Buffer(name: "links"),
         Import(name: "geometry", from: Geometry),

@@ -3,6 +3,7 @@
 //! This file holds the one match from a compiled pass to its prepared form.
 
 mod compute;
+mod compute_raster;
 mod deferred_shading;
 mod depth_prepass;
 mod forward_shading;
@@ -68,6 +69,7 @@ pub(super) fn prepare(
         PassKind::VplSpawn(p) => Box::new(vpl_spawn::prepare(cx, sp, p)?),
         PassKind::VisibilityBuffer => Box::new(visibility_buffer::prepare(cx, sp)?),
         PassKind::VisibilityShading(p) => Box::new(visibility_shading::prepare(cx, sp, p)?),
+        PassKind::ComputeRaster => Box::new(compute_raster::prepare(cx, sp)?),
         PassKind::Compute {
             shader,
             entry,

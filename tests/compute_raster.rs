@@ -1,0 +1,533 @@
+//! The compute rasterizer (`ComputeRaster`) against the hardware depth prepass on the
+//! same device: coverage equal but for a counted few edge pixels, depth equal within a
+//! tiny tolerance where both cover; near-plane clipping, the shared-workgroup path for
+//! large triangles, and depth ties (the later triangle wins, as LessEqual keeps it).
+
+mod common;
+use common::*;
+use glam::{Vec2, Vec3};
+use lightgraph::graph::{self, FrameSize};
+use lightgraph::render::SceneGpu;
+use lightgraph::scene::{AlphaMode, Camera, Light, Mesh, Scene};
+use lightgraph::shader::ShaderLibrary;
+use std::path::Path;
+
+const NO_TRIANGLE: u32 = u32::MAX;
+
+/// Both rasterizers into one image: compute depth, prepass depth, the id's two halves.
+const COMPARE: &str = r#"Graph(
+    name: "compute_raster_compare",
+    resources: [
+        Texture(name: "depth_cr", format: Depth32Float),
+        Texture(name: "depth_hw", format: Depth32Float),
+        Texture(name: "visibility", format: R32Uint),
+        Texture(name: "out", format: Rgba32Float),
+        Import(name: "geometry", from: Geometry),
+        Import(name: "vertices", from: Vertices),
+        Import(name: "triangles", from: Triangles),
+        Import(name: "material_triangles", from: MaterialTriangles),
+    ],
+    passes: [
+        Pass(name: "cr", kind: ComputeRaster, reads: ["vertices", "triangles", "material_triangles"], writes: ["depth=depth_cr", "visibility"]),
+        Pass(name: "pre", kind: DepthPrepass, reads: ["geometry"], writes: ["depth_hw"]),
+        Pass(name: "compare", kind: Fullscreen(shader: "visibility/compute_raster_compare.wgsl"), reads: ["depth_cr", "depth_hw", "visibility"], writes: ["out"]),
+    ],
+    output: "out",
+)"#;
+
+struct Pixel {
+    cr: f32,
+    hw: f32,
+    id: u32,
+}
+
+/// What the two rasterizers differ in over a frame.
+#[derive(Debug, Default)]
+struct Diff {
+    pixels: usize,
+    covered: usize,
+    /// Covered by one rasterizer only.
+    coverage: usize,
+    /// Largest depth difference where both cover.
+    depth: f32,
+    /// Ids past the scene's triangles, or a depth without an id.
+    bad_ids: usize,
+}
+
+fn rasterize(scene: &Scene, width: u32, height: u32) -> Vec<Pixel> {
+    let mut r = renderer();
+    let out = render_text(&mut r, COMPARE, scene, width, height);
+    out.image
+        .iter()
+        .map(|p| Pixel {
+            cr: p[0],
+            hw: p[1],
+            id: p[2] as u32 | (p[3] as u32) << 16,
+        })
+        .collect()
+}
+
+fn triangles(scene: &Scene) -> u32 {
+    scene
+        .meshes
+        .iter()
+        .filter(|m| scene.materials[m.material].alpha_mode != AlphaMode::Blend)
+        .map(|m| m.indices.len() as u32 / 3)
+        .sum()
+}
+
+fn diff(scene: &Scene, px: &[Pixel]) -> Diff {
+    let n = triangles(scene);
+    let mut d = Diff {
+        pixels: px.len(),
+        ..Default::default()
+    };
+    for p in px {
+        let cr = p.id != NO_TRIANGLE;
+        let hw = p.hw < 1.0;
+        d.bad_ids += (cr && p.id >= n) as usize + (!cr && p.cr != 1.0) as usize;
+        if cr && hw {
+            d.covered += 1;
+            d.depth = d.depth.max((p.cr - p.hw).abs());
+        } else if cr != hw {
+            d.coverage += 1;
+        }
+    }
+    d
+}
+
+fn load(rel: &str) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
+    lightgraph::scene::load(&path).unwrap().scene
+}
+
+#[test]
+fn lavapipe_has_the_64_bit_atomics() {
+    let r = renderer();
+    let have = r.ctx.device.features();
+    let needed = wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX;
+    eprintln!(
+        "compute raster: adapter {} offers SHADER_INT64 {}, SHADER_INT64_ATOMIC_MIN_MAX {}, TEXTURE_INT64_ATOMIC {}",
+        r.ctx.adapter_name(),
+        r.ctx.adapter.features().contains(wgpu::Features::SHADER_INT64),
+        r.ctx
+            .adapter
+            .features()
+            .contains(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX),
+        r.ctx
+            .adapter
+            .features()
+            .contains(wgpu::Features::TEXTURE_INT64_ATOMIC),
+    );
+    if !have.contains(needed) {
+        eprintln!(
+            "!!!!! THIS ADAPTER LACKS 64-BIT ATOMICS: the compute rasterizer cannot run; only its refusal is tested !!!!!"
+        );
+        drop(r);
+        let e = prepare_error(&random_scene(4, 1), COMPARE);
+        assert!(e.contains("pass 'cr'") && e.contains("SHADER_INT64"), "{e}");
+    }
+}
+
+/// The error preparing `graph` for `scene` (panics if it prepares).
+fn prepare_error(scene: &Scene, graph: &str) -> String {
+    let mut r = renderer();
+    let checked = graph::check_text(Path::new("<test>"), graph, &ShaderLibrary::builtin())
+        .expect("valid graph");
+    let size = FrameSize {
+        width: 64,
+        height: 36,
+        lights: scene.lights.len() as u32,
+    };
+    let compiled = graph::compile(checked, &scene.features(), size);
+    let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, scene).expect("materials");
+    match r.prepare(compiled, scene, &gpu, size, false) {
+        Ok(_) => panic!("expected the graph to be refused"),
+        Err(e) => e.to_string(),
+    }
+}
+
+fn has_atomics() -> bool {
+    let r = renderer();
+    let ok = r
+        .ctx
+        .device
+        .features()
+        .contains(wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX);
+    if !ok {
+        eprintln!(
+            "!!!!! no 64-bit atomics on {}: skipped !!!!!",
+            r.ctx.adapter_name()
+        );
+    }
+    ok
+}
+
+#[test]
+fn shipped_scenes_match_the_depth_prepass() {
+    if !has_atomics() {
+        return;
+    }
+    for rel in [
+        "scenes/harada.ron",
+        "scenes/atrium_amd.ron",
+        "scenes/chairs.ron",
+        "scenes/depth_discontinuity.ron",
+        "scenes/cornell_box/scene.gltf",
+    ] {
+        let scene = load(rel);
+        let px = rasterize(&scene, 333, 197);
+        let d = diff(&scene, &px);
+        eprintln!("{rel}: {d:?}");
+        assert!(d.covered > d.pixels / 4, "{rel}: {d:?}");
+        assert_matches(rel, &d);
+    }
+}
+
+/// Coverage may differ only where float rounding of a vertex's transform (the vertex
+/// stage and this compute shader may contract multiply-adds differently) moves its
+/// snapped 1/256-pixel position, which flips only pixel centres within 1/256 pixel of
+/// an edge: at most one pixel in 5000 (lavapipe: none on every scene here). Depth where
+/// both cover: the plane evaluated in another order, a few ulps of 1.0 (lavapipe: at
+/// most 4.2e-7, cornell box).
+const MAX_COVERAGE_DIFF: usize = 5000;
+const DEPTH_TOLERANCE: f32 = 1e-6;
+
+fn assert_matches(what: &str, d: &Diff) {
+    assert_eq!(d.bad_ids, 0, "{what}: {d:?}");
+    assert!(d.coverage <= d.pixels / MAX_COVERAGE_DIFF, "{what}: {d:?}");
+    assert!(d.depth <= DEPTH_TOLERANCE, "{what}: {d:?}");
+}
+
+/// A camera at the origin looking down -Z with a 90° field of view: at distance d the
+/// view spans [-d, d] in x and y (square frames).
+fn camera(near: f32) -> Camera {
+    Camera {
+        eye: Vec3::ZERO,
+        target: Vec3::NEG_Z,
+        up: Vec3::Y,
+        fov_y: 90f32.to_radians(),
+        near,
+        far: 100.0,
+    }
+}
+
+fn scene(
+    meshes: Vec<Mesh>,
+    materials: Vec<lightgraph::scene::SurfaceMaterial>,
+    camera: Camera,
+) -> Scene {
+    Scene {
+        name: "compute_raster".into(),
+        meshes,
+        materials,
+        lights: vec![Light::point(
+            Vec3::new(0.0, 2.0, -3.0),
+            20.0,
+            Vec3::ONE,
+            10.0,
+        )],
+        camera,
+        output_size: None,
+        ambient: Vec3::ZERO,
+        ..Default::default()
+    }
+}
+
+/// One triangle (normals towards +Z), material `material`.
+fn triangle(name: &str, p: [Vec3; 3], material: usize) -> Mesh {
+    Mesh {
+        name: name.into(),
+        material,
+        positions: p.to_vec(),
+        normals: vec![Vec3::Z; 3],
+        uvs: vec![Vec2::ZERO; 3],
+        tangents: vec![Vec3::X.extend(1.0); 3],
+        indices: vec![0, 1, 2],
+        ..Default::default()
+    }
+}
+
+fn double_sided(name: &str, albedo: Vec3) -> lightgraph::scene::SurfaceMaterial {
+    let mut m = lambert(name, albedo);
+    m.double_sided = true;
+    m
+}
+
+/// The screen split along its diagonal into two triangles at different depths whose
+/// corners project onto the frame's corners: the diagonal passes exactly through the
+/// centres of pixels (i, i). The top-left rule gives them to the upper-right triangle
+/// (the diagonal is its left edge; the lower-left one's right edge), the far one here.
+#[test]
+fn top_left_rule_on_a_diagonal_through_pixel_centres() {
+    if !has_atomics() {
+        return;
+    }
+    let (near, far) = (2.0, 4.0);
+    let s = scene(
+        vec![
+            // Lower left on screen, near.
+            triangle(
+                "near",
+                [
+                    Vec3::new(-near, near, -near),
+                    Vec3::new(-near, -near, -near),
+                    Vec3::new(near, -near, -near),
+                ],
+                0,
+            ),
+            // Upper right, far.
+            triangle(
+                "far",
+                [
+                    Vec3::new(-far, far, -far),
+                    Vec3::new(far, -far, -far),
+                    Vec3::new(far, far, -far),
+                ],
+                0,
+            ),
+        ],
+        vec![double_sided("grey", Vec3::splat(0.5))],
+        camera(0.1),
+    );
+    let n = 64;
+    let px = rasterize(&s, n, n);
+    let d = diff(&s, &px);
+    eprintln!("diagonal: {d:?}");
+    // Every diagonal centre shows the far triangle (id 1) in both rasterizers.
+    for i in 0..n as usize {
+        let p = &px[i * n as usize + i];
+        assert_eq!(
+            p.id, 1,
+            "pixel ({i}, {i}): id {} depth {} vs {}",
+            p.id, p.cr, p.hw
+        );
+        assert!(
+            (p.cr - p.hw).abs() <= DEPTH_TOLERANCE,
+            "pixel ({i}, {i}): {} vs {}",
+            p.cr,
+            p.hw
+        );
+    }
+    assert_eq!(d.covered, d.pixels, "{d:?}");
+    assert_matches("diagonal", &d);
+}
+
+/// A floor and a wall running from in front of the camera to behind it: their triangles
+/// cross the near plane (vertices with w < 0) and are clipped into up to two each.
+#[test]
+fn near_plane_crossing_triangles() {
+    if !has_atomics() {
+        return;
+    }
+    let mut floor = cuboid(
+        "floor",
+        Vec3::new(-6.0, -1.5, -30.0),
+        Vec3::new(6.0, -1.0, 8.0),
+        0,
+        false,
+    );
+    let wall = cuboid(
+        "wall",
+        Vec3::new(1.0, -1.0, -20.0),
+        Vec3::new(1.2, 3.0, 5.0),
+        1,
+        false,
+    );
+    floor.name = "floor".into();
+    let mut cam = camera(0.3);
+    cam.eye = Vec3::new(0.0, 0.2, 0.0);
+    cam.target = Vec3::new(0.3, -0.1, -1.0);
+    let s = scene(
+        vec![floor, wall],
+        vec![
+            lambert("grey", Vec3::splat(0.5)),
+            lambert("orange", Vec3::new(0.9, 0.5, 0.2)),
+        ],
+        cam,
+    );
+    // Some vertex lies behind the camera: the case is really exercised.
+    let vp = s.camera.projection(333.0 / 197.0) * s.camera.view();
+    let behind = s
+        .meshes
+        .iter()
+        .flat_map(|m| &m.positions)
+        .filter(|p| (vp * p.extend(1.0)).w < 0.0)
+        .count();
+    assert!(behind > 0);
+    let px = rasterize(&s, 333, 197);
+    let d = diff(&s, &px);
+    eprintln!("near plane: {d:?}, {behind} vertices behind the camera");
+    assert!(d.covered > d.pixels / 3, "{d:?}");
+    assert_matches("near plane", &d);
+}
+
+/// One triangle far larger than the frame (every pixel, clipped at the viewport's sides,
+/// bounding box over BIG_PIXELS: the shared-workgroup dispatch), small boxes in front.
+#[test]
+fn screen_filling_triangle() {
+    if !has_atomics() {
+        return;
+    }
+    let s = scene(
+        vec![
+            triangle(
+                "huge",
+                [
+                    Vec3::new(-100.0, -100.0, -10.0),
+                    Vec3::new(100.0, -100.0, -10.0),
+                    Vec3::new(0.0, 200.0, -10.0),
+                ],
+                0,
+            ),
+            cuboid(
+                "box",
+                Vec3::new(-1.0, -1.0, -6.0),
+                Vec3::new(0.5, 0.5, -5.0),
+                1,
+                false,
+            ),
+        ],
+        vec![
+            lambert("grey", Vec3::splat(0.5)),
+            lambert("orange", Vec3::new(0.9, 0.5, 0.2)),
+        ],
+        camera(0.1),
+    );
+    let px = rasterize(&s, 333, 197);
+    let d = diff(&s, &px);
+    eprintln!("screen filling: {d:?}");
+    assert_eq!(d.covered, d.pixels, "{d:?}");
+    assert_eq!(px[0].id, 0, "the corner shows the large triangle");
+    assert!(px.iter().any(|p| p.id > 0), "the box is in front somewhere");
+    assert_matches("screen filling", &d);
+}
+
+/// A 4 m square in the plane z = `z` facing +Z or away (-Z).
+fn square(name: &str, z: f32, material: usize, facing_camera: bool) -> Mesh {
+    let n = if facing_camera { Vec3::Z } else { Vec3::NEG_Z };
+    let mut m = Mesh {
+        name: name.into(),
+        material,
+        ..Default::default()
+    };
+    for (x, y) in [(-2.0, -2.0), (2.0, -2.0), (2.0, 2.0), (-2.0, 2.0)] {
+        m.positions.push(Vec3::new(x, y, z));
+        m.normals.push(n);
+        m.uvs.push(Vec2::ZERO);
+        m.tangents.push(Vec3::X.extend(1.0));
+    }
+    m.indices = if facing_camera {
+        vec![0, 1, 2, 0, 2, 3]
+    } else {
+        vec![0, 2, 1, 0, 3, 2]
+    };
+    m
+}
+
+/// Two double-sided squares in the same place: the one drawn later (larger ids) wins,
+/// as LessEqual keeps it (tests/depth_ties.rs). A single-sided square facing away in
+/// front of them is culled, as the hardware culls it.
+#[test]
+fn coincident_triangles_keep_the_later() {
+    if !has_atomics() {
+        return;
+    }
+    for second_faces_camera in [true, false] {
+        let s = scene(
+            vec![
+                cuboid(
+                    "wall",
+                    Vec3::new(-10.0, -10.0, -11.0),
+                    Vec3::new(10.0, 10.0, -10.0),
+                    0,
+                    false,
+                ),
+                square("red", -5.0, 1, true),
+                square("green", -5.0, 2, second_faces_camera),
+                square("away", -3.0, 3, false),
+            ],
+            vec![
+                lambert("grey", Vec3::splat(0.5)),
+                double_sided("red", Vec3::X),
+                double_sided("green", Vec3::Y),
+                lambert("single-sided", Vec3::Z),
+            ],
+            camera(0.1),
+        );
+        let (w, h) = (64, 36);
+        let px = rasterize(&s, w, h);
+        let d = diff(&s, &px);
+        eprintln!("coincident (second faces the camera: {second_faces_camera}): {d:?}");
+        // Ids: the wall 0..12, red 12..14, green 14..16, the away square 16..18.
+        let centre = &px[(h / 2 * w + w / 2) as usize];
+        assert!(
+            (14..16).contains(&centre.id),
+            "the centre shows triangle {}, not the green square's",
+            centre.id
+        );
+        let squares = px.iter().filter(|p| (12..16).contains(&p.id)).count();
+        assert!(
+            squares > 0
+                && px
+                    .iter()
+                    .all(|p| p.id < 12 || (14..16).contains(&p.id) || p.id == NO_TRIANGLE),
+            "the red square or the culled one shows"
+        );
+        assert_matches("coincident", &d);
+    }
+}
+
+/// Light culling on the compute rasterizer's depth (graphs/visibility_compute_raster.ron)
+/// shades exactly as on the prepass's (forward_plus.ron).
+#[test]
+fn shipped_graph_matches_forward_plus() {
+    if !has_atomics() {
+        return;
+    }
+    let s = load("scenes/harada.ron");
+    let mut r = renderer();
+    let reference = render_file(&mut r, "forward_plus.ron", &s, 333, 197);
+    let frame = render_file(&mut r, "visibility_compute_raster.ron", &s, 333, 197);
+    // The same tile lists: each tile's depth range from the compute depth bounds the
+    // same lights (all-ones depth, say, would keep more).
+    let (lists, reference_lists) = (&frame.culling[0].counts, &reference.culling[0].counts);
+    assert_eq!(lists.len(), reference_lists.len());
+    let differ = lists
+        .iter()
+        .zip(reference_lists)
+        .filter(|(a, b)| a != b)
+        .count();
+    eprintln!("{differ} of {} tile lists differ", lists.len());
+    assert_eq!(differ, 0);
+    assert!(lists.iter().any(|&c| c > 0));
+    let (image, reference) = (frame.image, reference.image);
+    let (worst, at) = max_rel_diff(&image, &reference);
+    let off = image
+        .iter()
+        .zip(&reference)
+        .filter(|(a, b)| (0..3).any(|c| (a[c] - b[c]).abs() > 1e-5 * b[c].abs().max(1e-3)))
+        .count();
+    eprintln!(
+        "visibility_compute_raster vs forward_plus: {off} pixels differ, worst {worst:e} at {at}"
+    );
+    assert!(
+        worst <= 2e-6,
+        "pixel {at}: {:?} vs {:?} ({worst:e})",
+        image[at],
+        reference[at]
+    );
+}
+
+/// Alpha-masked materials are refused, naming the pass, the file:line and the material.
+#[test]
+fn masked_materials_are_refused() {
+    if !has_atomics() {
+        return;
+    }
+    let mut s = random_scene(2, 5);
+    s.materials[1].alpha_mode = AlphaMode::Mask(0.5);
+    let e = prepare_error(&s, COMPARE);
+    assert!(e.contains("<test>:") && e.contains("pass 'cr'"), "{e}");
+    assert!(e.contains("material 'orange' is alpha-masked"), "{e}");
+}
