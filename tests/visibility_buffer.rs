@@ -150,7 +150,7 @@ fn every_visibility_graph_matches_brute_force_on_the_culling_scenes() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// An sRGB checker of two colours, `cells` cells a side, alpha from `alpha(x, y)`.
+/// An sRGB checker of two colours, `cells` cells a side, alpha in vertical stripes.
 fn checker(name: &str, size: u32, cells: u32, a: [u8; 3], b: [u8; 3]) -> TextureImage {
     let mut rgba8 = Vec::with_capacity((size * size * 4) as usize);
     for y in 0..size {
@@ -158,7 +158,11 @@ fn checker(name: &str, size: u32, cells: u32, a: [u8; 3], b: [u8; 3]) -> Texture
             let odd = (x * cells / size + y * cells / size) % 2 == 1;
             let c = if odd { a } else { b };
             // Alpha in stripes (for the masked material): opaque, then cut out.
-            let alpha = if (x * 4 / size) % 2 == 0 { 255 } else { 20 };
+            let alpha = if (x * 4 / size).is_multiple_of(2) {
+                255
+            } else {
+                20
+            };
             rgba8.extend([c[0], c[1], c[2], alpha]);
         }
     }
