@@ -20,12 +20,13 @@ use std::sync::Arc;
 const W: u32 = 333;
 const H: u32 = 197;
 
-/// Every visibility graph: one per culling variant, and brute force.
-const GRAPHS: [&str; 5] = [
+/// Every visibility graph: one per culling variant, linked lists, and brute force.
+const GRAPHS: [&str; 6] = [
     "visibility_buffer.ron",
     "visibility_buffer_half_z.ron",
     "visibility_buffer_depth_mask.ron",
     "visibility_buffer_clustered.ron",
+    "visibility_buffer_linked_list.ron",
     "visibility_buffer_brute_force.ron",
 ];
 
@@ -95,6 +96,10 @@ fn check_graphs(scene: &Scene, reference: &str, bound: Bound) -> Vec<String> {
         assert!(
             out.culling.iter().all(|c| c.overflowed_lists == 0),
             "{graph}: lists overflowed"
+        );
+        assert!(
+            out.links.iter().all(|l| l.links_dropped == 0),
+            "{graph}: link pool overflowed"
         );
         let (d, i) = worst_rel(&out.image, &expected.image);
         let p = p999(&out.image, &expected.image);
