@@ -20,12 +20,13 @@ use std::sync::Arc;
 const W: u32 = 333;
 const H: u32 = 197;
 
-/// Every visibility graph: one per culling variant, and brute force.
-const GRAPHS: [&str; 5] = [
+/// Every visibility graph: one per culling variant, linked lists, and brute force.
+const GRAPHS: [&str; 6] = [
     "visibility_buffer.ron",
     "visibility_buffer_half_z.ron",
     "visibility_buffer_depth_mask.ron",
     "visibility_buffer_clustered.ron",
+    "visibility_buffer_linked_list.ron",
     "visibility_buffer_brute_force.ron",
 ];
 
@@ -96,6 +97,10 @@ fn check_graphs(scene: &Scene, reference: &str, bound: Bound) -> Vec<String> {
             out.culling.iter().all(|c| c.overflowed_lists == 0),
             "{graph}: lists overflowed"
         );
+        assert!(
+            out.links.iter().all(|l| l.links_dropped == 0),
+            "{graph}: link pool overflowed"
+        );
         let (d, i) = worst_rel(&out.image, &expected.image);
         let p = p999(&out.image, &expected.image);
         println!(
@@ -150,7 +155,7 @@ fn every_visibility_graph_matches_brute_force_on_the_culling_scenes() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// An sRGB checker of two colours, `cells` cells a side, alpha from `alpha(x, y)`.
+/// An sRGB checker of two colours, `cells` cells a side, alpha in vertical stripes.
 fn checker(name: &str, size: u32, cells: u32, a: [u8; 3], b: [u8; 3]) -> TextureImage {
     let mut rgba8 = Vec::with_capacity((size * size * 4) as usize);
     for y in 0..size {
@@ -158,7 +163,11 @@ fn checker(name: &str, size: u32, cells: u32, a: [u8; 3], b: [u8; 3]) -> Texture
             let odd = (x * cells / size + y * cells / size) % 2 == 1;
             let c = if odd { a } else { b };
             // Alpha in stripes (for the masked material): opaque, then cut out.
-            let alpha = if (x * 4 / size) % 2 == 0 { 255 } else { 20 };
+            let alpha = if (x * 4 / size).is_multiple_of(2) {
+                255
+            } else {
+                20
+            };
             rgba8.extend([c[0], c[1], c[2], alpha]);
         }
     }

@@ -100,7 +100,7 @@ mod tests {
     fn refuses_shadows_and_multisampled_ids() {
         let e = errors(
             &format!(
-                r#"{VIS} {PREPASS} Pass(name: "s", kind: VisibilityShading(), reads: [{READS}, "mask"], writes: ["hdr"])"#
+                r#"{VIS} {PREPASS} Pass(name: "s", kind: VisibilityShading(), reads: [{READS}, "shadow_mask=mask"], writes: ["hdr"])"#
             ),
             "hdr",
         );

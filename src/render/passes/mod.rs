@@ -388,7 +388,7 @@ impl PrepareCtx<'_> {
             (None, Some(_)) => {
                 return Err(pass_error(
                     pass,
-                    "the shader declares material textures but the material has none".into(),
+                    "the shader declares bindings in group 2 (material textures) but the pass binds no material there".into(),
                 ))
             }
             _ => None,

@@ -22,19 +22,11 @@ pub(super) fn prepare(
     cx: &mut PrepareCtx,
     sp: &ScheduledPass,
 ) -> Result<VisibilityBuffer, RenderError> {
-    if !cx
-        .device()
-        .features()
-        .contains(wgpu::Features::PRIMITIVE_INDEX)
-    {
-        return Err(pass_error(
-            &sp.name,
-            format!(
-                "the visibility buffer writes triangle ids from the primitive index, which this adapter ({}) does not offer (wgpu feature PRIMITIVE_INDEX)",
-                cx.renderer.ctx.adapter.get_info().name
-            ),
-        ));
-    }
+    require_primitive_index(
+        cx.device().features(),
+        &cx.renderer.ctx.adapter.get_info().name,
+        &sp.name,
+    )?;
     let depth = sp.required(slot::DEPTH);
     let writes_depth = cx.graph.checked.desc.passes[sp.index]
         .writes
@@ -58,6 +50,24 @@ pub(super) fn prepare(
     })
 }
 
+/// Triangle ids come from `@builtin(primitive_index)`: refused, naming the pass and the
+/// adapter, where the device lacks it.
+fn require_primitive_index(
+    features: wgpu::Features,
+    adapter: &str,
+    pass: &str,
+) -> Result<(), RenderError> {
+    if features.contains(wgpu::Features::PRIMITIVE_INDEX) {
+        return Ok(());
+    }
+    Err(pass_error(
+        pass,
+        format!(
+            "the visibility buffer writes triangle ids from the primitive index, which this adapter ({adapter}) does not offer (wgpu feature PRIMITIVE_INDEX)"
+        ),
+    ))
+}
+
 impl PreparedPass for VisibilityBuffer {
     fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
         // Integer targets clear to the colour's red as an integer: NO_TRIANGLE is exact in f64.
@@ -76,5 +86,18 @@ impl PreparedPass for VisibilityBuffer {
             multiview_mask: None,
         });
         self.draws.record(&mut pass);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn refuses_an_adapter_without_primitive_index() {
+        let e = super::require_primitive_index(wgpu::Features::empty(), "SomeGPU", "vis")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("vis") && e.contains("SomeGPU"), "{e}");
+        assert!(e.contains("PRIMITIVE_INDEX"), "{e}");
+        super::require_primitive_index(wgpu::Features::PRIMITIVE_INDEX, "SomeGPU", "vis").unwrap();
     }
 }
