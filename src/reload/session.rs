@@ -15,7 +15,10 @@
 
 use super::{normalize_path, ChangeBatch, DependencyIndex, FileWatcher, WatchConfig, WatchError};
 use crate::graph::{self, CompiledGraph, FrameSize};
-use crate::render::{FrameResult, MaterialProgram, PreparedFrame, Renderer, SceneGpu};
+use crate::render::{
+    FrameResult, GpuStateAtBuild, MaterialProgram, PipelineBuild, PreparedFrame, RenderTimings,
+    Renderer, SceneGpu,
+};
 use crate::scene::{self, Scene};
 use crate::shader::assets;
 use std::collections::BTreeSet;
@@ -29,8 +32,8 @@ pub enum SceneSource {
 }
 
 /// Where the time of one reload went. `shader_compose` and `pipeline_build` are part of
-/// `prepare`.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// `prepare`; the parts of `render` are in `frame`.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct ReloadTimings {
     /// Reading, validating and uploading changed scene and material files.
     pub assets: Duration,
@@ -42,8 +45,19 @@ pub struct ReloadTimings {
     pub shader_compose: Duration,
     /// Creating shader modules and pipelines (pipeline-cache misses).
     pub pipeline_build: Duration,
+    /// Of `pipeline_build`: `create_shader_module`.
+    pub shader_modules: Duration,
+    /// Of `pipeline_build`: `create_render/compute_pipeline` (with layouts).
+    pub pipeline_create: Duration,
+    /// Each pipeline built, named by pass and material.
+    pub builds: Vec<PipelineBuild>,
+    /// Whether the GPU was busy with earlier frames when the first build began.
+    pub gpu_at_build: GpuStateAtBuild,
     /// Executing the new frame and reading it back.
     pub render: Duration,
+    /// The parts of `render` (submit, GPU wait, GPU time, readbacks); `None` when the
+    /// reload rendered nothing.
+    pub frame: Option<RenderTimings>,
 }
 
 /// What one reload did.
@@ -56,8 +70,11 @@ pub struct Reload {
     pub outcome: Result<Duration, String>,
     /// When the watcher delivered the batch.
     pub received: Instant,
-    /// When the new frame was ready (or the reload gave up).
+    /// When the new frame was ready and read back (or the reload gave up).
     pub finished: Instant,
+    /// When the new frame's GPU work was done, before it was read back: what a viewer
+    /// presents from then on (`None` if nothing rendered).
+    pub frame_ready: Option<Instant>,
     /// What was reloaded: `graph`, `scene`, `material <name>`, `shaders`; empty when the
     /// batch touched nothing the frame uses.
     pub rebuilt: Vec<String>,
@@ -162,6 +179,7 @@ struct Candidate {
     frame: FrameResult,
     prepare_time: Duration,
     render_time: Duration,
+    render_timings: RenderTimings,
 }
 
 impl ReloadSession {
@@ -332,11 +350,13 @@ impl ReloadSession {
             rebuilt.push("shaders".into());
         }
         let mut timings = ReloadTimings::default();
+        let mut frame_ready = None;
         let outcome = if rebuilt.is_empty() {
             // Nothing the frame uses (another material in a watched folder, say).
             Ok(received.elapsed())
         } else {
             self.reload(shaders, &mut timings).map(|candidate| {
+                frame_ready = Some(candidate.render_timings.gpu_done);
                 self.commit(candidate);
                 received.elapsed()
             })
@@ -347,6 +367,7 @@ impl ReloadSession {
             outcome,
             received,
             finished: Instant::now(),
+            frame_ready,
             rebuilt,
             timings,
         }
@@ -398,8 +419,14 @@ impl ReloadSession {
             self.prepare_and_render(graph, scene.as_ref().map(|(s, _, _)| s), gpu.as_ref())?;
         t.prepare = c.prepare_time;
         t.render = c.render_time;
-        t.shader_compose = c.prepared.stats().shader_compose;
-        t.pipeline_build = c.prepared.stats().pipeline_build;
+        t.frame = Some(c.render_timings);
+        let stats = c.prepared.stats();
+        t.shader_compose = stats.shader_compose;
+        t.pipeline_build = stats.pipeline_build;
+        t.shader_modules = stats.shader_modules;
+        t.pipeline_create = stats.pipeline_create;
+        t.builds = stats.builds.clone();
+        t.gpu_at_build = stats.gpu_at_build;
         c.resolved = self.stale.clone();
         c.scene = scene;
         c.gpu = gpu;
@@ -446,7 +473,9 @@ impl ReloadSession {
             .map_err(|e| e.to_string())?;
         let prepare_time = start.elapsed();
         let start = Instant::now();
-        let frame = prepared.render(&self.renderer).map_err(|e| e.to_string())?;
+        let (frame, render_timings) = prepared
+            .render_timed(&self.renderer)
+            .map_err(|e| e.to_string())?;
         Ok(Candidate {
             resolved: BTreeSet::new(),
             scene: None,
@@ -456,6 +485,7 @@ impl ReloadSession {
             frame,
             prepare_time,
             render_time: start.elapsed(),
+            render_timings,
         })
     }
 

@@ -16,7 +16,42 @@ use crate::graph::Name;
 use crate::graph::{CompiledGraph, FrameSize};
 use crate::scene::{Camera, Scene};
 use glam::Vec3;
+use std::time::{Duration, Instant};
 use wgpu::util::DeviceExt;
+
+/// Where the time of one executed (and read back) frame went.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderTimings {
+    /// Encoding every pass and `queue.submit`.
+    pub record_submit: Duration,
+    /// From the submit returning to the GPU having finished the frame (a blocking poll):
+    /// the GPU's work plus whatever the driver does on the queue (first-use compiles).
+    pub gpu_wait: Duration,
+    /// When the frame's GPU work was done: what a viewer could present from then on.
+    pub gpu_done: Instant,
+    /// The GPU's own time, the sum of the passes' timestamps (where the adapter has them).
+    pub gpu_frame_ms: Option<f64>,
+    /// Reading the timestamps back.
+    pub timestamps_read: Duration,
+    /// Copying the output image to a staging buffer, mapping it and converting it.
+    pub image_readback: Duration,
+    /// Reading back what passes counted (culling reports) and light statistics.
+    pub reports_readback: Duration,
+}
+
+impl Default for RenderTimings {
+    fn default() -> Self {
+        Self {
+            record_submit: Duration::ZERO,
+            gpu_wait: Duration::ZERO,
+            gpu_done: Instant::now(),
+            gpu_frame_ms: None,
+            timestamps_read: Duration::ZERO,
+            image_readback: Duration::ZERO,
+            reports_readback: Duration::ZERO,
+        }
+    }
+}
 
 /// A pass's error, named with the graph file:line that declares the pass.
 fn at_pass(graph: &CompiledGraph, sp: &crate::graph::ScheduledPass, e: RenderError) -> RenderError {
@@ -80,6 +115,7 @@ impl Renderer {
         let generation = self.pipelines.next_generation();
         let before = self.pipelines.counters();
         self.pipelines.take_built();
+        self.pipelines.take_builds();
         let pool = previous.map(|p| &p.resources);
         let file = graph.checked.source.file.clone();
         let result = self.prepare_unscoped(graph, scene, gpu, size, light_stats, pool);
@@ -89,7 +125,13 @@ impl Renderer {
             .iter()
             .map(|k| k.describe())
             .collect();
-        let stats = PrepareStats::from_cache(self.pipelines.counters() - before, built, generation);
+        let stats = PrepareStats::from_cache(
+            self.pipelines.counters() - before,
+            built,
+            self.pipelines.take_builds(),
+            self.pipelines.gpu_state_at_build(),
+            generation,
+        );
         match pollster::block_on(scope.pop()) {
             Some(e) => Err(RenderError::Wgpu(format!("{}: {e}", file.display()))),
             None => result.map(|mut frame| {
@@ -140,6 +182,7 @@ impl Renderer {
         };
         let mut prepared = Vec::with_capacity(graph.passes.len());
         for sp in &graph.passes {
+            cx.renderer.pipelines.set_pass(&sp.name);
             let pass = passes::prepare(&mut cx, sp).map_err(|e| at_pass(&graph, sp, e))?;
             prepared.push((sp.name.clone(), pass));
         }
@@ -167,6 +210,7 @@ impl Renderer {
             )
         });
         let stats = if light_stats {
+            self.pipelines.set_pass("light statistics");
             Some(LightStatsPass::prepare(
                 self,
                 &graph,
@@ -202,6 +246,14 @@ impl PreparedFrame {
     /// Records and submits one frame; returns GPU milliseconds per pass when the
     /// adapter has timestamps.
     pub fn execute(&self, r: &Renderer) -> Result<Option<Vec<(String, f64)>>, RenderError> {
+        self.execute_timed(r).map(|(ms, _)| ms)
+    }
+
+    /// Like [`execute`](Self::execute), also saying where the time went.
+    pub fn execute_timed(
+        &self,
+        r: &Renderer,
+    ) -> Result<(Option<Vec<(String, f64)>>, RenderTimings), RenderError> {
         let scope = r.ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let result = self.execute_unscoped(r);
         match pollster::block_on(scope.pop()) {
@@ -210,7 +262,17 @@ impl PreparedFrame {
         }
     }
 
-    fn execute_unscoped(&self, r: &Renderer) -> Result<Option<Vec<(String, f64)>>, RenderError> {
+    /// Records and submits one frame without waiting for it (a viewer's frame in flight).
+    pub fn submit(&self, r: &Renderer) -> Result<(), RenderError> {
+        let scope = r.ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        r.ctx.queue.submit([self.encode(r)]);
+        match pollster::block_on(scope.pop()) {
+            Some(e) => Err(RenderError::Wgpu(e.to_string())),
+            None => Ok(()),
+        }
+    }
+
+    fn encode(&self, r: &Renderer) -> wgpu::CommandBuffer {
         let device = &r.ctx.device;
         let plan = &self.graph.plan;
         let mut encoder = device.create_command_encoder(&Default::default());
@@ -255,32 +317,60 @@ impl PreparedFrame {
         if let Some((q, buf)) = &self.queries {
             encoder.resolve_query_set(q, 0..2 * self.passes.len() as u32, buf, 0);
         }
-        r.ctx.queue.submit([encoder.finish()]);
+        encoder.finish()
+    }
+
+    fn execute_unscoped(
+        &self,
+        r: &Renderer,
+    ) -> Result<(Option<Vec<(String, f64)>>, RenderTimings), RenderError> {
+        let device = &r.ctx.device;
+        let start = Instant::now();
+        r.ctx.queue.submit([self.encode(r)]);
+        let submitted = Instant::now();
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| RenderError::Wgpu(e.to_string()))?;
+        let gpu_done = Instant::now();
+        let mut timings = RenderTimings {
+            record_submit: submitted - start,
+            gpu_wait: gpu_done - submitted,
+            gpu_done,
+            ..Default::default()
+        };
         let Some((_, buf)) = &self.queries else {
-            device
-                .poll(wgpu::PollType::wait_indefinitely())
-                .map_err(|e| RenderError::Wgpu(e.to_string()))?;
-            return Ok(None);
+            return Ok((None, timings));
         };
         let bytes = read_buffer(device, &r.ctx.queue, buf)?;
         let ticks: &[u64] = bytemuck::cast_slice(&bytes);
         let period = r.ctx.queue.get_timestamp_period() as f64;
-        Ok(Some(
-            self.passes
-                .iter()
-                .enumerate()
-                .map(|(i, (n, _))| {
-                    let dt = ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period;
-                    (n.to_string(), dt / 1e6)
-                })
-                .collect(),
-        ))
+        let pass_ms: Vec<(String, f64)> = self
+            .passes
+            .iter()
+            .enumerate()
+            .map(|(i, (n, _))| {
+                let dt = ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period;
+                (n.to_string(), dt / 1e6)
+            })
+            .collect();
+        timings.gpu_frame_ms = Some(pass_ms.iter().map(|(_, ms)| ms).sum());
+        timings.timestamps_read = gpu_done.elapsed();
+        Ok((Some(pass_ms), timings))
     }
 
     /// Runs one frame and reads back the output, culling reports and statistics.
     pub fn render(&self, r: &Renderer) -> Result<FrameResult, RenderError> {
-        let pass_ms = self.execute(r)?;
+        self.render_timed(r).map(|(frame, _)| frame)
+    }
+
+    /// Like [`render`](Self::render), also saying where the time went: recording and
+    /// submitting, waiting for the GPU, the GPU's own time, and the readbacks.
+    pub fn render_timed(&self, r: &Renderer) -> Result<(FrameResult, RenderTimings), RenderError> {
+        let (pass_ms, mut timings) = self.execute_timed(r)?;
+        let start = Instant::now();
         let image = read_rgba32f(&r.ctx.device, &r.ctx.queue, self.output_texture())?;
+        timings.image_readback = start.elapsed();
+        let start = Instant::now();
         let (mut culling, mut shadows, mut atlases) = (Vec::new(), Vec::new(), Vec::new());
         let (mut shadow_compare, mut links, mut vpls) = (Vec::new(), Vec::new(), Vec::new());
         for report in self.pass_reports(r)? {
@@ -294,7 +384,8 @@ impl PreparedFrame {
             }
         }
         let light_stats = self.read_light_stats(r)?;
-        Ok(FrameResult {
+        timings.reports_readback = start.elapsed();
+        let frame = FrameResult {
             width: self.size.width,
             height: self.size.height,
             image,
@@ -306,7 +397,8 @@ impl PreparedFrame {
             shadow_compare,
             vpls,
             light_stats,
-        })
+        };
+        Ok((frame, timings))
     }
 
     /// The graph's output texture (Rgba32Float; sampled by the viewer). Planned for every

@@ -18,9 +18,11 @@ pub mod visibility_geometry;
 
 pub use bind::LayoutCache;
 pub use device_limits::supported_sample_counts;
-pub use frame::PreparedFrame;
+pub use frame::{PreparedFrame, RenderTimings};
 pub use materials::MaterialProgram;
-pub use pipelines::{CacheCounters, Pipeline, PipelineCache, PipelineKey};
+pub use pipelines::{
+    CacheCounters, GpuStateAtBuild, Pipeline, PipelineBuild, PipelineCache, PipelineKey,
+};
 pub use prepare_stats::PrepareStats;
 pub use report::{
     AtlasReport, CullingReport, FrameResult, LightStats, LinkReport, PassReport,

@@ -45,6 +45,48 @@ impl PipelineKey {
         }
         out
     }
+
+    /// The shader and the material its generated code comes from, without defines and
+    /// state: ``forward/forward.wgsl `car_paint` ``.
+    /// Without a material, the state (a compute pipeline's entry point) tells a shader's
+    /// pipelines apart.
+    pub fn short(&self) -> String {
+        let mut out = self.shader.clone();
+        let mut material = false;
+        for code in self.virtual_code.values() {
+            if let Some(name) = code.lines().next().unwrap_or("").split('`').nth(1) {
+                out.push_str(&format!(" `{name}`"));
+                material = true;
+            }
+        }
+        if !material && !self.state.is_empty() {
+            out.push_str(&format!(" ({})", self.state));
+        }
+        out
+    }
+}
+
+/// One pipeline built: which pass asked for it and where its time went.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PipelineBuild {
+    /// The pass being prepared when it was asked for (see [`PipelineCache::set_pass`]).
+    pub pass: String,
+    /// [`PipelineKey::short`]: shader and material.
+    pub pipeline: String,
+    /// Composing the shader source and validating it with naga.
+    pub compose: Duration,
+    /// `create_shader_module` (naga's WGSL front end and SPIR-V back end in wgpu).
+    pub module: Duration,
+    /// The pass's build function: layouts and `create_render/compute_pipeline` (the
+    /// driver's compile, unless it defers it to first use).
+    pub create: Duration,
+}
+
+impl PipelineBuild {
+    /// `pass: shader `material``, the name the benchmark shows.
+    pub fn name(&self) -> String {
+        format!("{}: {}", self.pass, self.pipeline)
+    }
 }
 
 #[derive(Clone)]
@@ -87,8 +129,12 @@ pub struct CacheCounters {
     pub builds: usize,
     /// Time spent composing shader sources and validating them with naga.
     pub compose: Duration,
-    /// Time spent creating shader modules and pipelines.
+    /// Time spent creating shader modules and pipelines (`module` + `create`).
     pub build: Duration,
+    /// Of `build`: creating shader modules.
+    pub module: Duration,
+    /// Of `build`: the build functions (`create_render/compute_pipeline`).
+    pub create: Duration,
 }
 
 impl std::ops::Sub for CacheCounters {
@@ -100,6 +146,8 @@ impl std::ops::Sub for CacheCounters {
             builds: self.builds - earlier.builds,
             compose: self.compose.saturating_sub(earlier.compose),
             build: self.build.saturating_sub(earlier.build),
+            module: self.module.saturating_sub(earlier.module),
+            create: self.create.saturating_sub(earlier.create),
         }
     }
 }
@@ -121,10 +169,30 @@ pub struct PipelineCache {
     hits: usize,
     misses: usize,
     compose_time: Duration,
-    build_time: Duration,
+    module_time: Duration,
+    create_time: Duration,
     /// Keys built since the last [`take_built`](Self::take_built).
     built: Vec<PipelineKey>,
+    /// What each build since the last [`take_builds`](Self::take_builds) cost.
+    records: Vec<PipelineBuild>,
+    /// The pass being prepared, named in [`PipelineBuild::pass`].
+    pass: String,
     generation: u64,
+    /// Whether the GPU was still busy when this generation's first build started
+    /// (`None`: nothing built yet in this generation).
+    gpu_busy: Option<bool>,
+    /// Wait for the GPU to go idle before a generation's first build, and how long that took.
+    pub wait_for_idle_before_build: bool,
+    gpu_wait: Duration,
+}
+
+/// Whether the GPU was busy with earlier submissions when a prepare's first pipeline
+/// build began, and how long waiting for it took (zero unless asked for).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GpuStateAtBuild {
+    /// `None`: nothing was built.
+    pub busy: Option<bool>,
+    pub wait: Duration,
 }
 
 impl PipelineCache {
@@ -159,17 +227,30 @@ impl PipelineCache {
         let start = Instant::now();
         let composed = shaders.compose(&key.shader, &key.defines, &key.virtual_code);
         let composed = composed.and_then(|c| c.validate().map(|m| (c, m)));
-        self.compose_time += start.elapsed();
+        let compose = start.elapsed();
+        self.compose_time += compose;
         let (composed, naga_module) = composed?;
         let bindings: Arc<[ReflectedBinding]> = reflect_bindings(&naga_module).into();
+        self.note_gpu_state(device);
         let start = Instant::now();
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(&key.shader),
             source: wgpu::ShaderSource::Wgsl(composed.text.clone().into()),
         });
+        let module_time = start.elapsed();
+        let start = Instant::now();
         let pipeline = build(&composed, module, &bindings);
-        self.build_time += start.elapsed();
+        let create = start.elapsed();
+        self.module_time += module_time;
+        self.create_time += create;
         self.builds += 1;
+        self.records.push(PipelineBuild {
+            pass: self.pass.clone(),
+            pipeline: key.short(),
+            compose,
+            module: module_time,
+            create,
+        });
         self.built.push(key.clone());
         self.pipelines.insert(
             key,
@@ -197,7 +278,51 @@ impl PipelineCache {
             misses: self.misses,
             builds: self.builds,
             compose: self.compose_time,
-            build: self.build_time,
+            build: self.module_time + self.create_time,
+            module: self.module_time,
+            create: self.create_time,
+        }
+    }
+
+    /// Names the pass whose pipelines are asked for next (in [`PipelineBuild::pass`]).
+    pub fn set_pass(&mut self, pass: &str) {
+        pass.clone_into(&mut self.pass);
+    }
+
+    /// What each build since the last call cost, oldest first.
+    pub fn take_builds(&mut self) -> Vec<PipelineBuild> {
+        std::mem::take(&mut self.records)
+    }
+
+    /// Whether the GPU was busy when this generation's first build began.
+    pub fn gpu_state_at_build(&self) -> GpuStateAtBuild {
+        GpuStateAtBuild {
+            busy: self.gpu_busy,
+            wait: self.gpu_wait,
+        }
+    }
+
+    /// Before a generation's first build: records whether the queue still had work
+    /// (a non-blocking poll) and, if asked, waits for it, timed. Drivers may serialise
+    /// pipeline creation behind in-flight work; this tells the two apart.
+    fn note_gpu_state(&mut self, device: &wgpu::Device) {
+        if self.gpu_busy.is_some() {
+            return;
+        }
+        let busy = match device.poll(wgpu::PollType::Poll) {
+            Ok(status) => !status.is_queue_empty(),
+            Err(e) => {
+                log::warn!("pipeline cache: polling the device: {e}");
+                false
+            }
+        };
+        self.gpu_busy = Some(busy);
+        if busy && self.wait_for_idle_before_build {
+            let start = Instant::now();
+            if let Err(e) = device.poll(wgpu::PollType::wait_indefinitely()) {
+                log::warn!("pipeline cache: waiting for the GPU: {e}");
+            }
+            self.gpu_wait = start.elapsed();
         }
     }
 
@@ -210,6 +335,8 @@ impl PipelineCache {
     /// [`evict_unused_since`](Self::evict_unused_since) can drop the ones a replaced frame
     /// alone used (old material versions, say) and the cache stays bounded under edits.
     pub fn next_generation(&mut self) -> u64 {
+        self.gpu_busy = None;
+        self.gpu_wait = Duration::ZERO;
         self.generation += 1;
         self.generation
     }
