@@ -299,6 +299,7 @@ pub fn run(
         Target::load(EditKind::Graph, graph.clone(), config.salt)?,
     ];
 
+    let pipeline_cache = gpu.pipeline_cache_status();
     let renderer = Renderer::new(gpu, ShaderLibrary::new(&shaders));
     let started = Instant::now();
     let mut session = ReloadSession::new(
@@ -317,8 +318,12 @@ pub fn run(
             pipelines_built: p.stats().pipelines_built.len(),
             shader_compose_ms: ms(p.stats().shader_compose),
             pipeline_build_ms: ms(p.stats().pipeline_build),
+            pipeline_cache,
         },
-        None => Startup::default(),
+        None => Startup {
+            pipeline_cache,
+            ..Default::default()
+        },
     };
     session.renderer.pipelines.wait_for_idle_before_build = config.wait_for_idle_before_build;
 
@@ -394,12 +399,14 @@ pub fn run(
 
 /// What starting the session (loading, the first prepare and render) cost: with a warm
 /// pipeline cache on disk, the builds here are where it shows.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct Startup {
     pub total_ms: f64,
     pub pipelines_built: usize,
     pub shader_compose_ms: f64,
     pub pipeline_build_ms: f64,
+    /// The driver's pipeline cache on disk: where, and what opening it found.
+    pub pipeline_cache: String,
 }
 
 /// A benchmark run: the session's start and every timed edit.
@@ -634,8 +641,13 @@ pub fn to_markdown(
     let st = &run.startup;
     let _ = writeln!(
         out,
-        "Session start: {:.1} ms; {} pipelines built (compose + naga {:.1} ms, build {:.1} ms).\n",
-        st.total_ms, st.pipelines_built, st.shader_compose_ms, st.pipeline_build_ms
+        "Session start: {:.1} ms; {} pipelines built (compose + naga {:.1} ms, build {:.1} ms). \
+         Pipeline cache: {}.\n",
+        st.total_ms,
+        st.pipelines_built,
+        st.shader_compose_ms,
+        st.pipeline_build_ms,
+        st.pipeline_cache
     );
     let kinds = summarize_kinds(samples);
     let _ = writeln!(out, "| edit | median | p10 | p90 |");

@@ -160,6 +160,7 @@ pub fn reload_bench(args: &ReloadBenchArgs) -> Result<()> {
     let gpu = lightgraph::gpu::GpuContext::new_headless()?;
     let adapter = gpu.adapter_name();
     println!("adapter: {adapter}");
+    println!("pipeline cache: {}", gpu.pipeline_cache_status());
     let result = rl::run(&config, gpu, |s| {
         println!(
             "{:<8} #{:<3} {:>8.1} ms  (watch {:.1}, compose {:.1}, build {:.1} [modules {:.1}, pipelines {:.1}{}], render {:.1} [submit {:.1}, GPU wait {:.1}, image readback {:.1}; again {:.1}]; {} pipelines built, {} resources reused, {} created)",

@@ -362,11 +362,17 @@ impl ReloadSession {
             })
         };
         self.error = outcome.as_ref().err().cloned();
+        let finished = Instant::now();
+        if !timings.builds.is_empty() {
+            // After the frame, outside the latency: what the builds added to the driver's
+            // pipeline cache goes to disk.
+            self.renderer.pipelines.save_driver_cache();
+        }
         Reload {
             changed,
             outcome,
             received,
-            finished: Instant::now(),
+            finished,
             frame_ready,
             rebuilt,
             timings,

@@ -70,9 +70,9 @@ pub struct Renderer {
 impl Renderer {
     pub fn new(ctx: GpuContext, shaders: ShaderLibrary) -> Self {
         Self {
+            pipelines: PipelineCache::with_driver_cache(ctx.pipeline_cache.clone()),
             ctx,
             shaders,
-            pipelines: PipelineCache::default(),
             layouts: Default::default(),
         }
     }

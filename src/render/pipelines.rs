@@ -3,11 +3,34 @@
 //! hits, misses and builds and times composing and building, so hot reload can show
 //! (and tests can check) exactly what an edit rebuilt.
 
+use crate::gpu::pipeline_cache::DiskPipelineCache;
 use crate::shader::{reflect_bindings, Composed, ReflectedBinding, ShaderError, ShaderLibrary};
+use std::cell::RefCell;
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
+
+thread_local! {
+    /// The driver cache of the pipeline a build function on this thread is building.
+    static DRIVER_CACHE: RefCell<Option<wgpu::PipelineCache>> = const { RefCell::new(None) };
+}
+
+/// The driver's pipeline cache (kept on disk) for the pipeline being built: every
+/// pipeline descriptor made in a [`PipelineCache`] build function sets
+/// `cache: driver_cache().as_ref()`. `None` outside build functions and where the adapter
+/// has no pipeline cache.
+pub fn driver_cache() -> Option<wgpu::PipelineCache> {
+    DRIVER_CACHE.with(|c| c.borrow().clone())
+}
+
+/// Runs `f` with [`driver_cache`] answering `cache`, then restores what it answered.
+fn with_driver_cache<R>(cache: Option<wgpu::PipelineCache>, f: impl FnOnce() -> R) -> R {
+    let previous = DRIVER_CACHE.with(|c| c.replace(cache));
+    let result = f();
+    DRIVER_CACHE.with(|c| c.replace(previous));
+    result
+}
 
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct PipelineKey {
@@ -111,7 +134,7 @@ impl Pipeline {
                 module,
                 entry_point: Some(entry),
                 compilation_options: Default::default(),
-                cache: None,
+                cache: driver_cache().as_ref(),
             },
         )))
     }
@@ -184,6 +207,8 @@ pub struct PipelineCache {
     /// Wait for the GPU to go idle before a generation's first build, and how long that took.
     pub wait_for_idle_before_build: bool,
     gpu_wait: Duration,
+    /// The driver's pipeline cache on disk, handed to every build (see [`driver_cache`]).
+    driver: Option<Arc<DiskPipelineCache>>,
 }
 
 /// Whether the GPU was busy with earlier submissions when a prepare's first pipeline
@@ -196,6 +221,22 @@ pub struct GpuStateAtBuild {
 }
 
 impl PipelineCache {
+    /// An empty cache whose builds use (and fill) the driver's pipeline cache `driver`.
+    pub fn with_driver_cache(driver: Option<Arc<DiskPipelineCache>>) -> Self {
+        Self {
+            driver,
+            ..Default::default()
+        }
+    }
+
+    /// Saves the driver's pipeline cache if it holds anything new (after a reload's
+    /// builds; it is saved on exit too). A failure is logged: the cache only saves time.
+    pub fn save_driver_cache(&self) {
+        if let Some(d) = &self.driver {
+            d.save_or_warn();
+        }
+    }
+
     /// Returns the cached pipeline or composes, validates (naga, with file:line errors)
     /// and builds it with `build`.
     pub fn get_or_build(
@@ -239,7 +280,8 @@ impl PipelineCache {
         });
         let module_time = start.elapsed();
         let start = Instant::now();
-        let pipeline = build(&composed, module, &bindings);
+        let driver = self.driver.as_ref().map(|d| d.cache().clone());
+        let pipeline = with_driver_cache(driver, || build(&composed, module, &bindings));
         let create = start.elapsed();
         self.module_time += module_time;
         self.create_time += create;
