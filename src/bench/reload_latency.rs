@@ -91,6 +91,9 @@ pub struct ReloadBenchConfig {
     pub frames_in_flight: usize,
     /// Wait for the GPU to go idle before building pipelines (timed in its own column).
     pub wait_for_idle_before_build: bool,
+    /// Build one pass's pipelines after another (the renderer builds them on one thread
+    /// per pass by default).
+    pub sequential_builds: bool,
 }
 
 /// One timed edit, in milliseconds.
@@ -117,6 +120,9 @@ pub struct ReloadSample {
     /// The same frame rendered again right after (not part of the latency): what of
     /// `render_ms` was the frame itself rather than first-use work in the driver.
     pub rerender_ms: f64,
+    /// Composing and building, wall time (less than the sum of the two with parallel
+    /// builds).
+    pub build_wall_ms: f64,
     /// Of `pipeline_build_ms`: `create_shader_module`.
     pub shader_module_ms: f64,
     /// Of `pipeline_build_ms`: `create_render/compute_pipeline` (with layouts).
@@ -326,6 +332,7 @@ pub fn run(
         },
     };
     session.renderer.pipelines.wait_for_idle_before_build = config.wait_for_idle_before_build;
+    session.renderer.pipelines.parallel_builds = !config.sequential_builds;
 
     let mut samples = Vec::new();
     for index in 0..config.repeats {
@@ -370,9 +377,8 @@ pub fn run(
                 graph_ms: ms(tm.graph),
                 shader_compose_ms: ms(tm.shader_compose),
                 pipeline_build_ms: ms(tm.pipeline_build),
-                prepare_other_ms: ms(tm
-                    .prepare
-                    .saturating_sub(tm.shader_compose + tm.pipeline_build)),
+                prepare_other_ms: ms(tm.prepare.saturating_sub(tm.build_wall)),
+                build_wall_ms: ms(tm.build_wall),
                 render_ms: ms(tm.render),
                 rerender_ms,
                 shader_module_ms: ms(tm.shader_modules),
@@ -462,7 +468,8 @@ const PARTS: [Part; 8] = [
 
 /// The parts of "pipeline build" and "render + readback" (not adding up to the total:
 /// `GPU frame` overlaps `submit → GPU done`).
-const DETAILS: [Part; 9] = [
+const DETAILS: [Part; 10] = [
+    ("compose + build, wall", |s| s.build_wall_ms),
     ("build: create_shader_module", |s| s.shader_module_ms),
     ("build: create_*_pipeline", |s| s.pipeline_create_ms),
     ("wait for idle GPU before build", |s| {
@@ -543,14 +550,14 @@ pub fn to_csv(samples: &[ReloadSample]) -> String {
          prepare_other_ms,render_ms,rerender_ms,pipelines_built,resources_created,resources_reused,\
          shader_module_ms,pipeline_create_ms,gpu_busy_at_build,gpu_wait_before_build_ms,\
          record_submit_ms,gpu_wait_ms,gpu_frame_ms,image_readback_ms,reports_readback_ms,\
-         rerender_gpu_wait_ms,slowest_pipeline,slowest_pipeline_create_ms\n",
+         rerender_gpu_wait_ms,slowest_pipeline,slowest_pipeline_create_ms,build_wall_ms\n",
     );
     for s in samples {
         let slowest = s.builds.iter().max_by(|a, b| a.create.cmp(&b.create));
         let _ = writeln!(
             out,
             "{},{},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{},{},{},\
-             {:.3},{:.3},{},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},\"{}\",{:.3}",
+             {:.3},{:.3},{},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},\"{}\",{:.3},{:.3}",
             s.kind,
             s.index,
             s.total_ms,
@@ -581,6 +588,7 @@ pub fn to_csv(samples: &[ReloadSample]) -> String {
             s.rerender_gpu_wait_ms,
             slowest.map_or(String::new(), |b| b.name().replace('"', "'")),
             slowest.map_or(0.0, |b| b.create.as_secs_f64() * 1e3),
+            s.build_wall_ms,
         );
     }
     out
@@ -623,8 +631,9 @@ pub fn to_markdown(
         out,
         "Adapter: {adapter}. Scene: harada geometry, boxes in `car_paint.ron`, {} random \
          lights; `forward_plus.ron`; {}×{}; {} edits of each kind, interleaved. Watcher \
-         debounce {} ms. Edit salt {}; {} frames in flight at each edit; {}. Times from the \
-         file write returning to the new frame read back.\n",
+         debounce {} ms. Edit salt {}; {} frames in flight at each edit; {}; pipelines of \
+         different passes built {}. Times from the file write returning to the new frame \
+         read back.\n",
         config.lights,
         config.width,
         config.height,
@@ -636,6 +645,11 @@ pub fn to_markdown(
             "waiting for an idle GPU before building"
         } else {
             "building without waiting for the GPU"
+        },
+        if config.sequential_builds {
+            "one after another"
+        } else {
+            "in parallel"
         }
     );
     let st = &run.startup;
@@ -663,7 +677,10 @@ pub fn to_markdown(
         out,
         "\nMedian of each part (ms); the parts before \"(same frame again)\" add up to the \
          total, which does not include that last one: the new frame rendered a second time, \
-         to tell the frame itself from first-use work in the driver.\n"
+         to tell the frame itself from first-use work in the driver. With pipelines built \
+         in parallel, \"shader compose + naga\" and \"pipeline build\" add up every \
+         thread's time; what they took together is \"compose + build, wall\" below, and \
+         \"other prepare\" is the rest of prepare.\n"
     );
     let _ = write!(out, "| edit |");
     for (name, _) in PARTS {

@@ -156,6 +156,7 @@ pub fn reload_bench(args: &ReloadBenchArgs) -> Result<()> {
         salt: args.salt,
         frames_in_flight: args.frames_in_flight,
         wait_for_idle_before_build: args.wait_for_idle_before_build,
+        sequential_builds: args.sequential_builds,
     };
     let gpu = lightgraph::gpu::GpuContext::new_headless()?;
     let adapter = gpu.adapter_name();

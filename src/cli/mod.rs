@@ -173,6 +173,10 @@ pub struct ReloadBenchArgs {
     /// Wait for the GPU to go idle before building pipelines (timed in its own column).
     #[arg(long)]
     pub wait_for_idle_before_build: bool,
+    /// Build the pipelines of different passes one after another, as before they were
+    /// built in parallel (for comparison).
+    #[arg(long)]
+    pub sequential_builds: bool,
 }
 
 #[derive(clap::Args, Default)]

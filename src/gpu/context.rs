@@ -15,7 +15,8 @@ pub enum GpuError {
     Readback(String),
 }
 
-/// A headless wgpu device and queue, plus what the adapter can do.
+/// A headless wgpu device and queue, plus what the adapter can do. Clones share them.
+#[derive(Clone)]
 pub struct GpuContext {
     pub adapter: wgpu::Adapter,
     pub device: wgpu::Device,

@@ -49,6 +49,9 @@ pub struct ReloadTimings {
     pub shader_modules: Duration,
     /// Of `pipeline_build`: `create_render/compute_pipeline` (with layouts).
     pub pipeline_create: Duration,
+    /// Wall time of `shader_compose` and `pipeline_build` together: less than their sum
+    /// when pipelines were built in parallel.
+    pub build_wall: Duration,
     /// Each pipeline built, named by pass and material.
     pub builds: Vec<PipelineBuild>,
     /// Whether the GPU was busy with earlier frames when the first build began.
@@ -431,6 +434,7 @@ impl ReloadSession {
         t.pipeline_build = stats.pipeline_build;
         t.shader_modules = stats.shader_modules;
         t.pipeline_create = stats.pipeline_create;
+        t.build_wall = stats.build_wall;
         t.builds = stats.builds.clone();
         t.gpu_at_build = stats.gpu_at_build;
         c.resolved = self.stale.clone();

@@ -53,6 +53,82 @@ impl Default for RenderTimings {
     }
 }
 
+/// Builds the pipelines the passes lack on scoped threads, one per pass, before the
+/// sequential prepare: each thread prepares its pass with a fork of the pipeline cache
+/// (and its own validation error scope) and drops the prepared pass; the forks' new
+/// pipelines are adopted in pass order, and the sequential prepare then finds them,
+/// counting and naming them as if it had built them (`PipelineCache::adopt`). A pass
+/// that fails on its thread contributes nothing: the sequential prepare meets the same
+/// error and reports it as before. Drivers compile pipelines concurrently (wgpu's Device
+/// is Send + Sync), so a reload rebuilding pipelines of several passes waits for the
+/// slowest instead of the sum.
+fn prebuild_in_parallel(cx: &mut PrepareCtx<'_>) {
+    let passes = &cx.graph.passes;
+    if !cx.renderer.pipelines.parallel_builds || passes.len() < 2 {
+        return;
+    }
+    let r = &mut *cx.renderer;
+    // Whether earlier frames were still on the GPU, noted before any thread builds.
+    r.pipelines.note_gpu_state_now(&r.ctx.device);
+    let (graph, gpu, resources, frame_uniform, size, scene) = (
+        cx.graph,
+        cx.gpu,
+        cx.resources,
+        cx.frame_uniform,
+        cx.size,
+        cx.scene,
+    );
+    let start = Instant::now();
+    let forks: Vec<Option<super::pipelines::ForkBuilds>> = std::thread::scope(|s| {
+        let threads: Vec<_> = passes
+            .iter()
+            .map(|sp| {
+                let mut fork = Renderer {
+                    ctx: r.ctx.clone(),
+                    shaders: r.shaders.clone(),
+                    pipelines: r.pipelines.fork(),
+                    layouts: r.layouts.clone(),
+                };
+                s.spawn(move || {
+                    fork.pipelines.set_pass(&sp.name);
+                    // Error scopes are per thread: this one sees this pass's errors.
+                    let scope = fork
+                        .ctx
+                        .device
+                        .push_error_scope(wgpu::ErrorFilter::Validation);
+                    let prepared = passes::prepare(
+                        &mut PrepareCtx {
+                            renderer: &mut fork,
+                            graph,
+                            gpu,
+                            resources,
+                            frame_uniform,
+                            size,
+                            scene,
+                        },
+                        sp,
+                    )
+                    .is_ok();
+                    let clean = pollster::block_on(scope.pop()).is_none();
+                    (prepared && clean).then(|| fork.pipelines.into_builds())
+                })
+            })
+            .collect();
+        threads
+            .into_iter()
+            .map(|t| t.join().ok().flatten())
+            .collect()
+    });
+    let mut built = 0;
+    for f in forks.into_iter().flatten() {
+        built += f.len();
+        r.pipelines.adopt(f);
+    }
+    if built > 0 {
+        r.pipelines.add_build_wall(start.elapsed());
+    }
+}
+
 /// A pass's error, named with the graph file:line that declares the pass.
 fn at_pass(graph: &CompiledGraph, sp: &crate::graph::ScheduledPass, e: RenderError) -> RenderError {
     let problem = match e {
@@ -119,6 +195,8 @@ impl Renderer {
         let pool = previous.map(|p| &p.resources);
         let file = graph.checked.source.file.clone();
         let result = self.prepare_unscoped(graph, scene, gpu, size, light_stats, pool);
+        self.pipelines.settle_prebuilt();
+        let build_wall = self.pipelines.take_build_wall();
         let built = self
             .pipelines
             .take_built()
@@ -136,6 +214,7 @@ impl Renderer {
             Some(e) => Err(RenderError::Wgpu(format!("{}: {e}", file.display()))),
             None => result.map(|mut frame| {
                 frame.prepare_stats = PrepareStats {
+                    build_wall,
                     resources_created: frame.resources.created(),
                     resources_reused: frame.resources.reused(),
                     ..stats
@@ -180,6 +259,7 @@ impl Renderer {
             size,
             scene,
         };
+        prebuild_in_parallel(&mut cx);
         let mut prepared = Vec::with_capacity(graph.passes.len());
         for sp in &graph.passes {
             cx.renderer.pipelines.set_pass(&sp.name);

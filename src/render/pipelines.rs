@@ -158,6 +158,8 @@ pub struct CacheCounters {
     pub module: Duration,
     /// Of `build`: the build functions (`create_render/compute_pipeline`).
     pub create: Duration,
+    /// Of `builds`: those built ahead on other threads ([`PipelineCache::fork`]).
+    pub prebuilt: usize,
 }
 
 impl std::ops::Sub for CacheCounters {
@@ -171,10 +173,12 @@ impl std::ops::Sub for CacheCounters {
             build: self.build.saturating_sub(earlier.build),
             module: self.module.saturating_sub(earlier.module),
             create: self.create.saturating_sub(earlier.create),
+            prebuilt: self.prebuilt - earlier.prebuilt,
         }
     }
 }
 
+#[derive(Clone)]
 struct Entry {
     pipeline: Pipeline,
     /// The composed shader's bindings, as naga reflects them.
@@ -183,6 +187,24 @@ struct Entry {
     files: Vec<PathBuf>,
     /// The generation that last asked for it (see [`PipelineCache::next_generation`]).
     last_used: u64,
+    /// Built on another thread ahead of the sequential prepare ([`PipelineCache::fork`]):
+    /// the first request counts it as the miss and build it replaced, with these times,
+    /// so counts, order and names are what a sequential prepare reports.
+    prebuilt: Option<PipelineBuild>,
+}
+
+/// What a [`PipelineCache::fork`] built, for [`PipelineCache::adopt`].
+pub struct ForkBuilds {
+    entries: Vec<(PipelineKey, Entry)>,
+}
+
+impl ForkBuilds {
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
 }
 
 #[derive(Default)]
@@ -192,6 +214,8 @@ pub struct PipelineCache {
     hits: usize,
     misses: usize,
     compose_time: Duration,
+    /// Builds done ahead on other threads and taken over.
+    prebuilt: usize,
     module_time: Duration,
     create_time: Duration,
     /// Keys built since the last [`take_built`](Self::take_built).
@@ -209,6 +233,13 @@ pub struct PipelineCache {
     gpu_wait: Duration,
     /// The driver's pipeline cache on disk, handed to every build (see [`driver_cache`]).
     driver: Option<Arc<DiskPipelineCache>>,
+    /// Prepare builds the pipelines a frame lacks on one thread per pass before the
+    /// sequential prepare (see `Renderer::prepare_reusing`); on by default.
+    pub parallel_builds: bool,
+    /// Wall time of composing and building since the last
+    /// [`take_build_wall`](Self::take_build_wall): the parallel phases, plus the builds
+    /// done in sequence.
+    build_wall: Duration,
 }
 
 /// Whether the GPU was busy with earlier submissions when a prepare's first pipeline
@@ -225,7 +256,70 @@ impl PipelineCache {
     pub fn with_driver_cache(driver: Option<Arc<DiskPipelineCache>>) -> Self {
         Self {
             driver,
+            parallel_builds: true,
             ..Default::default()
+        }
+    }
+
+    /// A cache for another thread: the same pipelines (shared handles), generation,
+    /// driver cache and pass, fresh counters. What it builds comes back with
+    /// [`into_builds`](Self::into_builds) and [`adopt`](Self::adopt).
+    pub fn fork(&self) -> Self {
+        Self {
+            pipelines: self.pipelines.clone(),
+            generation: self.generation,
+            // The GPU's state was noted (or not needed) before forking.
+            gpu_busy: Some(self.gpu_busy.unwrap_or(false)),
+            driver: self.driver.clone(),
+            pass: self.pass.clone(),
+            ..Default::default()
+        }
+    }
+
+    /// The pipelines this fork built (not those it was forked with).
+    pub fn into_builds(mut self) -> ForkBuilds {
+        let mut records = self.records.into_iter();
+        let entries = self
+            .built
+            .into_iter()
+            .filter_map(|key| {
+                let mut entry = self.pipelines.remove(&key)?;
+                entry.prebuilt = records.next();
+                Some((key, entry))
+            })
+            .collect();
+        ForkBuilds { entries }
+    }
+
+    /// Takes over what forks built, in the order given (the first of two builds of one
+    /// key wins; forks are adopted in pass order, so the result does not depend on which
+    /// thread finished first).
+    pub fn adopt(&mut self, builds: ForkBuilds) {
+        for (key, entry) in builds.entries {
+            self.pipelines.entry(key).or_insert(entry);
+        }
+    }
+
+    /// Adds the wall time of a parallel build phase.
+    pub fn add_build_wall(&mut self, wall: Duration) {
+        self.build_wall += wall;
+    }
+
+    /// Wall time of composing and building since the last call.
+    pub fn take_build_wall(&mut self) -> Duration {
+        std::mem::take(&mut self.build_wall)
+    }
+
+    /// Notes now whether the GPU is busy, before builds on other threads begin.
+    pub fn note_gpu_state_now(&mut self, device: &wgpu::Device) {
+        self.note_gpu_state(device);
+    }
+
+    /// Marks what forks built and nothing asked for as plain entries: a later request is
+    /// a hit, as it would have been after a sequential build.
+    pub fn settle_prebuilt(&mut self) {
+        for e in self.pipelines.values_mut() {
+            e.prebuilt = None;
         }
     }
 
@@ -261,7 +355,21 @@ impl PipelineCache {
     ) -> Result<(Pipeline, Arc<[ReflectedBinding]>), ShaderError> {
         if let Some(e) = self.pipelines.get_mut(&key) {
             e.last_used = self.generation;
-            self.hits += 1;
+            match e.prebuilt.take() {
+                // Built ahead on another thread: counted here, in request order.
+                Some(mut record) => {
+                    self.misses += 1;
+                    self.builds += 1;
+                    self.prebuilt += 1;
+                    self.compose_time += record.compose;
+                    self.module_time += record.module;
+                    self.create_time += record.create;
+                    self.pass.clone_into(&mut record.pass);
+                    self.records.push(record);
+                    self.built.push(key.clone());
+                }
+                None => self.hits += 1,
+            }
             return Ok((e.pipeline.clone(), e.bindings.clone()));
         }
         self.misses += 1;
@@ -270,6 +378,7 @@ impl PipelineCache {
         let composed = composed.and_then(|c| c.validate().map(|m| (c, m)));
         let compose = start.elapsed();
         self.compose_time += compose;
+        self.build_wall += compose;
         let (composed, naga_module) = composed?;
         let bindings: Arc<[ReflectedBinding]> = reflect_bindings(&naga_module).into();
         self.note_gpu_state(device);
@@ -283,6 +392,7 @@ impl PipelineCache {
         let driver = self.driver.as_ref().map(|d| d.cache().clone());
         let pipeline = with_driver_cache(driver, || build(&composed, module, &bindings));
         let create = start.elapsed();
+        self.build_wall += module_time + create;
         self.module_time += module_time;
         self.create_time += create;
         self.builds += 1;
@@ -301,6 +411,7 @@ impl PipelineCache {
                 bindings: bindings.clone(),
                 files: composed.files.clone(),
                 last_used: self.generation,
+                prebuilt: None,
             },
         );
         Ok((pipeline, bindings))
@@ -323,6 +434,7 @@ impl PipelineCache {
             build: self.module_time + self.create_time,
             module: self.module_time,
             create: self.create_time,
+            prebuilt: self.prebuilt,
         }
     }
 

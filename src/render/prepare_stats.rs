@@ -26,8 +26,14 @@ pub struct PrepareStats {
     pub pipeline_create: Duration,
     /// Each pipeline built, in the order asked for.
     pub builds: Vec<PipelineBuild>,
+    /// Of the pipelines built, those built on the passes' threads ahead of the
+    /// sequential prepare.
+    pub pipelines_built_in_parallel: usize,
     /// Whether the GPU still had earlier frames' work when the first build began.
     pub gpu_at_build: GpuStateAtBuild,
+    /// Wall time of composing and building: with parallel builds less than
+    /// `shader_compose + pipeline_build`, which add up each thread's time.
+    pub build_wall: Duration,
     /// The pipeline-cache generation this prepare used (see
     /// [`PipelineCache::evict_unused_since`](super::PipelineCache::evict_unused_since)).
     pub cache_generation: u64,
@@ -43,6 +49,7 @@ impl PrepareStats {
     ) -> Self {
         Self {
             shader_modules: delta.module,
+            pipelines_built_in_parallel: delta.prebuilt,
             pipeline_create: delta.create,
             builds,
             gpu_at_build,
