@@ -13,38 +13,68 @@ use std::path::Path;
 const W: u32 = 64;
 const H: u32 = 36;
 
-/// Prepares (twice: cold, then all from the cache) and renders the forward+ graph on a
-/// renderer of its own reading `shaders`: both prepares' stats and the image, or the
-/// first prepare's error.
-fn run(
-    parallel: bool,
-    shaders: ShaderLibrary,
-) -> Result<(PrepareStats, PrepareStats, Vec<[f32; 4]>), String> {
+/// The forward+ graph with fixed light lists of `capacity` (a define of both culling
+/// pipelines, which one pass builds).
+fn graph_text(capacity: u32) -> String {
+    let text = std::fs::read_to_string(graph_path("forward_plus.ron")).unwrap();
+    let marker = "lists: Compact(max_indices: ";
+    let start = text
+        .find(marker)
+        .expect("compact lists in forward_plus.ron");
+    let end = start + text[start..].find(')').unwrap() + 1;
+    format!("{}capacity: {capacity}{}", &text[..start], &text[end..])
+}
+
+struct Run {
+    /// Cold, after the graph edit (capacity 256 -> 252), and the same again.
+    stats: [PrepareStats; 3],
+    images: [Vec<[f32; 4]>; 2],
+}
+
+/// Prepares and renders the forward+ graph on a renderer of its own reading `shaders`:
+/// cold, then after a graph edit that changes both culling pipelines' keys, then the
+/// same again (all hits). Or the first prepare's error.
+fn run(parallel: bool, shaders: ShaderLibrary) -> Result<Run, String> {
     let mut r = Renderer::new(
         lightgraph::gpu::GpuContext::new_headless().unwrap(),
         shaders,
     );
     r.pipelines.parallel_builds = parallel;
     let scene = random_scene(40, 11);
-    let text = std::fs::read_to_string(graph_path("forward_plus.ron")).unwrap();
     let size = FrameSize {
         width: W,
         height: H,
         lights: scene.lights.len() as u32,
     };
-    let checked =
-        || graph::check_text(Path::new("<test>"), &text, &ShaderLibrary::builtin()).unwrap();
     let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, &scene).unwrap();
-    let compiled = graph::compile(checked(), &scene.features(), size);
+    let compiled = |capacity| {
+        let checked = graph::check_text(
+            Path::new("<test>"),
+            &graph_text(capacity),
+            &ShaderLibrary::builtin(),
+        )
+        .unwrap();
+        graph::compile(checked, &scene.features(), size)
+    };
     let first = r
-        .prepare(compiled, &scene, &gpu, size, false)
+        .prepare(compiled(256), &scene, &gpu, size, false)
         .map_err(|e| e.to_string())?;
     let image = first.render(&r).unwrap().image;
-    let compiled = graph::compile(checked(), &scene.features(), size);
-    let again = r
-        .prepare_reusing(compiled, &scene, &gpu, size, false, Some(&first))
+    let edited = r
+        .prepare_reusing(compiled(252), &scene, &gpu, size, false, Some(&first))
         .unwrap();
-    Ok((first.stats().clone(), again.stats().clone(), image))
+    let edited_image = edited.render(&r).unwrap().image;
+    let again = r
+        .prepare_reusing(compiled(252), &scene, &gpu, size, false, Some(&edited))
+        .unwrap();
+    Ok(Run {
+        stats: [
+            first.stats().clone(),
+            edited.stats().clone(),
+            again.stats().clone(),
+        ],
+        images: [image, edited_image],
+    })
 }
 
 fn names(s: &PrepareStats) -> Vec<String> {
@@ -53,37 +83,56 @@ fn names(s: &PrepareStats) -> Vec<String> {
 
 #[test]
 fn parallel_builds_report_and_render_what_sequential_builds_do() {
-    let (par, par_again, par_image) = run(true, ShaderLibrary::builtin()).unwrap();
-    let (seq, seq_again, seq_image) = run(false, ShaderLibrary::builtin()).unwrap();
-    assert!(par.pipelines_built.len() >= 3, "{:?}", par.pipelines_built);
-    assert_eq!(par.pipelines_built, seq.pipelines_built);
-    assert_eq!(names(&par), names(&seq));
-    assert_eq!(
-        (par.pipeline_hits, par.pipeline_misses),
-        (seq.pipeline_hits, seq.pipeline_misses)
+    let par = run(true, ShaderLibrary::builtin()).unwrap();
+    let seq = run(false, ShaderLibrary::builtin()).unwrap();
+    assert!(
+        par.stats[0].pipelines_built.len() >= 3,
+        "{:?}",
+        par.stats[0].pipelines_built
     );
-    // Every pipeline of the first prepare came from the passes' threads.
-    assert_eq!(par.pipelines_built_in_parallel, par.pipelines_built.len());
-    assert_eq!(seq.pipelines_built_in_parallel, 0);
+    for (p, s) in par.stats.iter().zip(&seq.stats) {
+        assert_eq!(p.pipelines_built, s.pipelines_built);
+        assert_eq!(names(p), names(s));
+        assert_eq!(
+            (p.pipeline_hits, p.pipeline_misses),
+            (s.pipeline_hits, s.pipeline_misses)
+        );
+        assert_eq!(s.pipelines_built_in_parallel, 0);
+    }
+    assert_eq!(par.images, seq.images);
+    // Cold: every pipeline came from the passes' threads.
+    let cold = &par.stats[0];
+    assert_eq!(cold.pipelines_built_in_parallel, cold.pipelines_built.len());
     // The names say which pass asked: forward shading's pipelines name their material.
     assert!(
-        names(&par)
+        names(cold)
             .iter()
             .any(|n| n.starts_with("forward_shading: ") && n.contains('`')),
         "{:?}",
-        names(&par)
+        names(cold)
     );
-    assert_eq!(par_image, seq_image);
+    // The graph edit rebuilds the culling pass's two pipelines, each on its own thread
+    // (one pass, two forks: ForkMode::Only).
+    let edit = &par.stats[1];
+    let culling: Vec<String> = names(edit)
+        .into_iter()
+        .filter(|n| n.starts_with("light_culling: "))
+        .collect();
+    assert!(culling.len() >= 2, "{:?}", names(edit));
+    assert_eq!(edit.pipelines_built_in_parallel, edit.pipelines_built.len());
+    assert!(edit.build_threads >= 2, "{} threads", edit.build_threads);
     // Prepared again, everything is a hit either way and nothing runs ahead.
-    for again in [&par_again, &seq_again] {
-        assert!(
-            again.pipelines_built.is_empty(),
-            "{:?}",
-            again.pipelines_built
-        );
-        assert_eq!(again.pipeline_hits, par.pipeline_hits + par.pipeline_misses);
-        assert_eq!(again.pipelines_built_in_parallel, 0);
-    }
+    let again = &par.stats[2];
+    assert!(
+        again.pipelines_built.is_empty(),
+        "{:?}",
+        again.pipelines_built
+    );
+    assert_eq!(again.pipelines_built_in_parallel, 0);
+    assert_eq!(
+        again.pipeline_hits,
+        edit.pipeline_hits + edit.pipeline_misses
+    );
 }
 
 #[test]

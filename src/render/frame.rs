@@ -63,11 +63,26 @@ impl Default for RenderTimings {
 /// is Send + Sync), so a reload rebuilding pipelines of several passes waits for the
 /// slowest instead of the sum.
 fn prebuild_in_parallel(cx: &mut PrepareCtx<'_>) {
-    let passes = &cx.graph.passes;
-    if !cx.renderer.pipelines.parallel_builds || passes.len() < 2 {
+    use super::pipelines::ForkMode;
+    let r = &mut *cx.renderer;
+    // One fork per pass; a pass that asked for several pipelines last time gets one fork
+    // per pipeline, each building one of them (ForkMode::Only).
+    let forks: Vec<(&crate::graph::ScheduledPass, ForkMode)> = cx
+        .graph
+        .passes
+        .iter()
+        .flat_map(|sp| {
+            let n = r.pipelines.pipelines_of_pass_last_time(&sp.name);
+            let modes: Vec<ForkMode> = match n {
+                0 | 1 => vec![ForkMode::All],
+                n => (0..n).map(ForkMode::Only).collect(),
+            };
+            modes.into_iter().map(move |m| (sp, m))
+        })
+        .collect();
+    if !r.pipelines.parallel_builds || forks.len() < 2 {
         return;
     }
-    let r = &mut *cx.renderer;
     // Whether earlier frames were still on the GPU, noted before any thread builds.
     r.pipelines.note_gpu_state_now(&r.ctx.device);
     let (graph, gpu, resources, frame_uniform, size, scene) = (
@@ -80,13 +95,13 @@ fn prebuild_in_parallel(cx: &mut PrepareCtx<'_>) {
     );
     let start = Instant::now();
     let forks: Vec<Option<super::pipelines::ForkBuilds>> = std::thread::scope(|s| {
-        let threads: Vec<_> = passes
+        let threads: Vec<_> = forks
             .iter()
-            .map(|sp| {
+            .map(|&(sp, mode)| {
                 let mut fork = Renderer {
                     ctx: r.ctx.clone(),
                     shaders: r.shaders.clone(),
-                    pipelines: r.pipelines.fork(),
+                    pipelines: r.pipelines.fork(mode),
                     layouts: r.layouts.clone(),
                 };
                 s.spawn(move || {
@@ -110,7 +125,13 @@ fn prebuild_in_parallel(cx: &mut PrepareCtx<'_>) {
                     )
                     .is_ok();
                     let clean = pollster::block_on(scope.pop()).is_none();
-                    (prepared && clean).then(|| fork.pipelines.into_builds())
+                    // A fork of one build ends its pass early on purpose (and may meet
+                    // errors its stand-ins made): its build's own scope decides.
+                    let keep = match mode {
+                        ForkMode::All => prepared && clean,
+                        ForkMode::Only(_) => fork.pipelines.fork_build_clean(),
+                    };
+                    keep.then(|| fork.pipelines.into_builds())
                 })
             })
             .collect();
@@ -120,12 +141,15 @@ fn prebuild_in_parallel(cx: &mut PrepareCtx<'_>) {
             .collect()
     });
     let mut built = 0;
-    for f in forks.into_iter().flatten() {
+    let mut threads = 0;
+    for f in forks.into_iter().flatten().filter(|f| !f.is_empty()) {
         built += f.len();
+        threads += 1;
         r.pipelines.adopt(f);
     }
     if built > 0 {
         r.pipelines.add_build_wall(start.elapsed());
+        r.pipelines.build_threads = threads;
     }
 }
 
@@ -196,6 +220,7 @@ impl Renderer {
         let file = graph.checked.source.file.clone();
         let result = self.prepare_unscoped(graph, scene, gpu, size, light_stats, pool);
         self.pipelines.settle_prebuilt();
+        let build_threads = std::mem::take(&mut self.pipelines.build_threads);
         let build_wall = self.pipelines.take_build_wall();
         let built = self
             .pipelines
@@ -215,6 +240,7 @@ impl Renderer {
             None => result.map(|mut frame| {
                 frame.prepare_stats = PrepareStats {
                     build_wall,
+                    build_threads,
                     resources_created: frame.resources.created(),
                     resources_reused: frame.resources.reused(),
                     ..stats

@@ -193,6 +193,19 @@ struct Entry {
     prebuilt: Option<PipelineBuild>,
 }
 
+/// What a fork of the cache builds on its thread.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ForkMode {
+    /// Every pipeline its pass lacks, one after another (the main cache: always).
+    #[default]
+    All,
+    /// Only the pass's `n`-th missing pipeline (from 0), then stop the pass: the misses
+    /// before it are answered with a stand-in (the pipeline of the same shader and state
+    /// the edit replaced) so the pass gets that far. Several such forks build one pass's
+    /// pipelines at once.
+    Only(usize),
+}
+
 /// What a [`PipelineCache::fork`] built, for [`PipelineCache::adopt`].
 pub struct ForkBuilds {
     entries: Vec<(PipelineKey, Entry)>,
@@ -240,6 +253,29 @@ pub struct PipelineCache {
     /// [`take_build_wall`](Self::take_build_wall): the parallel phases, plus the builds
     /// done in sequence.
     build_wall: Duration,
+    /// Threads that built pipelines in the last parallel phase (read by prepare).
+    pub build_threads: usize,
+    /// What this fork builds ([`ForkMode::All`] outside forks).
+    fork_mode: ForkMode,
+    /// Misses this fork has met.
+    fork_misses: usize,
+    /// Whether this fork's one build ([`ForkMode::Only`]) raised no validation error.
+    fork_build_clean: bool,
+    /// Entries dropped by [`invalidate_files`](Self::invalidate_files) until the next
+    /// eviction: stand-ins for forks (never answered as hits).
+    stale: HashMap<PipelineKey, Entry>,
+    /// Per pass, the keys it asked for since the generation began (hashes).
+    requested: HashMap<String, std::collections::HashSet<u64>>,
+    /// Per pass, how many distinct pipelines it asked for in the last generation.
+    keys_last_generation: HashMap<String, usize>,
+}
+
+/// Returned by a fork's request to end its pass early (never seen outside forks).
+fn stop_fork() -> ShaderError {
+    ShaderError::Io {
+        file: PathBuf::from("<parallel build>"),
+        message: "the fork built its pipeline".into(),
+    }
 }
 
 /// Whether the GPU was busy with earlier submissions when a prepare's first pipeline
@@ -264,9 +300,12 @@ impl PipelineCache {
     /// A cache for another thread: the same pipelines (shared handles), generation,
     /// driver cache and pass, fresh counters. What it builds comes back with
     /// [`into_builds`](Self::into_builds) and [`adopt`](Self::adopt).
-    pub fn fork(&self) -> Self {
+    pub fn fork(&self, mode: ForkMode) -> Self {
         Self {
             pipelines: self.pipelines.clone(),
+            stale: self.stale.clone(),
+            fork_mode: mode,
+            fork_build_clean: true,
             generation: self.generation,
             // The GPU's state was noted (or not needed) before forking.
             gpu_busy: Some(self.gpu_busy.unwrap_or(false)),
@@ -274,6 +313,16 @@ impl PipelineCache {
             pass: self.pass.clone(),
             ..Default::default()
         }
+    }
+
+    /// How many distinct pipelines `pass` asked for in the last generation (0: unknown).
+    pub fn pipelines_of_pass_last_time(&self, pass: &str) -> usize {
+        self.keys_last_generation.get(pass).copied().unwrap_or(0)
+    }
+
+    /// Whether this [`ForkMode::Only`] fork's build raised no validation error.
+    pub fn fork_build_clean(&self) -> bool {
+        self.fork_build_clean
     }
 
     /// The pipelines this fork built (not those it was forked with).
@@ -315,6 +364,20 @@ impl PipelineCache {
         self.note_gpu_state(device);
     }
 
+    /// For a fork: a pipeline to stand in for `key` until the fork reaches the one it
+    /// builds: `key`'s own entry the edit made stale, else one of the same shader and
+    /// state (another material, other defines).
+    fn stand_in(&self, key: &PipelineKey) -> Option<Pipeline> {
+        if let Some(e) = self.stale.get(key) {
+            return Some(e.pipeline.clone());
+        }
+        self.pipelines
+            .iter()
+            .chain(self.stale.iter())
+            .find(|(k, _)| k.shader == key.shader && k.state == key.state)
+            .map(|(_, e)| e.pipeline.clone())
+    }
+
     /// Marks what forks built and nothing asked for as plain entries: a later request is
     /// a hit, as it would have been after a sequential build.
     pub fn settle_prebuilt(&mut self) {
@@ -353,6 +416,15 @@ impl PipelineCache {
         build: impl FnOnce(&Composed, wgpu::ShaderModule, &[ReflectedBinding]) -> Pipeline,
         device: &wgpu::Device,
     ) -> Result<(Pipeline, Arc<[ReflectedBinding]>), ShaderError> {
+        if self.fork_mode == ForkMode::All {
+            use std::hash::{Hash, Hasher};
+            let mut h = std::collections::hash_map::DefaultHasher::new();
+            key.hash(&mut h);
+            self.requested
+                .entry(self.pass.clone())
+                .or_default()
+                .insert(h.finish());
+        }
         if let Some(e) = self.pipelines.get_mut(&key) {
             e.last_used = self.generation;
             match e.prebuilt.take() {
@@ -373,6 +445,13 @@ impl PipelineCache {
             return Ok((e.pipeline.clone(), e.bindings.clone()));
         }
         self.misses += 1;
+        let nth_miss = self.fork_misses;
+        self.fork_misses += 1;
+        let only = match self.fork_mode {
+            ForkMode::All => None,
+            ForkMode::Only(n) if nth_miss > n => return Err(stop_fork()),
+            ForkMode::Only(n) => Some(n),
+        };
         let start = Instant::now();
         let composed = shaders.compose(&key.shader, &key.defines, &key.virtual_code);
         let composed = composed.and_then(|c| c.validate().map(|m| (c, m)));
@@ -381,6 +460,16 @@ impl PipelineCache {
         self.build_wall += compose;
         let (composed, naga_module) = composed?;
         let bindings: Arc<[ReflectedBinding]> = reflect_bindings(&naga_module).into();
+        if only.is_some_and(|n| nth_miss < n) {
+            // A miss before the one this fork builds: a stand-in lets the pass go on.
+            return match self.stand_in(&key) {
+                Some(p) => Ok((p, bindings)),
+                None => Err(stop_fork()),
+            };
+        }
+        // A fork's one build gets a scope of its own: the stand-ins may make errors
+        // later in the pass that say nothing about this pipeline.
+        let scope = only.map(|_| device.push_error_scope(wgpu::ErrorFilter::Validation));
         self.note_gpu_state(device);
         let start = Instant::now();
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -392,6 +481,9 @@ impl PipelineCache {
         let driver = self.driver.as_ref().map(|d| d.cache().clone());
         let pipeline = with_driver_cache(driver, || build(&composed, module, &bindings));
         let create = start.elapsed();
+        if let Some(scope) = scope {
+            self.fork_build_clean = pollster::block_on(scope.pop()).is_none();
+        }
         self.build_wall += module_time + create;
         self.module_time += module_time;
         self.create_time += create;
@@ -414,6 +506,10 @@ impl PipelineCache {
                 prebuilt: None,
             },
         );
+        if only.is_some() {
+            // This fork's pipeline is built: the rest of the pass is other forks' work.
+            return Err(stop_fork());
+        }
         Ok((pipeline, bindings))
     }
 
@@ -489,6 +585,10 @@ impl PipelineCache {
     /// [`evict_unused_since`](Self::evict_unused_since) can drop the ones a replaced frame
     /// alone used (old material versions, say) and the cache stays bounded under edits.
     pub fn next_generation(&mut self) -> u64 {
+        self.keys_last_generation = std::mem::take(&mut self.requested)
+            .into_iter()
+            .map(|(pass, keys)| (pass, keys.len()))
+            .collect();
         self.gpu_busy = None;
         self.gpu_wait = Duration::ZERO;
         self.generation += 1;
@@ -498,6 +598,7 @@ impl PipelineCache {
     /// Drops every pipeline not asked for since `generation` began; returns how many.
     /// Frames already prepared keep theirs alive: this only affects later requests.
     pub fn evict_unused_since(&mut self, generation: u64) -> usize {
+        self.stale.clear();
         let before = self.pipelines.len();
         self.pipelines.retain(|_, e| e.last_used >= generation);
         before - self.pipelines.len()
@@ -509,9 +610,12 @@ impl PipelineCache {
         let canonical = |p: &Path| p.canonicalize().ok();
         let same =
             |a: &Path, b: &Path| a == b || (canonical(a).is_some() && canonical(a) == canonical(b));
-        let before = self.pipelines.len();
-        self.pipelines
-            .retain(|_, e| !e.files.iter().any(|u| files.iter().any(|f| same(u, f))));
-        before - self.pipelines.len()
+        let (dropped, kept): (HashMap<_, _>, HashMap<_, _>) = std::mem::take(&mut self.pipelines)
+            .into_iter()
+            .partition(|(_, e)| e.files.iter().any(|u| files.iter().any(|f| same(u, f))));
+        self.pipelines = kept;
+        let n = dropped.len();
+        self.stale.extend(dropped);
+        n
     }
 }

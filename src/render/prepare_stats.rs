@@ -34,6 +34,8 @@ pub struct PrepareStats {
     /// Wall time of composing and building: with parallel builds less than
     /// `shader_compose + pipeline_build`, which add up each thread's time.
     pub build_wall: Duration,
+    /// Threads that built pipelines ahead of the sequential prepare.
+    pub build_threads: usize,
     /// The pipeline-cache generation this prepare used (see
     /// [`PipelineCache::evict_unused_since`](super::PipelineCache::evict_unused_since)).
     pub cache_generation: u64,
