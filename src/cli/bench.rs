@@ -164,9 +164,10 @@ pub fn reload_bench(args: &ReloadBenchArgs) -> Result<()> {
     println!("pipeline cache: {}", gpu.pipeline_cache_status());
     let result = rl::run(&config, gpu, |s| {
         println!(
-            "{:<8} #{:<3} {:>8.1} ms  (watch {:.1}, compose {:.1}, build {:.1} [modules {:.1}, pipelines {:.1}{}], render {:.1} [submit {:.1}, GPU wait {:.1}, image readback {:.1}; again {:.1}]; {} pipelines built, {} resources reused, {} created)",
+            "{:<8} #{:<3} new frame {:>7.1} ms, read back {:>7.1} ms  (watch {:.1}, compose {:.1}, build {:.1} [modules {:.1}, pipelines {:.1}{}], render {:.1} [submit {:.1}, GPU wait {:.1}, image readback {:.1}; again {:.1}]; {} pipelines built, {} resources reused, {} created)",
             s.kind.to_string(),
             s.index,
+            s.frame_ms,
             s.total_ms,
             s.watch_ms,
             s.shader_compose_ms,
@@ -206,8 +207,8 @@ pub fn reload_bench(args: &ReloadBenchArgs) -> Result<()> {
     );
     for k in rl::summarize_kinds(&run.samples) {
         println!(
-            "{}: median {:.1} ms, p10 {:.1}, p90 {:.1}",
-            k.kind, k.total.median, k.total.p10, k.total.p90
+            "{}: edit -> new frame (viewer) median {:.1} ms, p10 {:.1}, p90 {:.1}; edit -> read back median {:.1} ms",
+            k.kind, k.frame.median, k.frame.p10, k.frame.p90, k.total.median
         );
     }
     println!("wrote {} and {}", csv.display(), md.display());

@@ -111,6 +111,9 @@ pub struct ReloadSession {
     prepared: Option<PreparedFrame>,
     /// Whether frames include the light statistics pass.
     light_stats: bool,
+    /// Whether a reload reads its new frame back into `frame` (a viewer, which presents
+    /// the output texture itself, does not wait for that).
+    read_back: bool,
     /// The last frame that rendered.
     pub frame: Option<FrameResult>,
     /// The current error, if the last reload failed.
@@ -179,7 +182,8 @@ struct Candidate {
     /// The files of materials reloaded alone.
     materials: MaterialFiles,
     prepared: PreparedFrame,
-    frame: FrameResult,
+    /// The frame read back (`None` without readback).
+    frame: Option<FrameResult>,
     prepare_time: Duration,
     render_time: Duration,
     render_timings: RenderTimings,
@@ -224,6 +228,7 @@ impl ReloadSession {
             stale: BTreeSet::new(),
             prepared: None,
             light_stats: false,
+            read_back: true,
             frame: None,
             error: None,
         };
@@ -238,6 +243,13 @@ impl ReloadSession {
         let candidate = session.prepare_and_render(graph, None, None)?;
         session.commit(candidate);
         Ok(session)
+    }
+
+    /// Whether reloads read the new frame back into [`frame`](Self::frame) (on by
+    /// default). A viewer presents the output texture and turns it off: its reloads end
+    /// when the frame's GPU work is done, and `frame` stays `None` from then on.
+    pub fn set_image_readback(&mut self, on: bool) {
+        self.read_back = on;
     }
 
     /// The last good prepared frame (what `frame` was rendered from), to execute again
@@ -483,9 +495,17 @@ impl ReloadSession {
             .map_err(|e| e.to_string())?;
         let prepare_time = start.elapsed();
         let start = Instant::now();
-        let (frame, render_timings) = prepared
-            .render_timed(&self.renderer)
-            .map_err(|e| e.to_string())?;
+        let (frame, render_timings) = if self.read_back {
+            let (frame, t) = prepared
+                .render_timed(&self.renderer)
+                .map_err(|e| e.to_string())?;
+            (Some(frame), t)
+        } else {
+            let (_, t) = prepared
+                .execute_timed(&self.renderer)
+                .map_err(|e| e.to_string())?;
+            (None, t)
+        };
         Ok(Candidate {
             resolved: BTreeSet::new(),
             scene: None,
@@ -525,7 +545,7 @@ impl ReloadSession {
             self.gpu = gpu;
         }
         self.prepared = Some(c.prepared);
-        self.frame = Some(c.frame);
+        self.frame = c.frame;
         self.stale.retain(|d| !c.resolved.contains(d));
         // Pipelines that only replaced frames used (old material versions) are dropped.
         self.renderer.pipelines.evict_unused_since(generation);
