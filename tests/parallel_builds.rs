@@ -140,17 +140,12 @@ fn a_broken_shader_fails_the_same_way_in_parallel() {
     let dir = tempfile::tempdir().unwrap();
     let shaders = dir.path().join("shaders");
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
-    for rel in ["common/lighting.wgsl"] {
-        let from = root.join(rel);
-        let to = shaders.join(rel);
-        std::fs::create_dir_all(to.parent().unwrap()).unwrap();
-        let text = std::fs::read_to_string(from).unwrap();
-        std::fs::write(
-            &to,
-            format!("{text}\nfn broken( -> f32 {{ return 1.0; }}\n"),
-        )
-        .unwrap();
-    }
+    let rel = "common/lighting.wgsl";
+    let to = shaders.join(rel);
+    std::fs::create_dir_all(to.parent().unwrap()).unwrap();
+    let text = std::fs::read_to_string(root.join(rel)).unwrap();
+    let broken = format!("{text}\nfn broken( -> f32 {{ return 1.0; }}\n");
+    std::fs::write(&to, broken).unwrap();
     let library = || ShaderLibrary::with_builtin(&shaders);
     let par = run(true, library()).map(|_| ()).unwrap_err();
     let seq = run(false, library()).map(|_| ()).unwrap_err();

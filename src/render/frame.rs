@@ -19,6 +19,9 @@ use glam::Vec3;
 use std::time::{Duration, Instant};
 use wgpu::util::DeviceExt;
 
+/// GPU milliseconds per pass, where the adapter has timestamps.
+pub type PassTimes = Option<Vec<(String, f64)>>;
+
 /// Where the time of one executed (and read back) frame went.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderTimings {
@@ -356,10 +359,7 @@ impl PreparedFrame {
     }
 
     /// Like [`execute`](Self::execute), also saying where the time went.
-    pub fn execute_timed(
-        &self,
-        r: &Renderer,
-    ) -> Result<(Option<Vec<(String, f64)>>, RenderTimings), RenderError> {
+    pub fn execute_timed(&self, r: &Renderer) -> Result<(PassTimes, RenderTimings), RenderError> {
         let scope = r.ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let result = self.execute_unscoped(r);
         match pollster::block_on(scope.pop()) {
@@ -426,10 +426,7 @@ impl PreparedFrame {
         encoder.finish()
     }
 
-    fn execute_unscoped(
-        &self,
-        r: &Renderer,
-    ) -> Result<(Option<Vec<(String, f64)>>, RenderTimings), RenderError> {
+    fn execute_unscoped(&self, r: &Renderer) -> Result<(PassTimes, RenderTimings), RenderError> {
         let device = &r.ctx.device;
         let start = Instant::now();
         r.ctx.queue.submit([self.encode(r)]);
