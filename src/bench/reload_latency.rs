@@ -12,7 +12,7 @@
 
 use super::report::{summarize, TimingSummary};
 use crate::reload::{Reload, ReloadSession, SceneSource, WatchConfig};
-use crate::render::Renderer;
+use crate::render::{PipelineBuild, RenderTimings, Renderer};
 use crate::shader::assets::{Project, RootSource};
 use crate::shader::ShaderLibrary;
 use std::fmt::Write as _;
@@ -81,6 +81,19 @@ pub struct ReloadBenchConfig {
     pub lights: u32,
     /// Edits of each kind.
     pub repeats: usize,
+    /// Makes the shader edits' values (and so every pipeline built after the first
+    /// shader edit) differ from another run's: a driver's own shader cache (NVIDIA keeps
+    /// one on disk) then cannot answer from an earlier run. 0: the historical values;
+    /// 1..=1023 give distinct values.
+    pub salt: u32,
+    /// Frames submitted without waiting right before each edit, as a viewer has in
+    /// flight: pipeline builds then start while the GPU is busy.
+    pub frames_in_flight: usize,
+    /// Wait for the GPU to go idle before building pipelines (timed in its own column).
+    pub wait_for_idle_before_build: bool,
+    /// Build one pass's pipelines after another (the renderer builds them on one thread
+    /// per pass by default).
+    pub sequential_builds: bool,
 }
 
 /// One timed edit, in milliseconds.
@@ -88,7 +101,10 @@ pub struct ReloadBenchConfig {
 pub struct ReloadSample {
     pub kind: EditKind,
     pub index: usize,
-    /// File write returned → new frame read back.
+    /// File write returned → the new frame's GPU work done: what a viewer shows (it
+    /// presents the output texture without reading it back). The headline.
+    pub frame_ms: f64,
+    /// File write returned → new frame read back (the HDR image copied to the CPU).
     pub total_ms: f64,
     /// File write returned → the watcher delivered the batch (debounce and event delivery).
     pub watch_ms: f64,
@@ -107,6 +123,31 @@ pub struct ReloadSample {
     /// The same frame rendered again right after (not part of the latency): what of
     /// `render_ms` was the frame itself rather than first-use work in the driver.
     pub rerender_ms: f64,
+    /// Composing and building, wall time (less than the sum of the two with parallel
+    /// builds).
+    pub build_wall_ms: f64,
+    /// Of `pipeline_build_ms`: `create_shader_module`.
+    pub shader_module_ms: f64,
+    /// Of `pipeline_build_ms`: `create_render/compute_pipeline` (with layouts).
+    pub pipeline_create_ms: f64,
+    /// Whether the GPU still had earlier frames' work when the first build began.
+    pub gpu_busy_at_build: Option<bool>,
+    /// Waiting for the GPU before building (only with `wait_for_idle_before_build`).
+    pub gpu_wait_before_build_ms: f64,
+    /// Each pipeline built: pass, shader and material, and its times.
+    pub builds: Vec<PipelineBuild>,
+    /// Of `render_ms`: encoding and `queue.submit`.
+    pub record_submit_ms: f64,
+    /// Of `render_ms`: submit returned → GPU done (blocking poll).
+    pub gpu_wait_ms: f64,
+    /// The GPU's time for the frame, from pass timestamps (NaN without timestamps).
+    pub gpu_frame_ms: f64,
+    /// Of `render_ms`: copying, mapping and converting the Rgba32Float output.
+    pub image_readback_ms: f64,
+    /// Of `render_ms`: timestamps, culling reports and statistics read back.
+    pub reports_readback_ms: f64,
+    /// The same frame again: submit returned → GPU done.
+    pub rerender_gpu_wait_ms: f64,
     pub pipelines_built: usize,
     pub resources_created: usize,
     pub resources_reused: usize,
@@ -122,16 +163,30 @@ const GRAPH_MARKER: &str = "capacity: ";
 /// in every earlier measurement: the shipped graph's compact lists (whose bound is a
 /// uniform, so editing it builds no pipeline) become fixed lists of 256 in the copy.
 fn fixed_lists(text: &str) -> String {
-    let Some(start) = text.find("lists: Compact(max_indices: ") else {
+    let Some(start) = find_in_code(text, "lists: Compact(max_indices: ") else {
         return text.to_string();
     };
     let end = start + text[start..].find(')').map_or(0, |e| e + 1);
     format!("{}capacity: 256{}", &text[..start], &text[end..])
 }
 
-/// `text` with the number right after the first `marker` replaced by `value`.
+/// Where `marker` first occurs outside `//` comments.
+fn find_in_code(text: &str, marker: &str) -> Option<usize> {
+    let mut offset = 0;
+    for line in text.split_inclusive('\n') {
+        let code = line.find("//").map_or(line, |c| &line[..c]);
+        if let Some(i) = code.find(marker) {
+            return Some(offset + i);
+        }
+        offset += line.len();
+    }
+    None
+}
+
+/// `text` with the number right after the first `marker` outside comments replaced by
+/// `value`.
 fn replace_number_after(text: &str, marker: &str, value: &str) -> Option<String> {
-    let start = text.find(marker)? + marker.len();
+    let start = find_in_code(text, marker)? + marker.len();
     let len = text[start..]
         .find(|c: char| !(c.is_ascii_digit() || c == '.'))
         .unwrap_or(text.len() - start);
@@ -143,15 +198,17 @@ struct Target {
     kind: EditKind,
     file: PathBuf,
     original: String,
+    salt: u32,
 }
 
 impl Target {
-    fn load(kind: EditKind, file: PathBuf) -> Result<Self, ReloadBenchError> {
+    fn load(kind: EditKind, file: PathBuf, salt: u32) -> Result<Self, ReloadBenchError> {
         let original = std::fs::read_to_string(&file).map_err(io(&file))?;
         let t = Target {
             kind,
             file,
             original,
+            salt,
         };
         // Fail before timing anything if the text to edit is missing.
         t.edited(0)?;
@@ -164,12 +221,18 @@ impl Target {
         let (text, what) = match self.kind {
             EditKind::Shader => (
                 self.original.contains(SHADER_LINE).then(|| {
+                    let scale = match self.salt {
+                        0 => format!("{:.4}", 1.0 + 1e-4 * step),
+                        // Exact in f32 (steps of 2^-22 near 1), so every (edit, salt)
+                        // pair compiles to its own constant.
+                        salt => format!(
+                            "{:.9}",
+                            1.0 + (step * 1024.0 + f64::from(salt % 1024)) / 4_194_304.0
+                        ),
+                    };
                     self.original.replace(
                         SHADER_LINE,
-                        &format!(
-                            "return {:.4} * clamp(1.0 - r * r, 0.0, 1.0);",
-                            1.0 + 1e-4 * step
-                        ),
+                        &format!("return {scale} * clamp(1.0 - r * r, 0.0, 1.0);"),
                     )
                 }),
                 SHADER_LINE,
@@ -223,7 +286,7 @@ pub fn run(
     config: &ReloadBenchConfig,
     gpu: crate::gpu::GpuContext,
     mut progress: impl FnMut(&ReloadSample),
-) -> Result<Vec<ReloadSample>, ReloadBenchError> {
+) -> Result<BenchRun, ReloadBenchError> {
     let work = &config.work;
     let shaders = work.join("shaders");
     let project = Project::at(&config.project, RootSource::Flag);
@@ -240,12 +303,14 @@ pub fn run(
     }
     std::fs::write(&scene, scene_text(config.lights)).map_err(io(&scene))?;
     let targets = [
-        Target::load(EditKind::Shader, shaders.join(SHADER_FILE))?,
-        Target::load(EditKind::Material, material)?,
-        Target::load(EditKind::Graph, graph.clone())?,
+        Target::load(EditKind::Shader, shaders.join(SHADER_FILE), config.salt)?,
+        Target::load(EditKind::Material, material, config.salt)?,
+        Target::load(EditKind::Graph, graph.clone(), config.salt)?,
     ];
 
+    let pipeline_cache = gpu.pipeline_cache_status();
     let renderer = Renderer::new(gpu, ShaderLibrary::new(&shaders));
+    let started = Instant::now();
     let mut session = ReloadSession::new(
         renderer,
         &graph,
@@ -255,6 +320,22 @@ pub fn run(
         &[],
     )
     .map_err(ReloadBenchError::Session)?;
+    let ms = |d: Duration| d.as_secs_f64() * 1e3;
+    let startup = match session.prepared() {
+        Some(p) => Startup {
+            total_ms: ms(started.elapsed()),
+            pipelines_built: p.stats().pipelines_built.len(),
+            shader_compose_ms: ms(p.stats().shader_compose),
+            pipeline_build_ms: ms(p.stats().pipeline_build),
+            pipeline_cache,
+        },
+        None => Startup {
+            pipeline_cache,
+            ..Default::default()
+        },
+    };
+    session.renderer.pipelines.wait_for_idle_before_build = config.wait_for_idle_before_build;
+    session.renderer.pipelines.parallel_builds = !config.sequential_builds;
 
     let mut samples = Vec::new();
     for index in 0..config.repeats {
@@ -268,34 +349,55 @@ pub fn run(
             };
             // Whatever a previous edit left behind is handled before the clock starts.
             while session.poll().is_some() {}
+            // A viewer's frames in flight when the edit lands.
+            if let Some(p) = session.prepared() {
+                for _ in 0..config.frames_in_flight {
+                    p.submit(&session.renderer)
+                        .map_err(|e| failed(e.to_string()))?;
+                }
+            }
             std::fs::write(&t.file, &text).map_err(io(&t.file))?;
             let written = Instant::now();
             let reload = reload_of(&mut session, &t.file).map_err(failed)?;
-            let ms = |d: Duration| d.as_secs_f64() * 1e3;
-            let (stats, rerender_ms) = match session.prepared() {
+            let (stats, rerender_ms, again) = match session.prepared() {
                 Some(p) => {
                     let start = Instant::now();
-                    p.render(&session.renderer)
+                    let (_, again) = p
+                        .render_timed(&session.renderer)
                         .map_err(|e| failed(e.to_string()))?;
-                    (p.stats().clone(), ms(start.elapsed()))
+                    (p.stats().clone(), ms(start.elapsed()), Some(again))
                 }
-                None => (Default::default(), f64::NAN),
+                None => (Default::default(), f64::NAN, None),
             };
             let tm = reload.timings;
+            let frame = tm.frame.unwrap_or_default();
             let sample = ReloadSample {
                 kind: t.kind,
                 index,
+                frame_ms: reload
+                    .frame_ready
+                    .map_or(f64::NAN, |t| ms(t.saturating_duration_since(written))),
                 total_ms: ms(reload.finished.saturating_duration_since(written)),
                 watch_ms: ms(reload.received.saturating_duration_since(written)),
                 assets_ms: ms(tm.assets),
                 graph_ms: ms(tm.graph),
                 shader_compose_ms: ms(tm.shader_compose),
                 pipeline_build_ms: ms(tm.pipeline_build),
-                prepare_other_ms: ms(tm
-                    .prepare
-                    .saturating_sub(tm.shader_compose + tm.pipeline_build)),
+                prepare_other_ms: ms(tm.prepare.saturating_sub(tm.build_wall)),
+                build_wall_ms: ms(tm.build_wall),
                 render_ms: ms(tm.render),
                 rerender_ms,
+                shader_module_ms: ms(tm.shader_modules),
+                pipeline_create_ms: ms(tm.pipeline_create),
+                gpu_busy_at_build: tm.gpu_at_build.busy,
+                gpu_wait_before_build_ms: ms(tm.gpu_at_build.wait),
+                builds: tm.builds,
+                record_submit_ms: ms(frame.record_submit),
+                gpu_wait_ms: ms(frame.gpu_wait),
+                gpu_frame_ms: frame.gpu_frame_ms.unwrap_or(f64::NAN),
+                image_readback_ms: ms(frame.image_readback),
+                reports_readback_ms: ms(frame.reports_readback + frame.timestamps_read),
+                rerender_gpu_wait_ms: again.map_or(f64::NAN, |a: RenderTimings| ms(a.gpu_wait)),
                 pipelines_built: stats.pipelines_built.len(),
                 resources_created: stats.resources_created,
                 resources_reused: stats.resources_reused,
@@ -304,7 +406,25 @@ pub fn run(
             samples.push(sample);
         }
     }
-    Ok(samples)
+    Ok(BenchRun { samples, startup })
+}
+
+/// What starting the session (loading, the first prepare and render) cost: with a warm
+/// pipeline cache on disk, the builds here are where it shows.
+#[derive(Clone, Debug, Default)]
+pub struct Startup {
+    pub total_ms: f64,
+    pub pipelines_built: usize,
+    pub shader_compose_ms: f64,
+    pub pipeline_build_ms: f64,
+    /// The driver's pipeline cache on disk: where, and what opening it found.
+    pub pipeline_cache: String,
+}
+
+/// A benchmark run: the session's start and every timed edit.
+pub struct BenchRun {
+    pub startup: Startup,
+    pub samples: Vec<ReloadSample>,
 }
 
 /// The reload that handled `file` (bounded wait), or its error.
@@ -327,9 +447,16 @@ fn reload_of(session: &mut ReloadSession, file: &Path) -> Result<Reload, String>
 pub struct KindSummary {
     pub kind: EditKind,
     pub samples: usize,
+    /// Edit → new frame on the GPU (what a viewer shows).
+    pub frame: TimingSummary,
+    /// Edit → new frame read back.
     pub total: TimingSummary,
     /// (column name, median ms) for each part of the breakdown.
     pub parts: Vec<(&'static str, f64)>,
+    /// (column name, median ms) for the parts of pipeline build and render.
+    pub details: Vec<(&'static str, f64)>,
+    /// Samples whose first build began with the GPU still busy, of those that built.
+    pub gpu_busy_at_build: (usize, usize),
     pub pipelines_built: f64,
     pub resources_reused: f64,
     pub resources_created: f64,
@@ -348,27 +475,87 @@ const PARTS: [Part; 8] = [
     ("(same frame again)", |s| s.rerender_ms),
 ];
 
+/// The parts of "pipeline build" and "render + readback" (not adding up to the total:
+/// `GPU frame` overlaps `submit → GPU done`).
+const DETAILS: [Part; 10] = [
+    ("compose + build, wall", |s| s.build_wall_ms),
+    ("build: create_shader_module", |s| s.shader_module_ms),
+    ("build: create_*_pipeline", |s| s.pipeline_create_ms),
+    ("wait for idle GPU before build", |s| {
+        s.gpu_wait_before_build_ms
+    }),
+    ("render: record + submit", |s| s.record_submit_ms),
+    ("render: submit → GPU done", |s| s.gpu_wait_ms),
+    ("GPU frame (timestamps)", |s| s.gpu_frame_ms),
+    ("render: image readback", |s| s.image_readback_ms),
+    ("render: reports readback", |s| s.reports_readback_ms),
+    ("(again: submit → GPU done)", |s| s.rerender_gpu_wait_ms),
+];
+
+fn median_of(values: Vec<f64>) -> f64 {
+    summarize(&values).map_or(f64::NAN, |t| t.median)
+}
+
 pub fn summarize_kinds(samples: &[ReloadSample]) -> Vec<KindSummary> {
     EditKind::ALL
         .iter()
         .filter_map(|&kind| {
             let of: Vec<&ReloadSample> = samples.iter().filter(|s| s.kind == kind).collect();
             let median = |f: &dyn Fn(&ReloadSample) -> f64| {
-                summarize(&of.iter().map(|s| f(s)).collect::<Vec<_>>()).map(|t| t.median)
+                median_of(of.iter().map(|s| f(s)).filter(|v| !v.is_nan()).collect())
             };
             let total = summarize(&of.iter().map(|s| s.total_ms).collect::<Vec<_>>())?;
+            let frame = summarize(
+                &of.iter()
+                    .map(|s| s.frame_ms)
+                    .filter(|v| !v.is_nan())
+                    .collect::<Vec<_>>(),
+            )?;
+            let built: Vec<bool> = of.iter().filter_map(|s| s.gpu_busy_at_build).collect();
             Some(KindSummary {
                 kind,
                 samples: of.len(),
+                frame,
                 total,
-                parts: PARTS
-                    .iter()
-                    .map(|(name, f)| (*name, median(f).unwrap_or(f64::NAN)))
-                    .collect(),
-                pipelines_built: median(&|s| s.pipelines_built as f64).unwrap_or(f64::NAN),
-                resources_reused: median(&|s| s.resources_reused as f64).unwrap_or(f64::NAN),
-                resources_created: median(&|s| s.resources_created as f64).unwrap_or(f64::NAN),
+                parts: PARTS.iter().map(|(name, f)| (*name, median(f))).collect(),
+                details: DETAILS.iter().map(|(name, f)| (*name, median(f))).collect(),
+                gpu_busy_at_build: (built.iter().filter(|b| **b).count(), built.len()),
+                pipelines_built: median(&|s| s.pipelines_built as f64),
+                resources_reused: median(&|s| s.resources_reused as f64),
+                resources_created: median(&|s| s.resources_created as f64),
             })
+        })
+        .collect()
+}
+
+/// Per edit kind and pipeline (pass: shader `material`): how often it was built and the
+/// median of its compose, module and pipeline-creation times (ms).
+pub struct PipelineSummary {
+    pub kind: EditKind,
+    pub name: String,
+    pub builds: usize,
+    pub compose_ms: f64,
+    pub module_ms: f64,
+    pub create_ms: f64,
+}
+
+pub fn summarize_pipelines(samples: &[ReloadSample]) -> Vec<PipelineSummary> {
+    let mut by: std::collections::BTreeMap<(EditKind, String), Vec<&PipelineBuild>> =
+        Default::default();
+    for s in samples {
+        for b in &s.builds {
+            by.entry((s.kind, b.name())).or_default().push(b);
+        }
+    }
+    let ms = |d: Duration| d.as_secs_f64() * 1e3;
+    by.into_iter()
+        .map(|((kind, name), builds)| PipelineSummary {
+            kind,
+            name,
+            builds: builds.len(),
+            compose_ms: median_of(builds.iter().map(|b| ms(b.compose)).collect()),
+            module_ms: median_of(builds.iter().map(|b| ms(b.module)).collect()),
+            create_ms: median_of(builds.iter().map(|b| ms(b.create)).collect()),
         })
         .collect()
 }
@@ -376,12 +563,17 @@ pub fn summarize_kinds(samples: &[ReloadSample]) -> Vec<KindSummary> {
 pub fn to_csv(samples: &[ReloadSample]) -> String {
     let mut out = String::from(
         "kind,index,total_ms,watch_ms,assets_ms,graph_ms,shader_compose_ms,pipeline_build_ms,\
-         prepare_other_ms,render_ms,rerender_ms,pipelines_built,resources_created,resources_reused\n",
+         prepare_other_ms,render_ms,rerender_ms,pipelines_built,resources_created,resources_reused,\
+         shader_module_ms,pipeline_create_ms,gpu_busy_at_build,gpu_wait_before_build_ms,\
+         record_submit_ms,gpu_wait_ms,gpu_frame_ms,image_readback_ms,reports_readback_ms,\
+         rerender_gpu_wait_ms,slowest_pipeline,slowest_pipeline_create_ms,build_wall_ms,frame_ms\n",
     );
     for s in samples {
+        let slowest = s.builds.iter().max_by(|a, b| a.create.cmp(&b.create));
         let _ = writeln!(
             out,
-            "{},{},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{},{},{}",
+            "{},{},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{},{},{},\
+             {:.3},{:.3},{},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},\"{}\",{:.3},{:.3},{:.3}",
             s.kind,
             s.index,
             s.total_ms,
@@ -395,48 +587,131 @@ pub fn to_csv(samples: &[ReloadSample]) -> String {
             s.rerender_ms,
             s.pipelines_built,
             s.resources_created,
-            s.resources_reused
+            s.resources_reused,
+            s.shader_module_ms,
+            s.pipeline_create_ms,
+            match s.gpu_busy_at_build {
+                Some(true) => "1",
+                Some(false) => "0",
+                None => "",
+            },
+            s.gpu_wait_before_build_ms,
+            s.record_submit_ms,
+            s.gpu_wait_ms,
+            s.gpu_frame_ms,
+            s.image_readback_ms,
+            s.reports_readback_ms,
+            s.rerender_gpu_wait_ms,
+            slowest.map_or(String::new(), |b| b.name().replace('"', "'")),
+            slowest.map_or(0.0, |b| b.create.as_secs_f64() * 1e3),
+            s.build_wall_ms,
+            s.frame_ms,
         );
     }
     out
 }
 
+/// One row per pipeline built: which edit, which pass and pipeline, and its times.
+pub fn pipelines_csv(samples: &[ReloadSample]) -> String {
+    let mut out = String::from("kind,index,pass,pipeline,compose_ms,module_ms,create_ms\n");
+    let ms = |d: Duration| d.as_secs_f64() * 1e3;
+    for s in samples {
+        for b in &s.builds {
+            let _ = writeln!(
+                out,
+                "{},{},\"{}\",\"{}\",{:.3},{:.3},{:.3}",
+                s.kind,
+                s.index,
+                b.pass.replace('"', "'"),
+                b.pipeline.replace('"', "'"),
+                ms(b.compose),
+                ms(b.module),
+                ms(b.create)
+            );
+        }
+    }
+    out
+}
+
 /// Markdown: the setup, then per kind the total (median, p10, p90) and the median of
-/// each part.
+/// each part, the parts of pipeline build and render, and each pipeline built.
 pub fn to_markdown(
-    samples: &[ReloadSample],
+    run: &BenchRun,
     config: &ReloadBenchConfig,
     adapter: &str,
     watch: &WatchConfig,
 ) -> String {
+    let samples = &run.samples;
     let mut out = String::new();
     let _ = writeln!(out, "# Hot reload: edit to new frame\n");
     let _ = writeln!(
         out,
         "Adapter: {adapter}. Scene: harada geometry, boxes in `car_paint.ron`, {} random \
          lights; `forward_plus.ron`; {}×{}; {} edits of each kind, interleaved. Watcher \
-         debounce {} ms. Times from the file write returning to the new frame read back.\n",
+         debounce {} ms. Edit salt {}; {} frames in flight at each edit; {}; pipelines of \
+         different passes built {}. Times from the file write returning to the new frame \
+         read back.\n\n\
+         **Edit → new frame** runs from the file write returning to the new frame's GPU work \
+         being done: what the viewer (`lightgraph view`) shows, since it presents the output \
+         texture without reading it back. **Edit → read back** adds copying the \
+         Rgba32Float image to the CPU (what `watch --out` and this benchmark's image need); \
+         the breakdown below adds up to it.\n",
         config.lights,
         config.width,
         config.height,
         config.repeats,
-        watch.debounce.as_millis()
+        watch.debounce.as_millis(),
+        config.salt,
+        config.frames_in_flight,
+        if config.wait_for_idle_before_build {
+            "waiting for an idle GPU before building"
+        } else {
+            "building without waiting for the GPU"
+        },
+        if config.sequential_builds {
+            "one after another"
+        } else {
+            "in parallel"
+        }
+    );
+    let st = &run.startup;
+    let _ = writeln!(
+        out,
+        "Session start: {:.1} ms; {} pipelines built (compose + naga {:.1} ms, build {:.1} ms). \
+         Pipeline cache: {}.\n",
+        st.total_ms,
+        st.pipelines_built,
+        st.shader_compose_ms,
+        st.pipeline_build_ms,
+        st.pipeline_cache
     );
     let kinds = summarize_kinds(samples);
-    let _ = writeln!(out, "| edit | median | p10 | p90 |");
-    let _ = writeln!(out, "|---|--:|--:|--:|");
+    let _ = writeln!(
+        out,
+        "| edit | **edit → new frame** (viewer): median | p10 | p90 | edit → read back: median | p10 | p90 |"
+    );
+    let _ = writeln!(out, "|---|--:|--:|--:|--:|--:|--:|");
     for k in &kinds {
         let _ = writeln!(
             out,
-            "| {} | {:.1} ms | {:.1} ms | {:.1} ms |",
-            k.kind, k.total.median, k.total.p10, k.total.p90
+            "| {} | **{:.1} ms** | {:.1} ms | {:.1} ms | {:.1} ms | {:.1} ms | {:.1} ms |",
+            k.kind,
+            k.frame.median,
+            k.frame.p10,
+            k.frame.p90,
+            k.total.median,
+            k.total.p10,
+            k.total.p90
         );
     }
     let _ = writeln!(
         out,
         "\nMedian of each part (ms); the parts before \"(same frame again)\" add up to the \
          total, which does not include that last one: the new frame rendered a second time, \
-         to tell the frame itself from first-use work in the driver.\n"
+         to tell the frame itself from first-use work in the driver. With pipelines built \
+         in parallel, \"shader compose + naga\" and \"pipeline build\" add up every \
+         thread's time; what they took together is \"compose + build, wall\" below, and \
+         \"other prepare\" is the rest of prepare.\n"
     );
     let _ = write!(out, "| edit |");
     for (name, _) in PARTS {
@@ -454,6 +729,43 @@ pub fn to_markdown(
             " {} | {} / {} |",
             k.pipelines_built, k.resources_reused, k.resources_created
         );
+    }
+    let _ = writeln!(
+        out,
+        "\nPipeline build and render in detail (median ms). \"GPU busy at build\": edits whose \
+         first pipeline build began while earlier frames were still on the GPU. A driver that \
+         compiles on first use shows it in \"submit → GPU done\" against the same frame \
+         again; \"GPU frame\" is the sum of the passes' timestamps.\n"
+    );
+    let _ = write!(out, "| edit |");
+    for (name, _) in DETAILS {
+        let _ = write!(out, " {name} |");
+    }
+    let _ = writeln!(out, " GPU busy at build |");
+    let _ = writeln!(out, "|---|{}--:|", "--:|".repeat(DETAILS.len()));
+    for k in &kinds {
+        let _ = write!(out, "| {} |", k.kind);
+        for (_, v) in &k.details {
+            let _ = write!(out, " {v:.1} |");
+        }
+        let (busy, of) = k.gpu_busy_at_build;
+        let _ = writeln!(out, " {busy} of {of} |");
+    }
+    let pipelines = summarize_pipelines(samples);
+    if !pipelines.is_empty() {
+        let _ = writeln!(
+            out,
+            "\nEach pipeline built (pass: shader `material`), median ms.\n\n\
+             | edit | pipeline | builds | compose + naga | create_shader_module | create_*_pipeline |\n\
+             |---|---|--:|--:|--:|--:|"
+        );
+        for p in &pipelines {
+            let _ = writeln!(
+                out,
+                "| {} | {} | {} | {:.1} | {:.1} | {:.1} |",
+                p.kind, p.name, p.builds, p.compose_ms, p.module_ms, p.create_ms
+            );
+        }
     }
     out
 }
@@ -496,12 +808,72 @@ mod tests {
                 kind,
                 file: PathBuf::from("x"),
                 original: original.clone(),
+                salt: 0,
             };
             let mut last = original;
             for i in 0..40 {
                 let next = t.edited(i).unwrap();
                 assert_ne!(next, last, "{kind} edit {i}");
                 last = next;
+            }
+        }
+    }
+
+    /// The shipped graph mentions `capacity: 256` in a comment above the culling pass:
+    /// the graph edit must change the pass, not the comment (it did, and built nothing).
+    #[test]
+    fn the_graph_edit_changes_the_culling_pass_not_a_comment() {
+        let text = "// `capacity: 256` instead gives fixed lists\n\
+                    kind: LightCulling(tile: 16, variant: Frustum, lists: Compact(max_indices: 64)),\n";
+        let fixed = fixed_lists(text);
+        assert!(
+            fixed.contains("variant: Frustum, capacity: 256)"),
+            "{fixed}"
+        );
+        let edited = replace_number_after(&fixed, GRAPH_MARKER, "252").unwrap();
+        assert!(edited.starts_with("// `capacity: 256` instead"), "{edited}");
+        assert!(
+            edited.contains("variant: Frustum, capacity: 252)"),
+            "{edited}"
+        );
+        let shipped = include_str!("../../graphs/forward_plus.ron");
+        let fixed = fixed_lists(shipped);
+        let edited = replace_number_after(&fixed, GRAPH_MARKER, "252").unwrap();
+        assert!(
+            edited.contains("capacity: 252)"),
+            "the shipped graph's culling pass"
+        );
+    }
+
+    /// Salted shader edits differ from every other salt's and the unsalted ones, also
+    /// once the WGSL literal is rounded to f32 (what reaches the driver).
+    #[test]
+    fn salted_shader_edits_are_distinct_in_f32() {
+        let original = format!("fn w() -> f32 {{ {SHADER_LINE} }}");
+        let scale = |salt: u32, i: usize| -> f32 {
+            let t = Target {
+                kind: EditKind::Shader,
+                file: PathBuf::from("x"),
+                original: original.clone(),
+                salt,
+            };
+            let text = t.edited(i).unwrap();
+            let number = text
+                .split("return ")
+                .nth(1)
+                .unwrap()
+                .split(' ')
+                .next()
+                .unwrap();
+            number.parse::<f32>().unwrap()
+        };
+        let mut seen = std::collections::HashSet::new();
+        for salt in [0, 1, 2, 511, 1023] {
+            for i in 0..40 {
+                assert!(
+                    seen.insert(scale(salt, i).to_bits()),
+                    "salt {salt} edit {i}"
+                );
             }
         }
     }

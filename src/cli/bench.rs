@@ -153,20 +153,35 @@ pub fn reload_bench(args: &ReloadBenchArgs) -> Result<()> {
         height: args.height,
         lights: args.lights,
         repeats: args.repeats,
+        salt: args.salt,
+        frames_in_flight: args.frames_in_flight,
+        wait_for_idle_before_build: args.wait_for_idle_before_build,
+        sequential_builds: args.sequential_builds,
     };
     let gpu = lightgraph::gpu::GpuContext::new_headless()?;
     let adapter = gpu.adapter_name();
     println!("adapter: {adapter}");
+    println!("pipeline cache: {}", gpu.pipeline_cache_status());
     let result = rl::run(&config, gpu, |s| {
         println!(
-            "{:<8} #{:<3} {:>8.1} ms  (watch {:.1}, compose {:.1}, build {:.1}, render {:.1} [again {:.1}]; {} pipelines built, {} resources reused, {} created)",
+            "{:<8} #{:<3} new frame {:>7.1} ms, read back {:>7.1} ms  (watch {:.1}, compose {:.1}, build {:.1} [modules {:.1}, pipelines {:.1}{}], render {:.1} [submit {:.1}, GPU wait {:.1}, image readback {:.1}; again {:.1}]; {} pipelines built, {} resources reused, {} created)",
             s.kind.to_string(),
             s.index,
+            s.frame_ms,
             s.total_ms,
             s.watch_ms,
             s.shader_compose_ms,
             s.pipeline_build_ms,
+            s.shader_module_ms,
+            s.pipeline_create_ms,
+            match s.gpu_busy_at_build {
+                Some(true) => ", GPU busy",
+                _ => "",
+            },
             s.render_ms,
+            s.record_submit_ms,
+            s.gpu_wait_ms,
+            s.image_readback_ms,
             s.rerender_ms,
             s.pipelines_built,
             s.resources_reused,
@@ -174,18 +189,26 @@ pub fn reload_bench(args: &ReloadBenchArgs) -> Result<()> {
         );
     });
     let _ = std::fs::remove_dir_all(&work);
-    let samples = result?;
+    let run = result?;
     std::fs::create_dir_all(&args.out).with_context(|| args.out.display().to_string())?;
     let csv = args.out.join("reload_latency.csv");
-    std::fs::write(&csv, rl::to_csv(&samples)).with_context(|| csv.display().to_string())?;
+    std::fs::write(&csv, rl::to_csv(&run.samples)).with_context(|| csv.display().to_string())?;
+    let pipelines = args.out.join("reload_pipelines.csv");
+    std::fs::write(&pipelines, rl::pipelines_csv(&run.samples))
+        .with_context(|| pipelines.display().to_string())?;
     let md = args.out.join("reload_latency.md");
     let watch = lightgraph::reload::WatchConfig::default();
-    std::fs::write(&md, rl::to_markdown(&samples, &config, &adapter, &watch))
+    std::fs::write(&md, rl::to_markdown(&run, &config, &adapter, &watch))
         .with_context(|| md.display().to_string())?;
-    for k in rl::summarize_kinds(&samples) {
+    let st = &run.startup;
+    println!(
+        "session start: {:.1} ms, {} pipelines built (compose {:.1} ms, build {:.1} ms)",
+        st.total_ms, st.pipelines_built, st.shader_compose_ms, st.pipeline_build_ms
+    );
+    for k in rl::summarize_kinds(&run.samples) {
         println!(
-            "{}: median {:.1} ms, p10 {:.1}, p90 {:.1}",
-            k.kind, k.total.median, k.total.p10, k.total.p90
+            "{}: edit -> new frame (viewer) median {:.1} ms, p10 {:.1}, p90 {:.1}; edit -> read back median {:.1} ms",
+            k.kind, k.frame.median, k.frame.p10, k.frame.p90, k.total.median
         );
     }
     println!("wrote {} and {}", csv.display(), md.display());

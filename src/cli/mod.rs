@@ -162,6 +162,21 @@ pub struct ReloadBenchArgs {
     /// Edits of each kind.
     #[arg(long, default_value_t = 10)]
     pub repeats: usize,
+    /// 1..=1023: shader edits use values no run with another salt used, so a driver's own
+    /// shader cache (NVIDIA's on disk) cannot answer from an earlier run. 0: the historical
+    /// values, the same in every run.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..1024))]
+    pub salt: u32,
+    /// Frames submitted without waiting right before each edit, as a viewer has in flight.
+    #[arg(long, default_value_t = 0)]
+    pub frames_in_flight: usize,
+    /// Wait for the GPU to go idle before building pipelines (timed in its own column).
+    #[arg(long)]
+    pub wait_for_idle_before_build: bool,
+    /// Build the pipelines of different passes one after another, as before they were
+    /// built in parallel (for comparison).
+    #[arg(long)]
+    pub sequential_builds: bool,
 }
 
 #[derive(clap::Args, Default)]

@@ -1,3 +1,5 @@
+use super::pipeline_cache::DiskPipelineCache;
+use std::sync::Arc;
 use thiserror::Error;
 
 #[derive(Debug, Error)]
@@ -13,13 +15,18 @@ pub enum GpuError {
     Readback(String),
 }
 
-/// A headless wgpu device and queue, plus what the adapter can do.
+/// A headless wgpu device and queue, plus what the adapter can do. Clones share them.
+#[derive(Clone)]
 pub struct GpuContext {
     pub adapter: wgpu::Adapter,
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     /// Whether per-pass GPU timestamps can be recorded.
     pub has_timestamps: bool,
+    /// The driver's pipeline cache, kept on disk between runs (Vulkan adapters offering
+    /// `Features::PIPELINE_CACHE`, unless `LIGHTGRAPH_PIPELINE_CACHE_DIR=off`). Saved when
+    /// the last handle goes and after hot reloads that built pipelines.
+    pub pipeline_cache: Option<Arc<DiskPipelineCache>>,
 }
 
 impl GpuContext {
@@ -64,7 +71,9 @@ impl GpuContext {
             | wgpu::Features::FLOAT32_BLENDABLE
             | wgpu::Features::PRIMITIVE_INDEX
             | wgpu::Features::SHADER_INT64
-            | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX;
+            | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX
+            // Compiled pipelines kept on disk between runs (see `pipeline_cache`).
+            | wgpu::Features::PIPELINE_CACHE;
         let features = adapter.features() & wanted;
         let has_timestamps = features.contains(timestamps);
         let adapter_limits = adapter.limits();
@@ -95,11 +104,18 @@ impl GpuContext {
                 adapter: adapter.get_info().name,
                 source,
             })?;
+        let pipeline_cache = features
+            .contains(wgpu::Features::PIPELINE_CACHE)
+            .then(super::pipeline_cache::default_dir)
+            .flatten()
+            .and_then(|dir| DiskPipelineCache::open(&device, &adapter.get_info(), &dir))
+            .map(Arc::new);
         Ok(Self {
             adapter,
             device,
             queue,
             has_timestamps,
+            pipeline_cache,
         })
     }
 
@@ -107,6 +123,27 @@ impl GpuContext {
     /// smaller default workloads there.
     pub fn is_software(&self) -> bool {
         self.adapter.get_info().device_type == wgpu::DeviceType::Cpu
+    }
+
+    /// The pipeline cache's state in words: where it is and what opening it found.
+    pub fn pipeline_cache_status(&self) -> String {
+        use super::pipeline_cache::CacheLoad;
+        match &self.pipeline_cache {
+            None => "off (no PIPELINE_CACHE on this adapter, or disabled)".into(),
+            Some(c) => format!(
+                "{} ({})",
+                c.path().display(),
+                match c.load() {
+                    CacheLoad::Empty => "no file yet: empty".to_string(),
+                    CacheLoad::Loaded { bytes } => format!(
+                        "loaded {bytes} bytes, accepted; the driver holds {} after opening",
+                        c.held_bytes()
+                    ),
+                    CacheLoad::Ignored(why) => format!("ignored: {why}"),
+                    CacheLoad::Refused(why) => format!("refused by wgpu or the driver: {why}"),
+                }
+            ),
+        }
     }
 
     /// "NVIDIA H200 (Vulkan)" or "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan)".

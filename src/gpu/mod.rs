@@ -1,6 +1,7 @@
 //! GPU side: device, GPU struct layouts, readback, timestamp queries.
 
 mod context;
+pub mod pipeline_cache;
 pub mod readback;
 pub mod structs;
 

@@ -15,7 +15,10 @@
 
 use super::{normalize_path, ChangeBatch, DependencyIndex, FileWatcher, WatchConfig, WatchError};
 use crate::graph::{self, CompiledGraph, FrameSize};
-use crate::render::{FrameResult, MaterialProgram, PreparedFrame, Renderer, SceneGpu};
+use crate::render::{
+    FrameResult, GpuStateAtBuild, MaterialProgram, PipelineBuild, PreparedFrame, RenderTimings,
+    Renderer, SceneGpu,
+};
 use crate::scene::{self, Scene};
 use crate::shader::assets;
 use std::collections::BTreeSet;
@@ -29,8 +32,8 @@ pub enum SceneSource {
 }
 
 /// Where the time of one reload went. `shader_compose` and `pipeline_build` are part of
-/// `prepare`.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// `prepare`; the parts of `render` are in `frame`.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct ReloadTimings {
     /// Reading, validating and uploading changed scene and material files.
     pub assets: Duration,
@@ -42,8 +45,22 @@ pub struct ReloadTimings {
     pub shader_compose: Duration,
     /// Creating shader modules and pipelines (pipeline-cache misses).
     pub pipeline_build: Duration,
+    /// Of `pipeline_build`: `create_shader_module`.
+    pub shader_modules: Duration,
+    /// Of `pipeline_build`: `create_render/compute_pipeline` (with layouts).
+    pub pipeline_create: Duration,
+    /// Wall time of `shader_compose` and `pipeline_build` together: less than their sum
+    /// when pipelines were built in parallel.
+    pub build_wall: Duration,
+    /// Each pipeline built, named by pass and material.
+    pub builds: Vec<PipelineBuild>,
+    /// Whether the GPU was busy with earlier frames when the first build began.
+    pub gpu_at_build: GpuStateAtBuild,
     /// Executing the new frame and reading it back.
     pub render: Duration,
+    /// The parts of `render` (submit, GPU wait, GPU time, readbacks); `None` when the
+    /// reload rendered nothing.
+    pub frame: Option<RenderTimings>,
 }
 
 /// What one reload did.
@@ -56,8 +73,11 @@ pub struct Reload {
     pub outcome: Result<Duration, String>,
     /// When the watcher delivered the batch.
     pub received: Instant,
-    /// When the new frame was ready (or the reload gave up).
+    /// When the new frame was ready and read back (or the reload gave up).
     pub finished: Instant,
+    /// When the new frame's GPU work was done, before it was read back: what a viewer
+    /// presents from then on (`None` if nothing rendered).
+    pub frame_ready: Option<Instant>,
     /// What was reloaded: `graph`, `scene`, `material <name>`, `shaders`; empty when the
     /// batch touched nothing the frame uses.
     pub rebuilt: Vec<String>,
@@ -91,6 +111,9 @@ pub struct ReloadSession {
     prepared: Option<PreparedFrame>,
     /// Whether frames include the light statistics pass.
     light_stats: bool,
+    /// Whether a reload reads its new frame back into `frame` (a viewer, which presents
+    /// the output texture itself, does not wait for that).
+    read_back: bool,
     /// The last frame that rendered.
     pub frame: Option<FrameResult>,
     /// The current error, if the last reload failed.
@@ -159,9 +182,11 @@ struct Candidate {
     /// The files of materials reloaded alone.
     materials: MaterialFiles,
     prepared: PreparedFrame,
-    frame: FrameResult,
+    /// The frame read back (`None` without readback).
+    frame: Option<FrameResult>,
     prepare_time: Duration,
     render_time: Duration,
+    render_timings: RenderTimings,
 }
 
 impl ReloadSession {
@@ -203,6 +228,7 @@ impl ReloadSession {
             stale: BTreeSet::new(),
             prepared: None,
             light_stats: false,
+            read_back: true,
             frame: None,
             error: None,
         };
@@ -217,6 +243,13 @@ impl ReloadSession {
         let candidate = session.prepare_and_render(graph, None, None)?;
         session.commit(candidate);
         Ok(session)
+    }
+
+    /// Whether reloads read the new frame back into [`frame`](Self::frame) (on by
+    /// default). A viewer presents the output texture and turns it off: its reloads end
+    /// when the frame's GPU work is done, and `frame` stays `None` from then on.
+    pub fn set_image_readback(&mut self, on: bool) {
+        self.read_back = on;
     }
 
     /// The last good prepared frame (what `frame` was rendered from), to execute again
@@ -332,21 +365,30 @@ impl ReloadSession {
             rebuilt.push("shaders".into());
         }
         let mut timings = ReloadTimings::default();
+        let mut frame_ready = None;
         let outcome = if rebuilt.is_empty() {
             // Nothing the frame uses (another material in a watched folder, say).
             Ok(received.elapsed())
         } else {
             self.reload(shaders, &mut timings).map(|candidate| {
+                frame_ready = Some(candidate.render_timings.gpu_done);
                 self.commit(candidate);
                 received.elapsed()
             })
         };
         self.error = outcome.as_ref().err().cloned();
+        let finished = Instant::now();
+        if !timings.builds.is_empty() {
+            // After the frame, outside the latency: what the builds added to the driver's
+            // pipeline cache goes to disk.
+            self.renderer.pipelines.save_driver_cache();
+        }
         Reload {
             changed,
             outcome,
             received,
-            finished: Instant::now(),
+            finished,
+            frame_ready,
             rebuilt,
             timings,
         }
@@ -398,8 +440,15 @@ impl ReloadSession {
             self.prepare_and_render(graph, scene.as_ref().map(|(s, _, _)| s), gpu.as_ref())?;
         t.prepare = c.prepare_time;
         t.render = c.render_time;
-        t.shader_compose = c.prepared.stats().shader_compose;
-        t.pipeline_build = c.prepared.stats().pipeline_build;
+        t.frame = Some(c.render_timings);
+        let stats = c.prepared.stats();
+        t.shader_compose = stats.shader_compose;
+        t.pipeline_build = stats.pipeline_build;
+        t.shader_modules = stats.shader_modules;
+        t.pipeline_create = stats.pipeline_create;
+        t.build_wall = stats.build_wall;
+        t.builds = stats.builds.clone();
+        t.gpu_at_build = stats.gpu_at_build;
         c.resolved = self.stale.clone();
         c.scene = scene;
         c.gpu = gpu;
@@ -446,7 +495,17 @@ impl ReloadSession {
             .map_err(|e| e.to_string())?;
         let prepare_time = start.elapsed();
         let start = Instant::now();
-        let frame = prepared.render(&self.renderer).map_err(|e| e.to_string())?;
+        let (frame, render_timings) = if self.read_back {
+            let (frame, t) = prepared
+                .render_timed(&self.renderer)
+                .map_err(|e| e.to_string())?;
+            (Some(frame), t)
+        } else {
+            let (_, t) = prepared
+                .execute_timed(&self.renderer)
+                .map_err(|e| e.to_string())?;
+            (None, t)
+        };
         Ok(Candidate {
             resolved: BTreeSet::new(),
             scene: None,
@@ -456,6 +515,7 @@ impl ReloadSession {
             frame,
             prepare_time,
             render_time: start.elapsed(),
+            render_timings,
         })
     }
 
@@ -485,7 +545,7 @@ impl ReloadSession {
             self.gpu = gpu;
         }
         self.prepared = Some(c.prepared);
-        self.frame = Some(c.frame);
+        self.frame = c.frame;
         self.stale.retain(|d| !c.resolved.contains(d));
         // Pipelines that only replaced frames used (old material versions) are dropped.
         self.renderer.pipelines.evict_unused_since(generation);

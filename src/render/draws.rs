@@ -430,7 +430,7 @@ fn build_pipeline(
             },
             fragment,
             multiview_mask: None,
-            cache: None,
+            cache: crate::render::pipelines::driver_cache().as_ref(),
         },
     )))
 }

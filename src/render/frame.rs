@@ -16,7 +16,145 @@ use crate::graph::Name;
 use crate::graph::{CompiledGraph, FrameSize};
 use crate::scene::{Camera, Scene};
 use glam::Vec3;
+use std::time::{Duration, Instant};
 use wgpu::util::DeviceExt;
+
+/// GPU milliseconds per pass, where the adapter has timestamps.
+pub type PassTimes = Option<Vec<(String, f64)>>;
+
+/// Where the time of one executed (and read back) frame went.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderTimings {
+    /// Encoding every pass and `queue.submit`.
+    pub record_submit: Duration,
+    /// From the submit returning to the GPU having finished the frame (a blocking poll):
+    /// the GPU's work plus whatever the driver does on the queue (first-use compiles).
+    pub gpu_wait: Duration,
+    /// When the frame's GPU work was done: what a viewer could present from then on.
+    pub gpu_done: Instant,
+    /// The GPU's own time, the sum of the passes' timestamps (where the adapter has them).
+    pub gpu_frame_ms: Option<f64>,
+    /// Reading the timestamps back.
+    pub timestamps_read: Duration,
+    /// Copying the output image to a staging buffer, mapping it and converting it.
+    pub image_readback: Duration,
+    /// Reading back what passes counted (culling reports) and light statistics.
+    pub reports_readback: Duration,
+}
+
+impl Default for RenderTimings {
+    fn default() -> Self {
+        Self {
+            record_submit: Duration::ZERO,
+            gpu_wait: Duration::ZERO,
+            gpu_done: Instant::now(),
+            gpu_frame_ms: None,
+            timestamps_read: Duration::ZERO,
+            image_readback: Duration::ZERO,
+            reports_readback: Duration::ZERO,
+        }
+    }
+}
+
+/// Builds the pipelines the passes lack on scoped threads, one per pass, before the
+/// sequential prepare: each thread prepares its pass with a fork of the pipeline cache
+/// (and its own validation error scope) and drops the prepared pass; the forks' new
+/// pipelines are adopted in pass order, and the sequential prepare then finds them,
+/// counting and naming them as if it had built them (`PipelineCache::adopt`). A pass
+/// that fails on its thread contributes nothing: the sequential prepare meets the same
+/// error and reports it as before. Drivers compile pipelines concurrently (wgpu's Device
+/// is Send + Sync), so a reload rebuilding pipelines of several passes waits for the
+/// slowest instead of the sum.
+fn prebuild_in_parallel(cx: &mut PrepareCtx<'_>) {
+    use super::pipelines::ForkMode;
+    let r = &mut *cx.renderer;
+    // One fork per pass; a pass that asked for several pipelines last time gets one fork
+    // per pipeline, each building one of them (ForkMode::Only).
+    let forks: Vec<(&crate::graph::ScheduledPass, ForkMode)> = cx
+        .graph
+        .passes
+        .iter()
+        .flat_map(|sp| {
+            let n = r.pipelines.pipelines_of_pass_last_time(&sp.name);
+            let modes: Vec<ForkMode> = match n {
+                0 | 1 => vec![ForkMode::All],
+                n => (0..n).map(ForkMode::Only).collect(),
+            };
+            modes.into_iter().map(move |m| (sp, m))
+        })
+        .collect();
+    if !r.pipelines.parallel_builds || forks.len() < 2 {
+        return;
+    }
+    // Whether earlier frames were still on the GPU, noted before any thread builds.
+    r.pipelines.note_gpu_state_now(&r.ctx.device);
+    let (graph, gpu, resources, frame_uniform, size, scene) = (
+        cx.graph,
+        cx.gpu,
+        cx.resources,
+        cx.frame_uniform,
+        cx.size,
+        cx.scene,
+    );
+    let start = Instant::now();
+    let forks: Vec<Option<super::pipelines::ForkBuilds>> = std::thread::scope(|s| {
+        let threads: Vec<_> = forks
+            .iter()
+            .map(|&(sp, mode)| {
+                let mut fork = Renderer {
+                    ctx: r.ctx.clone(),
+                    shaders: r.shaders.clone(),
+                    pipelines: r.pipelines.fork(mode),
+                    layouts: r.layouts.clone(),
+                };
+                s.spawn(move || {
+                    fork.pipelines.set_pass(&sp.name);
+                    // Error scopes are per thread: this one sees this pass's errors.
+                    let scope = fork
+                        .ctx
+                        .device
+                        .push_error_scope(wgpu::ErrorFilter::Validation);
+                    let prepared = passes::prepare(
+                        &mut PrepareCtx {
+                            renderer: &mut fork,
+                            graph,
+                            gpu,
+                            resources,
+                            frame_uniform,
+                            size,
+                            scene,
+                        },
+                        sp,
+                    )
+                    .is_ok();
+                    let clean = pollster::block_on(scope.pop()).is_none();
+                    // A fork of one build ends its pass early on purpose (and may meet
+                    // errors its stand-ins made): its build's own scope decides.
+                    let keep = match mode {
+                        ForkMode::All => prepared && clean,
+                        ForkMode::Only(_) => fork.pipelines.fork_build_clean(),
+                    };
+                    keep.then(|| fork.pipelines.into_builds())
+                })
+            })
+            .collect();
+        threads
+            .into_iter()
+            .map(|t| t.join().ok().flatten())
+            .collect()
+    });
+    let mut built = 0;
+    let mut threads = 0;
+    for f in forks.into_iter().flatten().filter(|f| !f.is_empty()) {
+        built += f.len();
+        threads += 1;
+        r.pipelines.adopt(f);
+    }
+    if built > 0 {
+        r.pipelines.add_build_wall(start.elapsed());
+        r.pipelines.build_threads = threads;
+    }
+}
 
 /// A pass's error, named with the graph file:line that declares the pass.
 fn at_pass(graph: &CompiledGraph, sp: &crate::graph::ScheduledPass, e: RenderError) -> RenderError {
@@ -80,20 +218,32 @@ impl Renderer {
         let generation = self.pipelines.next_generation();
         let before = self.pipelines.counters();
         self.pipelines.take_built();
+        self.pipelines.take_builds();
         let pool = previous.map(|p| &p.resources);
         let file = graph.checked.source.file.clone();
         let result = self.prepare_unscoped(graph, scene, gpu, size, light_stats, pool);
+        self.pipelines.settle_prebuilt();
+        let build_threads = std::mem::take(&mut self.pipelines.build_threads);
+        let build_wall = self.pipelines.take_build_wall();
         let built = self
             .pipelines
             .take_built()
             .iter()
             .map(|k| k.describe())
             .collect();
-        let stats = PrepareStats::from_cache(self.pipelines.counters() - before, built, generation);
+        let stats = PrepareStats::from_cache(
+            self.pipelines.counters() - before,
+            built,
+            self.pipelines.take_builds(),
+            self.pipelines.gpu_state_at_build(),
+            generation,
+        );
         match pollster::block_on(scope.pop()) {
             Some(e) => Err(RenderError::Wgpu(format!("{}: {e}", file.display()))),
             None => result.map(|mut frame| {
                 frame.prepare_stats = PrepareStats {
+                    build_wall,
+                    build_threads,
                     resources_created: frame.resources.created(),
                     resources_reused: frame.resources.reused(),
                     ..stats
@@ -138,8 +288,10 @@ impl Renderer {
             size,
             scene,
         };
+        prebuild_in_parallel(&mut cx);
         let mut prepared = Vec::with_capacity(graph.passes.len());
         for sp in &graph.passes {
+            cx.renderer.pipelines.set_pass(&sp.name);
             let pass = passes::prepare(&mut cx, sp).map_err(|e| at_pass(&graph, sp, e))?;
             prepared.push((sp.name.clone(), pass));
         }
@@ -167,6 +319,7 @@ impl Renderer {
             )
         });
         let stats = if light_stats {
+            self.pipelines.set_pass("light statistics");
             Some(LightStatsPass::prepare(
                 self,
                 &graph,
@@ -202,6 +355,11 @@ impl PreparedFrame {
     /// Records and submits one frame; returns GPU milliseconds per pass when the
     /// adapter has timestamps.
     pub fn execute(&self, r: &Renderer) -> Result<Option<Vec<(String, f64)>>, RenderError> {
+        self.execute_timed(r).map(|(ms, _)| ms)
+    }
+
+    /// Like [`execute`](Self::execute), also saying where the time went.
+    pub fn execute_timed(&self, r: &Renderer) -> Result<(PassTimes, RenderTimings), RenderError> {
         let scope = r.ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let result = self.execute_unscoped(r);
         match pollster::block_on(scope.pop()) {
@@ -210,7 +368,17 @@ impl PreparedFrame {
         }
     }
 
-    fn execute_unscoped(&self, r: &Renderer) -> Result<Option<Vec<(String, f64)>>, RenderError> {
+    /// Records and submits one frame without waiting for it (a viewer's frame in flight).
+    pub fn submit(&self, r: &Renderer) -> Result<(), RenderError> {
+        let scope = r.ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        r.ctx.queue.submit([self.encode(r)]);
+        match pollster::block_on(scope.pop()) {
+            Some(e) => Err(RenderError::Wgpu(e.to_string())),
+            None => Ok(()),
+        }
+    }
+
+    fn encode(&self, r: &Renderer) -> wgpu::CommandBuffer {
         let device = &r.ctx.device;
         let plan = &self.graph.plan;
         let mut encoder = device.create_command_encoder(&Default::default());
@@ -255,32 +423,57 @@ impl PreparedFrame {
         if let Some((q, buf)) = &self.queries {
             encoder.resolve_query_set(q, 0..2 * self.passes.len() as u32, buf, 0);
         }
-        r.ctx.queue.submit([encoder.finish()]);
+        encoder.finish()
+    }
+
+    fn execute_unscoped(&self, r: &Renderer) -> Result<(PassTimes, RenderTimings), RenderError> {
+        let device = &r.ctx.device;
+        let start = Instant::now();
+        r.ctx.queue.submit([self.encode(r)]);
+        let submitted = Instant::now();
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| RenderError::Wgpu(e.to_string()))?;
+        let gpu_done = Instant::now();
+        let mut timings = RenderTimings {
+            record_submit: submitted - start,
+            gpu_wait: gpu_done - submitted,
+            gpu_done,
+            ..Default::default()
+        };
         let Some((_, buf)) = &self.queries else {
-            device
-                .poll(wgpu::PollType::wait_indefinitely())
-                .map_err(|e| RenderError::Wgpu(e.to_string()))?;
-            return Ok(None);
+            return Ok((None, timings));
         };
         let bytes = read_buffer(device, &r.ctx.queue, buf)?;
         let ticks: &[u64] = bytemuck::cast_slice(&bytes);
         let period = r.ctx.queue.get_timestamp_period() as f64;
-        Ok(Some(
-            self.passes
-                .iter()
-                .enumerate()
-                .map(|(i, (n, _))| {
-                    let dt = ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period;
-                    (n.to_string(), dt / 1e6)
-                })
-                .collect(),
-        ))
+        let pass_ms: Vec<(String, f64)> = self
+            .passes
+            .iter()
+            .enumerate()
+            .map(|(i, (n, _))| {
+                let dt = ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period;
+                (n.to_string(), dt / 1e6)
+            })
+            .collect();
+        timings.gpu_frame_ms = Some(pass_ms.iter().map(|(_, ms)| ms).sum());
+        timings.timestamps_read = gpu_done.elapsed();
+        Ok((Some(pass_ms), timings))
     }
 
     /// Runs one frame and reads back the output, culling reports and statistics.
     pub fn render(&self, r: &Renderer) -> Result<FrameResult, RenderError> {
-        let pass_ms = self.execute(r)?;
+        self.render_timed(r).map(|(frame, _)| frame)
+    }
+
+    /// Like [`render`](Self::render), also saying where the time went: recording and
+    /// submitting, waiting for the GPU, the GPU's own time, and the readbacks.
+    pub fn render_timed(&self, r: &Renderer) -> Result<(FrameResult, RenderTimings), RenderError> {
+        let (pass_ms, mut timings) = self.execute_timed(r)?;
+        let start = Instant::now();
         let image = read_rgba32f(&r.ctx.device, &r.ctx.queue, self.output_texture())?;
+        timings.image_readback = start.elapsed();
+        let start = Instant::now();
         let (mut culling, mut shadows, mut atlases) = (Vec::new(), Vec::new(), Vec::new());
         let (mut shadow_compare, mut links, mut vpls) = (Vec::new(), Vec::new(), Vec::new());
         for report in self.pass_reports(r)? {
@@ -294,7 +487,8 @@ impl PreparedFrame {
             }
         }
         let light_stats = self.read_light_stats(r)?;
-        Ok(FrameResult {
+        timings.reports_readback = start.elapsed();
+        let frame = FrameResult {
             width: self.size.width,
             height: self.size.height,
             image,
@@ -306,7 +500,8 @@ impl PreparedFrame {
             shadow_compare,
             vpls,
             light_stats,
-        })
+        };
+        Ok((frame, timings))
     }
 
     /// The graph's output texture (Rgba32Float; sampled by the viewer). Planned for every

@@ -18,9 +18,11 @@ pub mod visibility_geometry;
 
 pub use bind::LayoutCache;
 pub use device_limits::supported_sample_counts;
-pub use frame::PreparedFrame;
+pub use frame::{PreparedFrame, RenderTimings};
 pub use materials::MaterialProgram;
-pub use pipelines::{CacheCounters, Pipeline, PipelineCache, PipelineKey};
+pub use pipelines::{
+    CacheCounters, GpuStateAtBuild, Pipeline, PipelineBuild, PipelineCache, PipelineKey,
+};
 pub use prepare_stats::PrepareStats;
 pub use report::{
     AtlasReport, CullingReport, FrameResult, LightStats, LinkReport, PassReport,
@@ -68,9 +70,9 @@ pub struct Renderer {
 impl Renderer {
     pub fn new(ctx: GpuContext, shaders: ShaderLibrary) -> Self {
         Self {
+            pipelines: PipelineCache::with_driver_cache(ctx.pipeline_cache.clone()),
             ctx,
             shaders,
-            pipelines: PipelineCache::default(),
             layouts: Default::default(),
         }
     }

@@ -168,6 +168,9 @@ impl Viewer {
             &options.watch,
         )
         .map_err(ViewError::Session)?;
+        // The window presents the output texture: reloads need not read it back.
+        let mut session = session;
+        session.set_image_readback(false);
         let camera = CameraController::new(&session.scene().camera);
         let egui_ctx = egui::Context::default();
         let egui_state = egui_winit::State::new(

@@ -85,7 +85,7 @@ pub(super) fn prepare(
                             targets: &[Some(format.into())],
                         }),
                         multiview_mask: None,
-                        cache: None,
+                        cache: crate::render::pipelines::driver_cache().as_ref(),
                     },
                 )))
             },

@@ -182,7 +182,7 @@ fn tile_clear_pipeline(
                         multisample: Default::default(),
                         fragment: None,
                         multiview_mask: None,
-                        cache: None,
+                        cache: crate::render::pipelines::driver_cache().as_ref(),
                     },
                 )))
             },
