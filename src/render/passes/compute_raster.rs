@@ -248,7 +248,7 @@ fn resolve_pipeline(
                             targets: &[Some(wgpu::TextureFormat::R32Uint.into())],
                         }),
                         multiview_mask: None,
-                        cache: None,
+                        cache: crate::render::pipelines::driver_cache().as_ref(),
                     },
                 )))
             },
