@@ -77,7 +77,7 @@ impl VisibilityGeometry {
                 r[1] = end as u32;
             }
         }
-        let limit = u64::from(device.limits().max_storage_buffer_binding_size);
+        let limit = device.limits().max_storage_buffer_binding_size;
         let vertex_bytes = std::mem::size_of_val(&vertices[..]) as u64;
         let triangle_bytes = std::mem::size_of_val(&triangles[..]) as u64;
         for (what, bytes) in [("vertices", vertex_bytes), ("triangles", triangle_bytes)] {
