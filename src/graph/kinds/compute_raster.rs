@@ -79,27 +79,33 @@ mod tests {
     use crate::graph::kinds::test_support::{errors, validate};
 
     const READS: &str = r#"reads: ["vertices", "triangles", "material_triangles"]"#;
+    /// A reader of the depth, so the graph has an Rgba32Float output.
+    const SHADE: &str = r#"Pass(name: "s", kind: ForwardShading(lights: AllLights), reads: ["depth", "lg", "lp"], writes: ["hdr"])"#;
 
     #[test]
     fn writes_depth_and_ids() {
         validate(
             &format!(
-                r#"Pass(name: "cr", kind: ComputeRaster, {READS}, writes: ["depth", "visibility"])"#
+                r#"Pass(name: "cr", kind: ComputeRaster, {READS}, writes: ["depth", "visibility"]), {SHADE}"#
             ),
-            "visibility",
+            "hdr",
         )
         .unwrap();
         let e = errors(
-            &format!(r#"Pass(name: "cr", kind: ComputeRaster, {READS}, writes: ["depth"])"#),
-            "depth",
+            &format!(
+                r#"Pass(name: "cr", kind: ComputeRaster, {READS}, writes: ["depth"]), {SHADE}"#
+            ),
+            "hdr",
         );
         assert!(
             e.contains("ComputeRaster needs a colour texture in writes (slot 'visibility')"),
             "{e}"
         );
         let e = errors(
-            r#"Pass(name: "cr", kind: ComputeRaster, reads: ["triangles"], writes: ["depth", "visibility"])"#,
-            "visibility",
+            &format!(
+                r#"Pass(name: "cr", kind: ComputeRaster, reads: ["triangles"], writes: ["depth", "visibility"]), {SHADE}"#
+            ),
+            "hdr",
         );
         assert!(
             e.contains("ComputeRaster needs an Import of Vertices in reads (slot 'vertices')"),
@@ -117,9 +123,9 @@ mod tests {
         assert!(e.contains("a single-sample R32Uint texture"), "{e}");
         let e = errors(
             &format!(
-                r#"Pass(name: "cr", kind: ComputeRaster, {READS}, writes: ["depth4", "ids4"])"#
+                r#"Pass(name: "cr", kind: ComputeRaster, {READS}, writes: ["depth4", "ids4"]), {SHADE}"#
             ),
-            "ids4",
+            "hdr",
         );
         assert!(e.contains("a single-sample Depth32Float texture"), "{e}");
         assert!(e.contains("a single-sample R32Uint texture"), "{e}");
