@@ -8,7 +8,7 @@
 set -u
 source "$(dirname "$0")/gpu_env.sh"
 $lg info > "$out/info.txt" 2>&1 || true
-for g in graphs/visibility_buffer.ron benches/graphs/visibility_compute_raster_shaded.ron graphs/tiled_deferred_prepass.ron; do
+for g in graphs/visibility_buffer.ron graphs/visibility_compute_raster.ron graphs/tiled_deferred_prepass.ron; do
     n=$(basename "$g" .ron)
     $lg render --scene scenes/harada.ron --graph "$g" --width 1920 --height 1080 --out "$out/$n.exr" > "$out/render_$n.txt" 2>&1
     echo "== $n"; cat "$out/render_$n.txt" | head -n 12

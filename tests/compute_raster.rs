@@ -480,20 +480,23 @@ fn coincident_triangles_keep_the_later() {
     }
 }
 
-/// Light culling on the compute rasterizer's depth (graphs/visibility_compute_raster.ron)
-/// shades exactly as on the prepass's (forward_plus.ron).
+/// The shipped compute-first frame (graphs/visibility_compute_raster.ron): light culling
+/// on the compute depth builds the same tile lists as on the hardware prepass
+/// (forward_plus.ron), and shading its ids gives the hardware visibility buffer's image
+/// (visibility_buffer.ron: same ids, same shading code).
 #[test]
-fn shipped_graph_matches_forward_plus() {
+fn shipped_graph_matches_the_hardware_visibility_buffer() {
     if !has_atomics() {
         return;
     }
     let s = load("scenes/harada.ron");
     let mut r = renderer();
-    let reference = render_file(&mut r, "forward_plus.ron", &s, 333, 197);
+    let forward = render_file(&mut r, "forward_plus.ron", &s, 333, 197);
+    let hardware = render_file(&mut r, "visibility_buffer.ron", &s, 333, 197);
     let frame = render_file(&mut r, "visibility_compute_raster.ron", &s, 333, 197);
     // The same tile lists: each tile's depth range from the compute depth bounds the
     // same lights (all-ones depth, say, would keep more).
-    let (lists, reference_lists) = (&frame.culling[0].counts, &reference.culling[0].counts);
+    let (lists, reference_lists) = (&frame.culling[0].counts, &forward.culling[0].counts);
     assert_eq!(lists.len(), reference_lists.len());
     let differ = lists
         .iter()
@@ -503,16 +506,25 @@ fn shipped_graph_matches_forward_plus() {
     eprintln!("{differ} of {} tile lists differ", lists.len());
     assert_eq!(differ, 0);
     assert!(lists.iter().any(|&c| c > 0));
-    let (image, reference) = (frame.image, reference.image);
+    let (image, reference) = (frame.image, hardware.image);
+    assert_eq!(image.len(), reference.len());
+    assert_eq!(image.len(), 333 * 197);
     let (worst, at) = max_rel_diff(&image, &reference);
-    let off = image
+    let lit = reference
         .iter()
-        .zip(&reference)
-        .filter(|(a, b)| (0..3).any(|c| (a[c] - b[c]).abs() > 1e-5 * b[c].abs().max(1e-3)))
+        .filter(|p| p[0] + p[1] + p[2] > 0.0)
         .count();
     eprintln!(
-        "visibility_compute_raster vs forward_plus: {off} pixels differ, worst {worst:e} at {at}"
+        "visibility_compute_raster vs visibility_buffer: worst {worst:e} at {at}, {lit} lit pixels"
     );
+    assert!(
+        lit > 10_000,
+        "only {lit} lit pixels: the comparison tests nothing"
+    );
+    // Coverage is equal on lavapipe (shipped_scenes_match_the_depth_prepass), so every
+    // pixel shades the same triangle with the same code: equal up to the compiler
+    // contracting a multiply-add differently (the two pipelines are built alike, so 0
+    // is expected; 2e-6 relative is one f32 rounding per light term, as culling_exact.rs).
     assert!(
         worst <= 2e-6,
         "pixel {at}: {:?} vs {:?} ({worst:e})",

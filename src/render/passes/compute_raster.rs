@@ -1,7 +1,7 @@
 //! `ComputeRaster`: the merged opaque triangles rasterized in compute. One compute pass
 //! clears a per-pixel `u64` buffer, rasterizes a triangle per thread with a 64-bit
 //! atomic min of (depth bits, inverted id), and hands triangles with large bounding boxes
-//! to an indirect dispatch of one workgroup each; a full-screen draw then resolves the
+//! to an indirect dispatch of one workgroup per 4,096 pixels of their boxes; a full-screen draw then resolves the
 //! buffer into the depth texture (`frag_depth`) and the R32Uint visibility texture.
 //! See `shaders/visibility/compute_raster.wgsl`.
 
@@ -25,6 +25,9 @@ const BIG_GROUP: u32 = 256;
 /// A (clipped) triangle whose pixel bounding box holds more pixels than this goes to the
 /// shared-workgroup dispatch: one thread would walk it alone while the others idle.
 const BIG_PIXELS: u32 = 1024;
+/// Pixels of a large triangle's box per workgroup (16 per thread): a screen-filling
+/// floor becomes hundreds of workgroups across the GPU instead of one.
+const BIG_CHUNK: u32 = 16 * BIG_GROUP;
 
 /// What the rasterizer needs of the device: 64-bit integers and their atomic min on
 /// storage buffers.
@@ -114,8 +117,10 @@ pub(super) fn prepare(
         ));
     }
     let max_groups = limits.max_compute_workgroups_per_dimension;
-    // The large-triangle list is dispatched one workgroup per entry, in x only.
-    let capacity = geometry.triangle_count.clamp(1, max_groups);
+    // The large-triangle list (triangle, chunk) is dispatched one workgroup per entry, in
+    // x only: as many entries as one dispatch holds (512 KiB at 65,535); a triangle that
+    // finds it full is drawn by its own thread instead.
+    let capacity = max_groups.max(1);
     let storage = |label: &str, size: u64, extra: wgpu::BufferUsages| {
         device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
@@ -131,7 +136,7 @@ pub(super) fn prepare(
     );
     let big_list = storage(
         "large triangles",
-        4 * capacity as u64,
+        8 * capacity as u64,
         wgpu::BufferUsages::empty(),
     );
     let big_args = storage("large triangle dispatch", 16, wgpu::BufferUsages::INDIRECT);
@@ -168,6 +173,7 @@ pub(super) fn prepare(
         ("GROUP", format!("{GROUP}u")),
         ("BIG_GROUP", format!("{BIG_GROUP}u")),
         ("BIG_PIXELS", format!("{BIG_PIXELS}u")),
+        ("BIG_CHUNK", format!("{BIG_CHUNK}u")),
     ];
     let (clear, clear_bind) =
         cx.compute_pipeline(&sp.name, key(&consts, "clear"), "clear", &offered)?;
