@@ -128,9 +128,15 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let uv = mat3x2<f32>(a.uv, b.uv, c.uv);
     p.uv = uv * w;
 #if MATERIAL_TEXTURED
-    // The uv one pixel right and one down: the footprint textureSampleGrad filters over.
-    material_uv_ddx = uv * bary_at(e, q + vec2<f32>(step.x, 0.0)) - p.uv;
-    material_uv_ddy = uv * bary_at(e, q + vec2<f32>(0.0, step.y)) - p.uv;
+    // The footprint textureSampleGrad filters over (its mip level): the uv one pixel
+    // right and one down, taken as the rasterizer's coarse derivatives are, across the
+    // pixel's 2×2 quad from its top-left pixel (the triangle's plane extended there, as
+    // helper invocations do), so the level matches textureSample in forward shading.
+    let corner = vec2<f32>(id.xy & vec2<u32>(~1u)) + 0.5;
+    let q0 = vec2<f32>(corner.x / size.x * 2.0 - 1.0, 1.0 - corner.y / size.y * 2.0);
+    let uv0 = uv * bary_at(e, q0);
+    material_uv_ddx = uv * bary_at(e, q0 + vec2<f32>(step.x, 0.0)) - uv0;
+    material_uv_ddy = uv * bary_at(e, q0 + vec2<f32>(0.0, step.y)) - uv0;
 #endif
     let m = material_setup(p);
     let view_z = -(frame.view * vec4<f32>(p.position, 1.0)).z;

@@ -20,6 +20,8 @@ pub struct MaterialProgram {
     pub double_sided: bool,
     /// Group 2's sampler and textures by binding name; None without textures.
     pub(super) textures: Option<BindingSet>,
+    /// GPU bytes of the material's textures, every mip level included (4/3 of level 0).
+    pub texture_bytes: u64,
 }
 
 impl MaterialProgram {
@@ -47,6 +49,7 @@ impl MaterialProgram {
         };
         // Offered by the names the generated WGSL declares (`material_sampler`,
         // `material_tex{i}`); the layout comes from reflecting the composed shader.
+        let mut texture_bytes = 0u64;
         let textures = if slots.is_empty() {
             None
         } else {
@@ -59,6 +62,8 @@ impl MaterialProgram {
                     address_mode_v: wgpu::AddressMode::Repeat,
                     mag_filter: wgpu::FilterMode::Linear,
                     min_filter: wgpu::FilterMode::Linear,
+                    // Trilinear: textures carry full mip chains (texture_mips.rs).
+                    mipmap_filter: wgpu::MipmapFilterMode::Linear,
                     ..Default::default()
                 })),
             );
@@ -73,6 +78,28 @@ impl MaterialProgram {
                     }
                 })?;
                 let image = fitted.as_ref().unwrap_or(&image);
+                let chain = super::texture_mips::mip_chain(
+                    image.width,
+                    image.height,
+                    &image.rgba8,
+                    image.srgb,
+                )
+                .map_err(|message| MaterialError::TextureDecode {
+                    name: image.name.clone(),
+                    path: material.path().to_path_buf(),
+                    message,
+                })?;
+                // The chain adds a third to level 0; said, so a memory report can add it.
+                texture_bytes += chain.rgba8.len() as u64;
+                log::debug!(
+                    "material {}: texture {} {}×{}, {} mip levels, {} bytes",
+                    material.name(),
+                    image.name,
+                    image.width,
+                    image.height,
+                    chain.levels,
+                    chain.rgba8.len()
+                );
                 let format = if image.srgb {
                     wgpu::TextureFormat::Rgba8UnormSrgb
                 } else {
@@ -87,7 +114,7 @@ impl MaterialProgram {
                             height: image.height,
                             depth_or_array_layers: 1,
                         },
-                        mip_level_count: 1,
+                        mip_level_count: chain.levels,
                         sample_count: 1,
                         dimension: wgpu::TextureDimension::D2,
                         format,
@@ -95,7 +122,7 @@ impl MaterialProgram {
                         view_formats: &[],
                     },
                     wgpu::util::TextureDataOrder::LayerMajor,
-                    &image.rgba8,
+                    &chain.rgba8,
                 );
                 set.offer(
                     &format!("material_tex{i}"),
@@ -111,6 +138,7 @@ impl MaterialProgram {
             alpha_mode,
             double_sided,
             textures,
+            texture_bytes,
         })
     }
 

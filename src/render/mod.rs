@@ -14,6 +14,7 @@ mod report;
 mod resources;
 mod scene_gpu;
 mod texture_fit;
+pub mod texture_mips;
 pub mod visibility_geometry;
 
 pub use bind::LayoutCache;
