@@ -25,6 +25,12 @@ seeds() {
         *) echo "unknown fuzz target $1" >&2; exit 2 ;;
     esac
 }
+# The committed corpus (what hours of coverage-guided runs grew, minimised with
+# -merge=1, xz-compressed to stay small beside the GPU tool's 64 MiB working-tree limit)
+# seeds fuzz/corpus/ the first time; later runs grow fuzz/corpus/ in place.
+if [ ! -d fuzz/corpus ] && [ -f fuzz/corpus.tar.xz ]; then
+    tar -xJf fuzz/corpus.tar.xz -C fuzz
+fi
 for t in "${targets[@]}"; do
     mkdir -p "fuzz/corpus/$t"
     echo "== fuzz $t for ${secs}s"
