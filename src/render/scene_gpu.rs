@@ -149,14 +149,7 @@ impl SceneGpu {
             .map(|(scene_mesh, m)| {
                 let (shadow_indices, chunks) =
                     crate::shadow::chunks::chunk_triangles(&m.positions, &m.indices);
-                let vertices: Vec<GpuVertex> = (0..m.positions.len())
-                    .map(|i| GpuVertex {
-                        position: m.positions[i].into(),
-                        normal: m.normals.get(i).copied().unwrap_or(glam::Vec3::Y).into(),
-                        uv: m.uvs.get(i).copied().unwrap_or_default().into(),
-                        tangent: m.tangents.get(i).copied().unwrap_or_default().into(),
-                    })
-                    .collect();
+                let vertices = gpu_vertices(m);
                 GpuMesh {
                     vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                         label: Some(&m.name),
@@ -191,20 +184,9 @@ impl SceneGpu {
             })
             .collect();
         let (geometry, properties) = light_buffers(&scene.lights);
-        // Storage bindings may not be empty: a scene without lights binds one unused entry.
+        // A scene without lights binds one unused entry.
         let storage = |label: &str, bytes: &[u8]| {
-            let padded;
-            let contents = if bytes.is_empty() {
-                padded = vec![0u8; 32];
-                &padded[..]
-            } else {
-                bytes
-            };
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            })
+            storage_buffer(device, label, bytes, wgpu::BufferUsages::COPY_DST)
         };
         let mut gpu = Self {
             meshes,
@@ -250,4 +232,39 @@ impl SceneGpu {
         let [lo, hi] = self.meshes[mesh].bounds;
         -view.transform_point3((lo + hi) * 0.5).z
     }
+}
+
+/// A mesh's vertices as the GPU reads them (missing normals point up, missing uvs and
+/// tangents are zero).
+pub(super) fn gpu_vertices(m: &crate::scene::Mesh) -> Vec<GpuVertex> {
+    (0..m.positions.len())
+        .map(|i| GpuVertex {
+            position: m.positions[i].into(),
+            normal: m.normals.get(i).copied().unwrap_or(glam::Vec3::Y).into(),
+            uv: m.uvs.get(i).copied().unwrap_or_default().into(),
+            tangent: m.tangents.get(i).copied().unwrap_or_default().into(),
+        })
+        .collect()
+}
+
+/// A storage buffer holding `bytes`, padded to 32 bytes when empty: storage bindings may
+/// not be empty.
+pub(super) fn storage_buffer(
+    device: &wgpu::Device,
+    label: &str,
+    bytes: &[u8],
+    extra: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    let padded;
+    let contents = if bytes.is_empty() {
+        padded = vec![0u8; 32];
+        &padded[..]
+    } else {
+        bytes
+    };
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents,
+        usage: wgpu::BufferUsages::STORAGE | extra,
+    })
 }

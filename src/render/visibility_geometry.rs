@@ -15,10 +15,9 @@
 //! - `material_triangles: array<vec2<u32>>`: per scene material, its triangles' range
 //!   `[first, end)` (empty where it has none).
 
-use super::scene_gpu::SceneGpu;
+use super::scene_gpu::{gpu_vertices, storage_buffer, SceneGpu};
 use crate::gpu::structs::GpuVertex;
 use crate::scene::Scene;
-use wgpu::util::DeviceExt;
 
 /// The id of "no surface" in a visibility buffer.
 pub const NO_TRIANGLE: u32 = u32::MAX;
@@ -55,12 +54,7 @@ impl VisibilityGeometry {
             }
             let base = u32::try_from(vertices.len())
                 .map_err(|_| "the scene has more than 2^32 vertices".to_string())?;
-            vertices.extend((0..m.positions.len()).map(|i| GpuVertex {
-                position: m.positions[i].into(),
-                normal: m.normals.get(i).copied().unwrap_or(glam::Vec3::Y).into(),
-                uv: m.uvs.get(i).copied().unwrap_or_default().into(),
-                tangent: m.tangents.get(i).copied().unwrap_or_default().into(),
-            }));
+            vertices.extend(gpu_vertices(m));
             triangles.extend(m.indices.iter().map(|&i| base + i));
             let end = (triangles.len() / 3) as u64;
             if end >= u64::from(NO_TRIANGLE) {
@@ -89,19 +83,7 @@ impl VisibilityGeometry {
         }
         let ranges: Vec<u32> = material_ranges.iter().flatten().copied().collect();
         let storage = |label: &str, bytes: &[u8]| {
-            // Storage bindings may not be empty.
-            let padded;
-            let contents = if bytes.is_empty() {
-                padded = vec![0u8; 16];
-                &padded[..]
-            } else {
-                bytes
-            };
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage: wgpu::BufferUsages::STORAGE,
-            })
+            storage_buffer(device, label, bytes, wgpu::BufferUsages::empty())
         };
         Ok(Self {
             vertices: storage("merged vertices", bytemuck::cast_slice(&vertices)),
