@@ -215,58 +215,43 @@ fn resolve_pipeline(
     let device = cx.device();
     let layouts = cx.renderer.layouts.clone();
     let stages = wgpu::ShaderStages::FRAGMENT;
-    let (pipeline, bindings) = cx
-        .renderer
-        .pipelines
-        .get_or_build_reflected(
-            &cx.renderer.shaders,
-            key,
-            |_, module, bindings| {
-                let bgl = layouts.get(&device, layout_entries(bindings, 0, stages));
-                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some(&sp.name),
-                    bind_group_layouts: &[Some(&bgl)],
-                    immediate_size: 0,
-                });
-                Pipeline::Render(Arc::new(device.create_render_pipeline(
-                    &wgpu::RenderPipelineDescriptor {
-                        label: Some(&sp.name),
-                        layout: Some(&layout),
-                        vertex: wgpu::VertexState {
-                            module: &module,
-                            entry_point: Some("resolve_vs"),
-                            compilation_options: Default::default(),
-                            buffers: &[],
-                        },
-                        primitive: Default::default(),
-                        depth_stencil: Some(wgpu::DepthStencilState {
-                            format: wgpu::TextureFormat::Depth32Float,
-                            depth_write_enabled: Some(true),
-                            depth_compare: Some(wgpu::CompareFunction::Always),
-                            stencil: Default::default(),
-                            bias: Default::default(),
-                        }),
-                        multisample: Default::default(),
-                        fragment: Some(wgpu::FragmentState {
-                            module: &module,
-                            entry_point: Some("resolve_fs"),
-                            compilation_options: Default::default(),
-                            targets: &[Some(wgpu::TextureFormat::R32Uint.into())],
-                        }),
-                        multiview_mask: None,
-                        cache: crate::render::pipelines::driver_cache().as_ref(),
-                    },
-                )))
+    let (pipeline, bindings) = cx.render_pipeline(&sp.name, key, |_, module, bindings| {
+        let bgl = layouts.get(&device, layout_entries(bindings, 0, stages));
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(&sp.name),
+            bind_group_layouts: &[Some(&bgl)],
+            immediate_size: 0,
+        });
+        Pipeline::Render(Arc::new(device.create_render_pipeline(
+            &wgpu::RenderPipelineDescriptor {
+                label: Some(&sp.name),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("resolve_vs"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: Default::default(),
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: wgpu::TextureFormat::Depth32Float,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Always),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("resolve_fs"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::TextureFormat::R32Uint.into())],
+                }),
+                multiview_mask: None,
+                cache: crate::render::pipelines::driver_cache().as_ref(),
             },
-            &device,
-        )
-        .map_err(|source| RenderError::Shader {
-            pass: sp.name.to_string(),
-            source,
-        })?;
-    let Pipeline::Render(pipeline) = pipeline else {
-        return Err(pass_error(&sp.name, "expected a render pipeline".into()));
-    };
+        )))
+    })?;
     let bgl = layouts.get(&device, layout_entries(&bindings, 0, stages));
     let bind = offered
         .bind(&device, &sp.name, &bgl, &bindings, 0)

@@ -54,50 +54,35 @@ pub(super) fn prepare(
         .shaders
         .read_source("common/fullscreen_vs.wgsl")
         .map_err(|e| pass_error(&sp.name, e.to_string()))?;
-    let (pipeline, bindings) = cx
-        .renderer
-        .pipelines
-        .get_or_build_reflected(
-            &cx.renderer.shaders,
-            key,
-            |c, _, _| {
-                let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                    label: Some(shader),
-                    source: wgpu::ShaderSource::Wgsl(format!("{}\n{vs_text}", c.text).into()),
-                });
-                Pipeline::Render(Arc::new(device.create_render_pipeline(
-                    &wgpu::RenderPipelineDescriptor {
-                        label: Some(&sp.name),
-                        layout: None,
-                        vertex: wgpu::VertexState {
-                            module: &module,
-                            entry_point: Some("lightgraph_fullscreen_vs"),
-                            compilation_options: Default::default(),
-                            buffers: &[],
-                        },
-                        primitive: Default::default(),
-                        depth_stencil: None,
-                        multisample: Default::default(),
-                        fragment: Some(wgpu::FragmentState {
-                            module: &module,
-                            entry_point: Some(entry),
-                            compilation_options: Default::default(),
-                            targets: &[Some(format.into())],
-                        }),
-                        multiview_mask: None,
-                        cache: crate::render::pipelines::driver_cache().as_ref(),
-                    },
-                )))
+    let (pipeline, bindings) = cx.render_pipeline(&sp.name, key, |c, _, _| {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(shader),
+            source: wgpu::ShaderSource::Wgsl(format!("{}\n{vs_text}", c.text).into()),
+        });
+        Pipeline::Render(Arc::new(device.create_render_pipeline(
+            &wgpu::RenderPipelineDescriptor {
+                label: Some(&sp.name),
+                layout: None,
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("lightgraph_fullscreen_vs"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: Default::default(),
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    targets: &[Some(format.into())],
+                }),
+                multiview_mask: None,
+                cache: crate::render::pipelines::driver_cache().as_ref(),
             },
-            &device,
-        )
-        .map_err(|source| RenderError::Shader {
-            pass: sp.name.to_string(),
-            source,
-        })?;
-    let Pipeline::Render(pipeline) = pipeline else {
-        return Err(pass_error(&sp.name, "expected a render pipeline".into()));
-    };
+        )))
+    })?;
     let bind = bind_generic(cx, sp, &pipeline.get_bind_group_layout(0), &bindings)?;
     Ok(FullscreenPass {
         name: sp.name.clone(),

@@ -309,6 +309,39 @@ impl PrepareCtx<'_> {
         Ok(ShadeLists::Tiles)
     }
 
+    /// A render pipeline from the pipeline cache (`build` runs on a miss with the
+    /// composed shader, its module and its reflected bindings), errors named by `pass`.
+    pub fn render_pipeline(
+        &mut self,
+        pass: &str,
+        key: PipelineKey,
+        build: impl FnOnce(
+            &crate::shader::Composed,
+            wgpu::ShaderModule,
+            &[crate::shader::ReflectedBinding],
+        ) -> Pipeline,
+    ) -> Result<
+        (
+            Arc<wgpu::RenderPipeline>,
+            Arc<[crate::shader::ReflectedBinding]>,
+        ),
+        RenderError,
+    > {
+        let device = self.device();
+        let (pipeline, bindings) = self
+            .renderer
+            .pipelines
+            .get_or_build_reflected(&self.renderer.shaders, key, build, &device)
+            .map_err(|source| RenderError::Shader {
+                pass: pass.to_string(),
+                source,
+            })?;
+        let Pipeline::Render(pipeline) = pipeline else {
+            return Err(pass_error(pass, "expected a render pipeline".into()));
+        };
+        Ok((pipeline, bindings))
+    }
+
     /// A compute pipeline whose group-0 layout is made from its own reflected bindings,
     /// with the bind group from `offered`.
     pub fn compute_pipeline(
