@@ -670,6 +670,11 @@ fn screen_filling_triangle_among_many_small_ones_is_exact() {
         let (serial, serial_report) = rasterize_limited(&s, w, h, "records=0");
         assert!(serial_report.serial_triangles > 300, "{serial_report:?}");
         assert_eq!(bit_differences(&px, &serial), 0);
+        // The huge triangle's fan triangles reserve their many tiles with a
+        // compare-exchange that stops at the capacity; here it runs out mid-box.
+        let (part, part_report) = rasterize_limited(&s, w, h, "tiles=30");
+        assert!(part_report.serial_tiles > 0, "{part_report:?}");
+        assert_eq!(bit_differences(&px, &part), 0);
     }
 }
 

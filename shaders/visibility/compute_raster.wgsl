@@ -85,9 +85,8 @@ const HALF_PIXEL: i32 = 128;
 // 4 pixels of atrium_amd's near-clipped balustrade took another depth.
 const GUARD: f32 = 1.0;
 const MAX_POLY: u32 = 8u;
-// Counter slots: entries appended to each list (they stop growing near the capacity, see
-// `reserve_tiles`), then fan triangles, tiles and blocks rasterized serially because
-// their list was full.
+// Counter slots: entries appended to each list (past the capacity too), then fan
+// triangles, tiles and blocks rasterized serially because their list was full.
 const RECORDS: u32 = 0u;
 const TILES: u32 = 1u;
 const BLOCKS: u32 = 2u;
@@ -97,6 +96,8 @@ const SERIAL_BLOCKS: u32 = 5u;
 // Record flags: bits 0-2, edge k is not a top or left edge (bias -1); RECORD_LINEAR, the
 // snapped coordinates are small enough for the edge functions to be exactly linear.
 const RECORD_LINEAR: u32 = 8u;
+// Tiles a fan triangle reserves without checking the count first (see `reserve_tiles`).
+const SMALL_BOX: u32 = 16u;
 // Snapped coordinates up to this (2^29 fixed point, 2^21 pixels) keep every difference
 // the edge functions take within i32 (pixel centres are under 2^22 for viewports up to
 // 16,384 pixels), so an edge function is exactly the linear function of the pixel.
@@ -378,16 +379,30 @@ fn within_linear_range(p: vec2<i32>) -> bool {
 }
 
 // Entries [first, first + n) of the tile list reserved (a slot at or past the capacity
-// has no room): returns the first slot, or the capacity when the list is already full.
-// One reservation per row of tiles (at most 16384 / TILE_PIXELS entries) after checking
-// the count is below capacity, so the counter exceeds capacity by at most a row per
-// thread in flight and never wraps.
+// has no room): returns the first slot. One reservation per fan triangle: a returned
+// atomic is a round trip to L2, and setup's slowest thread bounds the dispatch.
+// The counter never wraps: a box of up to SMALL_BOX tiles adds without checking (at most
+// SMALL_BOX x 2^22 records = 2^26 in all), a larger one only while the count is below
+// capacity (compare-exchange), adding at most 2^20 tiles (65,536² pixels) to under 2^24.
 fn reserve_tiles(n: u32) -> u32 {
     let capacity = list_capacity.y;
-    if (atomicLoad(&counters[TILES]) >= capacity) {
-        return capacity;
+    var first = capacity;
+    if (n <= SMALL_BOX) {
+        first = atomicAdd(&counters[TILES], n);
+    } else {
+        var old = atomicLoad(&counters[TILES]);
+        loop {
+            if (old >= capacity) {
+                break;
+            }
+            let swap = atomicCompareExchangeWeak(&counters[TILES], old, old + n);
+            if (swap.exchanged) {
+                first = old;
+                break;
+            }
+            old = swap.old_value;
+        }
     }
-    let first = atomicAdd(&counters[TILES], n);
     let end = min(first + n, capacity);
     if (end > first) {
         // Enough bin workgroups for every entry below `end`: x up to the per-dimension
@@ -449,11 +464,9 @@ fn setup_triangle(ca: vec4<f32>, cb: vec4<f32>, cc: vec4<f32>, id: u32, cull_bac
     t.dz = vec2<f32>(dzdx, dzdy);
     t.box = box;
     t.id = id;
-    // The count is checked first so that it stops growing once full (no wrap).
-    var r = list_capacity.x;
-    if (atomicLoad(&counters[RECORDS]) < list_capacity.x) {
-        r = atomicAdd(&counters[RECORDS], 1u);
-    }
+    // At most 6 fan triangles per triangle, and compute_raster.rs refuses scenes of
+    // over 2^32 / 8 triangles: the counter never wraps.
+    let r = atomicAdd(&counters[RECORDS], 1u);
     if (r >= list_capacity.x) {
         atomicAdd(&counters[SERIAL_TRIANGLES], 1u);
         raster_region(t, box);
@@ -464,8 +477,8 @@ fn setup_triangle(ca: vec4<f32>, cb: vec4<f32>, cc: vec4<f32>, id: u32, cull_bac
     let last = vec2<u32>(box.zw) / TILE_PIXELS;
     let capacity = list_capacity.y;
     var serial = 0u;
+    var slot = reserve_tiles((last.x - first.x + 1u) * (last.y - first.y + 1u));
     for (var ty = first.y; ty <= last.y; ty++) {
-        var slot = reserve_tiles(last.x - first.x + 1u);
         for (var tx = first.x; tx <= last.x; tx++) {
             if (slot < capacity) {
                 tiles[slot] = vec2<u32>(r, tx | (ty << 16u));
@@ -561,8 +574,8 @@ fn bin(
         let n = atomicLoad(&kept);
         var first = 0u;
         if (n > 0u) {
-            // At most TILE_BLOCKS² per bin workgroup, and the tile list is capped at
-            // 2^24 entries (compute_raster.rs): the counter stays under 2^30.
+            // At most TILE_BLOCKS² per bin workgroup, one per tile entry, and the tile
+            // list holds at most 2^24 (compute_raster.rs): the counter stays under 2^30.
             first = atomicAdd(&counters[BLOCKS], n);
             let end = min(first + n, capacity);
             if (end > first) {

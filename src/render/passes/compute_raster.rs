@@ -40,6 +40,12 @@ const ENTRY_BYTES: u64 = 8;
 /// Most entries a list holds: the block counter, which grows by at most TILE_BLOCKS² per
 /// tile entry without checking, then stays under 2^30 (no wrap).
 const MAX_ENTRIES: u64 = 1 << 24;
+/// Most records: the tile counter, which grows by up to 16 tiles per record without
+/// checking, then stays under 2^26 (see the shader's `reserve_tiles`).
+const MAX_RECORDS: u64 = 1 << 22;
+/// Most triangles: the record counter grows by up to 6 per triangle (a triangle clipped
+/// by five planes is a fan of six) without checking, so this keeps it from wrapping.
+const MAX_TRIANGLES: u32 = u32::MAX / 8;
 /// Words of the counter buffer (see the shader's `RECORDS`..`SERIAL_BLOCKS`).
 const COUNTERS: usize = 8;
 /// Test hook: `records=N,tiles=N,blocks=N,groups=N` (any of them) overrides the lists'
@@ -97,7 +103,7 @@ fn list_capacity(triangles: u32, width: u32, height: u32, max_binding: u64) -> L
     let records = triangles as u64 * 3 / 2 + 4096;
     let fit = |n: u64, bytes: u64| n.min(max_binding / bytes).min(MAX_ENTRIES) as u32;
     ListCapacity {
-        records: fit(records, RECORD_BYTES),
+        records: fit(records, RECORD_BYTES).min(MAX_RECORDS as u32),
         tiles: fit(2 * records + 16 * screen_tiles, ENTRY_BYTES),
         blocks: fit(4 * records + 8 * screen_blocks, ENTRY_BYTES),
     }
@@ -210,6 +216,15 @@ pub(super) fn prepare(
             &sp.name,
             format!(
                 "its per-pixel buffer of {bytes} bytes is over this device's storage buffer limit"
+            ),
+        ));
+    }
+    if geometry.triangle_count > MAX_TRIANGLES {
+        return Err(pass_error(
+            &sp.name,
+            format!(
+                "{} triangles are over the {MAX_TRIANGLES} it counts",
+                geometry.triangle_count
             ),
         ));
     }
@@ -508,9 +523,9 @@ mod tests {
         // A small binding limit caps each list by its entry size.
         let c = list_capacity(1 << 20, 1920, 1080, 1 << 20);
         assert_eq!((c.records, c.tiles, c.blocks), (1 << 14, 1 << 17, 1 << 17));
-        // And no list passes MAX_ENTRIES (the block counter stays under 2^30).
+        // And no list passes its maximum (the counters never wrap).
         let c = list_capacity(u32::MAX, 16384, 16384, u64::MAX);
-        assert_eq!((c.records, c.tiles, c.blocks), (1 << 24, 1 << 24, 1 << 24));
+        assert_eq!((c.records, c.tiles, c.blocks), (1 << 22, 1 << 24, 1 << 24));
     }
 
     #[test]
