@@ -15,11 +15,11 @@
 // - `setup` (SETUP), one thread per triangle: clip, snap, cull, and per fan triangle of
 //   the clipped polygon one 64-byte record (snapped vertices, top-left biases, depth
 //   plane, pixel box, id) and one entry per TILE_PIXELS² tile of its box.
-// - `bin` (BIN), one workgroup per tile entry, one thread per BLOCK² block of the tile:
+// - `bin` (BIN), a thread per BLOCK² block of a tile entry (TILES_PER_GROUP a workgroup):
 //   blocks inside the box that no edge rejects (tested at the block's corner where the
 //   edge function is largest: exact, as the function is linear) become block entries.
-// - `raster` (RASTER), one workgroup per block entry, one thread per pixel: the edge
-//   tests, the depth and the atomic min. No loops, no division.
+// - `raster` (RASTER), a thread per pixel of a block entry (BLOCKS_PER_GROUP a
+//   workgroup): the edge tests, the depth and the atomic min. No loops, no division.
 // Tiles and blocks are two levels so that setup writes at most a viewport's tiles
 // (510 at 1080p) for a screen-filling triangle instead of its 32,400 blocks. Both are
 // dispatched indirectly over x and y (flattened here), the arguments grown with atomicMax
@@ -137,15 +137,27 @@ fn resolve_fs(@builtin(position) pos: vec4<f32>) -> Resolved {
 #else
 // Pixels per side of a tile (BLOCK pixels per block, TILE_BLOCKS blocks per tile side).
 const TILE_PIXELS: u32 = BLOCK * TILE_BLOCKS;
+// Threads per block (one a pixel) and per tile (one a block).
+const BLOCK_THREADS: u32 = BLOCK * BLOCK;
+const TILE_THREADS: u32 = TILE_BLOCKS * TILE_BLOCKS;
+
+// Indirect dispatch size (x, y) for `entries` list entries, `per_group` a workgroup: x up
+// to the per-dimension limit, y as many rows of those as needed (flattened back by the
+// dispatch).
+fn dispatch_size(entries: u32, per_group: u32) -> vec2<u32> {
+    let groups = (entries + per_group - 1u) / per_group;
+    let row = raster_params.y;
+    return vec2<u32>(min(groups, row), (groups + row - 1u) / row);
+}
 #if CLEAR
 
-@compute @workgroup_size(GROUP)
+@compute @workgroup_size(CLEAR_GROUP)
 fn clear(
     @builtin(workgroup_id) wg: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
 ) {
-    let i = flat_index(wg, groups, local, GROUP);
+    let i = flat_index(wg, groups, local, CLEAR_GROUP);
     if (i < 8u) {
         counters[i] = 0u;
     }
@@ -405,11 +417,10 @@ fn reserve_tiles(n: u32) -> u32 {
     }
     let end = min(first + n, capacity);
     if (end > first) {
-        // Enough bin workgroups for every entry below `end`: x up to the per-dimension
-        // limit, y as many rows of those as needed.
-        let row = raster_params.y;
-        atomicMax(&tile_args[0], min(end, row));
-        atomicMax(&tile_args[1], (end + row - 1u) / row);
+        // Enough bin workgroups for every entry below `end`.
+        let size = dispatch_size(end, TILES_PER_GROUP);
+        atomicMax(&tile_args[0], size.x);
+        atomicMax(&tile_args[1], size.y);
     }
     return first;
 }
@@ -543,12 +554,14 @@ fn may_cover(t: Tri, region: vec4<i32>) -> bool {
 var<workgroup> kept: atomic<u32>;
 var<workgroup> kept_first: u32;
 
-@compute @workgroup_size(TILE_BLOCKS, TILE_BLOCKS)
+// TILES_PER_GROUP tiles a workgroup, a thread per block.
+@compute @workgroup_size(TILE_THREADS * TILES_PER_GROUP)
 fn bin(
     @builtin(workgroup_id) wg: vec3<u32>,
-    @builtin(local_invocation_id) local: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
 ) {
-    let i = wg.y * raster_params.y + wg.x;
+    let i = (wg.y * raster_params.y + wg.x) * TILES_PER_GROUP + local / TILE_THREADS;
+    let in_tile = local % TILE_THREADS;
     let capacity = list_capacity.z;
     var keep = false;
     var r = 0u;
@@ -560,7 +573,7 @@ fn bin(
         let entry = tiles[i];
         r = entry.x;
         t = load_record(r);
-        block = unpack_point(entry.y) * TILE_BLOCKS + local.xy;
+        block = unpack_point(entry.y) * TILE_BLOCKS + vec2<u32>(in_tile % TILE_BLOCKS, in_tile / TILE_BLOCKS);
         region = cell_region(t.box, block, BLOCK);
         keep = region.x <= region.z && region.y <= region.w && may_cover(t, region);
     }
@@ -570,18 +583,18 @@ fn bin(
         slot = atomicAdd(&kept, 1u);
     }
     workgroupBarrier();
-    if (all(local.xy == vec2<u32>(0u))) {
+    if (local == 0u) {
         let n = atomicLoad(&kept);
         var first = 0u;
         if (n > 0u) {
-            // At most TILE_BLOCKS² per bin workgroup, one per tile entry, and the tile
-            // list holds at most 2^24 (compute_raster.rs): the counter stays under 2^30.
+            // At most one per block of the workgroup's tile entries, which are at most
+            // 2^24 (compute_raster.rs): the counter stays under 2^30.
             first = atomicAdd(&counters[BLOCKS], n);
             let end = min(first + n, capacity);
             if (end > first) {
-                let row = raster_params.y;
-                atomicMax(&block_args[0], min(end, row));
-                atomicMax(&block_args[1], (end + row - 1u) / row);
+                let size = dispatch_size(end, BLOCKS_PER_GROUP);
+                atomicMax(&block_args[0], size.x);
+                atomicMax(&block_args[1], size.y);
             }
         }
         kept_first = first;
@@ -600,18 +613,20 @@ fn bin(
 #endif
 #if RASTER
 
-@compute @workgroup_size(BLOCK, BLOCK)
+// BLOCKS_PER_GROUP blocks a workgroup, a thread per pixel.
+@compute @workgroup_size(BLOCK_THREADS * BLOCKS_PER_GROUP)
 fn raster(
     @builtin(workgroup_id) wg: vec3<u32>,
-    @builtin(local_invocation_id) local: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
 ) {
-    let i = wg.y * raster_params.y + wg.x;
+    let i = (wg.y * raster_params.y + wg.x) * BLOCKS_PER_GROUP + local / BLOCK_THREADS;
     if (i >= min(counters[BLOCKS], list_capacity.z)) {
         return;
     }
     let entry = blocks[i];
     let t = load_record(entry.x);
-    let p = vec2<i32>(unpack_point(entry.y) * BLOCK + local.xy);
+    let in_block = local % BLOCK_THREADS;
+    let p = vec2<i32>(unpack_point(entry.y) * BLOCK + vec2<u32>(in_block % BLOCK, in_block / BLOCK));
     // The pixels the serial walk visits: the box (within the viewport).
     if (all(p >= t.box.xy) && all(p <= t.box.zw)) {
         cover(t, p.x, p.y);

@@ -1,9 +1,9 @@
 //! `ComputeRaster`: the merged opaque triangles rasterized in compute into a per-pixel
 //! `u64` buffer with a 64-bit atomic min of (depth bits, inverted id). One compute pass of
 //! four dispatches: `clear`; `setup`, a thread per triangle, appends a record per (clipped)
-//! fan triangle and its 64×64-pixel tiles to lists; `bin` (indirect), a workgroup per
-//! tile, appends the tile's 8×8-pixel blocks the triangle may cover; `raster` (indirect),
-//! a workgroup per block, a thread per pixel. A full-screen draw then resolves the buffer
+//! fan triangle and its 64×64-pixel tiles to lists; `bin` (indirect), a thread per block
+//! of a tile, appends the tile's 8×8-pixel blocks the triangle may cover; `raster`
+//! (indirect), a thread per pixel of a block. A full-screen draw then resolves the buffer
 //! into the depth texture (`frag_depth`) and the R32Uint visibility texture.
 //! See `shaders/visibility/compute_raster.wgsl`.
 
@@ -22,17 +22,24 @@ use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
 const SHADER: &str = "visibility/compute_raster.wgsl";
-/// Threads per workgroup of the clear and setup dispatches.
+/// Threads per workgroup of the setup dispatch (a thread per triangle).
 const GROUP: u32 = 64;
-/// Pixels per side of a block: one `raster` workgroup, a thread per pixel (two warps).
-/// Small enough to fit the many small triangles tightly (a box of a few pixels touches
-/// one to four blocks), large enough that a screen-filling triangle is 32,400 workgroups
-/// at 1080p, which the GPU launches in a few waves.
+/// Threads per workgroup of the clear (a thread per pixel): a quarter as many workgroups
+/// to launch as 64 (32,400 at 1080p).
+const CLEAR_GROUP: u32 = 256;
+/// Pixels per side of a block, a thread per pixel in `raster`: small enough to fit the
+/// many small triangles tightly (a box of a few pixels touches one to four blocks).
 const BLOCK: u32 = 8;
-/// Blocks per side of a tile: one `bin` workgroup, a thread per block. Setup lists a
-/// triangle's tiles serially, so a screen-filling triangle costs its thread 510 stores at
-/// 1080p (not 32,400 blocks).
+/// Blocks per `raster` workgroup (256 threads): tiny workgroups are bound by how fast
+/// the GPU launches them (harada lists ~57,500 blocks at 1080p); four blocks a workgroup
+/// launch a quarter as many, with the same occupancy and still a thread per pixel.
+const BLOCKS_PER_GROUP: u32 = 4;
+/// Blocks per side of a tile, a thread per block in `bin`. Setup lists a triangle's
+/// tiles serially, so a screen-filling triangle costs its thread 510 stores at 1080p
+/// (not 32,400 blocks).
 const TILE_BLOCKS: u32 = 8;
+/// Tiles per `bin` workgroup (256 threads), as for blocks.
+const TILES_PER_GROUP: u32 = 4;
 const TILE_PIXELS: u32 = BLOCK * TILE_BLOCKS;
 /// Bytes of a fan-triangle record and of a tile or block entry (as the shader's).
 const RECORD_BYTES: u64 = 64;
@@ -327,8 +334,11 @@ pub(super) fn prepare(
     let mut pipeline = |stage: &str, entry: &str| {
         let d = [
             ("GROUP", format!("{GROUP}u")),
+            ("CLEAR_GROUP", format!("{CLEAR_GROUP}u")),
             ("BLOCK", format!("{BLOCK}u")),
+            ("BLOCKS_PER_GROUP", format!("{BLOCKS_PER_GROUP}u")),
             ("TILE_BLOCKS", format!("{TILE_BLOCKS}u")),
+            ("TILES_PER_GROUP", format!("{TILES_PER_GROUP}u")),
             (stage, "1".into()),
         ];
         cx.compute_pipeline(&sp.name, key(&d, entry), entry, &offered)
@@ -344,7 +354,7 @@ pub(super) fn prepare(
         clear: (
             clear,
             clear_bind,
-            grid(pixels.min(u32::MAX as u64) as u32, GROUP, max_groups),
+            grid(pixels.min(u32::MAX as u64) as u32, CLEAR_GROUP, max_groups),
         ),
         setup: (
             setup,
