@@ -482,6 +482,14 @@ fn report(r: &Renderer, scene: &Scene, graph: &Path, result: &FrameResult) {
     for l in &result.links {
         link_report(l);
     }
+    for c in &result.rasters {
+        for line in c.lines() {
+            match line.strip_prefix("warning: ") {
+                Some(w) => println!("  WARNING: {w}"),
+                None => println!("  {line}"),
+            }
+        }
+    }
     if let Some(s) = &result.light_stats {
         println!(
             "  lights per pixel: listed avg {:.2} max {}, exact avg {:.2} max {}, listed/exact {:.2}",

@@ -476,6 +476,7 @@ impl PreparedFrame {
         let start = Instant::now();
         let (mut culling, mut shadows, mut atlases) = (Vec::new(), Vec::new(), Vec::new());
         let (mut shadow_compare, mut links, mut vpls) = (Vec::new(), Vec::new(), Vec::new());
+        let mut rasters = Vec::new();
         for report in self.pass_reports(r)? {
             match report {
                 PassReport::Culling(c) => culling.push(c),
@@ -484,6 +485,7 @@ impl PreparedFrame {
                 PassReport::ShadowCompare(c) => shadow_compare.push(c),
                 PassReport::Links(l) => links.push(l),
                 PassReport::Vpl(v) => vpls.push(v),
+                PassReport::Raster(c) => rasters.push(c),
             }
         }
         let light_stats = self.read_light_stats(r)?;
@@ -499,6 +501,7 @@ impl PreparedFrame {
             atlases,
             shadow_compare,
             vpls,
+            rasters,
             light_stats,
         };
         Ok((frame, timings))

@@ -26,7 +26,7 @@ pub use pipelines::{
 };
 pub use prepare_stats::PrepareStats;
 pub use report::{
-    AtlasReport, CullingReport, FrameResult, LightStats, LinkReport, PassReport,
+    AtlasReport, CullingReport, FrameResult, LightStats, LinkReport, PassReport, RasterReport,
     ShadowCompareReport, ShadowReport, VplReport,
 };
 pub use resources::FrameResources;

@@ -291,6 +291,54 @@ impl VplReport {
     }
 }
 
+/// Per ComputeRaster pass: how its work lists filled this frame. A full list loses
+/// nothing (what finds no room is rasterized serially, exactly, by the thread that
+/// found it full), but serial work is slow: a non-zero count is a warning.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RasterReport {
+    pub pass: String,
+    /// Entries used and capacity: fan-triangle records, tiles and blocks.
+    pub records: u32,
+    pub records_capacity: u32,
+    pub tiles: u32,
+    pub tiles_capacity: u32,
+    pub blocks: u32,
+    pub blocks_capacity: u32,
+    /// Rasterized serially for want of room: fan triangles without a record, tiles
+    /// without a tile entry, blocks without a block entry.
+    pub serial_triangles: u32,
+    pub serial_tiles: u32,
+    pub serial_blocks: u32,
+}
+
+impl RasterReport {
+    /// Fan triangles, tiles and blocks rasterized serially together.
+    pub fn serial(&self) -> u64 {
+        self.serial_triangles as u64 + self.serial_tiles as u64 + self.serial_blocks as u64
+    }
+    /// The report's lines for `render` (serial work is a warning).
+    pub fn lines(&self) -> Vec<String> {
+        let r = self;
+        let mut lines = vec![format!(
+            "{}: {} of {} triangle records, {} of {} tiles, {} of {} blocks",
+            r.pass,
+            r.records,
+            r.records_capacity,
+            r.tiles,
+            r.tiles_capacity,
+            r.blocks,
+            r.blocks_capacity
+        )];
+        if r.serial() > 0 {
+            lines.push(format!(
+                "warning: {}: lists full: {} fan triangles, {} tiles and {} blocks rasterized serially (exact, slow)",
+                r.pass, r.serial_triangles, r.serial_tiles, r.serial_blocks
+            ));
+        }
+        lines
+    }
+}
+
 /// What a pass counted on the GPU (or decided on the CPU for this frame).
 #[derive(Clone, Debug)]
 pub enum PassReport {
@@ -300,6 +348,7 @@ pub enum PassReport {
     ShadowCompare(ShadowCompareReport),
     Links(LinkReport),
     Vpl(VplReport),
+    Raster(RasterReport),
 }
 
 pub struct FrameResult {
@@ -315,5 +364,6 @@ pub struct FrameResult {
     pub atlases: Vec<AtlasReport>,
     pub shadow_compare: Vec<ShadowCompareReport>,
     pub vpls: Vec<VplReport>,
+    pub rasters: Vec<RasterReport>,
     pub light_stats: Option<LightStats>,
 }
