@@ -1,0 +1,94 @@
+// Visibility shading's faster light loops; both add exactly what common/light_loop.wgsl's
+// shade_surface adds, in list order, so the image is the same to the bit:
+// - `staged_lights` (STAGED_LIGHTS): when every pixel of an 8×8 workgroup reads the same
+//   tile list (one list per tile, the tile 8 or 16 pixels, so the workgroup lies inside
+//   one tile), the workgroup loads the list in batches, one light per invocation, into
+//   workgroup memory, and every pixel runs the batch from there: one global load per
+//   light and workgroup instead of three dependent loads per light and pixel.
+// - `shade_range_first` (RANGE_FIRST): the per-pixel cursor for lists that differ
+//   between pixels (HalfZ, Clustered, linked lists) and for all lights.
+// Both test the range window from the light's geometry before reading its properties:
+// a light out of range (window <= 0) gives zero radiance, which shade_surface never adds
+// (it adds only radiance > 0), so skipping it first changes no bit. The window tested is
+// the one incident_reached then uses (light_reach, computed once).
+
+// The emitted and ambient light every loop starts from, as shade_surface does.
+fn surface_unlit(p: ShadingPoint, m: MaterialSample) -> vec3<f32> {
+    return material_emission(m) + frame.ambient.rgb * material_eval(m, p.normal);
+}
+
+// Light (g, props) at reach r added to `color`, when the material takes it and it
+// gives radiance, as shade_surface adds it.
+fn add_reached(color: vec3<f32>, g: LightGeometry, props: LightProperties, r: LightReach, m: MaterialSample) -> vec3<f32> {
+    if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
+        return color;
+    }
+    let inc = incident_reached(g, props, r);
+    if (any(inc.radiance > vec3<f32>(0.0))) {
+        return color + inc.radiance * material_eval(m, inc.dir);
+    }
+    return color;
+}
+
+#if RANGE_FIRST
+fn shade_range_first(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f32) -> vec3<f32> {
+    var color = surface_unlit(p, m);
+    for (var c = light_first(pixel, view_z); light_valid(c); c = light_next(c)) {
+        if (!light_in_span(c, view_z)) {
+            continue;
+        }
+        let i = light_index(c);
+        let g = light_geometry[i];
+        let r = light_reach(g, p.position);
+        if (r.window <= 0.0) {
+            continue;
+        }
+        color = add_reached(color, g, light_properties[i], r, m);
+    }
+    return color;
+}
+#endif
+
+#if STAGED_LIGHTS
+// One light per invocation of the 8×8 workgroup: 64 × 64 bytes of workgroup memory.
+const STAGE_BATCH: u32 = 64u;
+var<workgroup> staged_geometry: array<LightGeometry, STAGE_BATCH>;
+var<workgroup> staged_properties: array<LightProperties, STAGE_BATCH>;
+
+// The tile list of the workgroup at `group` (8×8 pixels from group × 8): with one list
+// per tile and the tile a multiple of 8, the list of each of its pixels.
+fn group_list(group: vec2<u32>) -> LightRange {
+    let t = group * 8u / list_params.tile;
+    return list_entry(t.y * list_params.tiles_x + t.x);
+}
+
+// `list` is workgroup-uniform (from the workgroup id), so every invocation runs the same
+// batches and meets every barrier; `shades` says whether this one's pixel takes the
+// lights (p and m are its surface then).
+fn staged_lights(unlit: vec3<f32>, shades: bool, p: ShadingPoint, m: MaterialSample, lane: u32, list: LightRange) -> vec3<f32> {
+    var color = unlit;
+    for (var base = 0u; base < list.count; base += STAGE_BATCH) {
+        let k = base + lane;
+        if (k < list.count) {
+            let i = light_at(list, k);
+            staged_geometry[lane] = light_geometry[i];
+            staged_properties[lane] = light_properties[i];
+        }
+        workgroupBarrier();
+        if (shades) {
+            let n = min(STAGE_BATCH, list.count - base);
+            for (var j = 0u; j < n; j += 1u) {
+                let g = staged_geometry[j];
+                let r = light_reach(g, p.position);
+                if (r.window <= 0.0) {
+                    continue;
+                }
+                color = add_reached(color, g, staged_properties[j], r, m);
+            }
+        }
+        // The next batch overwrites what this one reads.
+        workgroupBarrier();
+    }
+    return color;
+}
+#endif
