@@ -50,10 +50,22 @@ fn shade_range_first(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_
 #endif
 
 #if STAGED_LIGHTS
-// One light per invocation of the 8×8 workgroup: 64 × 64 bytes of workgroup memory.
+// One light per invocation of the 8×8 workgroup: 64 × 80 bytes of workgroup memory.
 const STAGE_BATCH: u32 = 64u;
+// xyz: the light's position; w: a squared distance past which it surely adds nothing
+// here (`reject_beyond`), -1 when this material does not take it.
+var<workgroup> staged_reach: array<vec4<f32>, STAGE_BATCH>;
 var<workgroup> staged_geometry: array<LightGeometry, STAGE_BATCH>;
 var<workgroup> staged_properties: array<LightProperties, STAGE_BATCH>;
+
+// A squared distance past which range_window is surely zero: dist_sq over
+// fl(range²)·1.001 rounded down is over range² by 1e-3 at least, so the quotient r in
+// range_window, within 2.5 ulp (Vulkan's OpFDiv), is over 1, r² rounds to 1 or more, and
+// 1 − r² clamps to 0, fused or not. A NaN or infinite range rejects nothing here; the
+// exact test after it decides.
+fn reject_beyond(range: f32) -> f32 {
+    return range * range * 1.001;
+}
 
 // The tile list of the workgroup at `group` (8×8 pixels from group × 8): with one list
 // per tile and the tile a multiple of 8, the list of each of its pixels.
@@ -64,22 +76,40 @@ fn group_list(group: vec2<u32>) -> LightRange {
 
 // `list` is workgroup-uniform (from the workgroup id), so every invocation runs the same
 // batches and meets every barrier; `shades` says whether this one's pixel takes the
-// lights (p and m are its surface then).
+// lights (p and m are its surface then). Per light and pixel: one 16-byte read and a
+// multiply-add test for most lights (those out of range); the exact window, the
+// properties and the BRDF only for the rest.
 fn staged_lights(unlit: vec3<f32>, shades: bool, p: ShadingPoint, m: MaterialSample, lane: u32, list: LightRange) -> vec3<f32> {
     var color = unlit;
     for (var base = 0u; base < list.count; base += STAGE_BATCH) {
         let k = base + lane;
         if (k < list.count) {
             let i = light_at(list, k);
-            staged_geometry[lane] = light_geometry[i];
-            staged_properties[lane] = light_properties[i];
+            let g = light_geometry[i];
+            let props = light_properties[i];
+            // dist_sq >= 0 rejects a light the material does not take; a NaN dist_sq
+            // goes on to add_reached, which skips it.
+            var beyond = reject_beyond(g.range);
+            if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
+                beyond = -1.0;
+            }
+            staged_reach[lane] = vec4<f32>(g.position, beyond);
+            staged_geometry[lane] = g;
+            staged_properties[lane] = props;
         }
         workgroupBarrier();
         if (shades) {
             let n = min(STAGE_BATCH, list.count - base);
             for (var j = 0u; j < n; j += 1u) {
+                let reach = staged_reach[j];
+                // light_reach's arithmetic, from the same position bits.
+                let d = reach.xyz - p.position;
+                let dist_sq = dot(d, d);
+                if (dist_sq > reach.w) {
+                    continue;
+                }
                 let g = staged_geometry[j];
-                let r = light_reach(g, p.position);
+                let r = LightReach(d, dist_sq, range_window(dist_sq, g.range));
                 if (r.window <= 0.0) {
                     continue;
                 }
