@@ -50,13 +50,14 @@ fn shade_range_first(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_
 #endif
 
 #if STAGED_LIGHTS
-// One light per invocation of the 8×8 workgroup: 64 × 80 bytes of workgroup memory.
+// One light per invocation of the 8×8 workgroup, two batches (the one shaded, the one
+// stored): 2 × 64 × 80 bytes of workgroup memory.
 const STAGE_BATCH: u32 = 64u;
 // xyz: the light's position; w: a squared distance past which it surely adds nothing
 // here (`reject_beyond`), -1 when this material does not take it.
-var<workgroup> staged_reach: array<vec4<f32>, STAGE_BATCH>;
-var<workgroup> staged_geometry: array<LightGeometry, STAGE_BATCH>;
-var<workgroup> staged_properties: array<LightProperties, STAGE_BATCH>;
+var<workgroup> staged_reach: array<vec4<f32>, 128>;
+var<workgroup> staged_geometry: array<LightGeometry, 128>;
+var<workgroup> staged_properties: array<LightProperties, 128>;
 
 // A squared distance past which range_window is surely zero: dist_sq over
 // fl(range²)·1.001 rounded down is over range² by 1e-3 at least, so the quotient r in
@@ -74,33 +75,61 @@ fn group_list(group: vec2<u32>) -> LightRange {
     return list_entry(t.y * list_params.tiles_x + t.x);
 }
 
+struct ListedLight {
+    g: LightGeometry,
+    props: LightProperties,
+};
+
+fn listed_light(i: u32) -> ListedLight {
+    return ListedLight(light_geometry[i], light_properties[i]);
+}
+
+fn stage(slot: u32, l: ListedLight) {
+    // dist_sq >= 0 rejects a light the material does not take; a NaN dist_sq goes on to
+    // add_reached, which skips it.
+    var beyond = reject_beyond(l.g.range);
+    if ((l.props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
+        beyond = -1.0;
+    }
+    staged_reach[slot] = vec4<f32>(l.g.position, beyond);
+    staged_geometry[slot] = l.g;
+    staged_properties[slot] = l.props;
+}
+
 // `list` is workgroup-uniform (from the workgroup id), so every invocation runs the same
 // batches and meets every barrier; `shades` says whether this one's pixel takes the
-// lights (p and m are its surface then). Per light and pixel: one 16-byte read and a
-// multiply-add test for most lights (those out of range); the exact window, the
-// properties and the BRDF only for the rest.
+// lights (p and m are its surface then). Loads run ahead in registers: a batch's lights
+// are loaded while the batch before is shaded, and their list indices one batch earlier
+// still, so each load has a batch of shading to arrive in. Batches alternate between
+// two halves of workgroup memory, so one barrier a batch suffices: a batch is stored
+// after the barrier that ends the shading of the batch that used its half before.
+// Per light and pixel: one 16-byte read and a dot product for lights out of range; the
+// exact window, the properties and the BRDF only for the rest.
 fn staged_lights(unlit: vec3<f32>, shades: bool, p: ShadingPoint, m: MaterialSample, lane: u32, list: LightRange) -> vec3<f32> {
     var color = unlit;
+    var light: ListedLight;
+    if (lane < list.count) {
+        light = listed_light(light_at(list, lane));
+    }
+    var index = 0u;
+    if (STAGE_BATCH + lane < list.count) {
+        index = light_at(list, STAGE_BATCH + lane);
+    }
     for (var base = 0u; base < list.count; base += STAGE_BATCH) {
-        let k = base + lane;
-        if (k < list.count) {
-            let i = light_at(list, k);
-            let g = light_geometry[i];
-            let props = light_properties[i];
-            // dist_sq >= 0 rejects a light the material does not take; a NaN dist_sq
-            // goes on to add_reached, which skips it.
-            var beyond = reject_beyond(g.range);
-            if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
-                beyond = -1.0;
-            }
-            staged_reach[lane] = vec4<f32>(g.position, beyond);
-            staged_geometry[lane] = g;
-            staged_properties[lane] = props;
+        let half_start = (base / STAGE_BATCH) % 2u * STAGE_BATCH;
+        if (base + lane < list.count) {
+            stage(half_start + lane, light);
         }
         workgroupBarrier();
+        if (base + STAGE_BATCH + lane < list.count) {
+            light = listed_light(index);
+        }
+        if (base + 2u * STAGE_BATCH + lane < list.count) {
+            index = light_at(list, base + 2u * STAGE_BATCH + lane);
+        }
         if (shades) {
             let n = min(STAGE_BATCH, list.count - base);
-            for (var j = 0u; j < n; j += 1u) {
+            for (var j = half_start; j < half_start + n; j += 1u) {
                 let reach = staged_reach[j];
                 // light_reach's arithmetic, from the same position bits.
                 let d = reach.xyz - p.position;
@@ -116,8 +145,6 @@ fn staged_lights(unlit: vec3<f32>, shades: bool, p: ShadingPoint, m: MaterialSam
                 color = add_reached(color, g, staged_properties[j], r, m);
             }
         }
-        // The next batch overwrites what this one reads.
-        workgroupBarrier();
     }
     return color;
 }
