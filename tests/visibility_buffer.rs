@@ -633,7 +633,7 @@ fn staged_light_loop_equals_the_per_pixel_loop_to_the_bit() {
 /// and those on the range-first per-pixel walk (HalfZ, Clustered, linked lists, all
 /// lights) against forward brute force on the masked harada, within the Lambert bounds
 /// (the same cause: a rebuilt point; harada's GGX lobes are broad, roughness 0.4-0.5).
-/// Measured on lavapipe at 333x197 (2026-12-03), the same for all nine graphs: worst
+/// Measured on lavapipe at 333x197 (2026-12-02), the same for all nine graphs: worst
 /// 1.46e-3, 99.9% within 1.31e-4 (harada's glossy lobes turn the rebuilt point's error
 /// into a little more than the Lambert scenes' 7.5e-5).
 #[test]
