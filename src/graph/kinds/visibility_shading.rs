@@ -116,6 +116,16 @@ mod tests {
     }
 
     #[test]
+    fn stages_unless_told_not_to() {
+        use super::VisibilityShading;
+        let parse = |t: &str| ron::from_str::<VisibilityShading>(t).unwrap();
+        assert!(parse("(lights: Culled)").staging);
+        assert!(VisibilityShading::default().staging);
+        assert!(!parse("(lights: Culled, staging: false)").staging);
+        assert!(ron::from_str::<VisibilityShading>("(staged: false)").is_err());
+    }
+
+    #[test]
     fn refuses_shadows_and_multisampled_ids() {
         let e = errors(
             &format!(
