@@ -11,12 +11,31 @@ use crate::graph::error::GraphError;
 use crate::graph::model::{LightSource, SceneResource};
 use serde::{Deserialize, Serialize};
 
-/// `VisibilityShading(lights: Culled)`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
+/// `VisibilityShading(lights: Culled, staging: true)`.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
 #[serde(deny_unknown_fields)]
 pub struct VisibilityShading {
     #[serde(default)]
     pub lights: LightSource,
+    /// The faster light loop (default): a workgroup whose pixels all read one tile list
+    /// (Frustum and DepthMask lists) stages it in workgroup memory; other lists keep the
+    /// per-pixel walk; both test a light's range before its properties. `false` runs
+    /// forward shading's loop, for timing and comparing the two (the images are equal).
+    #[serde(default = "staging_default")]
+    pub staging: bool,
+}
+
+fn staging_default() -> bool {
+    true
+}
+
+impl Default for VisibilityShading {
+    fn default() -> Self {
+        Self {
+            lights: LightSource::default(),
+            staging: staging_default(),
+        }
+    }
 }
 
 pub const VERTICES: &str = "vertices";
@@ -94,6 +113,16 @@ mod tests {
             ),
             "{e}"
         );
+    }
+
+    #[test]
+    fn stages_unless_told_not_to() {
+        use super::VisibilityShading;
+        let parse = |t: &str| ron::from_str::<VisibilityShading>(t).unwrap();
+        assert!(parse("(lights: Culled)").staging);
+        assert!(VisibilityShading::default().staging);
+        assert!(!parse("(lights: Culled, staging: false)").staging);
+        assert!(ron::from_str::<VisibilityShading>("(staged: false)").is_err());
     }
 
     #[test]
