@@ -26,7 +26,7 @@ pub use pipelines::{
 };
 pub use prepare_stats::PrepareStats;
 pub use report::{
-    AtlasReport, CullingReport, FrameResult, LightStats, LinkReport, PassReport,
+    AtlasReport, CullingReport, FallbackReport, FrameResult, LightStats, LinkReport, PassReport,
     ShadowCompareReport, ShadowReport, VplReport,
 };
 pub use resources::FrameResources;
@@ -80,8 +80,14 @@ impl Renderer {
 
     /// Opens the first adapter and uses the project's shaders/.
     pub fn headless() -> Result<Self, GpuError> {
+        Self::headless_with(&crate::gpu::ContextOptions::default())
+    }
+
+    /// [`Self::headless`] with device options (features left off, as on an adapter
+    /// without them).
+    pub fn headless_with(options: &crate::gpu::ContextOptions) -> Result<Self, GpuError> {
         Ok(Self::new(
-            GpuContext::new_headless()?,
+            GpuContext::headless_with(options)?,
             ShaderLibrary::builtin(),
         ))
     }

@@ -291,6 +291,40 @@ impl VplReport {
     }
 }
 
+/// A pass that runs another way than its kind's own on this device: the compute
+/// rasterizer drawn with the hardware rasterizer where the adapter lacks its 64-bit
+/// atomics. Reported with every frame, so a run on such a device never passes silently
+/// for the compute path (timings included).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FallbackReport {
+    pub pass: String,
+    /// The adapter, as `GpuContext::adapter_name` gives it.
+    pub adapter: String,
+    /// What the pass needs that the device lacks.
+    pub missing: wgpu::Features,
+    /// Of `missing`, what the adapter offers but the context was asked to leave off
+    /// (`ContextOptions::disabled_features`).
+    pub disabled: wgpu::Features,
+    /// How the pass ran instead.
+    pub instead: &'static str,
+}
+
+impl FallbackReport {
+    /// One line for `render` and the viewer, e.g. `compute_raster: adapter X lacks
+    /// SHADER_INT64_ATOMIC_MIN_MAX; drawn with the hardware rasterizer`.
+    pub fn line(&self) -> String {
+        let disabled = if self.disabled.is_empty() {
+            String::new()
+        } else {
+            format!(" (offered, but disabled on request: {})", self.disabled)
+        };
+        format!(
+            "{}: adapter {} lacks {}{disabled}; {}",
+            self.pass, self.adapter, self.missing, self.instead
+        )
+    }
+}
+
 /// What a pass counted on the GPU (or decided on the CPU for this frame).
 #[derive(Clone, Debug)]
 pub enum PassReport {
@@ -300,6 +334,7 @@ pub enum PassReport {
     ShadowCompare(ShadowCompareReport),
     Links(LinkReport),
     Vpl(VplReport),
+    Fallback(FallbackReport),
 }
 
 pub struct FrameResult {
@@ -315,5 +350,7 @@ pub struct FrameResult {
     pub atlases: Vec<AtlasReport>,
     pub shadow_compare: Vec<ShadowCompareReport>,
     pub vpls: Vec<VplReport>,
+    /// Passes that ran another way on this device (see [`FallbackReport`]).
+    pub fallbacks: Vec<FallbackReport>,
     pub light_stats: Option<LightStats>,
 }
