@@ -130,7 +130,7 @@ fn without_the_atomics_it_draws_the_hardware_visibility_buffer() {
         assert_eq!(
             lines,
             [format!(
-                "compute_raster: adapter {adapter} lacks SHADER_INT64_ATOMIC_MIN_MAX (offered, but disabled on request: SHADER_INT64_ATOMIC_MIN_MAX); drawn with the hardware rasterizer"
+                "compute_raster: adapter {adapter} lacks SHADER_INT64_ATOMIC_MIN_MAX (offered by the adapter, disabled on request); drawn with the hardware rasterizer"
             )],
             "{what}"
         );
@@ -209,7 +209,7 @@ fn render_says_when_it_falls_back() {
     assert!(
         out.contains("  fallback: compute_raster: adapter ")
             && out.contains(
-                "lacks SHADER_INT64_ATOMIC_MIN_MAX (offered, but disabled on request: SHADER_INT64_ATOMIC_MIN_MAX); drawn with the hardware rasterizer"
+                "lacks SHADER_INT64_ATOMIC_MIN_MAX (offered by the adapter, disabled on request); drawn with the hardware rasterizer"
             ),
         "{out}"
     );

@@ -315,8 +315,10 @@ impl FallbackReport {
     pub fn line(&self) -> String {
         let disabled = if self.disabled.is_empty() {
             String::new()
+        } else if self.disabled == self.missing {
+            " (offered by the adapter, disabled on request)".to_string()
         } else {
-            format!(" (offered, but disabled on request: {})", self.disabled)
+            format!(" ({} disabled on request)", self.disabled)
         };
         format!(
             "{}: adapter {} lacks {}{disabled}; {}",
@@ -353,4 +355,37 @@ pub struct FrameResult {
     /// Passes that ran another way on this device (see [`FallbackReport`]).
     pub fallbacks: Vec<FallbackReport>,
     pub light_stats: Option<LightStats>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::FallbackReport;
+    use wgpu::Features as F;
+
+    #[test]
+    fn a_fallback_line_names_the_pass_adapter_and_missing_features() {
+        let mut f = FallbackReport {
+            pass: "cr".into(),
+            adapter: "Some GPU (Vulkan)".into(),
+            missing: F::SHADER_INT64 | F::SHADER_INT64_ATOMIC_MIN_MAX,
+            disabled: F::empty(),
+            instead: "drawn with the hardware rasterizer",
+        };
+        assert_eq!(
+            f.line(),
+            "cr: adapter Some GPU (Vulkan) lacks SHADER_INT64 | SHADER_INT64_ATOMIC_MIN_MAX; drawn with the hardware rasterizer"
+        );
+        f.disabled = F::SHADER_INT64_ATOMIC_MIN_MAX;
+        assert!(
+            f.line().contains("MIN_MAX (SHADER_INT64_ATOMIC_MIN_MAX disabled on request);"),
+            "{}",
+            f.line()
+        );
+        f.disabled = f.missing;
+        assert!(
+            f.line().contains("MIN_MAX (offered by the adapter, disabled on request);"),
+            "{}",
+            f.line()
+        );
+    }
 }
