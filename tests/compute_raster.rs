@@ -580,7 +580,10 @@ fn render_reading(
 fn shipped_graph_both_resolves() -> (String, String) {
     let compute = std::fs::read_to_string(graph_path("visibility_compute_raster.ron")).unwrap();
     let float = r#"Texture(name: "depth", format: R32Float, size: Output)"#;
-    assert!(compute.contains(float), "the shipped graph's depth is R32Float");
+    assert!(
+        compute.contains(float),
+        "the shipped graph's depth is R32Float"
+    );
     let draw = compute.replace(
         float,
         r#"Texture(name: "depth", format: Depth32Float, size: Output)"#,
@@ -615,7 +618,10 @@ fn compute_resolve_equals_the_draw_resolve_bit_for_bit() {
         eprintln!("{what}: {} of {} pixels empty", empty.len(), ids.len());
         assert!(ids.len() - empty.len() > 1000, "{what}: few pixels covered");
         if what.ends_with("sky") {
-            assert!(empty.len() > 1000, "{what}: no sky: the empty case is untested");
+            assert!(
+                empty.len() > 1000,
+                "{what}: no sky: the empty case is untested"
+            );
         }
         assert!(
             empty.iter().all(|&d| d == 1f32.to_bits()),
@@ -624,7 +630,10 @@ fn compute_resolve_equals_the_draw_resolve_bit_for_bit() {
         let differ = |x: &[u32], y: &[u32]| x.iter().zip(y).filter(|(p, q)| p != q).count();
         assert_eq!(differ(depth, &b_bits[0]), 0, "{what}: depth bits differ");
         assert_eq!(differ(ids, &b_bits[1]), 0, "{what}: ids differ");
-        assert_eq!(a.culling[0].counts, b.culling[0].counts, "{what}: tile lists");
+        assert_eq!(
+            a.culling[0].counts, b.culling[0].counts,
+            "{what}: tile lists"
+        );
         assert_eq!(a.image.len(), b.image.len());
         assert!(a.image == b.image, "{what}: images differ");
     }
@@ -651,7 +660,10 @@ fn culling_variants_read_the_r32float_depth_alike() {
         let (b, _) = render_reading(&with_culling(&draw, kind), &scene, (200, 120), &[]);
         let (la, lb) = (&a.culling[0], &b.culling[0]);
         eprintln!("{kind}: {} lights listed", la.listed());
-        assert!(la.listed() > 0, "{kind}: no lights listed: nothing compared");
+        assert!(
+            la.listed() > 0,
+            "{kind}: no lights listed: nothing compared"
+        );
         assert_eq!(la.counts, lb.counts, "{kind}: lists differ");
         assert_eq!(la.overflowed_lists, lb.overflowed_lists, "{kind}");
         assert!(a.image == b.image, "{kind}: images differ");

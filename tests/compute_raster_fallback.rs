@@ -84,7 +84,10 @@ fn the_masked_device_lacks_the_atomics() {
     let r = masked_renderer();
     assert!(!r.ctx.device.features().contains(MASKED));
     assert!(
-        r.ctx.device.features().contains(wgpu::Features::PRIMITIVE_INDEX),
+        r.ctx
+            .device
+            .features()
+            .contains(wgpu::Features::PRIMITIVE_INDEX),
         "the fallback draws need PRIMITIVE_INDEX"
     );
     assert_eq!(r.ctx.disabled_features, MASKED);
@@ -108,7 +111,10 @@ fn without_the_atomics_it_draws_the_hardware_visibility_buffer() {
     .unwrap();
     assert!(reference.fallbacks.is_empty(), "{:?}", reference.fallbacks);
     let covered = want[1].iter().filter(|&&id| id != NO_TRIANGLE).count();
-    assert!(covered > 10_000, "{covered} covered pixels: nothing compared");
+    assert!(
+        covered > 10_000,
+        "{covered} covered pixels: nothing compared"
+    );
     assert_eq!(want[0].len(), 333 * 197);
     for (what, graph) in compute_raster_graphs() {
         let (frame, got) = render_reading(&mut r, &graph, &scene, &["depth", "visibility"])
@@ -170,9 +176,14 @@ fn the_fallback_refuses_masked_materials_too() {
     let mut s = random_scene(2, 5);
     s.materials[1].alpha_mode = AlphaMode::Mask(0.5);
     let mut r = masked_renderer();
-    let e = render_reading(&mut r, &graph_text("visibility_compute_raster.ron"), &s, &[])
-        .err()
-        .expect("refused");
+    let e = render_reading(
+        &mut r,
+        &graph_text("visibility_compute_raster.ron"),
+        &s,
+        &[],
+    )
+    .err()
+    .expect("refused");
     assert!(e.contains("pass 'compute_raster'"), "{e}");
     assert!(e.contains("material 'orange' is alpha-masked"), "{e}");
     assert!(e.contains("hardware fallback"), "{e}");

@@ -202,7 +202,8 @@ mod tests {
 
     #[test]
     fn parses_feature_names_in_any_case() {
-        let f = ContextOptions::parse_features("shader_int64_atomic_min_max, SHADER_INT64").unwrap();
+        let f =
+            ContextOptions::parse_features("shader_int64_atomic_min_max, SHADER_INT64").unwrap();
         assert_eq!(
             f,
             wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX | wgpu::Features::SHADER_INT64

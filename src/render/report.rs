@@ -377,13 +377,15 @@ mod tests {
         );
         f.disabled = F::SHADER_INT64_ATOMIC_MIN_MAX;
         assert!(
-            f.line().contains("MIN_MAX (SHADER_INT64_ATOMIC_MIN_MAX disabled on request);"),
+            f.line()
+                .contains("MIN_MAX (SHADER_INT64_ATOMIC_MIN_MAX disabled on request);"),
             "{}",
             f.line()
         );
         f.disabled = f.missing;
         assert!(
-            f.line().contains("MIN_MAX (offered by the adapter, disabled on request);"),
+            f.line()
+                .contains("MIN_MAX (offered by the adapter, disabled on request);"),
             "{}",
             f.line()
         );

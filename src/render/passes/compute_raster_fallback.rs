@@ -61,7 +61,11 @@ impl HardwareRaster {
             disabled: missing & ctx.disabled_features,
             instead: INSTEAD,
         };
-        if !cx.device().features().contains(wgpu::Features::PRIMITIVE_INDEX) {
+        if !cx
+            .device()
+            .features()
+            .contains(wgpu::Features::PRIMITIVE_INDEX)
+        {
             return Err(pass_error(
                 &sp.name,
                 format!(
@@ -114,7 +118,11 @@ impl HardwareRaster {
             state: "copy_depth".into(),
         };
         let (pipeline, bind) = cx.compute_pipeline(&sp.name, key, "copy_depth", &offered)?;
-        let groups = [cx.size.width.div_ceil(TILE), cx.size.height.div_ceil(TILE), 1];
+        let groups = [
+            cx.size.width.div_ceil(TILE),
+            cx.size.height.div_ceil(TILE),
+            1,
+        ];
         let target = IdTargets {
             depth: drawn,
             clear_depth: true,

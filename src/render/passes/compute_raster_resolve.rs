@@ -59,7 +59,11 @@ impl Resolve {
             return Ok(Resolve::Compute {
                 pipeline,
                 bind,
-                groups: [cx.size.width.div_ceil(TILE), cx.size.height.div_ceil(TILE), 1],
+                groups: [
+                    cx.size.width.div_ceil(TILE),
+                    cx.size.height.div_ceil(TILE),
+                    1,
+                ],
             });
         }
         let (pipeline, bind) = draw_pipeline(cx, sp, draw_key, offered)?;
