@@ -474,18 +474,18 @@ impl PreparedFrame {
         let image = read_rgba32f(&r.ctx.device, &r.ctx.queue, self.output_texture())?;
         timings.image_readback = start.elapsed();
         let start = Instant::now();
+        let mut fallbacks = Vec::new();
         let (mut culling, mut shadows, mut atlases) = (Vec::new(), Vec::new(), Vec::new());
         let (mut shadow_compare, mut links, mut vpls) = (Vec::new(), Vec::new(), Vec::new());
-        let mut fallbacks = Vec::new();
         for report in self.pass_reports(r)? {
             match report {
+                PassReport::Fallback(f) => fallbacks.push(f),
                 PassReport::Culling(c) => culling.push(c),
                 PassReport::Shadow(s) => shadows.push(s),
                 PassReport::Atlas(a) => atlases.push(a),
                 PassReport::ShadowCompare(c) => shadow_compare.push(c),
                 PassReport::Links(l) => links.push(l),
                 PassReport::Vpl(v) => vpls.push(v),
-                PassReport::Fallback(f) => fallbacks.push(f),
             }
         }
         let light_stats = self.read_light_stats(r)?;
@@ -495,13 +495,13 @@ impl PreparedFrame {
             height: self.size.height,
             image,
             pass_ms,
+            fallbacks,
             culling,
             links,
             shadows,
             atlases,
             shadow_compare,
             vpls,
-            fallbacks,
             light_stats,
         };
         Ok((frame, timings))

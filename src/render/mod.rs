@@ -25,8 +25,9 @@ pub use pipelines::{
     CacheCounters, GpuStateAtBuild, Pipeline, PipelineBuild, PipelineCache, PipelineKey,
 };
 pub use prepare_stats::PrepareStats;
+pub use report::FallbackReport;
 pub use report::{
-    AtlasReport, CullingReport, FallbackReport, FrameResult, LightStats, LinkReport, PassReport,
+    AtlasReport, CullingReport, FrameResult, LightStats, LinkReport, PassReport,
     ShadowCompareReport, ShadowReport, VplReport,
 };
 pub use resources::FrameResources;

@@ -291,6 +291,36 @@ impl VplReport {
     }
 }
 
+/// What a pass counted on the GPU (or decided on the CPU for this frame).
+#[derive(Clone, Debug)]
+pub enum PassReport {
+    Fallback(FallbackReport),
+    Culling(CullingReport),
+    Shadow(ShadowReport),
+    Atlas(AtlasReport),
+    ShadowCompare(ShadowCompareReport),
+    Links(LinkReport),
+    Vpl(VplReport),
+}
+
+pub struct FrameResult {
+    pub width: u32,
+    pub height: u32,
+    /// Linear HDR RGBA, row-major.
+    pub image: Vec<[f32; 4]>,
+    /// GPU milliseconds per pass, when the adapter has timestamp queries.
+    pub pass_ms: Option<Vec<(String, f64)>>,
+    /// Passes that ran another way on this device (see [`FallbackReport`]).
+    pub fallbacks: Vec<FallbackReport>,
+    pub culling: Vec<CullingReport>,
+    pub links: Vec<LinkReport>,
+    pub shadows: Vec<ShadowReport>,
+    pub atlases: Vec<AtlasReport>,
+    pub shadow_compare: Vec<ShadowCompareReport>,
+    pub vpls: Vec<VplReport>,
+    pub light_stats: Option<LightStats>,
+}
+
 /// A pass that runs another way than its kind's own on this device: the compute
 /// rasterizer drawn with the hardware rasterizer where the adapter lacks its 64-bit
 /// atomics. Reported with every frame, so a run on such a device never passes silently
@@ -325,36 +355,6 @@ impl FallbackReport {
             self.pass, self.adapter, self.missing, self.instead
         )
     }
-}
-
-/// What a pass counted on the GPU (or decided on the CPU for this frame).
-#[derive(Clone, Debug)]
-pub enum PassReport {
-    Culling(CullingReport),
-    Shadow(ShadowReport),
-    Atlas(AtlasReport),
-    ShadowCompare(ShadowCompareReport),
-    Links(LinkReport),
-    Vpl(VplReport),
-    Fallback(FallbackReport),
-}
-
-pub struct FrameResult {
-    pub width: u32,
-    pub height: u32,
-    /// Linear HDR RGBA, row-major.
-    pub image: Vec<[f32; 4]>,
-    /// GPU milliseconds per pass, when the adapter has timestamp queries.
-    pub pass_ms: Option<Vec<(String, f64)>>,
-    pub culling: Vec<CullingReport>,
-    pub links: Vec<LinkReport>,
-    pub shadows: Vec<ShadowReport>,
-    pub atlases: Vec<AtlasReport>,
-    pub shadow_compare: Vec<ShadowCompareReport>,
-    pub vpls: Vec<VplReport>,
-    /// Passes that ran another way on this device (see [`FallbackReport`]).
-    pub fallbacks: Vec<FallbackReport>,
-    pub light_stats: Option<LightStats>,
 }
 
 #[cfg(test)]
