@@ -243,3 +243,25 @@ fn render_says_when_it_falls_back() {
         "{err}"
     );
 }
+
+/// Without PRIMITIVE_INDEX too, neither way can write ids: refused, naming both.
+#[test]
+fn without_primitive_index_too_it_is_refused_naming_both() {
+    let options = ContextOptions {
+        disabled_features: MASKED | wgpu::Features::PRIMITIVE_INDEX,
+    };
+    let mut r = Renderer::headless_with(&options).expect("a wgpu adapter (lavapipe on CI)");
+    let e = render_reading(
+        &mut r,
+        &graph_text("visibility_compute_raster.ron"),
+        &random_scene(2, 5),
+        &[],
+    )
+    .err()
+    .expect("refused");
+    assert!(e.contains("pass 'compute_raster'"), "{e}");
+    assert!(
+        e.contains("lacks SHADER_INT64_ATOMIC_MIN_MAX for the compute rasterizer, and PRIMITIVE_INDEX for its hardware fallback"),
+        "{e}"
+    );
+}
