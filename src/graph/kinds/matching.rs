@@ -43,7 +43,8 @@ pub(crate) fn resolve(
         .flat_map(|(write, list)| list.iter().map(move |name| (write, name)))
         .filter_map(|(write, name)| Some((write, name, slot_type_of(ctx, name)?)))
         .collect(); // unknown resources are reported by validation
-                    // An R32Float texture this kind cannot read as depth: say which kinds can.
+
+    // An R32Float texture this kind cannot read as depth: say which kinds can.
     let depth_hint = |name: &str| {
         let has_depth_slot = specs.iter().any(|s| s.ty == SlotType::DepthTexture);
         if float_depth(name) && has_depth_slot {
