@@ -342,6 +342,7 @@ impl RasterReport {
 /// What a pass counted on the GPU (or decided on the CPU for this frame).
 #[derive(Clone, Debug)]
 pub enum PassReport {
+    Fallback(FallbackReport),
     Culling(CullingReport),
     Shadow(ShadowReport),
     Atlas(AtlasReport),
@@ -358,6 +359,8 @@ pub struct FrameResult {
     pub image: Vec<[f32; 4]>,
     /// GPU milliseconds per pass, when the adapter has timestamp queries.
     pub pass_ms: Option<Vec<(String, f64)>>,
+    /// Passes that ran another way on this device (see [`FallbackReport`]).
+    pub fallbacks: Vec<FallbackReport>,
     pub culling: Vec<CullingReport>,
     pub links: Vec<LinkReport>,
     pub shadows: Vec<ShadowReport>,
@@ -366,4 +369,75 @@ pub struct FrameResult {
     pub vpls: Vec<VplReport>,
     pub rasters: Vec<RasterReport>,
     pub light_stats: Option<LightStats>,
+}
+
+/// A pass that runs another way than its kind's own on this device: the compute
+/// rasterizer drawn with the hardware rasterizer where the adapter lacks its 64-bit
+/// atomics. Reported with every frame, so a run on such a device never passes silently
+/// for the compute path (timings included).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FallbackReport {
+    pub pass: String,
+    /// The adapter, as `GpuContext::adapter_name` gives it.
+    pub adapter: String,
+    /// What the pass needs that the device lacks.
+    pub missing: wgpu::Features,
+    /// Of `missing`, what the adapter offers but the context was asked to leave off
+    /// (`ContextOptions::disabled_features`).
+    pub disabled: wgpu::Features,
+    /// How the pass ran instead.
+    pub instead: &'static str,
+}
+
+impl FallbackReport {
+    /// One line for `render` and the viewer, e.g. `compute_raster: adapter X lacks
+    /// SHADER_INT64_ATOMIC_MIN_MAX; drawn with the hardware rasterizer`.
+    pub fn line(&self) -> String {
+        let disabled = if self.disabled.is_empty() {
+            String::new()
+        } else if self.disabled == self.missing {
+            " (offered by the adapter, disabled on request)".to_string()
+        } else {
+            format!(" ({} disabled on request)", self.disabled)
+        };
+        format!(
+            "{}: adapter {} lacks {}{disabled}; {}",
+            self.pass, self.adapter, self.missing, self.instead
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::FallbackReport;
+    use wgpu::Features as F;
+
+    #[test]
+    fn a_fallback_line_names_the_pass_adapter_and_missing_features() {
+        let mut f = FallbackReport {
+            pass: "cr".into(),
+            adapter: "Some GPU (Vulkan)".into(),
+            missing: F::SHADER_INT64 | F::SHADER_INT64_ATOMIC_MIN_MAX,
+            disabled: F::empty(),
+            instead: "drawn with the hardware rasterizer",
+        };
+        assert_eq!(
+            f.line(),
+            "cr: adapter Some GPU (Vulkan) lacks SHADER_INT64 | SHADER_INT64_ATOMIC_MIN_MAX; drawn with the hardware rasterizer"
+        );
+        f.disabled = F::SHADER_INT64_ATOMIC_MIN_MAX;
+        assert!(
+            f.line()
+                .contains("MIN_MAX (SHADER_INT64_ATOMIC_MIN_MAX disabled on request);"),
+            "{}",
+            f.line()
+        );
+        f.disabled = f.missing;
+        assert!(
+            f.line()
+                .contains("MIN_MAX (offered by the adapter, disabled on request);"),
+            "{}",
+            f.line()
+        );
+    }
 }

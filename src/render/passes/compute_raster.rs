@@ -3,17 +3,16 @@
 //! four dispatches: `clear`; `setup`, a thread per triangle, appends a record per (clipped)
 //! fan triangle and its 64×64-pixel tiles to lists; `bin` (indirect), a thread per block
 //! of a tile, appends the tile's 8×8-pixel blocks the triangle may cover; `raster`
-//! (indirect), a thread per pixel of a block. A full-screen draw then resolves the buffer
-//! into the depth texture (`frag_depth`) and the R32Uint visibility texture.
+//! (indirect), a thread per pixel of a block. A resolve then writes the buffer into the
+//! depth texture and the R32Uint visibility texture (a draw or a dispatch, by the depth's
+//! format: `compute_raster_resolve.rs`).
 //! See `shaders/visibility/compute_raster.wgsl`.
 
+use super::compute_raster_resolve::Resolve;
 use super::{defines, pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::gpu::readback::read_buffer;
-use crate::graph::kinds::compute_raster::VISIBILITY;
-use crate::graph::{slot, Name, ScheduledPass};
-use crate::render::bind::layout_entries;
-use crate::render::draws::{color_attachment, depth_attachment};
-use crate::render::pipelines::{Pipeline, PipelineKey};
+use crate::graph::{Name, ScheduledPass};
+use crate::render::pipelines::PipelineKey;
 use crate::render::report::{PassReport, RasterReport};
 use crate::render::{RenderError, Renderer};
 use crate::scene::AlphaMode;
@@ -76,9 +75,7 @@ pub(super) struct ComputeRasterPass {
     block_args: wgpu::Buffer,
     counters: wgpu::Buffer,
     capacity: ListCapacity,
-    resolve: (Arc<wgpu::RenderPipeline>, wgpu::BindGroup),
-    depth: wgpu::TextureView,
-    visibility: wgpu::TextureView,
+    resolve: Resolve,
 }
 
 /// A 1D grid of `items` threads in groups of `per_group`, folded into y past the
@@ -347,8 +344,7 @@ pub(super) fn prepare(
     let (setup, setup_bind) = pipeline("SETUP", "setup")?;
     let bin = pipeline("BIN", "bin")?;
     let raster = pipeline("RASTER", "raster")?;
-    let resolve = resolve_pipeline(cx, sp, key(&[("RESOLVE", "1".into())], "resolve"), &offered)?;
-    let depth = sp.required(slot::DEPTH);
+    let resolve = Resolve::prepare(cx, sp, key(&[("RESOLVE", "1".into())], "resolve"), &offered)?;
     Ok(ComputeRasterPass {
         name: sp.name.clone(),
         clear: (
@@ -368,8 +364,6 @@ pub(super) fn prepare(
         counters,
         capacity,
         resolve,
-        depth: cx.view(&sp.name, depth)?,
-        visibility: cx.view(&sp.name, sp.required(VISIBILITY))?,
     })
 }
 
@@ -412,91 +406,18 @@ impl ComputeRasterPass {
     }
 }
 
-/// The full-screen draw that writes depth (`frag_depth`) and ids from the buffer.
-fn resolve_pipeline(
-    cx: &mut PrepareCtx,
-    sp: &ScheduledPass,
-    key: PipelineKey,
-    offered: &super::BindingSet,
-) -> Result<(Arc<wgpu::RenderPipeline>, wgpu::BindGroup), RenderError> {
-    let device = cx.device();
-    let layouts = cx.renderer.layouts.clone();
-    let stages = wgpu::ShaderStages::FRAGMENT;
-    let (pipeline, bindings) = cx.render_pipeline(&sp.name, key, |_, module, bindings| {
-        let bgl = layouts.get(&device, layout_entries(bindings, 0, stages));
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(&sp.name),
-            bind_group_layouts: &[Some(&bgl)],
-            immediate_size: 0,
-        });
-        Pipeline::Render(Arc::new(device.create_render_pipeline(
-            &wgpu::RenderPipelineDescriptor {
-                label: Some(&sp.name),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("resolve_vs"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: Default::default(),
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: wgpu::TextureFormat::Depth32Float,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Always),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("resolve_fs"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::TextureFormat::R32Uint.into())],
-                }),
-                multiview_mask: None,
-                cache: crate::render::pipelines::driver_cache().as_ref(),
-            },
-        )))
-    })?;
-    let bgl = layouts.get(&device, layout_entries(&bindings, 0, stages));
-    let bind = offered
-        .bind(&device, &sp.name, &bgl, &bindings, 0)
-        .map_err(|m| pass_error(&sp.name, m))?;
-    Ok((pipeline, bind))
-}
-
 impl PreparedPass for ComputeRasterPass {
     fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
-        // One timestamp pair around both halves: the compute pass opens it, the resolve
-        // closes it.
+        // One timestamp pair around all of it: the compute pass opens it, the resolve
+        // (a dispatch in it, or a draw after it) closes it.
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some(&self.name),
-            timestamp_writes: ts.compute().map(|t| wgpu::ComputePassTimestampWrites {
-                end_of_pass_write_index: None,
-                ..t
-            }),
+            timestamp_writes: self.resolve.compute_timestamps(ts),
         });
         self.record_raster(&mut pass);
+        self.resolve.dispatch(&mut pass);
         drop(pass);
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(&self.name),
-            color_attachments: &[Some(color_attachment(
-                &self.visibility,
-                Some(wgpu::Color::TRANSPARENT),
-                None,
-            ))],
-            depth_stencil_attachment: Some(depth_attachment(&self.depth, true)),
-            timestamp_writes: ts.render().map(|t| wgpu::RenderPassTimestampWrites {
-                beginning_of_pass_write_index: None,
-                ..t
-            }),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&self.resolve.0);
-        pass.set_bind_group(0, &self.resolve.1, &[]);
-        pass.draw(0..3, 0..1);
+        self.resolve.draw(encoder, &self.name, ts);
     }
 
     fn report(&self, r: &Renderer) -> Result<Option<PassReport>, RenderError> {
