@@ -11,31 +11,29 @@ use crate::graph::error::GraphError;
 use crate::graph::model::{LightSource, SceneResource};
 use serde::{Deserialize, Serialize};
 
-/// `VisibilityShading(lights: Culled, staging: true)`.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
+/// `VisibilityShading(lights: Culled, light_loop: Forward)`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
 #[serde(deny_unknown_fields)]
 pub struct VisibilityShading {
     #[serde(default)]
     pub lights: LightSource,
-    /// The faster light loop (default): a workgroup whose pixels all read one tile list
-    /// (Frustum and DepthMask lists) stages it in workgroup memory; other lists keep the
-    /// per-pixel walk; both test a light's range before its properties. `false` runs
-    /// forward shading's loop, for timing and comparing the two (the images are equal).
-    #[serde(default = "staging_default")]
-    pub staging: bool,
+    #[serde(default)]
+    pub light_loop: LightLoop,
 }
 
-fn staging_default() -> bool {
-    true
-}
-
-impl Default for VisibilityShading {
-    fn default() -> Self {
-        Self {
-            lights: LightSource::default(),
-            staging: staging_default(),
-        }
-    }
+/// How a pixel walks its lights. All three give the same image to the bit (tested); they
+/// differ only in speed, so a graph can time them side by side.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
+pub enum LightLoop {
+    /// Forward shading's loop (`common/light_loop.wgsl`), per pixel. The default: the
+    /// fastest of the three on an NVIDIA H200 (README "Visibility buffer").
+    #[default]
+    Forward,
+    /// Per pixel, a light's range tested before its properties are read.
+    RangeFirst,
+    /// A workgroup whose pixels all read one tile list (Frustum and DepthMask lists)
+    /// stages it in workgroup memory, a batch at a time; other lists run `RangeFirst`.
+    Staged,
 }
 
 pub const VERTICES: &str = "vertices";
@@ -116,13 +114,18 @@ mod tests {
     }
 
     #[test]
-    fn stages_unless_told_not_to() {
-        use super::VisibilityShading;
+    fn light_loop_defaults_to_forward_and_parses_each_kind() {
+        use super::{LightLoop, VisibilityShading};
         let parse = |t: &str| ron::from_str::<VisibilityShading>(t).unwrap();
-        assert!(parse("(lights: Culled)").staging);
-        assert!(VisibilityShading::default().staging);
-        assert!(!parse("(lights: Culled, staging: false)").staging);
-        assert!(ron::from_str::<VisibilityShading>("(staged: false)").is_err());
+        assert_eq!(parse("(lights: Culled)").light_loop, LightLoop::Forward);
+        assert_eq!(VisibilityShading::default().light_loop, LightLoop::Forward);
+        assert_eq!(parse("(light_loop: Staged)").light_loop, LightLoop::Staged);
+        assert_eq!(
+            parse("(light_loop: RangeFirst)").light_loop,
+            LightLoop::RangeFirst
+        );
+        assert!(ron::from_str::<VisibilityShading>("(staging: false)").is_err());
+        assert!(ron::from_str::<VisibilityShading>("(light_loop: Fast)").is_err());
     }
 
     #[test]

@@ -4,6 +4,7 @@
 //! (`MaterialProgram::compute_wgsl`) and bind their textures in group 2.
 
 use super::{defines, PrepareCtx, PreparedPass, ShadeLists, Timestamps};
+use crate::graph::kinds::visibility_shading::LightLoop;
 use crate::graph::Name;
 use crate::graph::{ListLayout, ScheduledPass, VisibilityShading};
 use crate::render::pipelines::PipelineKey;
@@ -52,7 +53,7 @@ pub(super) fn prepare(
             d.push(("MATERIAL_TEXTURED", "1".into()));
         }
         d.extend(lists.define());
-        d.extend(light_loop.define());
+        d.extend(loop_define(light_loop));
         let key = PipelineKey {
             shader: "visibility/visibility_shading.wgsl".into(),
             defines: defines(&d),
@@ -85,30 +86,16 @@ pub(super) fn prepare(
 /// Pixels per side of the shader's workgroup (`@workgroup_size(8, 8, 1)`).
 const WORKGROUP_SIDE: u32 = 8;
 
-/// Which light loop the shader runs (shaders/visibility/staged_lights.wgsl).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum LightLoop {
-    /// Forward shading's `shade_surface` (`staging: false`).
-    PerPixel,
-    /// The per-pixel walk with the range test first: lists that differ between the
-    /// pixels of a workgroup, and all lights.
-    RangeFirst,
-    /// The workgroup's one tile list staged in workgroup memory.
-    Staged,
-}
-
-impl LightLoop {
-    fn define(self) -> Option<(&'static str, String)> {
-        match self {
-            LightLoop::PerPixel => None,
-            LightLoop::RangeFirst => Some(("RANGE_FIRST", "1".into())),
-            LightLoop::Staged => Some(("STAGED_LIGHTS", "1".into())),
-        }
+/// The define that picks the shader's light loop (shaders/visibility/staged_lights.wgsl).
+fn loop_define(l: LightLoop) -> Option<(&'static str, String)> {
+    match l {
+        LightLoop::Forward => None,
+        LightLoop::RangeFirst => Some(("RANGE_FIRST", "1".into())),
+        LightLoop::Staged => Some(("STAGED_LIGHTS", "1".into())),
     }
 }
 
-/// The loop for `lights` read from `lists`: staged when every pixel of a workgroup
-/// reads one list.
+/// The loop the graph asked for, for `lights` read from `lists`.
 fn light_loop(
     cx: &PrepareCtx,
     sp: &ScheduledPass,
@@ -122,17 +109,19 @@ fn light_loop(
             .list_layout(sp.required(crate::graph::slot::LIGHT_LISTS)),
         ShadeLists::AllLights | ShadeLists::Links => None,
     };
-    choose_light_loop(p.staging, layout)
+    choose_light_loop(p.light_loop, layout)
 }
 
-/// Staged for tile lists with one list per tile (Frustum, DepthMask) whose tile is a
-/// multiple of the workgroup's side, so no workgroup straddles two tiles; `layout` is
-/// `None` for linked lists and all lights.
-fn choose_light_loop(staging: bool, layout: Option<ListLayout>) -> LightLoop {
-    match layout {
-        _ if !staging => LightLoop::PerPixel,
-        Some(l) if l.lists_per_tile == 1 && l.tile % WORKGROUP_SIDE == 0 => LightLoop::Staged,
-        _ => LightLoop::RangeFirst,
+/// `Staged` only for tile lists with one list per tile (Frustum, DepthMask) whose tile is
+/// a multiple of the workgroup's side, so no workgroup straddles two tiles (`RangeFirst`
+/// otherwise); `layout` is `None` for linked lists and all lights.
+fn choose_light_loop(asked: LightLoop, layout: Option<ListLayout>) -> LightLoop {
+    match (asked, layout) {
+        (LightLoop::Staged, Some(l)) if l.lists_per_tile == 1 && l.tile % WORKGROUP_SIDE == 0 => {
+            LightLoop::Staged
+        }
+        (LightLoop::Staged, _) => LightLoop::RangeFirst,
+        (other, _) => other,
     }
 }
 
@@ -156,7 +145,8 @@ impl PreparedPass for VisibilityShadingPass {
 
 #[cfg(test)]
 mod tests {
-    use super::{choose_light_loop, LightLoop};
+    use super::choose_light_loop;
+    use crate::graph::kinds::visibility_shading::LightLoop::{Forward, RangeFirst, Staged};
     use crate::graph::{CullVariant, ListLayout, ListStorage};
 
     fn layout(tile: u32, variant: CullVariant) -> Option<ListLayout> {
@@ -169,18 +159,19 @@ mod tests {
         for tile in [8, 16] {
             for variant in [CullVariant::Frustum, CullVariant::DepthMask] {
                 let l = layout(tile, variant);
-                assert_eq!(choose_light_loop(true, l), LightLoop::Staged, "{l:?}");
-                assert_eq!(choose_light_loop(false, l), LightLoop::PerPixel, "{l:?}");
+                assert_eq!(choose_light_loop(Staged, l), Staged, "{l:?}");
+                assert_eq!(choose_light_loop(Forward, l), Forward, "{l:?}");
+                assert_eq!(choose_light_loop(RangeFirst, l), RangeFirst, "{l:?}");
             }
             for variant in [CullVariant::HalfZ, CullVariant::Clustered { slices: 16 }] {
                 let l = layout(tile, variant);
-                assert_eq!(choose_light_loop(true, l), LightLoop::RangeFirst, "{l:?}");
+                assert_eq!(choose_light_loop(Staged, l), RangeFirst, "{l:?}");
             }
         }
         // A tile the workgroup would straddle (the culling pass refuses it today).
         let l = layout(12, CullVariant::Frustum);
-        assert_eq!(choose_light_loop(true, l), LightLoop::RangeFirst);
-        assert_eq!(choose_light_loop(true, None), LightLoop::RangeFirst);
-        assert_eq!(choose_light_loop(false, None), LightLoop::PerPixel);
+        assert_eq!(choose_light_loop(Staged, l), RangeFirst);
+        assert_eq!(choose_light_loop(Staged, None), RangeFirst);
+        assert_eq!(choose_light_loop(Forward, None), Forward);
     }
 }
