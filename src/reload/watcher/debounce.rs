@@ -1,5 +1,6 @@
 //! The watcher's debounce thread: events in, [`ChangeBatch`]es out.
 
+use super::settle::Progress;
 use super::{is_editor_temp_file, ChangeBatch, ChangeKind, WatchConfig};
 use notify::event::{AccessKind, AccessMode, EventKind};
 use std::collections::{BTreeSet, HashMap, HashSet};
@@ -54,8 +55,8 @@ pub(super) struct Debouncer {
     pub(super) shutdown: Arc<AtomicBool>,
     pub(super) events: Receiver<notify::Result<notify::Event>>,
     pub(super) batches: Sender<ChangeBatch>,
-    /// Paths with events since the last batch.
-    pub(super) pending: HashSet<PathBuf>,
+    /// Watched paths with events since the last batch, and whether they are saved.
+    pub(super) pending: HashMap<PathBuf, Progress>,
     /// (first, last) event time of the current burst.
     pub(super) burst: Option<(Instant, Instant)>,
     /// Empty or vanished files held back, with their deadline.
@@ -66,9 +67,17 @@ pub(super) struct Debouncer {
 const SHUTDOWN_POLL: Duration = Duration::from_millis(100);
 
 impl Debouncer {
+    /// When the current burst's batch is cut: [`WatchConfig::settle`] after the last
+    /// event if every path in it is saved, else [`WatchConfig::debounce`] after it; at
+    /// the latest `max_latency` after the first.
     fn burst_deadline(&self) -> Option<Instant> {
-        self.burst
-            .map(|(first, last)| (last + self.config.debounce).min(first + self.config.max_latency))
+        let (first, last) = self.burst?;
+        let quiet = if self.pending.values().all(Progress::is_complete) {
+            self.config.settle.min(self.config.debounce)
+        } else {
+            self.config.debounce
+        };
+        Some((last + quiet).min(first + self.config.max_latency))
     }
 
     pub(super) fn run(mut self) {
@@ -96,29 +105,48 @@ impl Debouncer {
 
     fn on_event(&mut self, event: notify::Event) {
         let now = Instant::now();
+        let shared = self.shared.lock().unwrap();
+        let mut touched = false;
         if event.need_rescan() {
-            let shared = self.shared.lock().unwrap();
+            // Events were lost: every file may have changed, and how far its writer got
+            // is unknown, so the batch waits for the debounce.
             let mut found = HashSet::new();
             for d in &shared.dirs {
                 scan_dir(d, &mut found);
             }
-            self.pending.extend(found);
-            self.pending.extend(shared.known.iter().cloned());
-            self.pending.extend(shared.files.iter().cloned());
+            let all = found
+                .into_iter()
+                .chain(shared.known.iter().cloned())
+                .chain(shared.files.iter().cloned());
+            for path in all {
+                self.pending.insert(path, Progress::UNKNOWN);
+                touched = true;
+            }
         }
-        match event.kind {
-            EventKind::Access(AccessKind::Close(AccessMode::Write)) => {}
-            EventKind::Access(_) | EventKind::Other => return,
-            _ => {}
+        // Opening, reading and closing without writing change nothing.
+        let ignored = match event.kind {
+            EventKind::Access(AccessKind::Close(AccessMode::Write)) => false,
+            EventKind::Access(_) | EventKind::Other => true,
+            _ => false,
+        };
+        if !ignored {
+            // Editors' temp files and unwatched siblings of watched files neither reach a
+            // batch nor hold one back (a swap file kept open must not).
+            for path in event.paths {
+                if shared.is_relevant(&path) {
+                    let known = shared.known.contains(&path);
+                    self.pending.entry(path).or_default().on(&event.kind, known);
+                    touched = true;
+                }
+            }
         }
-        if event.paths.is_empty() {
-            return;
+        drop(shared);
+        if touched {
+            self.burst = Some(match self.burst {
+                Some((first, _)) => (first, now),
+                None => (now, now),
+            });
         }
-        self.pending.extend(event.paths);
-        self.burst = Some(match self.burst {
-            Some((first, _)) => (first, now),
-            None => (now, now),
-        });
     }
 
     /// Cut a batch if the burst is over, and release held files whose grace ran out.
@@ -126,13 +154,13 @@ impl Debouncer {
         let burst_over = self.burst_deadline().is_some_and(|d| now >= d);
         let mut candidates: Vec<PathBuf> = Vec::new();
         if burst_over {
-            candidates.extend(self.pending.drain());
+            candidates.extend(self.pending.drain().map(|(path, _)| path));
             self.burst = None;
         }
         let expired: Vec<PathBuf> = self
             .held
             .iter()
-            .filter(|(p, d)| now >= **d && !self.pending.contains(*p))
+            .filter(|(p, d)| now >= **d && !self.pending.contains_key(*p))
             .map(|(p, _)| p.clone())
             .collect();
         candidates.extend(expired);

@@ -39,6 +39,7 @@
 mod batch;
 mod debounce;
 mod paths;
+mod settle;
 
 pub use batch::{ChangeBatch, ChangeKind, WatchError};
 pub use paths::{is_editor_temp_file, normalize_path};
@@ -62,6 +63,10 @@ pub struct WatchConfig {
     /// 20 ms leaves room for a writer descheduled mid-save and is a small part of the
     /// edit-to-frame latency (see `lightgraph reload-bench`).
     pub debounce: Duration,
+    /// Quiet time after the last event before a batch is cut when every file in it is
+    /// known to be saved (closed after writing, renamed into place, removed). Default
+    /// 5 ms; see [`DEFAULT_SETTLE`](Self::DEFAULT_SETTLE). Never longer than `debounce`.
+    pub settle: Duration,
     /// Longest a burst of events can delay a batch. Default 1 s.
     pub max_latency: Duration,
     /// How long an empty or vanished file is held back waiting for content / to reappear.
@@ -72,12 +77,15 @@ pub struct WatchConfig {
 impl WatchConfig {
     /// The default [`debounce`](Self::debounce).
     pub const DEFAULT_DEBOUNCE: Duration = Duration::from_millis(20);
+    /// The default [`settle`](Self::settle).
+    pub const DEFAULT_SETTLE: Duration = Duration::from_millis(5);
 }
 
 impl Default for WatchConfig {
     fn default() -> Self {
         Self {
             debounce: Self::DEFAULT_DEBOUNCE,
+            settle: Self::DEFAULT_SETTLE,
             max_latency: Duration::from_secs(1),
             grace: Duration::from_secs(1),
         }
@@ -123,7 +131,7 @@ impl FileWatcher {
                 shutdown: shutdown.clone(),
                 events: event_rx,
                 batches: batch_tx,
-                pending: HashSet::new(),
+                pending: HashMap::new(),
                 burst: None,
                 held: HashMap::new(),
             };
