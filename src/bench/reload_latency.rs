@@ -6,9 +6,10 @@
 //! benchmark makes real edits in turn (shader: the range window's scale; material: the
 //! pigment's red; graph: the culling pass's list capacity), each with a value the edit
 //! before did not use (and the session drops pipelines only replaced frames used), so
-//! every edit rebuilds what it really must. The clock starts when the file
-//! write has returned (so the watcher's debounce is included) and stops when the new
-//! frame has been read back.
+//! every edit rebuilds what it really must. The clock starts when the file write has
+//! returned, so the watcher's wait is included (`std::fs::write` closes the file: its
+//! batch comes `WatchConfig::settle` after the last event, not the whole debounce), and
+//! stops when the new frame has been read back.
 
 use super::report::{summarize, TimingSummary};
 use crate::reload::{Reload, ReloadSession, SceneSource, WatchConfig};
@@ -106,7 +107,8 @@ pub struct ReloadSample {
     pub frame_ms: f64,
     /// File write returned → new frame read back (the HDR image copied to the CPU).
     pub total_ms: f64,
-    /// File write returned → the watcher delivered the batch (debounce and event delivery).
+    /// File write returned → the watcher delivered the batch (event delivery, then the
+    /// settle time for a saved file or the debounce otherwise).
     pub watch_ms: f64,
     /// Reading and uploading changed materials / scene.
     pub assets_ms: f64,
@@ -465,7 +467,7 @@ pub struct KindSummary {
 type Part = (&'static str, fn(&ReloadSample) -> f64);
 
 const PARTS: [Part; 8] = [
-    ("watch (debounce + events)", |s| s.watch_ms),
+    ("watch (events + settle)", |s| s.watch_ms),
     ("material/scene load", |s| s.assets_ms),
     ("graph compile", |s| s.graph_ms),
     ("shader compose + naga", |s| s.shader_compose_ms),
@@ -647,9 +649,10 @@ pub fn to_markdown(
     let _ = writeln!(
         out,
         "Adapter: {adapter}. Scene: harada geometry, boxes in `car_paint.ron`, {} random \
-         lights; `forward_plus.ron`; {}×{}; {} edits of each kind, interleaved. Watcher \
-         debounce {} ms. Edit salt {}; {} frames in flight at each edit; {}; pipelines of \
-         different passes built {}. Times from the file write returning to the new frame \
+         lights; `forward_plus.ron`; {}×{}; {} edits of each kind, interleaved. Watcher: \
+         batches cut {} ms after a saved file's last event (debounce {} ms otherwise). Edit \
+         salt {}; {} frames in flight at each edit; {}; pipelines of different passes built \
+         {}. Times from the file write returning to the new frame \
          read back.\n\n\
          **Edit → new frame** runs from the file write returning to the new frame's GPU work \
          being done: what the viewer (`lightgraph view`) shows, since it presents the output \
@@ -660,6 +663,7 @@ pub fn to_markdown(
         config.width,
         config.height,
         config.repeats,
+        watch.settle.min(watch.debounce).as_millis(),
         watch.debounce.as_millis(),
         config.salt,
         config.frames_in_flight,
