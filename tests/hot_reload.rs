@@ -179,6 +179,7 @@ fn reloads_do_not_accumulate_gpu_memory() {
         repeats: 5,
         salt: 0,
         frames_in_flight: 0,
+        viewer_frames: 2,
         wait_for_idle_before_build: false,
         sequential_builds: false,
     };

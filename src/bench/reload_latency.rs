@@ -90,6 +90,11 @@ pub struct ReloadBenchConfig {
     /// Frames submitted without waiting right before each edit, as a viewer has in
     /// flight: pipeline builds then start while the GPU is busy.
     pub frames_in_flight: usize,
+    /// Frames rendered right before each edit, each waited for, as a viewer renders
+    /// continuously until a reload takes its loop: the GPU is as busy as under a viewer
+    /// (an idle GPU lowers its clocks; then the new frame takes longer), and nothing is
+    /// in flight when the edit lands.
+    pub viewer_frames: usize,
     /// Wait for the GPU to go idle before building pipelines (timed in its own column).
     pub wait_for_idle_before_build: bool,
     /// Build one pass's pipelines after another (the renderer builds them on one thread
@@ -351,8 +356,12 @@ pub fn run(
             };
             // Whatever a previous edit left behind is handled before the clock starts.
             while session.poll().is_some() {}
-            // A viewer's frames in flight when the edit lands.
+            // A viewer's frames, done or in flight when the edit lands.
             if let Some(p) = session.prepared() {
+                for _ in 0..config.viewer_frames {
+                    p.execute(&session.renderer)
+                        .map_err(|e| failed(e.to_string()))?;
+                }
                 for _ in 0..config.frames_in_flight {
                     p.submit(&session.renderer)
                         .map_err(|e| failed(e.to_string()))?;
@@ -651,8 +660,8 @@ pub fn to_markdown(
         "Adapter: {adapter}. Scene: harada geometry, boxes in `car_paint.ron`, {} random \
          lights; `forward_plus.ron`; {}×{}; {} edits of each kind, interleaved. Watcher: \
          batches cut {} ms after a saved file's last event (debounce {} ms otherwise). Edit \
-         salt {}; {} frames in flight at each edit; {}; pipelines of different passes built \
-         {}. Times from the file write returning to the new frame \
+         salt {}; {} frames rendered and {} more in flight right before each edit; {}; \
+         pipelines of different passes built {}. Times from the file write returning to the new frame \
          read back.\n\n\
          **Edit → new frame** runs from the file write returning to the new frame's GPU work \
          being done: what the viewer (`lightgraph view`) shows, since it presents the output \
@@ -666,6 +675,7 @@ pub fn to_markdown(
         watch.settle.min(watch.debounce).as_millis(),
         watch.debounce.as_millis(),
         config.salt,
+        config.viewer_frames,
         config.frames_in_flight,
         if config.wait_for_idle_before_build {
             "waiting for an idle GPU before building"
