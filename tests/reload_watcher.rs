@@ -401,7 +401,7 @@ fn saved_files_arrive_without_waiting_for_the_debounce() {
         ("in place, two writes", |lit, text| {
             let mut file = OpenOptions::new().write(true).open(lit).unwrap();
             file.write_all(b"// ").unwrap();
-            file.write_all(text[3..].as_bytes()).unwrap();
+            file.write_all(&text.as_bytes()[3..]).unwrap();
         }),
         ("temp file renamed over", |lit, text| {
             let tmp = lit.with_extension("wgsl.tmp");
