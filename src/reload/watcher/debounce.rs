@@ -2,7 +2,7 @@
 
 use super::settle::Progress;
 use super::{is_editor_temp_file, ChangeBatch, ChangeKind, WatchConfig};
-use notify::event::{AccessKind, AccessMode, EventKind};
+use notify::event::{AccessKind, AccessMode, EventKind, ModifyKind, RenameMode};
 use std::collections::{BTreeSet, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -123,10 +123,14 @@ impl Debouncer {
                 touched = true;
             }
         }
-        // Opening, reading and closing without writing change nothing.
         let ignored = match event.kind {
             EventKind::Access(AccessKind::Close(AccessMode::Write)) => false,
+            // Opening, reading and closing without writing change nothing.
             EventKind::Access(_) | EventKind::Other => true,
+            // inotify's rename pair, after the From and To events that say the same: when
+            // it arrives after the batch was cut (the notify thread losing its core between
+            // the two), it would name the renamed file again in a batch of its own.
+            EventKind::Modify(ModifyKind::Name(RenameMode::Both)) => true,
             _ => false,
         };
         if !ignored {
@@ -205,5 +209,94 @@ impl Debouncer {
         if !batch.is_empty() {
             let _ = self.batches.send(batch);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use notify::event::DataChange;
+    use std::sync::mpsc::{self, Receiver};
+
+    /// A debounce thread's state over a temp dir holding `lit.wgsl`, driven by hand.
+    fn debouncer() -> (tempfile::TempDir, PathBuf, Debouncer, Receiver<ChangeBatch>) {
+        let dir = tempfile::tempdir().unwrap();
+        let root = dir.path().canonicalize().unwrap();
+        std::fs::write(root.join("lit.wgsl"), "// v1\n").unwrap();
+        let mut shared = Shared::default();
+        shared.dirs.insert(root.clone());
+        scan_dir(&root, &mut shared.known);
+        let (batch_tx, batches) = mpsc::channel();
+        let d = Debouncer {
+            config: WatchConfig::default(),
+            shared: Arc::new(Mutex::new(shared)),
+            shutdown: Arc::new(AtomicBool::new(false)),
+            events: mpsc::channel().1,
+            batches: batch_tx,
+            pending: HashMap::new(),
+            burst: None,
+            held: HashMap::new(),
+        };
+        (dir, root, d, batches)
+    }
+
+    fn event(kind: EventKind, paths: &[&Path]) -> notify::Event {
+        paths
+            .iter()
+            .fold(notify::Event::new(kind), |e, p| e.add_path(p.to_path_buf()))
+    }
+
+    /// Evaluates as the thread would once `after` has passed since now.
+    fn evaluate_after(d: &mut Debouncer, after: Duration) {
+        d.evaluate(Instant::now() + after);
+    }
+
+    #[test]
+    fn a_saved_file_is_cut_after_the_settle_time_a_written_one_after_the_debounce() {
+        let (_dir, root, mut d, batches) = debouncer();
+        let lit = root.join("lit.wgsl");
+        let WatchConfig {
+            settle, debounce, ..
+        } = d.config;
+        let write = EventKind::Modify(ModifyKind::Data(DataChange::Any));
+        d.on_event(event(write, &[&lit]));
+        evaluate_after(&mut d, settle * 2);
+        assert!(batches.try_recv().is_err(), "cut while open for writing");
+        evaluate_after(&mut d, debounce * 2);
+        assert!(batches.try_recv().unwrap().contains(&lit), "the debounce");
+        d.on_event(event(write, &[&lit]));
+        d.on_event(event(
+            EventKind::Access(AccessKind::Close(AccessMode::Write)),
+            &[&lit],
+        ));
+        evaluate_after(&mut d, settle / 2);
+        assert!(batches.try_recv().is_err(), "cut within the settle time");
+        evaluate_after(&mut d, settle * 2);
+        assert!(
+            batches.try_recv().unwrap().contains(&lit),
+            "the settle time"
+        );
+    }
+
+    #[test]
+    fn a_late_rename_pair_does_not_name_the_file_again() {
+        let (_dir, root, mut d, batches) = debouncer();
+        let lit = root.join("lit.wgsl");
+        let tmp = root.join("xq7z");
+        let WatchConfig {
+            settle, debounce, ..
+        } = d.config;
+        let name = |mode| EventKind::Modify(ModifyKind::Name(mode));
+        d.on_event(event(name(RenameMode::From), &[&tmp]));
+        d.on_event(event(name(RenameMode::To), &[&lit]));
+        evaluate_after(&mut d, settle * 2);
+        let b = batches.try_recv().unwrap();
+        assert_eq!(b.paths().collect::<Vec<_>>(), vec![lit.as_path()]);
+        d.on_event(event(name(RenameMode::Both), &[&tmp, &lit]));
+        evaluate_after(&mut d, debounce * 2);
+        assert!(
+            batches.try_recv().is_err(),
+            "the rename pair named it again"
+        );
     }
 }
