@@ -597,11 +597,12 @@ fn event_traces() {
             // The gaps that would cut a batch early: those after an event that left every
             // file looking saved (as `settle.rs` judges: no write since a close-after-write,
             // rename or removal; no new file still there), and the last event's arrival.
-            // Opens and reads are no events to the watcher.
-            use notify::event::{AccessKind, AccessMode, EventKind, ModifyKind};
+            // Opens, reads and rename pairs are no events to the watcher.
+            use notify::event::{AccessKind, AccessMode, EventKind, ModifyKind, RenameMode};
             events.retain(|(_, e)| match e.kind {
                 EventKind::Access(AccessKind::Close(AccessMode::Write)) => true,
                 EventKind::Access(_) | EventKind::Other => false,
+                EventKind::Modify(ModifyKind::Name(RenameMode::Both)) => false,
                 _ => true,
             });
             let (mut open, mut fresh) = (HashSet::new(), HashSet::new());
