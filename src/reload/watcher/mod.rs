@@ -48,8 +48,9 @@
 //!   the new directory's watch atomically).
 //! - On a kernel event-queue overflow every known file under the roots is re-checked and reported.
 //!
-//! The parts: [`ChangeBatch`] and errors (`batch`), path helpers (`paths`), the debounce
-//! thread (`debounce`); [`FileWatcher`] here ties them together.
+//! The parts: [`ChangeBatch`] and errors (`batch`), path helpers (`paths`), what a burst's
+//! events say about a file being saved (`settle`), the debounce thread (`debounce`);
+//! [`FileWatcher`] here ties them together.
 
 mod batch;
 mod debounce;
