@@ -6,9 +6,10 @@
 //! benchmark makes real edits in turn (shader: the range window's scale; material: the
 //! pigment's red; graph: the culling pass's list capacity), each with a value the edit
 //! before did not use (and the session drops pipelines only replaced frames used), so
-//! every edit rebuilds what it really must. The clock starts when the file
-//! write has returned (so the watcher's debounce is included) and stops when the new
-//! frame has been read back.
+//! every edit rebuilds what it really must. The clock starts when the file write has
+//! returned, so the watcher's wait is included (`std::fs::write` closes the file: its
+//! batch comes `WatchConfig::settle` after the last event, not the whole debounce), and
+//! stops when the new frame has been read back.
 
 use super::report::{summarize, TimingSummary};
 use crate::reload::{Reload, ReloadSession, SceneSource, WatchConfig};
@@ -89,6 +90,11 @@ pub struct ReloadBenchConfig {
     /// Frames submitted without waiting right before each edit, as a viewer has in
     /// flight: pipeline builds then start while the GPU is busy.
     pub frames_in_flight: usize,
+    /// Frames rendered right before each edit, each waited for, as a viewer renders
+    /// continuously until a reload takes its loop: the GPU is as busy as under a viewer
+    /// (an idle GPU lowers its clocks; then the new frame takes longer), and nothing is
+    /// in flight when the edit lands.
+    pub viewer_frames: usize,
     /// Wait for the GPU to go idle before building pipelines (timed in its own column).
     pub wait_for_idle_before_build: bool,
     /// Build one pass's pipelines after another (the renderer builds them on one thread
@@ -106,7 +112,8 @@ pub struct ReloadSample {
     pub frame_ms: f64,
     /// File write returned → new frame read back (the HDR image copied to the CPU).
     pub total_ms: f64,
-    /// File write returned → the watcher delivered the batch (debounce and event delivery).
+    /// File write returned → the watcher delivered the batch (event delivery, then the
+    /// settle time for a saved file or the debounce otherwise).
     pub watch_ms: f64,
     /// Reading and uploading changed materials / scene.
     pub assets_ms: f64,
@@ -349,8 +356,12 @@ pub fn run(
             };
             // Whatever a previous edit left behind is handled before the clock starts.
             while session.poll().is_some() {}
-            // A viewer's frames in flight when the edit lands.
+            // A viewer's frames, done or in flight when the edit lands.
             if let Some(p) = session.prepared() {
+                for _ in 0..config.viewer_frames {
+                    p.execute(&session.renderer)
+                        .map_err(|e| failed(e.to_string()))?;
+                }
                 for _ in 0..config.frames_in_flight {
                     p.submit(&session.renderer)
                         .map_err(|e| failed(e.to_string()))?;
@@ -465,7 +476,7 @@ pub struct KindSummary {
 type Part = (&'static str, fn(&ReloadSample) -> f64);
 
 const PARTS: [Part; 8] = [
-    ("watch (debounce + events)", |s| s.watch_ms),
+    ("watch (events + settle)", |s| s.watch_ms),
     ("material/scene load", |s| s.assets_ms),
     ("graph compile", |s| s.graph_ms),
     ("shader compose + naga", |s| s.shader_compose_ms),
@@ -647,9 +658,10 @@ pub fn to_markdown(
     let _ = writeln!(
         out,
         "Adapter: {adapter}. Scene: harada geometry, boxes in `car_paint.ron`, {} random \
-         lights; `forward_plus.ron`; {}×{}; {} edits of each kind, interleaved. Watcher \
-         debounce {} ms. Edit salt {}; {} frames in flight at each edit; {}; pipelines of \
-         different passes built {}. Times from the file write returning to the new frame \
+         lights; `forward_plus.ron`; {}×{}; {} edits of each kind, interleaved. Watcher: \
+         batches cut {} ms after a saved file's last event (debounce {} ms otherwise). Edit \
+         salt {}; {} frames rendered and {} more in flight right before each edit; {}; \
+         pipelines of different passes built {}. Times from the file write returning to the new frame \
          read back.\n\n\
          **Edit → new frame** runs from the file write returning to the new frame's GPU work \
          being done: what the viewer (`lightgraph view`) shows, since it presents the output \
@@ -660,8 +672,10 @@ pub fn to_markdown(
         config.width,
         config.height,
         config.repeats,
+        watch.settle.min(watch.debounce).as_millis(),
         watch.debounce.as_millis(),
         config.salt,
+        config.viewer_frames,
         config.frames_in_flight,
         if config.wait_for_idle_before_build {
             "waiting for an idle GPU before building"

@@ -155,6 +155,7 @@ pub fn reload_bench(args: &ReloadBenchArgs) -> Result<()> {
         repeats: args.repeats,
         salt: args.salt,
         frames_in_flight: args.frames_in_flight,
+        viewer_frames: args.viewer_frames,
         wait_for_idle_before_build: args.wait_for_idle_before_build,
         sequential_builds: args.sequential_builds,
     };

@@ -170,6 +170,11 @@ pub struct ReloadBenchArgs {
     /// Frames submitted without waiting right before each edit, as a viewer has in flight.
     #[arg(long, default_value_t = 0)]
     pub frames_in_flight: usize,
+    /// Frames rendered, each waited for, right before each edit, as a viewer renders
+    /// continuously: keeps the GPU as busy as a viewer does (an idle GPU lowers its
+    /// clocks, and the new frame then takes longer).
+    #[arg(long, default_value_t = 0)]
+    pub viewer_frames: usize,
     /// Wait for the GPU to go idle before building pipelines (timed in its own column).
     #[arg(long)]
     pub wait_for_idle_before_build: bool,

@@ -1,7 +1,8 @@
 //! The watcher's debounce thread: events in, [`ChangeBatch`]es out.
 
+use super::settle::Progress;
 use super::{is_editor_temp_file, ChangeBatch, ChangeKind, WatchConfig};
-use notify::event::{AccessKind, AccessMode, EventKind};
+use notify::event::{AccessKind, AccessMode, EventKind, ModifyKind, RenameMode};
 use std::collections::{BTreeSet, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -54,8 +55,8 @@ pub(super) struct Debouncer {
     pub(super) shutdown: Arc<AtomicBool>,
     pub(super) events: Receiver<notify::Result<notify::Event>>,
     pub(super) batches: Sender<ChangeBatch>,
-    /// Paths with events since the last batch.
-    pub(super) pending: HashSet<PathBuf>,
+    /// Watched paths with events since the last batch, and whether they are saved.
+    pub(super) pending: HashMap<PathBuf, Progress>,
     /// (first, last) event time of the current burst.
     pub(super) burst: Option<(Instant, Instant)>,
     /// Empty or vanished files held back, with their deadline.
@@ -66,9 +67,17 @@ pub(super) struct Debouncer {
 const SHUTDOWN_POLL: Duration = Duration::from_millis(100);
 
 impl Debouncer {
+    /// When the current burst's batch is cut: [`WatchConfig::settle`] after the last
+    /// event if every path in it is saved, else [`WatchConfig::debounce`] after it; at
+    /// the latest `max_latency` after the first.
     fn burst_deadline(&self) -> Option<Instant> {
-        self.burst
-            .map(|(first, last)| (last + self.config.debounce).min(first + self.config.max_latency))
+        let (first, last) = self.burst?;
+        let quiet = if self.pending.values().all(Progress::is_complete) {
+            self.config.settle.min(self.config.debounce)
+        } else {
+            self.config.debounce
+        };
+        Some((last + quiet).min(first + self.config.max_latency))
     }
 
     pub(super) fn run(mut self) {
@@ -96,29 +105,52 @@ impl Debouncer {
 
     fn on_event(&mut self, event: notify::Event) {
         let now = Instant::now();
+        let shared = self.shared.lock().unwrap();
+        let mut touched = false;
         if event.need_rescan() {
-            let shared = self.shared.lock().unwrap();
+            // Events were lost: every file may have changed, and how far its writer got
+            // is unknown, so the batch waits for the debounce.
             let mut found = HashSet::new();
             for d in &shared.dirs {
                 scan_dir(d, &mut found);
             }
-            self.pending.extend(found);
-            self.pending.extend(shared.known.iter().cloned());
-            self.pending.extend(shared.files.iter().cloned());
+            let all = found
+                .into_iter()
+                .chain(shared.known.iter().cloned())
+                .chain(shared.files.iter().cloned());
+            for path in all {
+                self.pending.insert(path, Progress::UNKNOWN);
+                touched = true;
+            }
         }
-        match event.kind {
-            EventKind::Access(AccessKind::Close(AccessMode::Write)) => {}
-            EventKind::Access(_) | EventKind::Other => return,
-            _ => {}
+        let ignored = match event.kind {
+            EventKind::Access(AccessKind::Close(AccessMode::Write)) => false,
+            // Opening, reading and closing without writing change nothing.
+            EventKind::Access(_) | EventKind::Other => true,
+            // inotify's rename pair, after the From and To events that say the same: when
+            // it arrives after the batch was cut (the notify thread losing its core between
+            // the two), it would name the renamed file again in a batch of its own.
+            EventKind::Modify(ModifyKind::Name(RenameMode::Both)) => true,
+            _ => false,
+        };
+        if !ignored {
+            // Editors' temp files and unwatched siblings of watched files neither reach a
+            // batch nor hold one back (a swap file kept open must not).
+            for path in event.paths {
+                if shared.is_relevant(&path) {
+                    let known = shared.known.contains(&path);
+                    self.pending.entry(path).or_default().on(&event.kind, known);
+                    touched = true;
+                }
+            }
         }
-        if event.paths.is_empty() {
-            return;
+        drop(shared);
+        if touched {
+            self.burst = Some(match self.burst {
+                Some((first, _)) => (first, now),
+                None => (now, now),
+            });
         }
-        self.pending.extend(event.paths);
-        self.burst = Some(match self.burst {
-            Some((first, _)) => (first, now),
-            None => (now, now),
-        });
     }
 
     /// Cut a batch if the burst is over, and release held files whose grace ran out.
@@ -126,13 +158,13 @@ impl Debouncer {
         let burst_over = self.burst_deadline().is_some_and(|d| now >= d);
         let mut candidates: Vec<PathBuf> = Vec::new();
         if burst_over {
-            candidates.extend(self.pending.drain());
+            candidates.extend(self.pending.drain().map(|(path, _)| path));
             self.burst = None;
         }
         let expired: Vec<PathBuf> = self
             .held
             .iter()
-            .filter(|(p, d)| now >= **d && !self.pending.contains(*p))
+            .filter(|(p, d)| now >= **d && !self.pending.contains_key(*p))
             .map(|(p, _)| p.clone())
             .collect();
         candidates.extend(expired);
@@ -177,5 +209,94 @@ impl Debouncer {
         if !batch.is_empty() {
             let _ = self.batches.send(batch);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use notify::event::DataChange;
+    use std::sync::mpsc::{self, Receiver};
+
+    /// A debounce thread's state over a temp dir holding `lit.wgsl`, driven by hand.
+    fn debouncer() -> (tempfile::TempDir, PathBuf, Debouncer, Receiver<ChangeBatch>) {
+        let dir = tempfile::tempdir().unwrap();
+        let root = dir.path().canonicalize().unwrap();
+        std::fs::write(root.join("lit.wgsl"), "// v1\n").unwrap();
+        let mut shared = Shared::default();
+        shared.dirs.insert(root.clone());
+        scan_dir(&root, &mut shared.known);
+        let (batch_tx, batches) = mpsc::channel();
+        let d = Debouncer {
+            config: WatchConfig::default(),
+            shared: Arc::new(Mutex::new(shared)),
+            shutdown: Arc::new(AtomicBool::new(false)),
+            events: mpsc::channel().1,
+            batches: batch_tx,
+            pending: HashMap::new(),
+            burst: None,
+            held: HashMap::new(),
+        };
+        (dir, root, d, batches)
+    }
+
+    fn event(kind: EventKind, paths: &[&Path]) -> notify::Event {
+        paths
+            .iter()
+            .fold(notify::Event::new(kind), |e, p| e.add_path(p.to_path_buf()))
+    }
+
+    /// Evaluates as the thread would once `after` has passed since now.
+    fn evaluate_after(d: &mut Debouncer, after: Duration) {
+        d.evaluate(Instant::now() + after);
+    }
+
+    #[test]
+    fn a_saved_file_is_cut_after_the_settle_time_a_written_one_after_the_debounce() {
+        let (_dir, root, mut d, batches) = debouncer();
+        let lit = root.join("lit.wgsl");
+        let WatchConfig {
+            settle, debounce, ..
+        } = d.config;
+        let write = EventKind::Modify(ModifyKind::Data(DataChange::Any));
+        d.on_event(event(write, &[&lit]));
+        evaluate_after(&mut d, settle * 2);
+        assert!(batches.try_recv().is_err(), "cut while open for writing");
+        evaluate_after(&mut d, debounce * 2);
+        assert!(batches.try_recv().unwrap().contains(&lit), "the debounce");
+        d.on_event(event(write, &[&lit]));
+        d.on_event(event(
+            EventKind::Access(AccessKind::Close(AccessMode::Write)),
+            &[&lit],
+        ));
+        evaluate_after(&mut d, settle / 2);
+        assert!(batches.try_recv().is_err(), "cut within the settle time");
+        evaluate_after(&mut d, settle * 2);
+        assert!(
+            batches.try_recv().unwrap().contains(&lit),
+            "the settle time"
+        );
+    }
+
+    #[test]
+    fn a_late_rename_pair_does_not_name_the_file_again() {
+        let (_dir, root, mut d, batches) = debouncer();
+        let lit = root.join("lit.wgsl");
+        let tmp = root.join("xq7z");
+        let WatchConfig {
+            settle, debounce, ..
+        } = d.config;
+        let name = |mode| EventKind::Modify(ModifyKind::Name(mode));
+        d.on_event(event(name(RenameMode::From), &[&tmp]));
+        d.on_event(event(name(RenameMode::To), &[&lit]));
+        evaluate_after(&mut d, settle * 2);
+        let b = batches.try_recv().unwrap();
+        assert_eq!(b.paths().collect::<Vec<_>>(), vec![lit.as_path()]);
+        d.on_event(event(name(RenameMode::Both), &[&tmp, &lit]));
+        evaluate_after(&mut d, debounce * 2);
+        assert!(
+            batches.try_recv().is_err(),
+            "the rename pair named it again"
+        );
     }
 }
