@@ -21,7 +21,7 @@
 //! bit the same lists; and a bound reached with slots in use cuts only pooled lists.
 //! `mutations_are_caught` runs these checks on deliberately broken copies of the culling
 //! shader (scan off by one, the block scan's carry dropped from its total or its offsets,
-//! bound ignored, fill out of order, count short, and six ways of breaking the slots)
+//! bound ignored, fill out of order, count short, and nine ways of breaking the slots)
 //! and requires each check to fail, so none of them passes vacuously.
 
 mod common;
@@ -844,6 +844,24 @@ fn mutations_are_caught() {
             "pool over the slots",
             "let pool_start = scratch * lists;",
             "let pool_start = 0u;",
+        ),
+        // The fill leaves the slot's lights out of the pooled list.
+        (
+            "slot not copied",
+            "for (var k = local; k < min(compact.scratch, kept); k += THREADS) {",
+            "for (var k = local; k < 0u; k += THREADS) {",
+        ),
+        // The fill tests the slot's last light again: listed twice.
+        (
+            "slot's last light again",
+            "fill_below = atomicLoad(&light_lists[slot_word + compact.scratch - 1u]) + 1u;",
+            "fill_below = atomicLoad(&light_lists[slot_word + compact.scratch - 1u]);",
+        ),
+        // The fill starts coarse candidates at a light index, not a position.
+        (
+            "fill starts too late",
+            "first = select(below, compact.scratch, from_coarse);",
+            "first = select(compact.scratch, below, from_coarse);",
         ),
     ];
     for (what, from, to) in slot_mutations {

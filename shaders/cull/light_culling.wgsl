@@ -79,8 +79,9 @@ var<workgroup> depth_mask: atomic<u32>;
 var<workgroup> hits: array<array<atomic<u32>, MASK_WORDS>, 2>;
 var<workgroup> coarse_count: u32;
 #if COMPACT
-// The fill's list entry: (offset, kept count).
+// The fill's list entry: (offset, kept count), and the light after its slot's last.
 var<workgroup> fill_entry: vec2<u32>;
+var<workgroup> fill_below: u32;
 const PHASE_FILL: u32 = 1u;
 #else
 var<workgroup> list: array<u32, CAPACITY>;
@@ -276,8 +277,28 @@ fn main(
         }
     }
     var total = 0u;
+    // Candidates from `first` on; lights below `below` are not tested.
+    var first = 0u;
+    var below = 0u;
+#if COMPACT
+    if (filling && compact.scratch > 0u) {
+        // A pooled list's first `scratch` lights are in its slot since the count: copied,
+        // and only the candidates after the last of them are tested again. Candidates
+        // ascend, so the first `scratch` of them (of all lights: `below`) come no later.
+        let slot_word = list_params.pool_offset + list_index * compact.scratch;
+        for (var k = local; k < min(compact.scratch, kept); k += THREADS) {
+            atomicStore(&light_lists[offset + k], atomicLoad(&light_lists[slot_word + k]));
+        }
+        if (local == 0u) {
+            fill_below = atomicLoad(&light_lists[slot_word + compact.scratch - 1u]) + 1u;
+        }
+        below = workgroupUniformLoad(&fill_below);
+        total = compact.scratch;
+        first = select(below, compact.scratch, from_coarse);
+    }
+#endif
     var h = 0u;
-    for (var base = 0u; base < count; base += THREADS) {
+    for (var base = first; base < count; base += THREADS) {
         let k = base + local;
         var i = k;
         var hit = false;
@@ -285,7 +306,7 @@ fn main(
             if (from_coarse) {
                 i = coarse_lists[coarse_base + 1u + k];
             }
-            hit = light_touches_tile(light_geometry[i], bounds, lo, hi, tile_mask, tile_min, tile_max, 0.0);
+            hit = i >= below && light_touches_tile(light_geometry[i], bounds, lo, hi, tile_mask, tile_min, tile_max, 0.0);
         }
         if (hit) {
             atomicOr(&hits[h][local / 32u], 1u << (local % 32u));
