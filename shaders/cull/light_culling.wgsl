@@ -217,9 +217,15 @@ fn main(
     }
     let offset = list_params.pool_offset + start;
 #endif
-    // Ordered before their first use by the depth range's barriers.
+    // Ordered before their first use by the depth range's barriers. The coarse tile's
+    // count is read now, so the read overlaps the depth's instead of following it.
+    let coarse_x = (list_params.tiles_x + COARSE - 1u) / COARSE;
+    let coarse_base = ((group.y / COARSE) * coarse_x + group.x / COARSE) * COARSE_STRIDE;
     if (local == 0u) {
         atomicStore(&depth_mask, 0u);
+        if (COARSE > 1u) {
+            coarse_count = coarse_lists[coarse_base];
+        }
     }
     if (local < MASK_WORDS) {
         atomicStore(&hits[0][local], 0u);
@@ -262,14 +268,8 @@ fn main(
     // 4. Candidates: the coarse tile's lights, or every light. In batches of THREADS;
     //    ranks within a batch from a bit mask keep the list in ascending light order.
     var count = frame.light_count;
-    var coarse_base = 0u;
     var from_coarse = false;
     if (COARSE > 1u) {
-        let coarse_x = (list_params.tiles_x + COARSE - 1u) / COARSE;
-        coarse_base = ((group.y / COARSE) * coarse_x + group.x / COARSE) * COARSE_STRIDE;
-        if (local == 0u) {
-            coarse_count = coarse_lists[coarse_base];
-        }
         let n = workgroupUniformLoad(&coarse_count);
         if (n <= COARSE_CAPACITY) {
             count = n;
