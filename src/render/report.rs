@@ -51,17 +51,16 @@ impl CullingReport {
         let avg = per_tile.iter().map(|&x| x as f64).sum::<f64>() / per_tile.len().max(1) as f64;
         let storage = match self.layout.storage {
             ListStorage::Fixed { capacity } => format!("fixed, capacity {capacity}"),
-            ListStorage::Compact { max_indices, .. } => match self.layout.scratch_per_list() {
-                0 => format!("compact, {} of max_indices {max_indices}", self.listed()),
-                s => format!(
-                    "compact, {} of max_indices {max_indices}, {} of them in scratch slots of {s}",
-                    self.listed(),
-                    self.scratch_held
-                ),
-            },
+            ListStorage::Compact { max_indices, .. } => {
+                format!("compact, {} of max_indices {max_indices}", self.listed())
+            }
+        };
+        let slots = match self.layout.scratch_per_list() {
+            0 => String::new(),
+            s => format!("; {} in scratch slots of {s}", self.scratch_held),
         };
         format!(
-            "{}: {} tiles x {} lists, lights per tile avg {avg:.1} max {}, longest list wanted {} ({storage}; {:.2} MiB)",
+            "{}: {} tiles x {} lists, lights per tile avg {avg:.1} max {}, longest list wanted {} ({storage}; {:.2} MiB{slots})",
             self.pass,
             self.layout.tiles_x * self.layout.tiles_y,
             self.layout.lists_per_tile,
