@@ -1,6 +1,6 @@
 // Tiled light culling (Forward+, seed 000): one workgroup per tile and list. The
-// workgroup finds the tile's depth range with atomics on the float bits (depths are
-// non-negative, so their bits order like integers), tests every light against the
+// workgroup finds the tile's depth range as the min and max of the float bits (depths
+// are non-negative, so their bits order like integers), tests every light against the
 // tile's frustum, builds the list in workgroup memory in ascending light order, then
 // reserves room in the shared pool with one global atomic.
 // With COARSE > 1 a first dispatch (`coarse`) culls every light against coarse tiles of
