@@ -4,6 +4,7 @@
 # depth prepass, then lightgraph's sweep again (the drift between the two tells how far
 # the machine moved). Usage from the project root after
 #   ../shared/gpu/prepare.sh target/release/lightgraph; xz -9 -c peer_bevy > .gpu/peer_bevy.xz
+#   xz -c .gpu/lightgraph > .gpu/lightgraph.xz && rm .gpu/lightgraph   (both fit 64 MiB only so)
 #   scripts/gpu_bench_peer.sh
 set -u
 source "$(dirname "$0")/gpu_env.sh"
@@ -11,8 +12,11 @@ bevy=/tmp/peer_bevy
 xz -dc .gpu/peer_bevy.xz > $bevy && chmod +x $bevy
 timeout 150 $lg bench --sweep benches/sweeps/peer_bevy.ron --out "$out/lightgraph_1" > "$out/lightgraph_1.log" 2>&1
 for n in 1024 3072 16384; do
-    timeout 60 $bevy --light-set sweep --lights $n --width 1920 --height 1080 > "$out/bevy_$n.txt" 2>&1
-    timeout 60 $bevy --light-set sweep --lights $n --width 1920 --height 1080 --depth-prepass > "$out/bevy_${n}_prepass.txt" 2>&1
+    # 16,384 lights: 150+ ms a Bevy frame, so fewer frames than the default 60 + 300.
+    frames=""
+    [ $n -ge 16384 ] && frames="--warmup 10 --frames 40"
+    timeout 120 $bevy --light-set sweep --lights $n --width 1920 --height 1080 $frames > "$out/bevy_$n.txt" 2>&1
+    timeout 120 $bevy --light-set sweep --lights $n --width 1920 --height 1080 --depth-prepass $frames > "$out/bevy_${n}_prepass.txt" 2>&1
 done
 timeout 150 $lg bench --sweep benches/sweeps/peer_bevy.ron --out "$out/lightgraph_2" > "$out/lightgraph_2.log" 2>&1
 nvidia-smi --query-gpu=clocks.sm --format=csv >> "$out/gpu.txt" 2>&1

@@ -7,7 +7,7 @@ mod common;
 use common::*;
 use glam::{Vec2, Vec3};
 use lightgraph::graph::{self, FrameSize};
-use lightgraph::render::SceneGpu;
+use lightgraph::render::{RasterReport, SceneGpu};
 use lightgraph::scene::{AlphaMode, Camera, Light, Mesh, Scene};
 use lightgraph::shader::ShaderLibrary;
 use std::path::Path;
@@ -55,16 +55,60 @@ struct Diff {
 }
 
 fn rasterize(scene: &Scene, width: u32, height: u32) -> Vec<Pixel> {
+    rasterize_limited(scene, width, height, "").0
+}
+
+/// The compute rasterizer's test hook (`compute_raster.rs`): list capacities and
+/// workgroups per dispatch dimension, read when the pass is prepared.
+const TEST_LIMITS: &str = "LIGHTGRAPH_COMPUTE_RASTER_TEST_LIMITS";
+
+/// Sets the test hook while alive.
+struct Limits;
+impl Limits {
+    fn set(limits: &str) -> Self {
+        std::env::set_var(TEST_LIMITS, limits);
+        Limits
+    }
+}
+impl Drop for Limits {
+    fn drop(&mut self) {
+        std::env::remove_var(TEST_LIMITS);
+    }
+}
+
+/// As `rasterize`, under the test hook's `limits` ("" for none), with the pass's report.
+fn rasterize_limited(
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    limits: &str,
+) -> (Vec<Pixel>, RasterReport) {
+    // The renderer's lock keeps the other tests of this binary from preparing while the
+    // variable is set (dropped after `_limits`).
     let mut r = renderer();
+    let _limits = Limits::set(limits);
     let out = render_text(&mut r, COMPARE, scene, width, height);
-    out.image
+    assert_eq!(out.image.len(), (width * height) as usize);
+    assert_eq!(out.rasters.len(), 1, "one ComputeRaster report");
+    let px = out
+        .image
         .iter()
         .map(|p| Pixel {
             cr: p[0],
             hw: p[1],
             id: p[2] as u32 | (p[3] as u32) << 16,
         })
-        .collect()
+        .collect();
+    (px, out.rasters[0].clone())
+}
+
+/// Pixels whose compute depth bits or id differ between two runs.
+fn bit_differences(a: &[Pixel], b: &[Pixel]) -> usize {
+    assert_eq!(a.len(), b.len());
+    a.iter()
+        .zip(b)
+        .filter(|(p, q)| p.cr.to_bits() != q.cr.to_bits() || p.id != q.id)
+        .count()
 }
 
 fn triangles(scene: &Scene) -> u32 {
@@ -121,11 +165,11 @@ fn lavapipe_has_the_64_bit_atomics() {
     );
     if !have.contains(needed) {
         eprintln!(
-            "!!!!! THIS ADAPTER LACKS 64-BIT ATOMICS: the compute rasterizer cannot run; only its refusal is tested !!!!!"
+            "!!!!! THIS ADAPTER LACKS 64-BIT ATOMICS: the compute rasterizer cannot run; only its hardware fallback is tested (tests/compute_raster_fallback.rs) !!!!!"
         );
         drop(r);
-        let e = prepare_error(&random_scene(4, 1), COMPARE);
-        assert!(e.contains("pass 'cr'") && e.contains("SHADER_INT64"), "{e}");
+        let frame = render_text(&mut renderer(), COMPARE, &random_scene(4, 1), 64, 36);
+        assert_eq!(frame.fallbacks.len(), 1, "the fallback says so");
     }
 }
 
@@ -176,9 +220,10 @@ fn shipped_scenes_match_the_depth_prepass() {
         "scenes/cornell_box/scene.gltf",
     ] {
         let scene = load(rel);
-        let px = rasterize(&scene, 333, 197);
+        let (px, report) = rasterize_limited(&scene, 333, 197, "");
         let d = diff(&scene, &px);
-        eprintln!("{rel}: {d:?}");
+        eprintln!("{rel}: {d:?}, {report:?}");
+        assert_eq!(report.serial(), 0, "{rel}: the lists hold the scene");
         assert!(d.covered > d.pixels / 4, "{rel}: {d:?}");
         assert_matches(rel, &d);
     }
@@ -544,4 +589,294 @@ fn masked_materials_are_refused() {
     let e = prepare_error(&s, COMPARE);
     assert!(e.contains("<test>:") && e.contains("pass 'cr'"), "{e}");
     assert!(e.contains("material 'orange' is alpha-masked"), "{e}");
+}
+
+/// A triangle covering the whole viewport behind a field of small triangles (some under
+/// a pixel, some single-sided and facing away, many across tile and block borders): the
+/// tiled path (setup, bin, raster) against the hardware prepass, and bit for bit against
+/// every triangle rasterized serially by its setup thread (records=0, the list-full
+/// path, which walks each triangle's box as the one-thread-per-triangle rasterizer did).
+#[test]
+fn screen_filling_triangle_among_many_small_ones_is_exact() {
+    if !has_atomics() {
+        return;
+    }
+    let mut rng = Rng(7);
+    let mut small = |name: &str, material: usize| {
+        let mut m = Mesh {
+            name: name.into(),
+            material,
+            ..Default::default()
+        };
+        for i in 0..300u32 {
+            let z = rng.range(-9.0, -2.0);
+            let centre = rng.vec3(
+                Vec3::new(-0.9 * -z, -0.9 * -z, z),
+                Vec3::new(0.9 * -z, 0.9 * -z, z),
+            );
+            // Sizes from a fraction of a pixel to a sixth of the frame.
+            let size = -z * 0.3 * rng.f32().powi(3);
+            for _ in 0..3 {
+                let offset = rng.vec3(Vec3::splat(-size), Vec3::splat(size));
+                m.positions.push(centre + offset);
+                m.normals.push(Vec3::Z);
+                m.uvs.push(Vec2::ZERO);
+                m.tangents.push(Vec3::X.extend(1.0));
+            }
+            m.indices.extend([3 * i, 3 * i + 1, 3 * i + 2]);
+        }
+        m
+    };
+    let (two_sided, one_sided) = (small("double-sided", 1), small("single-sided", 2));
+    let s = scene(
+        vec![
+            triangle(
+                "huge",
+                [
+                    Vec3::new(-100.0, -100.0, -10.0),
+                    Vec3::new(100.0, -100.0, -10.0),
+                    Vec3::new(0.0, 200.0, -10.0),
+                ],
+                0,
+            ),
+            two_sided,
+            one_sided,
+        ],
+        vec![
+            lambert("grey", Vec3::splat(0.5)),
+            double_sided("red", Vec3::X),
+            lambert("green", Vec3::Y),
+        ],
+        camera(0.1),
+    );
+    for (w, h) in [(333, 197), (480, 270)] {
+        let (px, report) = rasterize_limited(&s, w, h, "");
+        let d = diff(&s, &px);
+        eprintln!("{w}x{h}: {d:?}, {report:?}");
+        assert_eq!(d.covered, d.pixels, "{d:?}");
+        assert_matches("screen filling among small", &d);
+        assert_eq!(report.serial(), 0, "{report:?}");
+        // The huge triangle alone lists every tile and block of the frame.
+        assert!(
+            report.tiles >= w.div_ceil(64) * h.div_ceil(64),
+            "{report:?}"
+        );
+        assert!(report.blocks >= w.div_ceil(8) * h.div_ceil(8), "{report:?}");
+        let shown = |lo: u32, hi: u32| px.iter().filter(|p| (lo..hi).contains(&p.id)).count();
+        assert!(
+            shown(1, 301) > 1000 && shown(301, 601) > 1000,
+            "both fields show"
+        );
+        let (serial, serial_report) = rasterize_limited(&s, w, h, "records=0");
+        assert!(serial_report.serial_triangles > 300, "{serial_report:?}");
+        assert_eq!(bit_differences(&px, &serial), 0);
+        // The huge triangle's fan triangles reserve their many tiles with a
+        // compare-exchange that stops at the capacity; here it runs out mid-box.
+        let (part, part_report) = rasterize_limited(&s, w, h, "tiles=30");
+        assert!(part_report.serial_tiles > 0, "{part_report:?}");
+        assert_eq!(bit_differences(&px, &part), 0);
+    }
+}
+
+/// Every list full in turn, and dispatches folded into y: the image is bit for bit the
+/// one with room everywhere, and the serial work is counted where it happened.
+#[test]
+fn full_lists_fall_back_exactly_and_are_counted() {
+    if !has_atomics() {
+        return;
+    }
+    let s = load("scenes/harada.ron");
+    let (w, h) = (333, 197);
+    let (reference, room) = rasterize_limited(&s, w, h, "");
+    eprintln!("room everywhere: {room:?}");
+    assert_eq!(room.serial(), 0);
+    assert!(
+        room.records > 100 && room.tiles > 100 && room.blocks > 1000,
+        "{room:?}"
+    );
+    // Bin and raster fold thousands of workgroups into rows of 3 under "groups=3";
+    // clear and setup too.
+    for limits in [
+        "records=0",
+        "records=100",
+        "tiles=40",
+        "blocks=300",
+        "groups=3",
+    ] {
+        let (px, r) = rasterize_limited(&s, w, h, limits);
+        eprintln!("{limits}: {r:?}");
+        let counted = match limits {
+            // Every fan triangle that had a record with room is drawn by its setup thread.
+            "records=0" => r.serial_triangles == room.records && r.records == 0,
+            "records=100" => r.serial_triangles == room.records - 100 && r.records == 100,
+            "tiles=40" => r.serial_triangles == 0 && r.serial_tiles > 0 && r.tiles == 40,
+            "blocks=300" => {
+                r.serial_triangles + r.serial_tiles == 0 && r.serial_blocks > 0 && r.blocks == 300
+            }
+            _ => r.serial() == 0 && r.blocks == room.blocks,
+        };
+        assert!(counted, "{limits}: {r:?}");
+        assert_eq!(bit_differences(&px, &reference), 0, "{limits}");
+    }
+}
+
+/// One frame of `graph` (text) for `scene` at `width`×`height`: the result, and the bits
+/// of each texture in `read` (depths and ids, compared exactly).
+fn render_reading(
+    graph: &str,
+    scene: &Scene,
+    (width, height): (u32, u32),
+    read: &[&str],
+) -> (lightgraph::render::FrameResult, Vec<Vec<u32>>) {
+    let mut r = renderer();
+    let checked = graph::check_text(Path::new("<test>"), graph, &ShaderLibrary::builtin())
+        .expect("valid graph");
+    let size = FrameSize {
+        width,
+        height,
+        lights: scene.lights.len() as u32,
+    };
+    let compiled = graph::compile(checked, &scene.features(), size);
+    let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, scene).expect("materials");
+    let prepared = r
+        .prepare(compiled, scene, &gpu, size, false)
+        .expect("prepare");
+    let result = prepared.render(&r).expect("render");
+    let bits = read
+        .iter()
+        .map(|name| prepared.read_texture_bits(&r, name).expect("readback"))
+        .collect();
+    (result, bits)
+}
+
+/// The shipped compute-only graph (R32Float depth, compute resolve) and the same graph
+/// with a Depth32Float depth (the full-screen draw resolve).
+fn shipped_graph_both_resolves() -> (String, String) {
+    let compute = std::fs::read_to_string(graph_path("visibility_compute_raster.ron")).unwrap();
+    let float = r#"Texture(name: "depth", format: R32Float, size: Output)"#;
+    assert!(
+        compute.contains(float),
+        "the shipped graph's depth is R32Float"
+    );
+    let draw = compute.replace(
+        float,
+        r#"Texture(name: "depth", format: Depth32Float, size: Output)"#,
+    );
+    (compute, draw)
+}
+
+/// The compute resolve writes exactly what the draw resolve writes: every depth's bits
+/// and every id, covered pixels and empty ones (1.0 and NO_TRIANGLE) alike; so culling and
+/// shading on either agree exactly too.
+#[test]
+fn compute_resolve_equals_the_draw_resolve_bit_for_bit() {
+    if !has_atomics() {
+        return;
+    }
+    let (compute, draw) = shipped_graph_both_resolves();
+    // harada from its camera, and looking up past its walls: pixels nothing covers.
+    let mut sky = load("scenes/harada.ron");
+    sky.camera.target += Vec3::new(0.0, 6.0, 0.0);
+    for (what, scene) in [("harada", load("scenes/harada.ron")), ("harada, sky", sky)] {
+        let (a, a_bits) = render_reading(&compute, &scene, (333, 197), &["depth", "visibility"]);
+        let (b, b_bits) = render_reading(&draw, &scene, (333, 197), &["depth", "visibility"]);
+        let (depth, ids) = (&a_bits[0], &a_bits[1]);
+        assert_eq!(depth.len(), 333 * 197);
+        assert_eq!(ids.len(), 333 * 197);
+        let empty: Vec<u32> = ids
+            .iter()
+            .zip(depth)
+            .filter(|(&id, _)| id == NO_TRIANGLE)
+            .map(|(_, &d)| d)
+            .collect();
+        eprintln!("{what}: {} of {} pixels empty", empty.len(), ids.len());
+        assert!(ids.len() - empty.len() > 1000, "{what}: few pixels covered");
+        if what.ends_with("sky") {
+            assert!(
+                empty.len() > 1000,
+                "{what}: no sky: the empty case is untested"
+            );
+        }
+        assert!(
+            empty.iter().all(|&d| d == 1f32.to_bits()),
+            "{what}: an empty pixel's depth is not 1.0"
+        );
+        let differ = |x: &[u32], y: &[u32]| x.iter().zip(y).filter(|(p, q)| p != q).count();
+        assert_eq!(differ(depth, &b_bits[0]), 0, "{what}: depth bits differ");
+        assert_eq!(differ(ids, &b_bits[1]), 0, "{what}: ids differ");
+        assert_eq!(
+            a.culling[0].counts, b.culling[0].counts,
+            "{what}: tile lists"
+        );
+        assert_eq!(a.image.len(), b.image.len());
+        assert!(a.image == b.image, "{what}: images differ");
+    }
+}
+
+/// Every culling variant and list layout the shaded graphs use builds the same lists on
+/// the R32Float depth (`FLOAT_DEPTH`) as on the Depth32Float one: the depths are the same
+/// bits, so any difference is the variant reading the float texture wrongly.
+#[test]
+fn culling_variants_read_the_r32float_depth_alike() {
+    if !has_atomics() {
+        return;
+    }
+    let (compute, draw) = shipped_graph_both_resolves();
+    let scene = pillar_scene(64);
+    for kind in [
+        "LightCulling(tile: 16, variant: Frustum, lists: Compact(max_indices: 16777216))",
+        "LightCulling(tile: 16, variant: HalfZ, lists: Compact(max_indices: 16777216), coarse: 0)",
+        "LightCulling(tile: 8, variant: DepthMask, capacity: 256, coarse: 4)",
+        "LightCulling(tile: 16, variant: Clustered(slices: 16), capacity: 128, coarse: 0)",
+        "LightCulling(tile: 16, variant: Frustum, capacity: 256, coarse: 4)",
+    ] {
+        let (a, _) = render_reading(&with_culling(&compute, kind), &scene, (200, 120), &[]);
+        let (b, _) = render_reading(&with_culling(&draw, kind), &scene, (200, 120), &[]);
+        let (la, lb) = (&a.culling[0], &b.culling[0]);
+        eprintln!("{kind}: {} lights listed", la.listed());
+        assert!(
+            la.listed() > 0,
+            "{kind}: no lights listed: nothing compared"
+        );
+        assert_eq!(la.counts, lb.counts, "{kind}: lists differ");
+        assert_eq!(la.overflowed_lists, lb.overflowed_lists, "{kind}");
+        assert!(a.image == b.image, "{kind}: images differ");
+    }
+}
+
+/// A light linked list built on the R32Float depth equals one built on the Depth32Float.
+#[test]
+fn light_linked_list_reads_the_r32float_depth_alike() {
+    if !has_atomics() {
+        return;
+    }
+    let (compute, draw) = shipped_graph_both_resolves();
+    let linked = |graph: &str| {
+        graph
+            .replace(
+                r#"Buffer(name: "light_lists", size: Auto),"#,
+                r#"Buffer(name: "light_lists", size: Auto), Buffer(name: "light_links", size: Auto),"#,
+            )
+            .replace(
+                r#"reads: ["visibility", "vertices", "triangles", "material_triangles", "light_geometry", "light_properties", "light_lists"],"#,
+                r#"reads: ["visibility", "vertices", "triangles", "material_triangles", "light_geometry", "light_properties", "light_links"],"#,
+            )
+            .replace(
+                r#"Pass(
+            name: "visibility_shading","#,
+                r#"Pass(name: "links", kind: LightLinkedList(scale: 2, links_per_pixel: 32), reads: ["depth", "light_geometry", "light_lists"], writes: ["light_links"]),
+        Pass(
+            name: "visibility_shading","#,
+            )
+    };
+    let (compute, draw) = (linked(&compute), linked(&draw));
+    assert!(compute.contains("LightLinkedList") && compute.contains(r#""light_links"],"#));
+    let scene = pillar_scene(64);
+    let (a, _) = render_reading(&compute, &scene, (200, 120), &[]);
+    let (b, _) = render_reading(&draw, &scene, (200, 120), &[]);
+    let (la, lb) = (&a.links[0], &b.links[0]);
+    eprintln!("linked list: {} links", la.links());
+    assert!(la.links() > 0, "no links: nothing compared");
+    assert_eq!(la, lb);
+    assert!(a.image == b.image, "images differ");
 }

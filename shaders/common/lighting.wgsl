@@ -25,24 +25,42 @@ struct Incident {
     dir: vec3<f32>,
 };
 
-fn incident_light(g: LightGeometry, p: LightProperties, pos: vec3<f32>) -> Incident {
+// How far a light reaches a point: the vector to the light, its squared length, and the
+// range window there (zero at and past the range).
+struct LightReach {
+    to_light: vec3<f32>,
+    dist_sq: f32,
+    window: f32,
+};
+
+fn light_reach(g: LightGeometry, pos: vec3<f32>) -> LightReach {
     let d = g.position - pos;
     let dist_sq = dot(d, d);
+    return LightReach(d, dist_sq, range_window(dist_sq, g.range));
+}
+
+// `incident_light` from a reach computed before: radiance is exactly zero where
+// `r.window <= 0.0`, so a loop that tests the window first (before reading p) and skips
+// those lights skips only lights that add nothing.
+fn incident_reached(g: LightGeometry, p: LightProperties, r: LightReach) -> Incident {
     var out: Incident;
-    out.dir = d * inverseSqrt(max(dist_sq, 1e-30));
-    let window = range_window(dist_sq, g.range);
-    if (window <= 0.0) {
+    out.dir = r.to_light * inverseSqrt(max(r.dist_sq, 1e-30));
+    if (r.window <= 0.0) {
         out.radiance = vec3<f32>(0.0);
         return out;
     }
     if ((p.flags & LIGHT_VPL) != 0u) {
         let lobe = max(dot(g.direction, -out.dir), 0.0);
-        out.radiance = p.color * (lobe * window / max(dist_sq, p.cos_inner * p.cos_inner));
+        out.radiance = p.color * (lobe * r.window / max(r.dist_sq, p.cos_inner * p.cos_inner));
         return out;
     }
-    let falloff = window / max(dist_sq, MIN_DISTANCE_SQ);
+    let falloff = r.window / max(r.dist_sq, MIN_DISTANCE_SQ);
     out.radiance = p.color * (falloff * spot_factor(g, p, out.dir));
     return out;
+}
+
+fn incident_light(g: LightGeometry, p: LightProperties, pos: vec3<f32>) -> Incident {
+    return incident_reached(g, p, light_reach(g, pos));
 }
 
 // A virtual point light (VplSpawn): a cosine-weighted hemisphere about `direction`

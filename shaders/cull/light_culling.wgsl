@@ -9,6 +9,8 @@
 // The coarse test is the same conservative test on a larger frustum and depth range,
 // so the tiles' lists are exactly those without it.
 // MSAA: the depth is multisampled and every one of its SAMPLES samples bounds the tile.
+// FLOAT_DEPTH: the depth is single-sample R32Float (a compute resolve's; the same values
+// a depth texture holds), read as texture_2d<f32>. Not with MSAA or TRANSPARENT.
 // TRANSPARENT: lists for transparent surfaces (seed 004). A sample where a transparent
 // surface lies in front of the opaque one contributes the range from the nearest
 // transparent depth to the opaque depth (the far plane over the background): every
@@ -24,7 +26,7 @@
 // (`list_params.pool_indices`, the graph's max_indices) only when the long lists
 // together want more than the pool: its count is cut to what fits, and the cut is counted.
 // Defines: TILE (8 or 16), CAPACITY, VARIANT (see types.wgsl), COARSE, COARSE_CAPACITY,
-// SAMPLES, MSAA, TRANSPARENT, COMPACT, SCAN_BLOCK.
+// SAMPLES, MSAA, FLOAT_DEPTH, TRANSPARENT, COMPACT, SCAN_BLOCK.
 
 #include "common/types.wgsl"
 #include "common/view_space.wgsl"
@@ -34,7 +36,11 @@
 #if MSAA
 @group(0) @binding(2) var depth: texture_depth_multisampled_2d;
 #else
+#if FLOAT_DEPTH
+@group(0) @binding(2) var depth: texture_2d<f32>;
+#else
 @group(0) @binding(2) var depth: texture_depth_2d;
+#endif
 #endif
 @group(0) @binding(3) var<storage, read_write> light_lists: array<atomic<u32>>;
 @group(0) @binding(4) var<uniform> list_params: ListParams;
@@ -100,7 +106,11 @@ fn sample_range(pixel: vec2<u32>, s: u32) -> vec2<f32> {
     if (any(pixel >= frame.size)) {
         return none;
     }
+#if FLOAT_DEPTH
+    let d = textureLoad(depth, pixel, s).x;
+#else
     let d = textureLoad(depth, pixel, s);
+#endif
 #if TRANSPARENT
     let t = textureLoad(transparent_depth, pixel, s);
     // No transparent surface here, or every one is behind the opaque surface.

@@ -11,14 +11,19 @@
 // workgroup sums them and reserves one run of the pool with one global atomic; links
 // past the pool are dropped and counted (header: wanted, dropped, pixels that lost
 // links, longest list wanted).
-// Defines: SCALE (1, 2, 4 or 8), LIGHT_LISTS.
+// Defines: SCALE (1, 2, 4 or 8), LIGHT_LISTS, FLOAT_DEPTH (the depth is R32Float: a
+// compute resolve's, read as texture_2d<f32>).
 
 #include "common/types.wgsl"
 #include "common/view_space.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
+#if FLOAT_DEPTH
+@group(0) @binding(2) var depth: texture_2d<f32>;
+#else
 @group(0) @binding(2) var depth: texture_depth_2d;
+#endif
 #if LIGHT_LISTS
 @group(0) @binding(3) var<storage, read> light_lists: array<u32>;
 @group(0) @binding(4) var<uniform> list_params: ListParams;
@@ -104,7 +109,11 @@ fn main(
             for (var x = 0u; x < SCALE; x++) {
                 let p = origin + vec2<u32>(x, y);
                 if (all(p < frame.size)) {
+#if FLOAT_DEPTH
+                    z_max = max(z_max, view_depth(textureLoad(depth, p, 0).x));
+#else
                     z_max = max(z_max, view_depth(textureLoad(depth, p, 0)));
+#endif
                 }
             }
         }

@@ -2,44 +2,77 @@
 // (depth bits << 32) | ~id, kept with a 64-bit atomic min. Depths are non-negative
 // floats, so their bits order like integers; on equal depth the larger id has the
 // smaller ~id and wins, as the render pipelines' LessEqual keeps the later draw.
-// Entries: `clear` (the buffer to all ones, the large-triangle dispatch to zero
-// workgroups), `raster` (one thread per triangle; a triangle whose clipped bounding box
-// is over BIG_PIXELS goes to a list instead), `raster_big` (one workgroup of BIG_GROUP
-// threads per listed triangle, sharing its pixels), `resolve_vs`/`resolve_fs` (a
-// full-screen draw writing the id and frag_depth).
 // Per triangle, as the hardware does: clip space with the vertex shader's own expression
 // (frame.view_proj * position), clipped against the near plane z >= 0 and the viewport's
-// sides (only where a vertex lies outside them), vertices
-// snapped to 1/256 pixel, back faces of single-sided materials culled (front is
-// counter-clockwise in NDC), pixel centres tested with exact 64-bit edge functions and
-// the top-left rule, depth from the triangle's plane in screen space, pixels past the
-// far plane (depth > 1) dropped.
-// Defines: GROUP, BIG_GROUP, BIG_PIXELS; ATOMIC (raster entries: the buffer as atomics),
-// BIG with it (`raster_big`, which does not bind the dispatch arguments it reads);
-// RESOLVE (the resolve draw).
+// sides (only where a vertex lies outside them), vertices snapped to 1/256 pixel, back
+// faces of single-sided materials culled (front is counter-clockwise in NDC), pixel
+// centres tested with exact 64-bit edge functions and the top-left rule, depth from the
+// triangle's plane in screen space, pixels past the far plane (depth > 1) dropped.
+//
+// Four dispatches, each spreading its work over threads so that no thread walks many
+// pixels (the GPU waits for its slowest thread):
+// - `clear` (CLEAR): the buffer to all ones; list counters and indirect arguments reset.
+// - `setup` (SETUP), one thread per triangle: clip, snap, cull, and per fan triangle of
+//   the clipped polygon one 64-byte record (snapped vertices, top-left biases, depth
+//   plane, pixel box, id) and one entry per TILE_PIXELS² tile of its box.
+// - `bin` (BIN), a thread per BLOCK² block of a tile entry (TILES_PER_GROUP a workgroup):
+//   blocks inside the box that no edge rejects (tested at the block's corner where the
+//   edge function is largest: exact, as the function is linear) become block entries.
+// - `raster` (RASTER), a thread per pixel of a block entry (BLOCKS_PER_GROUP a
+//   workgroup): the edge tests, the depth and the atomic min. No loops, no division.
+// Tiles and blocks are two levels so that setup writes at most a viewport's tiles
+// (510 at 1080p) for a screen-filling triangle instead of its 32,400 blocks. Both are
+// dispatched indirectly over x and y (flattened here), the arguments grown with atomicMax
+// as entries are appended. A list that is full loses nothing: setup rasterizes a fan
+// triangle without a record, or a tile without an entry, in its own thread; bin a block
+// without an entry. Each is counted (`counters`), read back for the pass's report. Every
+// path runs the same per-pixel code (`cover`), and an atomic min is order-independent,
+// so the image does not depend on which path drew a pixel.
+// RESOLVE: the full-screen draw writing the id and frag_depth.
 
 #include "common/types.wgsl"
 
-// Triangle count, large-triangle list capacity, width, height.
+// Triangle count, workgroups per dispatch dimension, width, height.
 @group(0) @binding(1) var<uniform> raster_params: vec4<u32>;
 #if RESOLVE
 @group(0) @binding(2) var<storage, read> vis: array<vec2<u32>>;
 #else
+// Capacities (entries) of the record, tile and block lists; unused.
+@group(0) @binding(12) var<uniform> list_capacity: vec4<u32>;
+#if CLEAR
+@group(0) @binding(7) var<storage, read_write> vis: array<vec2<u32>>;
+@group(0) @binding(8) var<storage, read_write> counters: array<u32, 8>;
+@group(0) @binding(9) var<storage, read_write> tile_args: array<u32, 4>;
+@group(0) @binding(10) var<storage, read_write> block_args: array<u32, 4>;
+#else
+@group(0) @binding(7) var<storage, read_write> vis: array<atomic<u64>>;
+// Four vec4<u32> per record (see `store_record`).
+#if SETUP
+@group(0) @binding(5) var<storage, read_write> records: array<vec4<u32>>;
+#else
+@group(0) @binding(5) var<storage, read> records: array<vec4<u32>>;
+#endif
+#if RASTER
+@group(0) @binding(8) var<storage, read> counters: array<u32, 8>;
+@group(0) @binding(11) var<storage, read> blocks: array<vec2<u32>>;
+#else
+@group(0) @binding(8) var<storage, read_write> counters: array<atomic<u32>, 8>;
+#endif
+#if SETUP
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(2) var<storage, read> vertices: array<f32>;
 @group(0) @binding(3) var<storage, read> triangles: array<u32>;
 @group(0) @binding(4) var<storage, read> single_sided: array<u32>;
-@group(0) @binding(5) var<storage, read_write> big_list: array<u32>;
-#if BIG
-#else
-// An indirect dispatch's arguments: the large-triangle dispatch reads them, so it binds
-// nothing it could write.
-@group(0) @binding(6) var<storage, read_write> big_args: array<atomic<u32>, 4>;
+@group(0) @binding(6) var<storage, read_write> tiles: array<vec2<u32>>;
+// The bin dispatch's arguments (so the bin dispatch, which reads them, binds nothing it
+// could write them with).
+@group(0) @binding(9) var<storage, read_write> tile_args: array<atomic<u32>, 4>;
 #endif
-#if ATOMIC
-@group(0) @binding(7) var<storage, read_write> vis: array<atomic<u64>>;
-#else
-@group(0) @binding(7) var<storage, read_write> vis: array<vec2<u32>>;
+#if BIN
+@group(0) @binding(6) var<storage, read> tiles: array<vec2<u32>>;
+@group(0) @binding(11) var<storage, read_write> blocks: array<vec2<u32>>;
+@group(0) @binding(10) var<storage, read_write> block_args: array<atomic<u32>, 4>;
+#endif
 #endif
 #endif
 
@@ -52,6 +85,23 @@ const HALF_PIXEL: i32 = 128;
 // 4 pixels of atrium_amd's near-clipped balustrade took another depth.
 const GUARD: f32 = 1.0;
 const MAX_POLY: u32 = 8u;
+// Counter slots: entries appended to each list (past the capacity too), then fan
+// triangles, tiles and blocks rasterized serially because their list was full.
+const RECORDS: u32 = 0u;
+const TILES: u32 = 1u;
+const BLOCKS: u32 = 2u;
+const SERIAL_TRIANGLES: u32 = 3u;
+const SERIAL_TILES: u32 = 4u;
+const SERIAL_BLOCKS: u32 = 5u;
+// Record flags: bits 0-2, edge k is not a top or left edge (bias -1); RECORD_LINEAR, the
+// snapped coordinates are small enough for the edge functions to be exactly linear.
+const RECORD_LINEAR: u32 = 8u;
+// Tiles a fan triangle reserves without checking the count first (see `reserve_tiles`).
+const SMALL_BOX: u32 = 16u;
+// Snapped coordinates up to this (2^29 fixed point, 2^21 pixels) keep every difference
+// the edge functions take within i32 (pixel centres are under 2^22 for viewports up to
+// 16,384 pixels), so an edge function is exactly the linear function of the pixel.
+const LINEAR_RANGE: i32 = 536870912;
 
 fn flat_index(wg: vec3<u32>, groups: vec3<u32>, local: u32, size: u32) -> u32 {
     return (wg.y * groups.x + wg.x) * size + local;
@@ -85,27 +135,150 @@ fn resolve_fs(@builtin(position) pos: vec4<f32>) -> Resolved {
     return out;
 }
 #else
-#if ATOMIC
-#else
+// Pixels per side of a tile (BLOCK pixels per block, TILE_BLOCKS blocks per tile side).
+const TILE_PIXELS: u32 = BLOCK * TILE_BLOCKS;
+// Threads per block (one a pixel) and per tile (one a block).
+const BLOCK_THREADS: u32 = BLOCK * BLOCK;
+const TILE_THREADS: u32 = TILE_BLOCKS * TILE_BLOCKS;
 
-@compute @workgroup_size(GROUP)
+// Indirect dispatch size (x, y) for `entries` list entries, `per_group` a workgroup: x up
+// to the per-dimension limit, y as many rows of those as needed (flattened back by the
+// dispatch).
+fn dispatch_size(entries: u32, per_group: u32) -> vec2<u32> {
+    let groups = (entries + per_group - 1u) / per_group;
+    let row = raster_params.y;
+    return vec2<u32>(min(groups, row), (groups + row - 1u) / row);
+}
+#if CLEAR
+
+@compute @workgroup_size(CLEAR_GROUP)
 fn clear(
     @builtin(workgroup_id) wg: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
 ) {
-    let i = flat_index(wg, groups, local, GROUP);
-    if (i == 0u) {
-        atomicStore(&big_args[0], 0u);
-        atomicStore(&big_args[1], 1u);
-        atomicStore(&big_args[2], 1u);
+    let i = flat_index(wg, groups, local, CLEAR_GROUP);
+    if (i < 8u) {
+        counters[i] = 0u;
+    }
+    if (i < 4u) {
+        // Zero workgroups: (0, 1, 1); the appenders grow x and y.
+        let arg = select(1u, 0u, i == 0u);
+        tile_args[i] = arg;
+        block_args[i] = arg;
     }
     if (i < raster_params.z * raster_params.w) {
         vis[i] = vec2<u32>(0xffffffffu, 0xffffffffu);
     }
 }
-#endif
-#if ATOMIC
+#else
+
+// A fan triangle ready to rasterize: oriented with positive area (clockwise on screen).
+struct Tri {
+    // Snapped vertices (1/256 pixel).
+    a: vec2<i32>,
+    b: vec2<i32>,
+    c: vec2<i32>,
+    // Added to the edge functions of b -> c, c -> a, a -> b: -1 where a centre exactly
+    // on the edge is not covered (not a top or left edge), else 0.
+    bias: vec3<i32>,
+    // The first vertex unsnapped (x, y in pixels, depth) and the depth's slopes.
+    sa: vec3<f32>,
+    dz: vec2<f32>,
+    // Pixels whose centres lie in the vertices' box, within the viewport: x0, y0, x1, y1.
+    box: vec4<i32>,
+    id: u32,
+    flags: u32,
+};
+
+fn edge(a: vec2<i32>, b: vec2<i32>, p: vec2<i32>) -> i64 {
+    return i64(b.x - a.x) * i64(p.y - a.y) - i64(b.y - a.y) * i64(p.x - a.x);
+}
+
+// The pixel (px, py) of `t`, if its centre is covered and its depth within the far plane.
+fn cover(t: Tri, px: i32, py: i32) {
+    let p = vec2<i32>(px, py) * 256 + vec2<i32>(HALF_PIXEL);
+    if (edge(t.b, t.c, p) + i64(t.bias.x) < 0 || edge(t.c, t.a, p) + i64(t.bias.y) < 0 || edge(t.a, t.b, p) + i64(t.bias.z) < 0) {
+        return;
+    }
+    let centre = vec2<f32>(f32(px) + 0.5, f32(py) + 0.5);
+    let z = t.sa.z + t.dz.x * (centre.x - t.sa.x) + t.dz.y * (centre.y - t.sa.y);
+    if (!(z <= 1.0)) {
+        return;
+    }
+    let key = (u64(bitcast<u32>(max(z, 0.0))) << 32u) | u64(~t.id);
+    atomicMin(&vis[u32(py) * raster_params.z + u32(px)], key);
+}
+
+// Pixels x..x+7 of row y, those up to `last`.
+fn cover_span(t: Tri, x: i32, y: i32, last: i32) {
+    cover(t, x, y);
+    if (x + 1 <= last) { cover(t, x + 1, y); }
+    if (x + 2 <= last) { cover(t, x + 2, y); }
+    if (x + 3 <= last) { cover(t, x + 3, y); }
+    if (x + 4 <= last) { cover(t, x + 4, y); }
+    if (x + 5 <= last) { cover(t, x + 5, y); }
+    if (x + 6 <= last) { cover(t, x + 6, y); }
+    if (x + 7 <= last) { cover(t, x + 7, y); }
+}
+
+// Every pixel of `region` (x0, y0, x1, y1, inclusive) in this thread: the fallback when
+// a list is full. Exact; slow for large regions. Eight pixels a loop iteration:
+// llvmpipe (lavapipe) ends all loops of an invocation after 65,535 iterations in total
+// (LP_MAX_TGSI_LOOP_ITERATIONS), which one pixel an iteration reaches with a
+// screen-filling triangle at 333×197; eight keep it exact there up to ~500,000 pixels
+// a thread.
+fn raster_region(t: Tri, region: vec4<i32>) {
+    for (var y = region.y; y <= region.w; y++) {
+        for (var x = region.x; x <= region.z; x += 8) {
+            cover_span(t, x, y, region.z);
+        }
+    }
+}
+
+// The pixels of cell `cell` (`size` pixels a side) within the triangle's box.
+fn cell_region(box: vec4<i32>, cell: vec2<u32>, size: u32) -> vec4<i32> {
+    let lo = vec2<i32>(cell * size);
+    let hi = lo + vec2<i32>(i32(size) - 1);
+    return vec4<i32>(max(lo, box.xy), min(hi, box.zw));
+}
+
+fn pack_point(p: vec2<i32>) -> u32 {
+    return u32(p.x) | (u32(p.y) << 16u);
+}
+
+fn unpack_point(v: u32) -> vec2<u32> {
+    return vec2<u32>(v & 0xffffu, v >> 16u);
+}
+
+fn load_record(r: u32) -> Tri {
+    let i = 4u * r;
+    let w0 = records[i];
+    let w1 = records[i + 1u];
+    let w2 = records[i + 2u];
+    let w3 = records[i + 3u];
+    var t: Tri;
+    t.a = bitcast<vec2<i32>>(w0.xy);
+    t.b = bitcast<vec2<i32>>(w0.zw);
+    t.c = bitcast<vec2<i32>>(w1.xy);
+    t.box = vec4<i32>(vec2<i32>(unpack_point(w1.z)), vec2<i32>(unpack_point(w1.w)));
+    t.sa = bitcast<vec3<f32>>(w2.xyz);
+    t.dz = vec2<f32>(bitcast<f32>(w2.w), bitcast<f32>(w3.x));
+    t.id = w3.y;
+    t.flags = w3.z;
+    t.bias = -vec3<i32>(vec3<u32>(t.flags, t.flags >> 1u, t.flags >> 2u) & vec3<u32>(1u));
+    return t;
+}
+
+#if SETUP
+
+fn store_record(r: u32, t: Tri) {
+    let i = 4u * r;
+    records[i] = bitcast<vec4<u32>>(vec4<i32>(t.a, t.b));
+    records[i + 1u] = vec4<u32>(bitcast<vec2<u32>>(t.c), pack_point(t.box.xy), pack_point(t.box.zw));
+    records[i + 2u] = vec4<u32>(bitcast<vec3<u32>>(t.sa), bitcast<u32>(t.dz.x));
+    records[i + 3u] = vec4<u32>(bitcast<u32>(t.dz.y), t.id, t.flags, 0u);
+}
 
 fn clip_position(v: u32) -> vec4<f32> {
     let b = 12u * v;
@@ -121,6 +294,17 @@ fn plane_distance(c: vec4<f32>, k: u32) -> f32 {
     }
     let axis = select(c.y, c.x, k < 3u);
     return GUARD * c.w + select(axis, -axis, k % 2u == 1u);
+}
+
+// Whether `clip_triangle` would change the triangle: some vertex outside some plane.
+// Most triangles are inside: they skip the polygon array (local memory on GPUs).
+fn needs_clipping(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) -> bool {
+    for (var k = 0u; k < 5u; k++) {
+        if (plane_distance(a, k) < 0.0 || plane_distance(b, k) < 0.0 || plane_distance(c, k) < 0.0) {
+            return true;
+        }
+    }
+    return false;
 }
 
 // The triangle clipped to a convex polygon (Sutherland-Hodgman), fanned from vertex 0.
@@ -195,10 +379,6 @@ fn pixel_box(lo: vec2<i32>, hi: vec2<i32>) -> vec4<i32> {
     return vec4<i32>(max(first, vec2<i32>(0)), min(last, size - 1));
 }
 
-fn edge(a: vec2<i32>, b: vec2<i32>, p: vec2<i32>) -> i64 {
-    return i64(b.x - a.x) * i64(p.y - a.y) - i64(b.y - a.y) * i64(p.x - a.x);
-}
-
 // The top-left rule, for an edge a -> b of a triangle with positive area (clockwise on
 // screen, y down): a left edge goes up, a top edge goes right.
 fn top_left(a: vec2<i32>, b: vec2<i32>) -> bool {
@@ -206,17 +386,48 @@ fn top_left(a: vec2<i32>, b: vec2<i32>) -> bool {
     return d.y < 0 || (d.y == 0 && d.x > 0);
 }
 
-// Pixels of one (clipped) triangle, the ones from `start` in steps of `stride` in
-// row-major order of its box.
-fn raster_triangle(
-    ca: vec4<f32>,
-    cb: vec4<f32>,
-    cc: vec4<f32>,
-    id: u32,
-    cull_back: bool,
-    start: u32,
-    stride: u32,
-) {
+fn within_linear_range(p: vec2<i32>) -> bool {
+    return all(abs(p) < vec2<i32>(LINEAR_RANGE));
+}
+
+// Entries [first, first + n) of the tile list reserved (a slot at or past the capacity
+// has no room): returns the first slot. One reservation per fan triangle: a returned
+// atomic is a round trip to L2, and setup's slowest thread bounds the dispatch.
+// The counter never wraps: a box of up to SMALL_BOX tiles adds without checking (at most
+// SMALL_BOX x 2^22 records = 2^26 in all), a larger one only while the count is below
+// capacity (compare-exchange), adding at most 2^20 tiles (65,536² pixels) to under 2^24.
+fn reserve_tiles(n: u32) -> u32 {
+    let capacity = list_capacity.y;
+    var first = capacity;
+    if (n <= SMALL_BOX) {
+        first = atomicAdd(&counters[TILES], n);
+    } else {
+        var old = atomicLoad(&counters[TILES]);
+        loop {
+            if (old >= capacity) {
+                break;
+            }
+            let swap = atomicCompareExchangeWeak(&counters[TILES], old, old + n);
+            if (swap.exchanged) {
+                first = old;
+                break;
+            }
+            old = swap.old_value;
+        }
+    }
+    let end = min(first + n, capacity);
+    if (end > first) {
+        // Enough bin workgroups for every entry below `end`.
+        let size = dispatch_size(end, TILES_PER_GROUP);
+        atomicMax(&tile_args[0], size.x);
+        atomicMax(&tile_args[1], size.y);
+    }
+    return first;
+}
+
+// One fan triangle: rejected, or recorded with its tiles listed (or drawn here where a
+// list is full).
+fn setup_triangle(ca: vec4<f32>, cb: vec4<f32>, cc: vec4<f32>, id: u32, cull_back: bool) {
     let sa = to_screen(ca);
     var sb = to_screen(cb);
     var sc = to_screen(cc);
@@ -250,92 +461,177 @@ fn raster_triangle(
     let det = e1.x * e2.y - e1.y * e2.x;
     let dzdx = (e1.z * e2.y - e2.z * e1.y) / det;
     let dzdy = (e2.z * e1.x - e1.z * e2.x) / det;
+    var t: Tri;
+    t.a = a;
+    t.b = b;
+    t.c = c;
     // Edge biases: a centre exactly on an edge counts only on top and left edges.
-    let bias0 = select(-1, 0, top_left(b, c));
-    let bias1 = select(-1, 0, top_left(c, a));
-    let bias2 = select(-1, 0, top_left(a, b));
-    let w = u32(box.z - box.x + 1);
-    let count = w * u32(box.w - box.y + 1);
-    let row = raster_params.z;
-    for (var i = start; i < count; i += stride) {
-        let px = box.x + i32(i % w);
-        let py = box.y + i32(i / w);
-        let p = vec2<i32>(px, py) * 256 + vec2<i32>(HALF_PIXEL);
-        if (edge(b, c, p) + i64(bias0) < 0 || edge(c, a, p) + i64(bias1) < 0 || edge(a, b, p) + i64(bias2) < 0) {
-            continue;
-        }
-        let centre = vec2<f32>(f32(px) + 0.5, f32(py) + 0.5);
-        let z = sa.z + dzdx * (centre.x - sa.x) + dzdy * (centre.y - sa.y);
-        if (!(z <= 1.0)) {
-            continue;
-        }
-        let key = (u64(bitcast<u32>(max(z, 0.0))) << 32u) | u64(~id);
-        atomicMin(&vis[u32(py) * row + u32(px)], key);
+    t.flags = select(1u, 0u, top_left(b, c)) | select(2u, 0u, top_left(c, a)) | select(4u, 0u, top_left(a, b));
+    if (within_linear_range(a) && within_linear_range(b) && within_linear_range(c)) {
+        t.flags |= RECORD_LINEAR;
     }
-}
-
-// Triangle `id` clipped and rasterized; `defer`: hand it to the large-triangle list if
-// its box is large (and the list has room).
-fn raster_id(id: u32, start: u32, stride: u32, defer: bool) {
-    let t = 3u * id;
-    let poly = clip_triangle(
-        clip_position(triangles[t]),
-        clip_position(triangles[t + 1u]),
-        clip_position(triangles[t + 2u]),
-    );
-    if (poly.n < 3u) {
+    t.bias = -vec3<i32>(vec3<u32>(t.flags, t.flags >> 1u, t.flags >> 2u) & vec3<u32>(1u));
+    t.sa = sa;
+    t.dz = vec2<f32>(dzdx, dzdy);
+    t.box = box;
+    t.id = id;
+    // At most 6 fan triangles per triangle, and compute_raster.rs refuses scenes of
+    // over 2^32 / 8 triangles: the counter never wraps.
+    let r = atomicAdd(&counters[RECORDS], 1u);
+    if (r >= list_capacity.x) {
+        atomicAdd(&counters[SERIAL_TRIANGLES], 1u);
+        raster_region(t, box);
         return;
     }
-#if BIG
-#else
-    if (defer) {
-        var lo = vec2<i32>(2147483647);
-        var hi = vec2<i32>(-2147483647);
-        for (var i = 0u; i < poly.n; i++) {
-            let s = snap(to_screen(poly.v[i]));
-            lo = min(lo, s);
-            hi = max(hi, s);
-        }
-        let box = pixel_box(lo, hi);
-        let pixels = max(box.z - box.x + 1, 0) * max(box.w - box.y + 1, 0);
-        if (pixels > i32(BIG_PIXELS)) {
-            let slot = atomicAdd(&big_args[0], 1u);
-            if (slot < raster_params.y) {
-                big_list[slot] = id;
-                return;
+    store_record(r, t);
+    let first = vec2<u32>(box.xy) / TILE_PIXELS;
+    let last = vec2<u32>(box.zw) / TILE_PIXELS;
+    let capacity = list_capacity.y;
+    var serial = 0u;
+    var slot = reserve_tiles((last.x - first.x + 1u) * (last.y - first.y + 1u));
+    for (var ty = first.y; ty <= last.y; ty++) {
+        for (var tx = first.x; tx <= last.x; tx++) {
+            if (slot < capacity) {
+                tiles[slot] = vec2<u32>(r, tx | (ty << 16u));
+                slot++;
+            } else {
+                serial++;
+                raster_region(t, cell_region(box, vec2<u32>(tx, ty), TILE_PIXELS));
             }
-            // Full: counted back out, and drawn here.
-            atomicSub(&big_args[0], 1u);
         }
     }
-#endif
-    let cull_back = (single_sided[id / 32u] & (1u << (id % 32u))) != 0u;
-    for (var k = 1u; k + 1u < poly.n; k++) {
-        raster_triangle(poly.v[0], poly.v[k], poly.v[k + 1u], id, cull_back, start, stride);
+    if (serial > 0u) {
+        atomicAdd(&counters[SERIAL_TILES], serial);
     }
 }
 
-#if BIG
-@compute @workgroup_size(BIG_GROUP)
-fn raster_big(
-    @builtin(workgroup_id) wg: vec3<u32>,
-    @builtin(local_invocation_index) local: u32,
-) {
-    raster_id(big_list[wg.x], local, BIG_GROUP, false);
-}
-#else
 @compute @workgroup_size(GROUP)
-fn raster(
+fn setup(
     @builtin(workgroup_id) wg: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
 ) {
     let id = flat_index(wg, groups, local, GROUP);
-    if (id < raster_params.x) {
-        raster_id(id, 0u, 1u, true);
+    if (id >= raster_params.x) {
+        return;
+    }
+    let t = 3u * id;
+    let a = clip_position(triangles[t]);
+    let b = clip_position(triangles[t + 1u]);
+    let c = clip_position(triangles[t + 2u]);
+    let cull_back = (single_sided[id / 32u] & (1u << (id % 32u))) != 0u;
+    if (!needs_clipping(a, b, c)) {
+        setup_triangle(a, b, c, id, cull_back);
+        return;
+    }
+    let poly = clip_triangle(a, b, c);
+    for (var k = 1u; k + 1u < poly.n; k++) {
+        setup_triangle(poly.v[0], poly.v[k], poly.v[k + 1u], id, cull_back);
     }
 }
+#endif
+#if BIN
 
+// Whether some pixel centre of `region` may lie inside edge a -> b: its edge function
+// (plus bias) is not negative at the corner where the function is largest, the one its
+// gradient (-(b.y - a.y), b.x - a.x) points to.
+fn edge_reaches(a: vec2<i32>, b: vec2<i32>, bias: i32, lo: vec2<i32>, hi: vec2<i32>) -> bool {
+    let p = vec2<i32>(select(lo.x, hi.x, b.y < a.y), select(lo.y, hi.y, b.x > a.x));
+    return edge(a, b, p) + i64(bias) >= 0;
+}
+
+// False only if every pixel centre of `region` is outside an edge. Skipped (true) for
+// coordinates so large that the edge functions wrap in i32 and stop being linear.
+fn may_cover(t: Tri, region: vec4<i32>) -> bool {
+    if ((t.flags & RECORD_LINEAR) == 0u) {
+        return true;
+    }
+    let lo = region.xy * 256 + vec2<i32>(HALF_PIXEL);
+    let hi = region.zw * 256 + vec2<i32>(HALF_PIXEL);
+    return edge_reaches(t.b, t.c, t.bias.x, lo, hi) && edge_reaches(t.c, t.a, t.bias.y, lo, hi) && edge_reaches(t.a, t.b, t.bias.z, lo, hi);
+}
+
+var<workgroup> kept: atomic<u32>;
+var<workgroup> kept_first: u32;
+
+// TILES_PER_GROUP tiles a workgroup, a thread per block.
+@compute @workgroup_size(TILE_THREADS * TILES_PER_GROUP)
+fn bin(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    let i = (wg.y * raster_params.y + wg.x) * TILES_PER_GROUP + local / TILE_THREADS;
+    let in_tile = local % TILE_THREADS;
+    let capacity = list_capacity.z;
+    var keep = false;
+    var r = 0u;
+    var t: Tri;
+    var block = vec2<u32>(0u);
+    var region = vec4<i32>(0);
+    // No early return: every thread reaches the barriers.
+    if (i < min(atomicLoad(&counters[TILES]), list_capacity.y)) {
+        let entry = tiles[i];
+        r = entry.x;
+        t = load_record(r);
+        block = unpack_point(entry.y) * TILE_BLOCKS + vec2<u32>(in_tile % TILE_BLOCKS, in_tile / TILE_BLOCKS);
+        region = cell_region(t.box, block, BLOCK);
+        keep = region.x <= region.z && region.y <= region.w && may_cover(t, region);
+    }
+    // One append for the workgroup: a slot within it per kept block, then its first.
+    var slot = 0u;
+    if (keep) {
+        slot = atomicAdd(&kept, 1u);
+    }
+    workgroupBarrier();
+    if (local == 0u) {
+        let n = atomicLoad(&kept);
+        var first = 0u;
+        if (n > 0u) {
+            // At most one per block of the workgroup's tile entries, which are at most
+            // 2^24 (compute_raster.rs): the counter stays under 2^30.
+            first = atomicAdd(&counters[BLOCKS], n);
+            let end = min(first + n, capacity);
+            if (end > first) {
+                let size = dispatch_size(end, BLOCKS_PER_GROUP);
+                atomicMax(&block_args[0], size.x);
+                atomicMax(&block_args[1], size.y);
+            }
+        }
+        kept_first = first;
+    }
+    let first = workgroupUniformLoad(&kept_first);
+    if (keep) {
+        let s = first + slot;
+        if (s < capacity) {
+            blocks[s] = vec2<u32>(r, block.x | (block.y << 16u));
+        } else {
+            atomicAdd(&counters[SERIAL_BLOCKS], 1u);
+            raster_region(t, region);
+        }
+    }
+}
+#endif
+#if RASTER
+
+// BLOCKS_PER_GROUP blocks a workgroup, a thread per pixel.
+@compute @workgroup_size(BLOCK_THREADS * BLOCKS_PER_GROUP)
+fn raster(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    let i = (wg.y * raster_params.y + wg.x) * BLOCKS_PER_GROUP + local / BLOCK_THREADS;
+    if (i >= min(counters[BLOCKS], list_capacity.z)) {
+        return;
+    }
+    let entry = blocks[i];
+    let t = load_record(entry.x);
+    let in_block = local % BLOCK_THREADS;
+    let p = vec2<i32>(unpack_point(entry.y) * BLOCK + vec2<u32>(in_block % BLOCK, in_block / BLOCK));
+    // The pixels the serial walk visits: the box (within the viewport).
+    if (all(p >= t.box.xy) && all(p <= t.box.zw)) {
+        cover(t, p.x, p.y);
+    }
+}
 #endif
 #endif
 #endif

@@ -5,7 +5,11 @@
 // loop as forward shading. Ids: src/render/visibility_geometry.rs (NO_TRIANGLE where
 // nothing was drawn).
 // Defines: MATERIAL_INDEX, CLEARS (this dispatch stores black where nothing was drawn),
-// LIGHT_LISTS (tile lists) or LINKED_LISTS (a light linked list).
+// LIGHT_LISTS (tile lists) or LINKED_LISTS (a light linked list), and the light loop:
+// STAGED_LIGHTS (the workgroup's one tile list staged in workgroup memory, in
+// visibility/staged_lights.wgsl), RANGE_FIRST (the per-pixel cursor with the range test
+// before the light's properties), or neither (common/light_loop.wgsl's shade_surface,
+// as forward shading runs it).
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"
@@ -41,6 +45,7 @@ struct ShadingPoint {
 // with material_uv_ddx / material_uv_ddy, set below before material_setup.
 #include <material>
 #include "common/light_loop.wgsl"
+#include "visibility/staged_lights.wgsl"
 
 const NO_TRIANGLE: u32 = 0xffffffffu;
 const VERTEX_FLOATS: u32 = 12u;
@@ -79,22 +84,15 @@ fn bary_at(e: Edges, q: vec2<f32>) -> vec3<f32> {
     return b / (b.x + b.y + b.z);
 }
 
-@compute @workgroup_size(8, 8, 1)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (any(id.xy >= frame.size)) {
-        return;
-    }
-    let tri = textureLoad(visibility, id.xy, 0).x;
-    let range = material_triangles[MATERIAL_INDEX];
-    if (tri == NO_TRIANGLE) {
-#if CLEARS
-        textureStore(hdr, id.xy, vec4<f32>(0.0));
-#endif
-        return;
-    }
-    if (tri < range.x || tri >= range.y) {
-        return;
-    }
+// A pixel's surface, rebuilt from its triangle, with what the light loop takes.
+struct Surface {
+    p: ShadingPoint,
+    m: MaterialSample,
+    pixel: vec2<f32>,
+    view_z: f32,
+};
+
+fn rebuild(id: vec2<u32>, tri: u32) -> Surface {
     let a = fetch(triangles[3u * tri]);
     let b = fetch(triangles[3u * tri + 1u]);
     let c = fetch(triangles[3u * tri + 2u]);
@@ -107,7 +105,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let e = Edges(cross(h1, h2), cross(h2, h0), cross(h0, h1));
     // The pixel centre in NDC, and one pixel's step along x and y (NDC y points up).
     let size = vec2<f32>(frame.size);
-    let pixel = vec2<f32>(id.xy) + 0.5;
+    let pixel = vec2<f32>(id) + 0.5;
     let q = vec2<f32>(pixel.x / size.x * 2.0 - 1.0, 1.0 - pixel.y / size.y * 2.0);
     let step = vec2<f32>(2.0 / size.x, -2.0 / size.y);
     let w = bary_at(e, q);
@@ -132,7 +130,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     // right and one down, taken as the rasterizer's coarse derivatives are, across the
     // pixel's 2×2 quad from its top-left pixel (the triangle's plane extended there, as
     // helper invocations do), so the level matches textureSample in forward shading.
-    let corner = vec2<f32>(id.xy & vec2<u32>(~1u)) + 0.5;
+    let corner = vec2<f32>(id & vec2<u32>(~1u)) + 0.5;
     let q0 = vec2<f32>(corner.x / size.x * 2.0 - 1.0, 1.0 - corner.y / size.y * 2.0);
     let uv0 = uv * bary_at(e, q0);
     material_uv_ddx = uv * bary_at(e, q0 + vec2<f32>(step.x, 0.0)) - uv0;
@@ -140,5 +138,74 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
 #endif
     let m = material_setup(p);
     let view_z = -(frame.view * vec4<f32>(p.position, 1.0)).z;
-    textureStore(hdr, id.xy, vec4<f32>(shade_surface(p, m, pixel, view_z), material_alpha(m)));
+    return Surface(p, m, pixel, view_z);
 }
+
+#if STAGED_LIGHTS
+// Whether any pixel of the workgroup is this material's (zeroed at workgroup start).
+var<workgroup> group_shades: atomic<u32>;
+
+// Every invocation, its pixel in the frame or not, takes part in staging the lights: the
+// barriers need all of them. A workgroup none of whose pixels is this material's leaves
+// before loading anything.
+@compute @workgroup_size(8, 8, 1)
+fn main(
+    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+    @builtin(workgroup_id) group: vec3<u32>,
+) {
+    let inside = all(id.xy < frame.size);
+    var tri = NO_TRIANGLE;
+    if (inside) {
+        tri = textureLoad(visibility, id.xy, 0).x;
+    }
+#if CLEARS
+    if (inside && tri == NO_TRIANGLE) {
+        textureStore(hdr, id.xy, vec4<f32>(0.0));
+    }
+#endif
+    let range = material_triangles[MATERIAL_INDEX];
+    let shades = tri != NO_TRIANGLE && tri >= range.x && tri < range.y;
+    if (shades) {
+        atomicOr(&group_shades, 1u);
+    }
+    if (workgroupUniformLoad(&group_shades) == 0u) {
+        return;
+    }
+    // Every invocation rebuilds a surface (one of this material's triangles where its
+    // pixel has none of them) and the light loop skips those that do not shade: a
+    // surface rebuilt in a branch and shaded after it came out one ulp off in a few
+    // pixels on lavapipe (the compiler fuses the arithmetic differently). A warp with
+    // any pixel of this material pays for the rebuild anyway.
+    let s = rebuild(id.xy, select(range.x, tri, shades));
+    let color = staged_lights(surface_unlit(s.p, s.m), shades, s.p, s.m, lane, group_list(group.xy));
+    if (shades) {
+        textureStore(hdr, id.xy, vec4<f32>(color, material_alpha(s.m)));
+    }
+}
+#else
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (any(id.xy >= frame.size)) {
+        return;
+    }
+    let tri = textureLoad(visibility, id.xy, 0).x;
+    let range = material_triangles[MATERIAL_INDEX];
+    if (tri == NO_TRIANGLE) {
+#if CLEARS
+        textureStore(hdr, id.xy, vec4<f32>(0.0));
+#endif
+        return;
+    }
+    if (tri < range.x || tri >= range.y) {
+        return;
+    }
+    let s = rebuild(id.xy, tri);
+#if RANGE_FIRST
+    let color = shade_range_first(s.p, s.m, s.pixel, s.view_z);
+#else
+    let color = shade_surface(s.p, s.m, s.pixel, s.view_z);
+#endif
+    textureStore(hdr, id.xy, vec4<f32>(color, material_alpha(s.m)));
+}
+#endif

@@ -200,6 +200,11 @@ pub struct RenderArgs {
     /// Lights-per-tile heat map (PNG); a histogram CSV is written beside it.
     #[arg(long)]
     pub heatmap: Option<PathBuf>,
+    /// wgpu features to open the device without, as if the adapter lacked them
+    /// (comma-separated, e.g. shader_int64_atomic_min_max: the compute rasterizer then
+    /// runs its hardware fallback and says so).
+    #[arg(long, value_name = "FEATURES")]
+    pub disable_features: Option<String>,
 }
 
 #[derive(clap::Args)]

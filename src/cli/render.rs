@@ -183,7 +183,14 @@ pub fn render(args: RenderArgs) -> Result<()> {
         .graph
         .clone()
         .unwrap_or_else(|| project_path("graphs/forward_plus.ron"));
-    let mut renderer = Renderer::headless()?;
+    let options = lightgraph::gpu::ContextOptions {
+        disabled_features: match &args.disable_features {
+            Some(list) => lightgraph::gpu::ContextOptions::parse_features(list)
+                .map_err(|e| anyhow::anyhow!("--disable-features: {e}"))?,
+            None => wgpu::Features::empty(),
+        },
+    };
+    let mut renderer = Renderer::headless_with(&options)?;
     let checked = assets::check_graph(&graph_path, &renderer.shaders)?;
     let ((width, height), why) = pick_size(
         &args,
@@ -473,6 +480,10 @@ fn report(r: &Renderer, scene: &Scene, graph: &Path, result: &FrameResult) {
         }
         None => println!("  (this adapter has no timestamp queries: no per-pass GPU times)"),
     }
+    // Passes that ran another way on this adapter (their times above are that way's).
+    for f in &result.fallbacks {
+        println!("  fallback: {}", f.line());
+    }
     for c in &result.culling {
         println!("  {}", c.summary());
         for w in c.warnings() {
@@ -481,6 +492,14 @@ fn report(r: &Renderer, scene: &Scene, graph: &Path, result: &FrameResult) {
     }
     for l in &result.links {
         link_report(l);
+    }
+    for c in &result.rasters {
+        for line in c.lines() {
+            match line.strip_prefix("warning: ") {
+                Some(w) => println!("  WARNING: {w}"),
+                None => println!("  {line}"),
+            }
+        }
     }
     if let Some(s) = &result.light_stats {
         println!(

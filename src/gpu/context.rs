@@ -15,6 +15,34 @@ pub enum GpuError {
     Readback(String),
 }
 
+/// How to open the device. The default takes every feature the project uses that the
+/// adapter offers.
+#[derive(Clone, Debug, Default)]
+pub struct ContextOptions {
+    /// Features left off the device even where the adapter offers them, so the device is
+    /// what an adapter without them gives: tests of the fallbacks on lavapipe, and
+    /// `render --disable-features`.
+    pub disabled_features: wgpu::Features,
+}
+
+impl ContextOptions {
+    /// Feature names as wgpu spells them (`SHADER_INT64_ATOMIC_MIN_MAX`, any case),
+    /// separated by commas, spaces or `|`.
+    pub fn parse_features(list: &str) -> Result<wgpu::Features, String> {
+        let mut features = wgpu::Features::empty();
+        for name in list
+            .split([',', '|', ' '])
+            .map(str::trim)
+            .filter(|n| !n.is_empty())
+        {
+            features |= wgpu::Features::from_name(&name.to_ascii_uppercase()).ok_or_else(|| {
+                format!("'{name}' is not a wgpu feature name (e.g. shader_int64_atomic_min_max)")
+            })?;
+        }
+        Ok(features)
+    }
+}
+
 /// A headless wgpu device and queue, plus what the adapter can do. Clones share them.
 #[derive(Clone)]
 pub struct GpuContext {
@@ -27,14 +55,22 @@ pub struct GpuContext {
     /// `Features::PIPELINE_CACHE`, unless `LIGHTGRAPH_PIPELINE_CACHE_DIR=off`). Saved when
     /// the last handle goes and after hot reloads that built pipelines.
     pub pipeline_cache: Option<Arc<DiskPipelineCache>>,
+    /// Features the adapter offers that the device was opened without, on request
+    /// ([`ContextOptions::disabled_features`]): passes that fall back say so.
+    pub disabled_features: wgpu::Features,
 }
 
 impl GpuContext {
     /// Opens the first adapter wgpu finds (Vulkan), without a window.
     pub fn new_headless() -> Result<Self, GpuError> {
+        Self::headless_with(&ContextOptions::default())
+    }
+
+    /// [`Self::new_headless`] with `options` (features left off).
+    pub fn headless_with(options: &ContextOptions) -> Result<Self, GpuError> {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
         desc.backends = wgpu::Backends::VULKAN;
-        pollster::block_on(Self::open(&wgpu::Instance::new(desc), None))
+        pollster::block_on(Self::open(&wgpu::Instance::new(desc), None, options))
     }
 
     /// Opens an adapter that can present to `surface` (the viewer's window).
@@ -42,12 +78,17 @@ impl GpuContext {
         instance: &wgpu::Instance,
         surface: &wgpu::Surface<'_>,
     ) -> Result<Self, GpuError> {
-        pollster::block_on(Self::open(instance, Some(surface)))
+        pollster::block_on(Self::open(
+            instance,
+            Some(surface),
+            &ContextOptions::default(),
+        ))
     }
 
     async fn open(
         instance: &wgpu::Instance,
         compatible_surface: Option<&wgpu::Surface<'_>>,
+        options: &ContextOptions,
     ) -> Result<Self, GpuError> {
         let adapter = instance
             .request_adapter(&wgpu::RequestAdapterOptions {
@@ -74,7 +115,8 @@ impl GpuContext {
             | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX
             // Compiled pipelines kept on disk between runs (see `pipeline_cache`).
             | wgpu::Features::PIPELINE_CACHE;
-        let features = adapter.features() & wanted;
+        let disabled_features = adapter.features() & wanted & options.disabled_features;
+        let features = (adapter.features() & wanted) - disabled_features;
         let has_timestamps = features.contains(timestamps);
         let adapter_limits = adapter.limits();
         let limits = wgpu::Limits {
@@ -116,6 +158,7 @@ impl GpuContext {
             queue,
             has_timestamps,
             pipeline_cache,
+            disabled_features,
         })
     }
 
@@ -150,5 +193,26 @@ impl GpuContext {
     pub fn adapter_name(&self) -> String {
         let info = self.adapter.get_info();
         format!("{} ({:?})", info.name, info.backend)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ContextOptions;
+
+    #[test]
+    fn parses_feature_names_in_any_case() {
+        let f =
+            ContextOptions::parse_features("shader_int64_atomic_min_max, SHADER_INT64").unwrap();
+        assert_eq!(
+            f,
+            wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX | wgpu::Features::SHADER_INT64
+        );
+        assert_eq!(
+            ContextOptions::parse_features("").unwrap(),
+            wgpu::Features::empty()
+        );
+        let e = ContextOptions::parse_features("shader_int64|nope").unwrap_err();
+        assert!(e.contains("'nope' is not a wgpu feature name"), "{e}");
     }
 }

@@ -5,4 +5,4 @@ pub mod pipeline_cache;
 pub mod readback;
 pub mod structs;
 
-pub use context::{GpuContext, GpuError};
+pub use context::{ContextOptions, GpuContext, GpuError};

@@ -391,6 +391,11 @@ fn describe(
                         Usage::Attachment => T::RENDER_ATTACHMENT,
                         Usage::Sampled => T::TEXTURE_BINDING,
                         Usage::Storage => T::STORAGE_BINDING,
+                        Usage::AttachmentOrStorage if format.is_depth() => T::RENDER_ATTACHMENT,
+                        Usage::AttachmentOrStorage if *format == TextureFormat::R32Float => {
+                            T::STORAGE_BINDING
+                        }
+                        Usage::AttachmentOrStorage => T::RENDER_ATTACHMENT | T::STORAGE_BINDING,
                         Usage::Bound => T::empty(),
                     };
                 }

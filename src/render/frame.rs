@@ -474,16 +474,20 @@ impl PreparedFrame {
         let image = read_rgba32f(&r.ctx.device, &r.ctx.queue, self.output_texture())?;
         timings.image_readback = start.elapsed();
         let start = Instant::now();
+        let mut fallbacks = Vec::new();
         let (mut culling, mut shadows, mut atlases) = (Vec::new(), Vec::new(), Vec::new());
         let (mut shadow_compare, mut links, mut vpls) = (Vec::new(), Vec::new(), Vec::new());
+        let mut rasters = Vec::new();
         for report in self.pass_reports(r)? {
             match report {
+                PassReport::Fallback(f) => fallbacks.push(f),
                 PassReport::Culling(c) => culling.push(c),
                 PassReport::Shadow(s) => shadows.push(s),
                 PassReport::Atlas(a) => atlases.push(a),
                 PassReport::ShadowCompare(c) => shadow_compare.push(c),
                 PassReport::Links(l) => links.push(l),
                 PassReport::Vpl(v) => vpls.push(v),
+                PassReport::Raster(c) => rasters.push(c),
             }
         }
         let light_stats = self.read_light_stats(r)?;
@@ -493,12 +497,14 @@ impl PreparedFrame {
             height: self.size.height,
             image,
             pass_ms,
+            fallbacks,
             culling,
             links,
             shadows,
             atlases,
             shadow_compare,
             vpls,
+            rasters,
             light_stats,
         };
         Ok((frame, timings))
@@ -596,6 +602,29 @@ impl PreparedFrame {
                 message: format!("'{name}' is not a planned texture"),
             })?;
         Ok(read_rgba32f(&r.ctx.device, &r.ctx.queue, texture)?)
+    }
+
+    /// Reads back a planned single-sample texture of 32 bits a texel (R32Float, R32Uint,
+    /// Depth32Float) of the last executed frame, each texel's bits as they are (tests
+    /// that compare depths and ids exactly, inspection).
+    pub fn read_texture_bits(&self, r: &Renderer, name: &str) -> Result<Vec<u32>, RenderError> {
+        use wgpu::TextureFormat as F;
+        self.check_not_reused(name)?;
+        let texture = self
+            .resources
+            .texture(&self.graph.plan, name)
+            .filter(|t| {
+                t.sample_count() == 1
+                    && matches!(t.format(), F::R32Float | F::R32Uint | F::Depth32Float)
+            })
+            .ok_or_else(|| RenderError::Pass {
+                pass: "readback".into(),
+                message: format!(
+                    "'{name}' is not a planned single-sample R32Float, R32Uint or Depth32Float texture"
+                ),
+            })?;
+        let bytes = crate::gpu::readback::read_texture(&r.ctx.device, &r.ctx.queue, texture, 4)?;
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 
     /// Moves the camera without re-preparing (benchmarks, the viewer).

@@ -25,8 +25,9 @@ pub use pipelines::{
     CacheCounters, GpuStateAtBuild, Pipeline, PipelineBuild, PipelineCache, PipelineKey,
 };
 pub use prepare_stats::PrepareStats;
+pub use report::FallbackReport;
 pub use report::{
-    AtlasReport, CullingReport, FrameResult, LightStats, LinkReport, PassReport,
+    AtlasReport, CullingReport, FrameResult, LightStats, LinkReport, PassReport, RasterReport,
     ShadowCompareReport, ShadowReport, VplReport,
 };
 pub use resources::FrameResources;
@@ -80,8 +81,14 @@ impl Renderer {
 
     /// Opens the first adapter and uses the project's shaders/.
     pub fn headless() -> Result<Self, GpuError> {
+        Self::headless_with(&crate::gpu::ContextOptions::default())
+    }
+
+    /// [`Self::headless`] with device options (features left off, as on an adapter
+    /// without them).
+    pub fn headless_with(options: &crate::gpu::ContextOptions) -> Result<Self, GpuError> {
         Ok(Self::new(
-            GpuContext::new_headless()?,
+            GpuContext::headless_with(options)?,
             ShaderLibrary::builtin(),
         ))
     }

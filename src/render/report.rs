@@ -317,15 +317,65 @@ impl VplReport {
     }
 }
 
+/// Per ComputeRaster pass: how its work lists filled this frame. A full list loses
+/// nothing (what finds no room is rasterized serially, exactly, by the thread that
+/// found it full), but serial work is slow: a non-zero count is a warning.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RasterReport {
+    pub pass: String,
+    /// Entries used and capacity: fan-triangle records, tiles and blocks.
+    pub records: u32,
+    pub records_capacity: u32,
+    pub tiles: u32,
+    pub tiles_capacity: u32,
+    pub blocks: u32,
+    pub blocks_capacity: u32,
+    /// Rasterized serially for want of room: fan triangles without a record, tiles
+    /// without a tile entry, blocks without a block entry.
+    pub serial_triangles: u32,
+    pub serial_tiles: u32,
+    pub serial_blocks: u32,
+}
+
+impl RasterReport {
+    /// Fan triangles, tiles and blocks rasterized serially together.
+    pub fn serial(&self) -> u64 {
+        self.serial_triangles as u64 + self.serial_tiles as u64 + self.serial_blocks as u64
+    }
+    /// The report's lines for `render` (serial work is a warning).
+    pub fn lines(&self) -> Vec<String> {
+        let r = self;
+        let mut lines = vec![format!(
+            "{}: {} of {} triangle records, {} of {} tiles, {} of {} blocks",
+            r.pass,
+            r.records,
+            r.records_capacity,
+            r.tiles,
+            r.tiles_capacity,
+            r.blocks,
+            r.blocks_capacity
+        )];
+        if r.serial() > 0 {
+            lines.push(format!(
+                "warning: {}: lists full: {} fan triangles, {} tiles and {} blocks rasterized serially (exact, slow)",
+                r.pass, r.serial_triangles, r.serial_tiles, r.serial_blocks
+            ));
+        }
+        lines
+    }
+}
+
 /// What a pass counted on the GPU (or decided on the CPU for this frame).
 #[derive(Clone, Debug)]
 pub enum PassReport {
+    Fallback(FallbackReport),
     Culling(CullingReport),
     Shadow(ShadowReport),
     Atlas(AtlasReport),
     ShadowCompare(ShadowCompareReport),
     Links(LinkReport),
     Vpl(VplReport),
+    Raster(RasterReport),
 }
 
 pub struct FrameResult {
@@ -335,11 +385,85 @@ pub struct FrameResult {
     pub image: Vec<[f32; 4]>,
     /// GPU milliseconds per pass, when the adapter has timestamp queries.
     pub pass_ms: Option<Vec<(String, f64)>>,
+    /// Passes that ran another way on this device (see [`FallbackReport`]).
+    pub fallbacks: Vec<FallbackReport>,
     pub culling: Vec<CullingReport>,
     pub links: Vec<LinkReport>,
     pub shadows: Vec<ShadowReport>,
     pub atlases: Vec<AtlasReport>,
     pub shadow_compare: Vec<ShadowCompareReport>,
     pub vpls: Vec<VplReport>,
+    pub rasters: Vec<RasterReport>,
     pub light_stats: Option<LightStats>,
+}
+
+/// A pass that runs another way than its kind's own on this device: the compute
+/// rasterizer drawn with the hardware rasterizer where the adapter lacks its 64-bit
+/// atomics. Reported with every frame, so a run on such a device never passes silently
+/// for the compute path (timings included).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FallbackReport {
+    pub pass: String,
+    /// The adapter, as `GpuContext::adapter_name` gives it.
+    pub adapter: String,
+    /// What the pass needs that the device lacks.
+    pub missing: wgpu::Features,
+    /// Of `missing`, what the adapter offers but the context was asked to leave off
+    /// (`ContextOptions::disabled_features`).
+    pub disabled: wgpu::Features,
+    /// How the pass ran instead.
+    pub instead: &'static str,
+}
+
+impl FallbackReport {
+    /// One line for `render` and the viewer, e.g. `compute_raster: adapter X lacks
+    /// SHADER_INT64_ATOMIC_MIN_MAX; drawn with the hardware rasterizer`.
+    pub fn line(&self) -> String {
+        let disabled = if self.disabled.is_empty() {
+            String::new()
+        } else if self.disabled == self.missing {
+            " (offered by the adapter, disabled on request)".to_string()
+        } else {
+            format!(" ({} disabled on request)", self.disabled)
+        };
+        format!(
+            "{}: adapter {} lacks {}{disabled}; {}",
+            self.pass, self.adapter, self.missing, self.instead
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::FallbackReport;
+    use wgpu::Features as F;
+
+    #[test]
+    fn a_fallback_line_names_the_pass_adapter_and_missing_features() {
+        let mut f = FallbackReport {
+            pass: "cr".into(),
+            adapter: "Some GPU (Vulkan)".into(),
+            missing: F::SHADER_INT64 | F::SHADER_INT64_ATOMIC_MIN_MAX,
+            disabled: F::empty(),
+            instead: "drawn with the hardware rasterizer",
+        };
+        assert_eq!(
+            f.line(),
+            "cr: adapter Some GPU (Vulkan) lacks SHADER_INT64 | SHADER_INT64_ATOMIC_MIN_MAX; drawn with the hardware rasterizer"
+        );
+        f.disabled = F::SHADER_INT64_ATOMIC_MIN_MAX;
+        assert!(
+            f.line()
+                .contains("MIN_MAX (SHADER_INT64_ATOMIC_MIN_MAX disabled on request);"),
+            "{}",
+            f.line()
+        );
+        f.disabled = f.missing;
+        assert!(
+            f.line()
+                .contains("MIN_MAX (offered by the adapter, disabled on request);"),
+            "{}",
+            f.line()
+        );
+    }
 }

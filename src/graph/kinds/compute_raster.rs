@@ -1,7 +1,10 @@
 //! `ComputeRaster`: the scene's opaque triangles rasterized in compute from the merged
 //! visibility geometry, resolved per pixel with a 64-bit atomic min of (depth, id), into a
 //! depth texture and an R32Uint visibility texture (triangle ids, `NO_TRIANGLE` where
-//! nothing covers). Runs `shaders/visibility/compute_raster.wgsl`.
+//! nothing covers). The depth is Depth32Float (resolved by a full-screen draw, for later
+//! passes that test against it) or R32Float (resolved in compute: a frame without vertex
+//! or fragment work, read by LightCulling and LightLinkedList). Runs
+//! `shaders/visibility/compute_raster.wgsl` and `compute_raster_resolve.wgsl`.
 
 use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
@@ -34,18 +37,20 @@ pub const SLOTS: &[SlotSpec] = &[
         Usage::Bound,
     )
     .optional(),
-    // Written by the resolve's full-screen draw (compute cannot store depth formats).
+    // Depth32Float: written by the resolve's full-screen draw (compute cannot store
+    // depth formats). R32Float: stored by a compute resolve, so the frame has no draw.
+    // The hardware fallback draws the ids (and a Depth32Float depth).
     SlotSpec::new(
         slot::DEPTH,
-        SlotType::DepthTexture,
+        SlotType::DepthValues,
         Access::Write,
-        Usage::Attachment,
+        Usage::AttachmentOrStorage,
     ),
     SlotSpec::new(
         VISIBILITY,
         SlotType::ColorTexture,
         Access::Write,
-        Usage::Attachment,
+        Usage::AttachmentOrStorage,
     ),
 ];
 
@@ -57,10 +62,13 @@ pub fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         _ => None,
     };
     if let Some(depth) = ctx.slot(slot::DEPTH) {
-        if format(depth) != Some((TextureFormat::Depth32Float, 1)) {
+        if !matches!(
+            format(depth),
+            Some((TextureFormat::Depth32Float | TextureFormat::R32Float, 1))
+        ) {
             errors.push(ctx.mismatch(
                 depth,
-                "ComputeRaster writes 32-bit float depth per pixel: a single-sample Depth32Float texture",
+                "ComputeRaster writes 32-bit float depth per pixel: a single-sample Depth32Float texture (resolved by a draw) or R32Float (resolved in compute)",
             ));
         }
     }
@@ -109,6 +117,63 @@ mod tests {
         );
         assert!(
             e.contains("ComputeRaster needs an Import of Vertices in reads (slot 'vertices')"),
+            "{e}"
+        );
+    }
+
+    /// ComputeRaster with an R32Float depth ("fdepth", matched by type), shaded from its
+    /// ids with the lists of a culling pass on that depth.
+    const FLOAT_FRAME: &str = r#"Pass(name: "cr", kind: ComputeRaster, reads: ["vertices", "triangles", "material_triangles"], writes: ["fdepth", "visibility"]),
+        Pass(name: "c", kind: LightCulling(tile: 16), reads: ["fdepth", "lg"], writes: ["lists"]),
+        Pass(name: "s", kind: VisibilityShading(lights: Culled), reads: ["visibility", "vertices", "triangles", "material_triangles", "lg", "lp", "lists"], writes: ["hdr"])"#;
+
+    #[test]
+    fn writes_an_r32float_depth_that_culling_reads() {
+        validate(FLOAT_FRAME, "hdr").unwrap();
+        let linked = format!(
+            r#"{FLOAT_FRAME}, Pass(name: "ll", kind: LightLinkedList(scale: 1), reads: ["fdepth", "lg", "lists"], writes: ["links"])"#
+        );
+        validate(&linked, "hdr").unwrap();
+    }
+
+    #[test]
+    fn an_r32float_depth_is_single_sample_and_read_only_where_supported() {
+        let msaa = FLOAT_FRAME.replace("fdepth", "fdepth4");
+        let e = errors(&msaa, "hdr");
+        assert!(
+            e.contains("pass 'cr', resource 'fdepth4': ComputeRaster writes 32-bit float depth per pixel: a single-sample Depth32Float texture (resolved by a draw) or R32Float"),
+            "{e}"
+        );
+        assert!(
+            e.contains("pass 'c', resource 'fdepth4': an R32Float depth is single-sample"),
+            "{e}"
+        );
+        // Forward shading tests its fragments against the depth: a depth format only.
+        let e = errors(
+            &format!(
+                r#"{FLOAT_FRAME}, Pass(name: "f", kind: ForwardShading(lights: AllLights), reads: ["fdepth", "lg", "lp"], writes: ["small"])"#
+            ),
+            "hdr",
+        );
+        assert!(e.contains("t.ron:"), "{e}");
+        assert!(
+            e.contains("pass 'f', resource 'fdepth': ForwardShading has no free slot for a colour texture in reads"),
+            "{e}"
+        );
+        assert!(
+            e.contains("an R32Float depth is read by LightCulling and LightLinkedList"),
+            "{e}"
+        );
+        // Transparent lists compare two depth textures.
+        let e = errors(
+            &FLOAT_FRAME.replace(
+                r#"reads: ["fdepth", "lg"]"#,
+                r#"reads: ["fdepth", "transparent_depth=depth", "lg"]"#,
+            ),
+            "hdr",
+        );
+        assert!(
+            e.contains("pass 'c', resource 'depth': transparent lists compare the transparent depth with the opaque one as depth textures; 'fdepth' is R32Float"),
             "{e}"
         );
     }

@@ -1,6 +1,8 @@
 //! `LightCulling`: per-tile light lists from the prepass depth (Frustum, HalfZ,
 //! DepthMask, Clustered), with an optional coarse stage. Runs `shaders/cull/light_culling.wgsl`.
-//! A multisampled depth is read sample by sample. With a `transparent_depth` (a
+//! A multisampled depth is read sample by sample. The depth may also be a single-sample
+//! R32Float texture (ComputeRaster's compute resolve), read as `texture_2d<f32>`
+//! (`FLOAT_DEPTH`); not with transparent lists. With a `transparent_depth` (a
 //! TransparentDepth pass's) the lists are for transparent surfaces: a tile spans, over
 //! its pixels that hold one, from the nearest transparent depth to the opaque depth
 //! behind it (seed 004).
@@ -123,9 +125,10 @@ impl LightCulling {
 }
 
 pub const SLOTS: &[SlotSpec] = &[
+    // A depth format, or R32Float depths (a compute-only frame's ComputeRaster).
     SlotSpec::new(
         slot::DEPTH,
-        SlotType::DepthTexture,
+        SlotType::DepthValues,
         Access::Read,
         Usage::Sampled,
     ),
@@ -146,6 +149,15 @@ pub const SLOTS: &[SlotSpec] = &[
 ];
 
 pub fn check(p: &LightCulling, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+    super::check_float_depth_samples(ctx, errors);
+    if let (Some(depth), Some(t)) = (ctx.slot(slot::DEPTH), ctx.slot(slot::TRANSPARENT_DEPTH)) {
+        if ctx.is_float_depth(depth) {
+            errors.push(ctx.mismatch(
+                t,
+                format!("transparent lists compare the transparent depth with the opaque one as depth textures; '{depth}' is R32Float: give the graph a Depth32Float opaque depth"),
+            ));
+        }
+    }
     if let (Some(depth), Some(t)) = (ctx.slot(slot::DEPTH), ctx.slot(slot::TRANSPARENT_DEPTH)) {
         let (ds, ts) = (ctx.samples(depth), ctx.samples(t));
         if ds != ts {

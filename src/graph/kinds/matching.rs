@@ -1,7 +1,7 @@
 //! The slot matcher every built-in kind shares: a pass's declared resources to its
 //! kind's slot table, by name where the declaration says so, else by type and order.
 
-use super::{check, KindCtx, SlotSpec, SlotType};
+use super::{check, is_float_depth, KindCtx, SlotSpec, SlotType};
 use crate::graph::error::GraphError;
 use crate::graph::model::{Name, PassDesc, ResourceDesc};
 use crate::graph::roles::{PassRoles, RoleCtx};
@@ -31,10 +31,11 @@ pub(crate) fn resolve(
     let names = || specs.iter().map(|s| s.name).collect::<Vec<_>>().join(", ");
     // Explicit slots and resources named like a free slot of their type go first, so
     // one that fills by type order cannot take the slot a later one is named after.
+    let float_depth = |name: &str| is_float_depth(ctx.resources.get(name).copied());
     let named_like = |name: &str, ty: SlotType, write: bool| {
-        specs
-            .iter()
-            .any(|s| s.name == name && s.ty.takes(ty, true) && s.access.allows(write))
+        specs.iter().any(|s| {
+            s.name == name && s.ty.takes(ty, true, float_depth(name)) && s.access.allows(write)
+        })
     };
     // Each resource's slot type, looked up once for both rounds.
     let typed: Vec<(bool, &Name, SlotType)> = [(false, &pass.reads), (true, &pass.writes)]
@@ -42,6 +43,16 @@ pub(crate) fn resolve(
         .flat_map(|(write, list)| list.iter().map(move |name| (write, name)))
         .filter_map(|(write, name)| Some((write, name, slot_type_of(ctx, name)?)))
         .collect(); // unknown resources are reported by validation
+
+    // An R32Float texture this kind cannot read as depth: say which kinds can.
+    let depth_hint = |name: &str| {
+        let has_depth_slot = specs.iter().any(|s| s.ty == SlotType::DepthTexture);
+        if float_depth(name) && has_depth_slot {
+            format!(" ({kind} reads depth from a depth texture only; an R32Float depth is read by LightCulling and LightLinkedList)")
+        } else {
+            String::new()
+        }
+    };
     for by_name in [true, false] {
         for &(write, name, ty) in &typed {
             let first = pass.explicit_slot(name).is_some() || named_like(name, ty, write);
@@ -67,14 +78,17 @@ pub(crate) fn resolve(
                         ));
                         continue;
                     }
-                    Some(s) if !s.ty.takes(ty, true) || !s.access.allows(write) => {
+                    Some(s)
+                        if !s.ty.takes(ty, true, float_depth(name)) || !s.access.allows(write) =>
+                    {
                         errors.push(ctx.mismatch(
                             pass,
                             name,
                             format!(
-                                "slot '{wanted}' takes {} {}",
+                                "slot '{wanted}' takes {} {}{}",
                                 s.ty.describe(),
-                                s.access.describe()
+                                s.access.describe(),
+                                depth_hint(name)
                             ),
                         ));
                         continue;
@@ -82,7 +96,7 @@ pub(crate) fn resolve(
                     Some(s) => s,
                 },
                 None => match specs.iter().find(|s| {
-                    s.ty.takes(ty, false)
+                    s.ty.takes(ty, false, float_depth(name))
                         && s.access.allows(write)
                         && !roles.slots.contains_key(s.name)
                 }) {
@@ -93,9 +107,10 @@ pub(crate) fn resolve(
                             pass,
                             name,
                             format!(
-                                "{kind} has no free slot for {} in {list} (its slots: {})",
+                                "{kind} has no free slot for {} in {list} (its slots: {}){}",
                                 ty.describe(),
-                                names()
+                                names(),
+                                depth_hint(name)
                             ),
                         ));
                         continue;

@@ -46,6 +46,10 @@ pub mod slot {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SlotType {
     DepthTexture,
+    /// A depth texture, or a single-sample R32Float texture of depth values (what a
+    /// compute-only frame writes: compute cannot store depth formats). Only kinds whose
+    /// shaders read either take it (`FLOAT_DEPTH` selects `texture_2d<f32>`).
+    DepthValues,
     /// Any texture that is not depth (the kind's checks narrow the format).
     ColorTexture,
     Buffer,
@@ -59,6 +63,7 @@ impl SlotType {
     fn describe(self) -> String {
         match self {
             SlotType::DepthTexture => "a depth texture".into(),
+            SlotType::DepthValues => "a depth texture (or an R32Float texture of depths)".into(),
             SlotType::ColorTexture => "a colour texture".into(),
             SlotType::Buffer => "a buffer".into(),
             SlotType::Import(from) => format!("an Import of {from:?}"),
@@ -68,12 +73,14 @@ impl SlotType {
         }
     }
     /// Whether a resource of type `ty` fills a slot of this type; `by_name`: the
-    /// resource is named after the slot (or names it).
-    fn takes(self, ty: SlotType, by_name: bool) -> bool {
+    /// resource is named after the slot (or names it); `float_depth`: it is an R32Float
+    /// texture (a colour texture that may hold depths; the kind checks its samples).
+    fn takes(self, ty: SlotType, by_name: bool, float_depth: bool) -> bool {
         match self {
             SlotType::Lights(from) => {
                 ty == SlotType::Import(from) || (by_name && ty == SlotType::Buffer)
             }
+            SlotType::DepthValues => ty == SlotType::DepthTexture || float_depth,
             _ => self == ty,
         }
     }
@@ -114,6 +121,10 @@ pub enum Usage {
     Sampled,
     /// A storage texture.
     Storage,
+    /// Drawn into or stored from compute, whichever the pass picks on this device (the
+    /// compute rasterizer and its hardware fallback): a depth format is an attachment,
+    /// R32Float a storage texture, any other format both.
+    AttachmentOrStorage,
     /// Buffers and imports: bound as storage or uniform.
     Bound,
 }
@@ -367,6 +378,11 @@ impl KindCtx<'_> {
             })
         )
     }
+    /// Whether the texture holds depths as R32Float (a `DepthValues` slot's other
+    /// format), at any sample count.
+    pub fn is_float_depth(&self, name: &str) -> bool {
+        is_float_depth(self.graph.resources.get(name).copied())
+    }
     pub fn is_single_rgba32f(&self, name: &str) -> bool {
         matches!(
             self.graph.resources.get(name),
@@ -379,6 +395,34 @@ impl KindCtx<'_> {
     }
     pub fn writes(&self, name: &str) -> bool {
         self.pass.writes.iter().any(|w| w == name)
+    }
+}
+
+/// Whether a resource is an R32Float texture: what a `DepthValues` slot takes besides
+/// depth formats.
+pub(crate) fn is_float_depth(resource: Option<&ResourceDesc>) -> bool {
+    matches!(
+        resource,
+        Some(ResourceDesc::Texture {
+            format: super::model::TextureFormat::R32Float,
+            ..
+        })
+    )
+}
+
+/// A `DepthValues` slot filled with an R32Float texture: single-sample (compute stores
+/// one value a pixel), else an error naming the pass and resource.
+pub fn check_float_depth_samples(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+    if let Some(depth) = ctx.slot(slot::DEPTH) {
+        if ctx.is_float_depth(depth) && ctx.samples(depth) > 1 {
+            errors.push(ctx.mismatch(
+                depth,
+                format!(
+                    "an R32Float depth is single-sample (compute stores one depth a pixel); it has {} samples: use a multisampled Depth32Float for MSAA",
+                    ctx.samples(depth)
+                ),
+            ));
+        }
     }
 }
 
@@ -519,6 +563,8 @@ pub(crate) mod test_support {
         Import(name: "material_triangles", from: MaterialTriangles),
         Texture(name: "visibility", format: R32Uint),
         Texture(name: "ids4", format: R32Uint, samples: 4),
+        Texture(name: "fdepth", format: R32Float),
+        Texture(name: "fdepth4", format: R32Float, samples: 4),
         Buffer(name: "lists"),
         Buffer(name: "links"),
         Import(name: "geometry", from: Geometry),

@@ -11,12 +11,29 @@ use crate::graph::error::GraphError;
 use crate::graph::model::{LightSource, SceneResource};
 use serde::{Deserialize, Serialize};
 
-/// `VisibilityShading(lights: Culled)`.
+/// `VisibilityShading(lights: Culled, light_loop: Forward)`.
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
 #[serde(deny_unknown_fields)]
 pub struct VisibilityShading {
     #[serde(default)]
     pub lights: LightSource,
+    #[serde(default)]
+    pub light_loop: LightLoop,
+}
+
+/// How a pixel walks its lights. All three give the same image to the bit (tested); they
+/// differ only in speed, so a graph can time them side by side.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
+pub enum LightLoop {
+    /// Forward shading's loop (`common/light_loop.wgsl`), per pixel. The default: the
+    /// fastest of the three on an NVIDIA H200 (README "Visibility buffer").
+    #[default]
+    Forward,
+    /// Per pixel, a light's range tested before its properties are read.
+    RangeFirst,
+    /// A workgroup whose pixels all read one tile list (Frustum and DepthMask lists)
+    /// stages it in workgroup memory, a batch at a time; other lists run `RangeFirst`.
+    Staged,
 }
 
 pub const VERTICES: &str = "vertices";
@@ -94,6 +111,21 @@ mod tests {
             ),
             "{e}"
         );
+    }
+
+    #[test]
+    fn light_loop_defaults_to_forward_and_parses_each_kind() {
+        use super::{LightLoop, VisibilityShading};
+        let parse = |t: &str| ron::from_str::<VisibilityShading>(t).unwrap();
+        assert_eq!(parse("(lights: Culled)").light_loop, LightLoop::Forward);
+        assert_eq!(VisibilityShading::default().light_loop, LightLoop::Forward);
+        assert_eq!(parse("(light_loop: Staged)").light_loop, LightLoop::Staged);
+        assert_eq!(
+            parse("(light_loop: RangeFirst)").light_loop,
+            LightLoop::RangeFirst
+        );
+        assert!(ron::from_str::<VisibilityShading>("(staging: false)").is_err());
+        assert!(ron::from_str::<VisibilityShading>("(light_loop: Fast)").is_err());
     }
 
     #[test]

@@ -1,33 +1,63 @@
-//! `ComputeRaster`: the merged opaque triangles rasterized in compute. One compute pass
-//! clears a per-pixel `u64` buffer, rasterizes a triangle per thread with a 64-bit
-//! atomic min of (depth bits, inverted id), and hands triangles with large bounding boxes
-//! to an indirect dispatch of one workgroup per 4,096 pixels of their boxes; a full-screen draw then resolves the
-//! buffer into the depth texture (`frag_depth`) and the R32Uint visibility texture.
+//! `ComputeRaster`: the merged opaque triangles rasterized in compute into a per-pixel
+//! `u64` buffer with a 64-bit atomic min of (depth bits, inverted id). One compute pass of
+//! four dispatches: `clear`; `setup`, a thread per triangle, appends a record per (clipped)
+//! fan triangle and its 64×64-pixel tiles to lists; `bin` (indirect), a thread per block
+//! of a tile, appends the tile's 8×8-pixel blocks the triangle may cover; `raster`
+//! (indirect), a thread per pixel of a block. A resolve then writes the buffer into the
+//! depth texture and the R32Uint visibility texture (a draw or a dispatch, by the depth's
+//! format: `compute_raster_resolve.rs`).
 //! See `shaders/visibility/compute_raster.wgsl`.
 
+use super::compute_raster_resolve::Resolve;
 use super::{defines, pass_error, PrepareCtx, PreparedPass, Timestamps};
-use crate::graph::kinds::compute_raster::VISIBILITY;
-use crate::graph::{slot, Name, ScheduledPass};
-use crate::render::bind::layout_entries;
-use crate::render::draws::{color_attachment, depth_attachment};
-use crate::render::pipelines::{Pipeline, PipelineKey};
-use crate::render::RenderError;
+use crate::gpu::readback::read_buffer;
+use crate::graph::{Name, ScheduledPass};
+use crate::render::pipelines::PipelineKey;
+use crate::render::report::{PassReport, RasterReport};
+use crate::render::{RenderError, Renderer};
 use crate::scene::AlphaMode;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
 const SHADER: &str = "visibility/compute_raster.wgsl";
-/// Threads per workgroup of the clear and per-triangle dispatches.
+/// Threads per workgroup of the setup dispatch (a thread per triangle).
 const GROUP: u32 = 64;
-/// Threads sharing one large triangle.
-const BIG_GROUP: u32 = 256;
-/// A (clipped) triangle whose pixel bounding box holds more pixels than this goes to the
-/// shared-workgroup dispatch: one thread would walk it alone while the others idle.
-const BIG_PIXELS: u32 = 1024;
-/// Pixels of a large triangle's box per workgroup (16 per thread): a screen-filling
-/// floor becomes hundreds of workgroups across the GPU instead of one.
-const BIG_CHUNK: u32 = 16 * BIG_GROUP;
+/// Threads per workgroup of the clear (a thread per pixel): a quarter as many workgroups
+/// to launch as 64 (32,400 at 1080p).
+const CLEAR_GROUP: u32 = 256;
+/// Pixels per side of a block, a thread per pixel in `raster`: small enough to fit the
+/// many small triangles tightly (a box of a few pixels touches one to four blocks).
+const BLOCK: u32 = 8;
+/// Blocks per `raster` workgroup (256 threads): tiny workgroups are bound by how fast
+/// the GPU launches them (harada lists ~57,500 blocks at 1080p); four blocks a workgroup
+/// launch a quarter as many, with the same occupancy and still a thread per pixel.
+const BLOCKS_PER_GROUP: u32 = 4;
+/// Blocks per side of a tile, a thread per block in `bin`. Setup lists a triangle's
+/// tiles serially, so a screen-filling triangle costs its thread 510 stores at 1080p
+/// (not 32,400 blocks).
+const TILE_BLOCKS: u32 = 8;
+/// Tiles per `bin` workgroup (256 threads), as for blocks.
+const TILES_PER_GROUP: u32 = 4;
+const TILE_PIXELS: u32 = BLOCK * TILE_BLOCKS;
+/// Bytes of a fan-triangle record and of a tile or block entry (as the shader's).
+const RECORD_BYTES: u64 = 64;
+const ENTRY_BYTES: u64 = 8;
+/// Most entries a list holds: the block counter, which grows by at most TILE_BLOCKS² per
+/// tile entry without checking, then stays under 2^30 (no wrap).
+const MAX_ENTRIES: u64 = 1 << 24;
+/// Most records: the tile counter, which grows by up to 16 tiles per record without
+/// checking, then stays under 2^26 (see the shader's `reserve_tiles`).
+const MAX_RECORDS: u64 = 1 << 22;
+/// Most triangles: the record counter grows by up to 6 per triangle (a triangle clipped
+/// by five planes is a fan of six) without checking, so this keeps it from wrapping.
+const MAX_TRIANGLES: u32 = u32::MAX / 8;
+/// Words of the counter buffer (see the shader's `RECORDS`..`SERIAL_BLOCKS`).
+const COUNTERS: usize = 8;
+/// Test hook: `records=N,tiles=N,blocks=N,groups=N` (any of them) overrides the lists'
+/// capacities and the workgroups per dispatch dimension, so tests can fill the lists and
+/// fold small dispatches into y. Read when the pass is prepared.
+pub const TEST_LIMITS_VAR: &str = "LIGHTGRAPH_COMPUTE_RASTER_TEST_LIMITS";
 
 /// What the rasterizer needs of the device: 64-bit integers and their atomic min on
 /// storage buffers.
@@ -37,12 +67,15 @@ pub const FEATURES: wgpu::Features =
 pub(super) struct ComputeRasterPass {
     name: Name,
     clear: (Arc<wgpu::ComputePipeline>, wgpu::BindGroup, [u32; 3]),
-    raster: (Arc<wgpu::ComputePipeline>, wgpu::BindGroup, [u32; 3]),
-    big: (Arc<wgpu::ComputePipeline>, wgpu::BindGroup),
-    big_args: wgpu::Buffer,
-    resolve: (Arc<wgpu::RenderPipeline>, wgpu::BindGroup),
-    depth: wgpu::TextureView,
-    visibility: wgpu::TextureView,
+    setup: (Arc<wgpu::ComputePipeline>, wgpu::BindGroup, [u32; 3]),
+    bin: (Arc<wgpu::ComputePipeline>, wgpu::BindGroup),
+    raster: (Arc<wgpu::ComputePipeline>, wgpu::BindGroup),
+    /// Indirect arguments of `bin` and `raster`, written by the dispatch before each.
+    tile_args: wgpu::Buffer,
+    block_args: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    capacity: ListCapacity,
+    resolve: Resolve,
 }
 
 /// A 1D grid of `items` threads in groups of `per_group`, folded into y past the
@@ -53,6 +86,81 @@ fn grid(items: u32, per_group: u32, max: u32) -> [u32; 3] {
         [groups, 1, 1]
     } else {
         [max, groups.div_ceil(max), 1]
+    }
+}
+
+/// Entries of the three work lists.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct ListCapacity {
+    records: u32,
+    tiles: u32,
+    blocks: u32,
+}
+
+/// Room for 1.5 fan triangles per triangle (back faces and triangles off screen give
+/// none, most others one; near-plane and side clipping give more), two tiles per record plus 16 screens of tiles, four blocks per record
+/// plus 8 screens of blocks (depth complexity 8 of large triangles), each within the
+/// device's binding size. Past that, work is rasterized serially and counted.
+fn list_capacity(triangles: u32, width: u32, height: u32, max_binding: u64) -> ListCapacity {
+    let screen_tiles = width.div_ceil(TILE_PIXELS) as u64 * height.div_ceil(TILE_PIXELS) as u64;
+    let screen_blocks = width.div_ceil(BLOCK) as u64 * height.div_ceil(BLOCK) as u64;
+    let records = triangles as u64 * 3 / 2 + 4096;
+    let fit = |n: u64, bytes: u64| n.min(max_binding / bytes).min(MAX_ENTRIES) as u32;
+    ListCapacity {
+        records: fit(records, RECORD_BYTES).min(MAX_RECORDS as u32),
+        tiles: fit(2 * records + 16 * screen_tiles, ENTRY_BYTES),
+        blocks: fit(4 * records + 8 * screen_blocks, ENTRY_BYTES),
+    }
+}
+
+/// The test hook's overrides (`TEST_LIMITS_VAR`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct TestLimits {
+    records: Option<u32>,
+    tiles: Option<u32>,
+    blocks: Option<u32>,
+    groups: Option<u32>,
+}
+
+fn parse_test_limits(text: &str) -> Result<TestLimits, String> {
+    let mut limits = TestLimits::default();
+    for item in text.split(',').map(str::trim).filter(|i| !i.is_empty()) {
+        let bad = || {
+            format!(
+                "{TEST_LIMITS_VAR}: '{item}' is not NAME=COUNT (records, tiles, blocks, groups)"
+            )
+        };
+        let (name, value) = item.split_once('=').ok_or_else(bad)?;
+        let value: u32 = value.trim().parse().map_err(|_| bad())?;
+        let field = match name.trim() {
+            "records" => &mut limits.records,
+            "tiles" => &mut limits.tiles,
+            "blocks" => &mut limits.blocks,
+            "groups" if value >= 1 => &mut limits.groups,
+            _ => return Err(bad()),
+        };
+        *field = Some(value);
+    }
+    Ok(limits)
+}
+
+impl TestLimits {
+    fn from_env() -> Result<Self, String> {
+        match std::env::var(TEST_LIMITS_VAR) {
+            Ok(text) => parse_test_limits(&text),
+            Err(_) => Ok(Self::default()),
+        }
+    }
+    fn apply(self, c: ListCapacity, max_groups: u32) -> (ListCapacity, u32) {
+        let capacity = ListCapacity {
+            records: self.records.map_or(c.records, |n| n.min(c.records)),
+            tiles: self.tiles.map_or(c.tiles, |n| n.min(c.tiles)),
+            blocks: self.blocks.map_or(c.blocks, |n| n.min(c.blocks)),
+        };
+        (
+            capacity,
+            self.groups.map_or(max_groups, |g| g.min(max_groups)),
+        )
     }
 }
 
@@ -104,11 +212,10 @@ pub(super) fn prepare(
     let pixels = width as u64 * height as u64;
     let limits = device.limits();
     let bytes = 8 * pixels;
-    if bytes
-        > limits
-            .max_storage_buffer_binding_size
-            .min(limits.max_buffer_size)
-    {
+    let max_binding = limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size);
+    if bytes > max_binding {
         return Err(pass_error(
             &sp.name,
             format!(
@@ -116,11 +223,27 @@ pub(super) fn prepare(
             ),
         ));
     }
-    let max_groups = limits.max_compute_workgroups_per_dimension;
-    // The large-triangle list (triangle, chunk) is dispatched one workgroup per entry, in
-    // x only: as many entries as one dispatch holds (512 KiB at 65,535); a triangle that
-    // finds it full is drawn by its own thread instead.
-    let capacity = max_groups.max(1);
+    if geometry.triangle_count > MAX_TRIANGLES {
+        return Err(pass_error(
+            &sp.name,
+            format!(
+                "{} triangles are over the {MAX_TRIANGLES} it counts",
+                geometry.triangle_count
+            ),
+        ));
+    }
+    // Pixel coordinates are packed in 16 bits in the lists' entries.
+    if width > 1 << 16 || height > 1 << 16 {
+        return Err(pass_error(
+            &sp.name,
+            format!("{width}×{height} is over the 65,536 pixels a side it addresses"),
+        ));
+    }
+    let test_limits = TestLimits::from_env().map_err(|m| pass_error(&sp.name, m))?;
+    let (capacity, max_groups) = test_limits.apply(
+        list_capacity(geometry.triangle_count, width, height, max_binding),
+        limits.max_compute_workgroups_per_dimension.max(1),
+    );
     let storage = |label: &str, size: u64, extra: wgpu::BufferUsages| {
         device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
@@ -134,12 +257,38 @@ pub(super) fn prepare(
         bytes,
         wgpu::BufferUsages::empty(),
     );
-    let big_list = storage(
-        "large triangles",
-        8 * capacity as u64,
-        wgpu::BufferUsages::empty(),
+    let none = wgpu::BufferUsages::empty();
+    // At least one entry each: a buffer of capacity 0 (the test hook) still binds.
+    let records = storage(
+        "compute raster triangle records",
+        RECORD_BYTES * capacity.records.max(1) as u64,
+        none,
     );
-    let big_args = storage("large triangle dispatch", 16, wgpu::BufferUsages::INDIRECT);
+    let tiles = storage(
+        "compute raster tiles",
+        ENTRY_BYTES * capacity.tiles.max(1) as u64,
+        none,
+    );
+    let blocks = storage(
+        "compute raster blocks",
+        ENTRY_BYTES * capacity.blocks.max(1) as u64,
+        none,
+    );
+    let counters = storage(
+        "compute raster counters",
+        4 * COUNTERS as u64,
+        wgpu::BufferUsages::COPY_SRC,
+    );
+    let tile_args = storage(
+        "compute raster bin dispatch",
+        16,
+        wgpu::BufferUsages::INDIRECT,
+    );
+    let block_args = storage(
+        "compute raster block dispatch",
+        16,
+        wgpu::BufferUsages::INDIRECT,
+    );
     let init = |label: &str, contents: &[u8], usage| {
         device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some(label),
@@ -149,7 +298,12 @@ pub(super) fn prepare(
     };
     let params = init(
         "compute raster params",
-        bytemuck::cast_slice(&[geometry.triangle_count, capacity, width, height]),
+        bytemuck::cast_slice(&[geometry.triangle_count, max_groups, width, height]),
+        wgpu::BufferUsages::UNIFORM,
+    );
+    let list_capacity = init(
+        "compute raster list capacity",
+        bytemuck::cast_slice(&[capacity.records, capacity.tiles, capacity.blocks, 0]),
         wgpu::BufferUsages::UNIFORM,
     );
     let sides = init(
@@ -159,145 +313,115 @@ pub(super) fn prepare(
     );
     let mut offered = cx.declared(sp)?;
     offered.buffer("raster_params", &params);
+    offered.buffer("list_capacity", &list_capacity);
     offered.buffer("single_sided", &sides);
     offered.buffer("vis", &vis);
-    offered.buffer("big_list", &big_list);
-    offered.buffer("big_args", &big_args);
+    offered.buffer("records", &records);
+    offered.buffer("tiles", &tiles);
+    offered.buffer("blocks", &blocks);
+    offered.buffer("counters", &counters);
+    offered.buffer("tile_args", &tile_args);
+    offered.buffer("block_args", &block_args);
     let key = |d: &[(&str, String)], state: &str| PipelineKey {
         shader: SHADER.into(),
         defines: defines(d),
         virtual_code: BTreeMap::new(),
         state: state.into(),
     };
-    let consts = [
-        ("GROUP", format!("{GROUP}u")),
-        ("BIG_GROUP", format!("{BIG_GROUP}u")),
-        ("BIG_PIXELS", format!("{BIG_PIXELS}u")),
-        ("BIG_CHUNK", format!("{BIG_CHUNK}u")),
-    ];
-    let (clear, clear_bind) =
-        cx.compute_pipeline(&sp.name, key(&consts, "clear"), "clear", &offered)?;
-    let mut atomic = consts.to_vec();
-    atomic.push(("ATOMIC", "1".into()));
-    let (raster, raster_bind) =
-        cx.compute_pipeline(&sp.name, key(&atomic, "raster"), "raster", &offered)?;
-    atomic.push(("BIG", "1".into()));
-    let big = cx.compute_pipeline(&sp.name, key(&atomic, "raster_big"), "raster_big", &offered)?;
-    let resolve = resolve_pipeline(cx, sp, key(&[("RESOLVE", "1".into())], "resolve"), &offered)?;
-    let depth = sp.required(slot::DEPTH);
+    let mut pipeline = |stage: &str, entry: &str| {
+        let d = [
+            ("GROUP", format!("{GROUP}u")),
+            ("CLEAR_GROUP", format!("{CLEAR_GROUP}u")),
+            ("BLOCK", format!("{BLOCK}u")),
+            ("BLOCKS_PER_GROUP", format!("{BLOCKS_PER_GROUP}u")),
+            ("TILE_BLOCKS", format!("{TILE_BLOCKS}u")),
+            ("TILES_PER_GROUP", format!("{TILES_PER_GROUP}u")),
+            (stage, "1".into()),
+        ];
+        cx.compute_pipeline(&sp.name, key(&d, entry), entry, &offered)
+    };
+    let (clear, clear_bind) = pipeline("CLEAR", "clear")?;
+    let (setup, setup_bind) = pipeline("SETUP", "setup")?;
+    let bin = pipeline("BIN", "bin")?;
+    let raster = pipeline("RASTER", "raster")?;
+    let resolve = Resolve::prepare(cx, sp, key(&[("RESOLVE", "1".into())], "resolve"), &offered)?;
     Ok(ComputeRasterPass {
         name: sp.name.clone(),
         clear: (
             clear,
             clear_bind,
-            grid(pixels.min(u32::MAX as u64) as u32, GROUP, max_groups),
+            grid(pixels.min(u32::MAX as u64) as u32, CLEAR_GROUP, max_groups),
         ),
-        raster: (
-            raster,
-            raster_bind,
+        setup: (
+            setup,
+            setup_bind,
             grid(geometry.triangle_count, GROUP, max_groups),
         ),
-        big,
-        big_args,
+        bin,
+        raster,
+        tile_args,
+        block_args,
+        counters,
+        capacity,
         resolve,
-        depth: cx.view(&sp.name, depth)?,
-        visibility: cx.view(&sp.name, sp.required(VISIBILITY))?,
     })
 }
 
-/// The full-screen draw that writes depth (`frag_depth`) and ids from the buffer.
-fn resolve_pipeline(
-    cx: &mut PrepareCtx,
-    sp: &ScheduledPass,
-    key: PipelineKey,
-    offered: &super::BindingSet,
-) -> Result<(Arc<wgpu::RenderPipeline>, wgpu::BindGroup), RenderError> {
-    let device = cx.device();
-    let layouts = cx.renderer.layouts.clone();
-    let stages = wgpu::ShaderStages::FRAGMENT;
-    let (pipeline, bindings) = cx.render_pipeline(&sp.name, key, |_, module, bindings| {
-        let bgl = layouts.get(&device, layout_entries(bindings, 0, stages));
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(&sp.name),
-            bind_group_layouts: &[Some(&bgl)],
-            immediate_size: 0,
-        });
-        Pipeline::Render(Arc::new(device.create_render_pipeline(
-            &wgpu::RenderPipelineDescriptor {
-                label: Some(&sp.name),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("resolve_vs"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: Default::default(),
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: wgpu::TextureFormat::Depth32Float,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Always),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("resolve_fs"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::TextureFormat::R32Uint.into())],
-                }),
-                multiview_mask: None,
-                cache: crate::render::pipelines::driver_cache().as_ref(),
-            },
-        )))
-    })?;
-    let bgl = layouts.get(&device, layout_entries(&bindings, 0, stages));
-    let bind = offered
-        .bind(&device, &sp.name, &bgl, &bindings, 0)
-        .map_err(|m| pass_error(&sp.name, m))?;
-    Ok((pipeline, bind))
-}
-
-impl PreparedPass for ComputeRasterPass {
-    fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
-        // One timestamp pair around both halves: the compute pass opens it, the resolve
-        // closes it.
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(&self.name),
-            timestamp_writes: ts.compute().map(|t| wgpu::ComputePassTimestampWrites {
-                end_of_pass_write_index: None,
-                ..t
-            }),
-        });
-        // wgpu orders dispatches that use a buffer read-write with a barrier between them.
-        for (pipeline, bind, [x, y, z]) in [&self.clear, &self.raster] {
+impl ComputeRasterPass {
+    /// The rasterizing dispatches, in one compute pass (wgpu orders dispatches that use a
+    /// buffer read-write, or as indirect arguments after writing it, with barriers).
+    fn record_raster(&self, pass: &mut wgpu::ComputePass<'_>) {
+        for (pipeline, bind, [x, y, z]) in [&self.clear, &self.setup] {
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, bind, &[]);
             pass.dispatch_workgroups(*x, *y, *z);
         }
-        pass.set_pipeline(&self.big.0);
-        pass.set_bind_group(0, &self.big.1, &[]);
-        pass.dispatch_workgroups_indirect(&self.big_args, 0);
-        drop(pass);
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        for ((pipeline, bind), args) in [
+            (&self.bin, &self.tile_args),
+            (&self.raster, &self.block_args),
+        ] {
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, bind, &[]);
+            pass.dispatch_workgroups_indirect(args, 0);
+        }
+    }
+
+    /// The lists' fill and the serial fallbacks of the last frame.
+    fn raster_report(&self, r: &Renderer) -> Result<RasterReport, RenderError> {
+        let bytes = read_buffer(&r.ctx.device, &r.ctx.queue, &self.counters)?;
+        let c: &[u32] = bytemuck::cast_slice(&bytes);
+        let cap = self.capacity;
+        Ok(RasterReport {
+            pass: self.name.to_string(),
+            records: c[0].min(cap.records),
+            records_capacity: cap.records,
+            tiles: c[1].min(cap.tiles),
+            tiles_capacity: cap.tiles,
+            blocks: c[2].min(cap.blocks),
+            blocks_capacity: cap.blocks,
+            serial_triangles: c[3],
+            serial_tiles: c[4],
+            serial_blocks: c[5],
+        })
+    }
+}
+
+impl PreparedPass for ComputeRasterPass {
+    fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
+        // One timestamp pair around all of it: the compute pass opens it, the resolve
+        // (a dispatch in it, or a draw after it) closes it.
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some(&self.name),
-            color_attachments: &[Some(color_attachment(
-                &self.visibility,
-                Some(wgpu::Color::TRANSPARENT),
-                None,
-            ))],
-            depth_stencil_attachment: Some(depth_attachment(&self.depth, true)),
-            timestamp_writes: ts.render().map(|t| wgpu::RenderPassTimestampWrites {
-                beginning_of_pass_write_index: None,
-                ..t
-            }),
-            occlusion_query_set: None,
-            multiview_mask: None,
+            timestamp_writes: self.resolve.compute_timestamps(ts),
         });
-        pass.set_pipeline(&self.resolve.0);
-        pass.set_bind_group(0, &self.resolve.1, &[]);
-        pass.draw(0..3, 0..1);
+        self.record_raster(&mut pass);
+        self.resolve.dispatch(&mut pass);
+        drop(pass);
+        self.resolve.draw(encoder, &self.name, ts);
+    }
+
+    fn report(&self, r: &Renderer) -> Result<Option<PassReport>, RenderError> {
+        Ok(Some(PassReport::Raster(self.raster_report(r)?)))
     }
 }
 
@@ -318,5 +442,56 @@ mod tests {
         assert_eq!(grid(0, 64, 65535), [1, 1, 1]);
         assert_eq!(grid(64 * 65535, 64, 65535), [65535, 1, 1]);
         assert_eq!(grid(64 * 65535 + 1, 64, 65535), [65535, 2, 1]);
+    }
+
+    #[test]
+    fn lists_hold_the_scene_and_fit_the_binding() {
+        // harada at 1080p: 2,240 triangles, 30×17 tiles, 240×135 blocks.
+        let c = list_capacity(2240, 1920, 1080, 1 << 30);
+        assert_eq!(c.records, 3 * 2240 / 2 + 4096);
+        assert_eq!(c.tiles, 2 * c.records + 16 * 30 * 17);
+        assert_eq!(c.blocks, 4 * c.records + 8 * 240 * 135);
+        // A small binding limit caps each list by its entry size.
+        let c = list_capacity(1 << 20, 1920, 1080, 1 << 20);
+        assert_eq!((c.records, c.tiles, c.blocks), (1 << 14, 1 << 17, 1 << 17));
+        // And no list passes its maximum (the counters never wrap).
+        let c = list_capacity(u32::MAX, 16384, 16384, u64::MAX);
+        assert_eq!((c.records, c.tiles, c.blocks), (1 << 22, 1 << 24, 1 << 24));
+    }
+
+    #[test]
+    fn test_limits_parse_and_only_lower() {
+        assert_eq!(parse_test_limits(""), Ok(TestLimits::default()));
+        let t = parse_test_limits("records=0, blocks=7,groups=3").unwrap();
+        assert_eq!(
+            t,
+            TestLimits {
+                records: Some(0),
+                tiles: None,
+                blocks: Some(7),
+                groups: Some(3)
+            }
+        );
+        let full = ListCapacity {
+            records: 10,
+            tiles: 20,
+            blocks: 5,
+        };
+        let (c, groups) = t.apply(full, 65535);
+        assert_eq!(
+            (c, groups),
+            (
+                ListCapacity {
+                    records: 0,
+                    tiles: 20,
+                    blocks: 5
+                },
+                3
+            )
+        );
+        for bad in ["records", "tiles=x", "groups=0", "pixels=3"] {
+            let e = parse_test_limits(bad).unwrap_err();
+            assert!(e.contains(TEST_LIMITS_VAR) && e.contains(bad), "{e}");
+        }
     }
 }

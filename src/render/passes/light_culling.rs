@@ -87,6 +87,10 @@ pub(super) fn prepare(
     if sp.samples > 1 {
         d.push(("MSAA", "1".into()));
     }
+    // A compute resolve's R32Float depth (validation keeps it single-sample and opaque).
+    if cx.float_depth(sp.required(slot::DEPTH)) {
+        d.push(("FLOAT_DEPTH", "1".into()));
+    }
     if sp.roles.slot(slot::TRANSPARENT_DEPTH).is_some() {
         d.push(("TRANSPARENT", "1".into()));
     }

@@ -41,6 +41,9 @@ pub(super) fn prepare(
     let mut offered = cx.declared(sp)?;
     offered.buffer("link_params", &params.buffer(&cx.device()));
     let mut d = vec![("SCALE", format!("{}u", layout.scale))];
+    if cx.float_depth(sp.required(slot::DEPTH)) {
+        d.push(("FLOAT_DEPTH", "1".into()));
+    }
     if let Some(lists) = sp.roles.slot(slot::LIGHT_LISTS) {
         let tiles = cx.graph.plan.list_layout(lists).ok_or_else(|| {
             pass_error(

@@ -4,6 +4,8 @@
 
 mod compute;
 mod compute_raster;
+mod compute_raster_fallback;
+mod compute_raster_resolve;
 mod deferred_shading;
 mod depth_prepass;
 mod forward_shading;
@@ -69,7 +71,9 @@ pub(super) fn prepare(
         PassKind::VplSpawn(p) => Box::new(vpl_spawn::prepare(cx, sp, p)?),
         PassKind::VisibilityBuffer => Box::new(visibility_buffer::prepare(cx, sp)?),
         PassKind::VisibilityShading(p) => Box::new(visibility_shading::prepare(cx, sp, p)?),
-        PassKind::ComputeRaster => Box::new(compute_raster::prepare(cx, sp)?),
+        // The compute rasterizer, or its hardware fallback on an adapter without its
+        // 64-bit atomics.
+        PassKind::ComputeRaster => compute_raster_fallback::prepare(cx, sp)?,
         PassKind::Compute {
             shader,
             entry,
@@ -145,6 +149,20 @@ impl PrepareCtx<'_> {
             .view(&self.graph.plan, name)
             .cloned()
             .ok_or_else(|| pass_error(pass, format!("texture '{name}' is not planned")))
+    }
+
+    /// Whether the declared texture holds depths as R32Float (a compute resolve's)
+    /// rather than in a depth format: its readers bind it as `texture_2d<f32>`
+    /// (`FLOAT_DEPTH`).
+    pub fn float_depth(&self, name: &str) -> bool {
+        crate::graph::kinds::is_float_depth(
+            self.graph
+                .checked
+                .desc
+                .resources
+                .iter()
+                .find(|r| r.name() == name),
+        )
     }
 
     pub fn buffer(&self, pass: &str, name: &str) -> Result<wgpu::Buffer, RenderError> {

@@ -22,20 +22,47 @@ pub(super) fn prepare(
     cx: &mut PrepareCtx,
     sp: &ScheduledPass,
 ) -> Result<VisibilityBuffer, RenderError> {
-    require_primitive_index(
-        cx.device().features(),
-        &cx.renderer.ctx.adapter.get_info().name,
-        &sp.name,
-    )?;
     let depth = sp.required(slot::DEPTH);
     let writes_depth = cx.graph.checked.desc.passes[sp.index]
         .writes
         .iter()
         .any(|w| w == depth);
+    let target = IdTargets {
+        depth: cx.view(&sp.name, depth)?,
+        clear_depth: sp.clears(depth),
+        writes_depth,
+        ids: cx.view(&sp.name, sp.required(VISIBILITY))?,
+    };
+    draw_ids(cx, sp, target)
+}
+
+/// Where the opaque meshes' ids are drawn: the ids (cleared to `NO_TRIANGLE`) over a
+/// single-sample Depth32Float depth, cleared to 1.0 or loaded.
+pub(super) struct IdTargets {
+    pub depth: wgpu::TextureView,
+    pub clear_depth: bool,
+    pub writes_depth: bool,
+    pub ids: wgpu::TextureView,
+}
+
+/// The hardware visibility pass's draws into `target`, for `sp` (this kind's pass, or the
+/// compute rasterizer's hardware fallback, which draws the same ids).
+pub(super) fn draw_ids(
+    cx: &mut PrepareCtx,
+    sp: &ScheduledPass,
+    target: IdTargets,
+) -> Result<VisibilityBuffer, RenderError> {
+    require_primitive_index(
+        cx.device().features(),
+        &cx.renderer.ctx.adapter.get_info().name,
+        &sp.name,
+    )?;
     let offered = cx.declared(sp)?;
     let draws = cx.renderer.mesh_draws(
         cx.gpu,
-        DrawMode::Visibility { writes_depth },
+        DrawMode::Visibility {
+            writes_depth: target.writes_depth,
+        },
         MeshSet::Opaque,
         sp.samples,
         &sp.name,
@@ -43,9 +70,9 @@ pub(super) fn prepare(
     )?;
     Ok(VisibilityBuffer {
         name: sp.name.clone(),
-        depth: cx.view(&sp.name, depth)?,
-        clear_depth: sp.clears(depth),
-        ids: cx.view(&sp.name, sp.required(VISIBILITY))?,
+        depth: target.depth,
+        clear_depth: target.clear_depth,
+        ids: target.ids,
         draws,
     })
 }
@@ -68,8 +95,14 @@ fn require_primitive_index(
     ))
 }
 
-impl PreparedPass for VisibilityBuffer {
-    fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
+impl VisibilityBuffer {
+    /// The draws in one render pass, with `timestamp_writes` (a fallback that runs more
+    /// after it writes only the start).
+    pub(super) fn record_with(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) {
         // Integer targets clear to the colour's red as an integer: NO_TRIANGLE is exact in f64.
         let empty = wgpu::Color {
             r: f64::from(NO_TRIANGLE),
@@ -81,11 +114,17 @@ impl PreparedPass for VisibilityBuffer {
             label: Some(&self.name),
             color_attachments: &[Some(color_attachment(&self.ids, Some(empty), None))],
             depth_stencil_attachment: Some(depth_attachment(&self.depth, self.clear_depth)),
-            timestamp_writes: ts.render(),
+            timestamp_writes,
             occlusion_query_set: None,
             multiview_mask: None,
         });
         self.draws.record(&mut pass);
+    }
+}
+
+impl PreparedPass for VisibilityBuffer {
+    fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
+        self.record_with(encoder, ts.render());
     }
 }
 

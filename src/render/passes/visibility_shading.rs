@@ -3,9 +3,10 @@
 //! visibility_shading.wgsl). Textured materials sample with explicit derivatives
 //! (`MaterialProgram::compute_wgsl`) and bind their textures in group 2.
 
-use super::{defines, PrepareCtx, PreparedPass, Timestamps};
+use super::{defines, PrepareCtx, PreparedPass, ShadeLists, Timestamps};
+use crate::graph::kinds::visibility_shading::LightLoop;
 use crate::graph::Name;
-use crate::graph::{ScheduledPass, VisibilityShading};
+use crate::graph::{ListLayout, ScheduledPass, VisibilityShading};
 use crate::render::pipelines::PipelineKey;
 use crate::render::RenderError;
 use std::collections::BTreeMap;
@@ -30,6 +31,7 @@ pub(super) fn prepare(
 ) -> Result<VisibilityShadingPass, RenderError> {
     let mut offered = cx.declared(sp)?;
     let lists = cx.shading_lists(sp, p.lights, &mut offered)?;
+    let light_loop = light_loop(cx, sp, p, lists);
     let ranges = cx.merged(&sp.name)?.material_ranges.clone();
     // Only materials that own triangles get a dispatch (blended ones never do); the first
     // also clears pixels nothing covers, so one runs even for a scene without triangles.
@@ -51,6 +53,7 @@ pub(super) fn prepare(
             d.push(("MATERIAL_TEXTURED", "1".into()));
         }
         d.extend(lists.define());
+        d.extend(loop_define(light_loop));
         let key = PipelineKey {
             shader: "visibility/visibility_shading.wgsl".into(),
             defines: defines(&d),
@@ -72,8 +75,54 @@ pub(super) fn prepare(
         name: sp.name.clone(),
         dispatches,
         bind: bind.ok_or_else(|| super::pass_error(&sp.name, "no material to shade".into()))?,
-        groups: [cx.size.width.div_ceil(8), cx.size.height.div_ceil(8), 1],
+        groups: [
+            cx.size.width.div_ceil(WORKGROUP_SIDE),
+            cx.size.height.div_ceil(WORKGROUP_SIDE),
+            1,
+        ],
     })
+}
+
+/// Pixels per side of the shader's workgroup (`@workgroup_size(8, 8, 1)`).
+const WORKGROUP_SIDE: u32 = 8;
+
+/// The define that picks the shader's light loop (shaders/visibility/staged_lights.wgsl).
+fn loop_define(l: LightLoop) -> Option<(&'static str, String)> {
+    match l {
+        LightLoop::Forward => None,
+        LightLoop::RangeFirst => Some(("RANGE_FIRST", "1".into())),
+        LightLoop::Staged => Some(("STAGED_LIGHTS", "1".into())),
+    }
+}
+
+/// The loop the graph asked for, for `lights` read from `lists`.
+fn light_loop(
+    cx: &PrepareCtx,
+    sp: &ScheduledPass,
+    p: &VisibilityShading,
+    lists: ShadeLists,
+) -> LightLoop {
+    let layout = match lists {
+        ShadeLists::Tiles => cx
+            .graph
+            .plan
+            .list_layout(sp.required(crate::graph::slot::LIGHT_LISTS)),
+        ShadeLists::AllLights | ShadeLists::Links => None,
+    };
+    choose_light_loop(p.light_loop, layout)
+}
+
+/// `Staged` only for tile lists with one list per tile (Frustum, DepthMask) whose tile is
+/// a multiple of the workgroup's side, so no workgroup straddles two tiles (`RangeFirst`
+/// otherwise); `layout` is `None` for linked lists and all lights.
+fn choose_light_loop(asked: LightLoop, layout: Option<ListLayout>) -> LightLoop {
+    match (asked, layout) {
+        (LightLoop::Staged, Some(l)) if l.lists_per_tile == 1 && l.tile % WORKGROUP_SIDE == 0 => {
+            LightLoop::Staged
+        }
+        (LightLoop::Staged, _) => LightLoop::RangeFirst,
+        (other, _) => other,
+    }
 }
 
 impl PreparedPass for VisibilityShadingPass {
@@ -91,5 +140,38 @@ impl PreparedPass for VisibilityShadingPass {
             }
             pass.dispatch_workgroups(x, y, z);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::choose_light_loop;
+    use crate::graph::kinds::visibility_shading::LightLoop::{Forward, RangeFirst, Staged};
+    use crate::graph::{CullVariant, ListLayout, ListStorage};
+
+    fn layout(tile: u32, variant: CullVariant) -> Option<ListLayout> {
+        let storage = ListStorage::Compact { max_indices: 1024 };
+        Some(ListLayout::new(tile, variant, storage, 333, 197))
+    }
+
+    #[test]
+    fn stages_one_list_per_tile_and_walks_the_rest_per_pixel() {
+        for tile in [8, 16] {
+            for variant in [CullVariant::Frustum, CullVariant::DepthMask] {
+                let l = layout(tile, variant);
+                assert_eq!(choose_light_loop(Staged, l), Staged, "{l:?}");
+                assert_eq!(choose_light_loop(Forward, l), Forward, "{l:?}");
+                assert_eq!(choose_light_loop(RangeFirst, l), RangeFirst, "{l:?}");
+            }
+            for variant in [CullVariant::HalfZ, CullVariant::Clustered { slices: 16 }] {
+                let l = layout(tile, variant);
+                assert_eq!(choose_light_loop(Staged, l), RangeFirst, "{l:?}");
+            }
+        }
+        // A tile the workgroup would straddle (the culling pass refuses it today).
+        let l = layout(12, CullVariant::Frustum);
+        assert_eq!(choose_light_loop(Staged, l), RangeFirst);
+        assert_eq!(choose_light_loop(Staged, None), RangeFirst);
+        assert_eq!(choose_light_loop(Forward, None), Forward);
     }
 }

@@ -1,0 +1,188 @@
+//! `ComputeRaster` on an adapter without its 64-bit atomics (`compute_raster::FEATURES`):
+//! drawn with the hardware rasterizer instead, by the `VisibilityBuffer` pass's own draws
+//! (`visibility_buffer::draw_ids`: the same ids and depth as `graphs/visibility_buffer.ron`),
+//! into the pass's outputs, and every frame's report says so ([`FallbackReport`]). An
+//! R32Float depth is drawn into an internal Depth32Float texture (outside the graph's
+//! memory plan) and copied into it by one compute dispatch
+//! (`shaders/visibility/compute_raster_depth_copy.wgsl`, bit-exact).
+//! Alpha-masked materials stay refused: the draws could alpha-test them, but a graph
+//! should draw the same pixels on every adapter.
+
+use super::compute_raster::{self, FEATURES};
+use super::visibility_buffer::{draw_ids, IdTargets, VisibilityBuffer};
+use super::{defines, pass_error, PrepareCtx, PreparedPass, Timestamps};
+use crate::graph::kinds::compute_raster::VISIBILITY;
+use crate::graph::{slot, Name, ScheduledPass};
+use crate::render::bind::Bound;
+use crate::render::pipelines::PipelineKey;
+use crate::render::report::{FallbackReport, PassReport};
+use crate::render::{RenderError, Renderer};
+use crate::scene::AlphaMode;
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+const COPY_SHADER: &str = "visibility/compute_raster_depth_copy.wgsl";
+/// The copy's workgroup side (8×8 pixels).
+const TILE: u32 = 8;
+/// What the report says the pass did instead.
+const INSTEAD: &str = "drawn with the hardware rasterizer";
+
+/// The compute rasterizer where the device has its features, else the hardware fallback.
+pub(super) fn prepare(
+    cx: &mut PrepareCtx,
+    sp: &ScheduledPass,
+) -> Result<Box<dyn PreparedPass>, RenderError> {
+    let missing = FEATURES - cx.device().features();
+    if missing.is_empty() {
+        return Ok(Box::new(compute_raster::prepare(cx, sp)?));
+    }
+    Ok(Box::new(HardwareRaster::prepare(cx, sp, missing)?))
+}
+
+struct HardwareRaster {
+    name: Name,
+    draws: VisibilityBuffer,
+    /// An R32Float depth: the copy from the drawn Depth32Float.
+    copy: Option<(Arc<wgpu::ComputePipeline>, wgpu::BindGroup, [u32; 3])>,
+    report: FallbackReport,
+}
+
+impl HardwareRaster {
+    fn prepare(
+        cx: &mut PrepareCtx,
+        sp: &ScheduledPass,
+        missing: wgpu::Features,
+    ) -> Result<Self, RenderError> {
+        let ctx = &cx.renderer.ctx;
+        let report = FallbackReport {
+            pass: sp.name.to_string(),
+            adapter: ctx.adapter_name(),
+            missing,
+            disabled: missing & ctx.disabled_features,
+            instead: INSTEAD,
+        };
+        if !cx
+            .device()
+            .features()
+            .contains(wgpu::Features::PRIMITIVE_INDEX)
+        {
+            return Err(pass_error(
+                &sp.name,
+                format!(
+                    "adapter {} lacks {missing} for the compute rasterizer, and PRIMITIVE_INDEX for its hardware fallback (the visibility buffer's draws): neither can write triangle ids here",
+                    report.adapter
+                ),
+            ));
+        }
+        refuse_alpha_masked(cx, sp)?;
+        let depth = sp.required(slot::DEPTH);
+        let ids = cx.view(&sp.name, sp.required(VISIBILITY))?;
+        if !cx.float_depth(depth) {
+            let target = IdTargets {
+                depth: cx.view(&sp.name, depth)?,
+                clear_depth: true,
+                writes_depth: true,
+                ids,
+            };
+            return Ok(Self {
+                name: sp.name.clone(),
+                draws: draw_ids(cx, sp, target)?,
+                copy: None,
+                report,
+            });
+        }
+        let device = cx.device();
+        let drawn = device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some("compute raster fallback depth"),
+                size: wgpu::Extent3d {
+                    width: cx.size.width,
+                    height: cx.size.height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Depth32Float,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+            .create_view(&Default::default());
+        let mut offered = cx.declared(sp)?;
+        offered.offer("drawn_depth", Bound::View(drawn.clone()));
+        let key = PipelineKey {
+            shader: COPY_SHADER.into(),
+            defines: defines(&[]),
+            virtual_code: BTreeMap::new(),
+            state: "copy_depth".into(),
+        };
+        let (pipeline, bind) = cx.compute_pipeline(&sp.name, key, "copy_depth", &offered)?;
+        let groups = [
+            cx.size.width.div_ceil(TILE),
+            cx.size.height.div_ceil(TILE),
+            1,
+        ];
+        let target = IdTargets {
+            depth: drawn,
+            clear_depth: true,
+            writes_depth: true,
+            ids,
+        };
+        Ok(Self {
+            name: sp.name.clone(),
+            draws: draw_ids(cx, sp, target)?,
+            copy: Some((pipeline, bind, groups)),
+            report,
+        })
+    }
+}
+
+/// Masked materials are refused as the compute rasterizer refuses them, naming the pass
+/// and the material.
+fn refuse_alpha_masked(cx: &PrepareCtx, sp: &ScheduledPass) -> Result<(), RenderError> {
+    for mesh in cx.gpu.opaque_draws() {
+        let material = &cx.gpu.materials[cx.gpu.meshes[mesh].material];
+        if let AlphaMode::Mask(_) = material.alpha_mode {
+            return Err(pass_error(
+                &sp.name,
+                format!(
+                    "material '{}' is alpha-masked: ComputeRaster has no alpha test, and its hardware fallback on this adapter ({INSTEAD}) refuses it alike so a graph draws the same everywhere (use DepthPrepass or VisibilityBuffer for scenes with masked materials)",
+                    material.name
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+impl PreparedPass for HardwareRaster {
+    fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
+        let Some((pipeline, bind, groups)) = &self.copy else {
+            self.draws.record_with(encoder, ts.render());
+            return;
+        };
+        // One timestamp pair: the draws open it, the copy closes it.
+        self.draws.record_with(
+            encoder,
+            ts.render().map(|t| wgpu::RenderPassTimestampWrites {
+                end_of_pass_write_index: None,
+                ..t
+            }),
+        );
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(&self.name),
+            timestamp_writes: ts.compute().map(|t| wgpu::ComputePassTimestampWrites {
+                beginning_of_pass_write_index: None,
+                ..t
+            }),
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, bind, &[]);
+        pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
+    }
+
+    fn report(&self, _r: &Renderer) -> Result<Option<PassReport>, RenderError> {
+        Ok(Some(PassReport::Fallback(self.report.clone())))
+    }
+}
