@@ -299,18 +299,26 @@ fn render_reports_compact_lists_and_their_bound() {
     for (g, bound) in [(graph, 16_777_216), (small, 1000)] {
         let out = render_64x36(dir.path(), &g, &["--scene", scene.to_str().unwrap()]);
         // Harada's 3,072 lights at 64x36 want 4,375 indices: fixed lists of 256 overflow
-        // in six tiles, compact lists hold them all under the shipped bound.
+        // in six tiles, compact lists hold them all under the shipped bound (681 in the
+        // scratch slots of the six lists of at most 256). Under 1,000 the slots are
+        // lowered to 41 (they take at most half the bound: 1000 / (2 · 12)), no list is
+        // that short, and the pool after the slots holds 508 of the 4,375.
         assert!(out.contains("light_culling: 12 tiles x 1 lists"), "{out}");
-        let held = if bound == 1000 { 1000 } else { 4375 };
+        let (held, slots) = if bound == 1000 {
+            (508, "0 in scratch slots of 41")
+        } else {
+            (4375, "681 in scratch slots of 256")
+        };
         assert!(
             out.contains(&format!("(compact, {held} of max_indices {bound}; ")),
             "{out}"
         );
-        let warning =
-            "WARNING: light_culling: the lists wanted 4375 light indices, over max_indices 1000: ";
+        assert!(out.contains(&format!(" MiB; {slots})")), "{out}");
+        let warning = "WARNING: light_culling: the lists wanted 4375 light indices, 4375 of them in lists longer than their scratch slot of 41, over the 508 the pool holds (max_indices 1000 less 492 in scratch slots): ";
         assert_eq!(out.contains(warning), bound == 1000, "{out}");
         if bound == 1000 {
-            assert!(out.contains("(max_indices: 4375 fits this frame)"), "{out}");
+            // Slots of the whole 256 and a pool for every pooled list: 12 · 256 + 4,375.
+            assert!(out.contains("(max_indices: 7447 fits this frame)"), "{out}");
         }
     }
 }

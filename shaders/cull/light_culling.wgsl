@@ -1,6 +1,6 @@
 // Tiled light culling (Forward+, seed 000): one workgroup per tile and list. The
-// workgroup finds the tile's depth range with atomics on the float bits (depths are
-// non-negative, so their bits order like integers), tests every light against the
+// workgroup finds the tile's depth range as the min and max of the float bits (depths
+// are non-negative, so their bits order like integers), tests every light against the
 // tile's frustum, builds the list in workgroup memory in ascending light order, then
 // reserves room in the shared pool with one global atomic.
 // With COARSE > 1 a first dispatch (`coarse`) culls every light against coarse tiles of
@@ -17,11 +17,14 @@
 // visible transparent fragment lies in it. Samples without one contribute nothing.
 // COMPACT: lists that never overflow (count → prefix sum → fill). `main` runs twice with
 // the same pipeline, so both runs test every light with the same machine code:
-// `cull_phase.x` 0 counts each list (entry count, depth range, block sums), 1 fills it.
-// Between them `scan_blocks` (one workgroup) and `scan_lists` (a workgroup per
-// SCAN_BLOCK lists) turn the counts into offsets in one flat index array. A list runs
-// past the array's end (`list_params.pool_indices`, the graph's max_indices) only when
-// the lists together want more: its count is cut to what fits, and the cut is counted.
+// `compact.phase` 0 counts each list (entry count, depth range, block sums) and writes
+// its first `compact.scratch` indices to the list's scratch slot; 1 fills the lists
+// longer than their slot (the other workgroups return at once). Between them
+// `scan_blocks` (one workgroup) and `scan_lists` (a workgroup per SCAN_BLOCK lists) point
+// each list that fits its slot there, and prefix-sum the longer lists' counts into
+// offsets in the pool after the slots. A list runs past the index array's end
+// (`list_params.pool_indices`, the graph's max_indices) only when the long lists
+// together want more than the pool: its count is cut to what fits, and the cut is counted.
 // Defines: TILE (8 or 16), CAPACITY, VARIANT (see types.wgsl), COARSE, COARSE_CAPACITY,
 // SAMPLES, MSAA, FLOAT_DEPTH, TRANSPARENT, COMPACT, SCAN_BLOCK.
 
@@ -52,26 +55,39 @@
 #endif
 #endif
 #if COMPACT
-// Per scan block of SCAN_BLOCK lists: the sum of its lists' counts (then, after
-// `scan_blocks`, the offset of its first list) and whether the sum wrapped past u32.
+// Per scan block of SCAN_BLOCK lists: the sum of the counts of its lists longer than
+// their scratch slot (then, after `scan_blocks`, the block's first offset in the pool)
+// and whether the sum wrapped past u32.
 @group(0) @binding(7) var<storage, read_write> list_block_sums: array<atomic<u32>>;
-// x: 0 count, 1 fill.
-@group(0) @binding(8) var<uniform> cull_phase: vec4<u32>;
+@group(0) @binding(8) var<uniform> compact: CompactParams;
+
+struct CompactParams {
+    // 0 count, 1 fill.
+    phase: u32,
+    // Light indices of each list's scratch slot (`ListLayout::scratch_per_list`): slot l
+    // is words l·scratch.. of the index array; the pool follows all slots.
+    scratch: u32,
+    _pad0: u32,
+    _pad1: u32,
+};
 #endif
 
 const THREADS: u32 = TILE * TILE;
 const MASK_WORDS: u32 = THREADS / 32u;
 const FAR_BITS: u32 = 0x7f7fffffu;
 
-var<workgroup> z_min_bits: atomic<u32>;
-var<workgroup> z_max_bits: atomic<u32>;
+// Per invocation, then per column of invocations: (min, max) view-depth bits (see
+// `workgroup_depth_range`).
+var<workgroup> depth_partial: array<vec2<u32>, THREADS>;
 var<workgroup> depth_mask: atomic<u32>;
-var<workgroup> hits: array<atomic<u32>, MASK_WORDS>;
-var<workgroup> list_len: u32;
+// Hit bits of a batch of candidates, two sets: a batch clears the next batch's set while
+// it reads its own, so a batch needs two barriers, not three.
+var<workgroup> hits: array<array<atomic<u32>, MASK_WORDS>, 2>;
 var<workgroup> coarse_count: u32;
 #if COMPACT
-var<workgroup> fill_offset: u32;
-var<workgroup> fill_kept: u32;
+// The fill's list entry: (offset, kept count), and the light after its slot's last.
+var<workgroup> fill_entry: vec2<u32>;
+var<workgroup> fill_below: u32;
 const PHASE_FILL: u32 = 1u;
 #else
 var<workgroup> list: array<u32, CAPACITY>;
@@ -111,24 +127,57 @@ fn sample_range(pixel: vec2<u32>, s: u32) -> vec2<f32> {
 #endif
 }
 
-// Folds every sample of a pixel into the workgroup's depth range.
-fn add_depth_sample(pixel: vec2<u32>) {
+// Folds every sample of a pixel into `acc`: the (min, max) float bits of the view
+// depths of the samples that hold geometry. Depths are non-negative, so their bits order
+// like integers; (FAR_BITS, 0) holds nothing.
+fn add_depth_sample(acc: vec2<u32>, pixel: vec2<u32>) -> vec2<u32> {
+    var a = acc;
     for (var s = 0u; s < SAMPLES; s++) {
         let r = sample_range(pixel, s);
         if (r.x >= 0.0) {
-            atomicMin(&z_min_bits, bitcast<u32>(r.x));
-            atomicMax(&z_max_bits, bitcast<u32>(r.y));
+            a = vec2<u32>(min(a.x, bitcast<u32>(r.x)), max(a.y, bitcast<u32>(r.y)));
         }
     }
+    return a;
+}
+
+// The (min, max) of every invocation's `v`, for every invocation: each of the first TILE
+// invocations folds a column of TILE values (THREADS = TILE²), then every invocation
+// folds the TILE column results. Min and max are exact in any order, so this is bit for
+// bit what atomics on two workgroup words gave, without 2·THREADS atomics queueing on
+// the same two words. Two barriers; the first also orders what was stored before it.
+fn workgroup_depth_range(local: u32, v: vec2<u32>) -> vec2<u32> {
+    depth_partial[local] = v;
+    workgroupBarrier();
+    if (local < TILE) {
+        // Reads only words TILE.. and writes only its own word below TILE.
+        var a = v;
+        for (var k = 1u; k < TILE; k++) {
+            let b = depth_partial[local + k * TILE];
+            a = vec2<u32>(min(a.x, b.x), max(a.y, b.y));
+        }
+        depth_partial[local] = a;
+    }
+    workgroupBarrier();
+    var a = depth_partial[0];
+    for (var k = 1u; k < TILE; k++) {
+        let b = depth_partial[k];
+        a = vec2<u32>(min(a.x, b.x), max(a.y, b.y));
+    }
+    return a;
 }
 
 // The 2.5D mask's cells every sample of a pixel occupies within [lo, hi].
 fn add_depth_cells(pixel: vec2<u32>, lo: f32, hi: f32) {
+    var cells = 0u;
     for (var s = 0u; s < SAMPLES; s++) {
         let r = sample_range(pixel, s);
         if (r.x >= 0.0) {
-            atomicOr(&depth_mask, cells_between(cell_of(r.x, lo, hi), cell_of(r.y, lo, hi)));
+            cells |= cells_between(cell_of(r.x, lo, hi), cell_of(r.y, lo, hi));
         }
+    }
+    if (cells != 0u) {
+        atomicOr(&depth_mask, cells);
     }
 }
 
@@ -155,21 +204,49 @@ fn main(
     @builtin(local_invocation_index) local: u32,
     @builtin(local_invocation_id) lid: vec3<u32>,
 ) {
-    if (local == 0u) {
-        atomicStore(&z_min_bits, FAR_BITS);
-        atomicStore(&z_max_bits, 0u);
-        atomicStore(&depth_mask, 0u);
-        list_len = 0u;
+    let list_index = (group.y * list_params.tiles_x + group.x) * list_params.lists_per_tile + group.z;
+#if COMPACT
+    // Where the hits go: counting, the first `scratch` to the list's scratch slot;
+    // filling, the `kept` the scan gave the list, from its offset.
+    let filling = compact.phase == PHASE_FILL;
+    var start = list_index * compact.scratch;
+    var kept = compact.scratch;
+    if (filling) {
+        if (local == 0u) {
+            let e = HEADER_WORDS + ENTRY_WORDS * list_index;
+            fill_entry = vec2<u32>(atomicLoad(&light_lists[e]), atomicLoad(&light_lists[e + 1u]));
+        }
+        let entry = workgroupUniformLoad(&fill_entry);
+        start = entry.x;
+        kept = entry.y;
+        // A list in its scratch slot is whole since the count; an empty one, or one
+        // with no room left under the bound, has nothing to place.
+        if (kept == 0u || start < compact.scratch * list_count()) {
+            return;
+        }
     }
-    workgroupBarrier();
+    let offset = list_params.pool_offset + start;
+#endif
+    // Ordered before their first use by the depth range's barriers. The coarse tile's
+    // count is read now, so the read overlaps the depth's instead of following it.
+    let coarse_x = (list_params.tiles_x + COARSE - 1u) / COARSE;
+    let coarse_base = ((group.y / COARSE) * coarse_x + group.x / COARSE) * COARSE_STRIDE;
+    if (local == 0u) {
+        atomicStore(&depth_mask, 0u);
+        if (COARSE > 1u) {
+            coarse_count = coarse_lists[coarse_base];
+        }
+    }
+    if (local < MASK_WORDS) {
+        atomicStore(&hits[0][local], 0u);
+    }
 
     // 1. The tile's depth range, over the samples that hold geometry.
     let pixel = group.xy * TILE + lid.xy;
-    add_depth_sample(pixel);
-    workgroupBarrier();
-    let tile_min = bitcast<f32>(atomicLoad(&z_min_bits));
-    let tile_max = bitcast<f32>(atomicLoad(&z_max_bits));
-    let empty_tile = atomicLoad(&z_max_bits) == 0u;
+    let range = workgroup_depth_range(local, add_depth_sample(vec2<u32>(FAR_BITS, 0u), pixel));
+    let tile_min = bitcast<f32>(range.x);
+    let tile_max = bitcast<f32>(range.y);
+    let empty_tile = range.y == 0u;
 
     // 2. This list's depth range.
     var lo = tile_min;
@@ -185,60 +262,53 @@ fn main(
         if (group.z == 0u) { lo = tile_min; }
     }
     let empty = empty_tile || lo > hi;
-    if (VARIANT == VARIANT_DEPTH_MASK && !empty_tile) {
-        add_depth_cells(pixel, tile_min, tile_max);
-    }
 
-    // 3. Side planes and bounding sphere of the tile's frustum slice.
+    // 3. Side planes and bounding sphere of the tile's frustum slice, and (DepthMask)
+    //    the cells of the tile's depth range its samples occupy.
     let bounds = tile_bounds(group.xy * TILE, TILE, lo, hi, empty);
-    workgroupBarrier();
-    let tile_mask = atomicLoad(&depth_mask);
+    var tile_mask = 0u;
+    if (VARIANT == VARIANT_DEPTH_MASK) {
+        if (!empty_tile) {
+            add_depth_cells(pixel, tile_min, tile_max);
+        }
+        workgroupBarrier();
+        tile_mask = atomicLoad(&depth_mask);
+    }
 
     // 4. Candidates: the coarse tile's lights, or every light. In batches of THREADS;
     //    ranks within a batch from a bit mask keep the list in ascending light order.
     var count = frame.light_count;
-    var coarse_base = 0u;
     var from_coarse = false;
     if (COARSE > 1u) {
-        let coarse_x = (list_params.tiles_x + COARSE - 1u) / COARSE;
-        coarse_base = ((group.y / COARSE) * coarse_x + group.x / COARSE) * COARSE_STRIDE;
-        if (local == 0u) {
-            coarse_count = coarse_lists[coarse_base];
-        }
         let n = workgroupUniformLoad(&coarse_count);
         if (n <= COARSE_CAPACITY) {
             count = n;
             from_coarse = true;
         }
     }
-    let list_index = (group.y * list_params.tiles_x + group.x) * list_params.lists_per_tile + group.z;
-#if COMPACT
-    // The fill writes straight into the list's run of the index array (nothing while
-    // counting: `kept` 0).
-    let filling = cull_phase.x == PHASE_FILL;
-    var start = 0u;
-    var kept = 0u;
-    if (filling) {
-        if (local == 0u) {
-            let e = HEADER_WORDS + ENTRY_WORDS * list_index;
-            fill_offset = atomicLoad(&light_lists[e]);
-            fill_kept = atomicLoad(&light_lists[e + 1u]);
-        }
-        start = workgroupUniformLoad(&fill_offset);
-        kept = workgroupUniformLoad(&fill_kept);
-        // A list with no room (no lights, or all past the bound) has nothing to place.
-        if (kept == 0u) {
-            count = 0u;
-        }
-    }
-    let offset = list_params.pool_offset + start;
-#endif
     var total = 0u;
-    for (var base = 0u; base < count; base += THREADS) {
-        if (local < MASK_WORDS) {
-            atomicStore(&hits[local], 0u);
+    // Candidates from `first` on; lights below `below` are not tested.
+    var first = 0u;
+    var below = 0u;
+#if COMPACT
+    if (filling && compact.scratch > 0u) {
+        // A pooled list's first `scratch` lights are in its slot since the count: copied,
+        // and only the candidates after the last of them are tested again. Candidates
+        // ascend, so the first `scratch` of them (of all lights: `below`) come no later.
+        let slot_word = list_params.pool_offset + list_index * compact.scratch;
+        for (var k = local; k < min(compact.scratch, kept); k += THREADS) {
+            atomicStore(&light_lists[offset + k], atomicLoad(&light_lists[slot_word + k]));
         }
-        workgroupBarrier();
+        if (local == 0u) {
+            fill_below = atomicLoad(&light_lists[slot_word + compact.scratch - 1u]) + 1u;
+        }
+        below = workgroupUniformLoad(&fill_below);
+        total = compact.scratch;
+        first = select(below, compact.scratch, from_coarse);
+    }
+#endif
+    var h = 0u;
+    for (var base = first; base < count; base += THREADS) {
         let k = base + local;
         var i = k;
         var hit = false;
@@ -246,13 +316,13 @@ fn main(
             if (from_coarse) {
                 i = coarse_lists[coarse_base + 1u + k];
             }
-            hit = light_touches_tile(light_geometry[i], bounds, lo, hi, tile_mask, tile_min, tile_max, 0.0);
+            hit = i >= below && light_touches_tile(light_geometry[i], bounds, lo, hi, tile_mask, tile_min, tile_max, 0.0);
         }
         if (hit) {
-            atomicOr(&hits[local / 32u], 1u << (local % 32u));
+            atomicOr(&hits[h][local / 32u], 1u << (local % 32u));
         }
         workgroupBarrier();
-        let slot = total + rank_in_batch(local);
+        let slot = total + rank_in_batch(h, local);
 #if COMPACT
         if (hit && slot < kept) {
             atomicStore(&light_lists[offset + slot], i);
@@ -262,14 +332,20 @@ fn main(
             list[slot] = i;
         }
 #endif
-        total += hits_in_batch();
+        total += hits_in_batch(h);
+        // The next batch's set, last read before the previous barrier.
+        if (local < MASK_WORDS) {
+            atomicStore(&hits[1u - h][local], 0u);
+        }
         workgroupBarrier();
+        h = 1u - h;
     }
 
 #if COMPACT
-    // 5. Counting: publish the count and depth range, add the count to the list's scan
-    //    block. Filling: check that the count found now gives the kept count the scan
-    //    wrote from the first run's count.
+    // 5. Counting: publish the count and depth range; a list longer than its scratch
+    //    slot adds its count to its scan block's (it takes room in the pool). Filling:
+    //    check that the count found now gives the kept count the scan wrote from the
+    //    first run's count.
     if (local == 0u) {
         let e = HEADER_WORDS + ENTRY_WORDS * list_index;
         if (filling) {
@@ -281,10 +357,12 @@ fn main(
             atomicStore(&light_lists[e + 2u], bitcast<u32>(select(lo, 0.0, empty)));
             atomicStore(&light_lists[e + 3u], bitcast<u32>(select(hi, 0.0, empty)));
             atomicMax(&light_lists[2], total);
-            let b = 2u * (list_index / SCAN_BLOCK);
-            let before = atomicAdd(&list_block_sums[b], total);
-            if (before + total < before) {
-                atomicStore(&list_block_sums[b + 1u], 1u);
+            if (total > compact.scratch) {
+                let b = 2u * (list_index / SCAN_BLOCK);
+                let before = atomicAdd(&list_block_sums[b], total);
+                if (before + total < before) {
+                    atomicStore(&list_block_sums[b + 1u], 1u);
+                }
             }
         }
     }
@@ -354,20 +432,21 @@ fn tile_bounds(origin: vec2<u32>, span: u32, lo: f32, hi: f32, empty: bool) -> T
     return b;
 }
 
-// How many lights before this invocation's in the batch hit (its place in the list).
-fn rank_in_batch(local: u32) -> u32 {
+// How many lights before this invocation's in the batch hit (its place in the list);
+// `h` is the batch's set of hit bits.
+fn rank_in_batch(h: u32, local: u32) -> u32 {
     var rank = 0u;
     let word = local / 32u;
     for (var w = 0u; w < word; w++) {
-        rank += countOneBits(atomicLoad(&hits[w]));
+        rank += countOneBits(atomicLoad(&hits[h][w]));
     }
-    return rank + countOneBits(atomicLoad(&hits[word]) & ((1u << (local % 32u)) - 1u));
+    return rank + countOneBits(atomicLoad(&hits[h][word]) & ((1u << (local % 32u)) - 1u));
 }
 
-fn hits_in_batch() -> u32 {
+fn hits_in_batch(h: u32) -> u32 {
     var n = 0u;
     for (var w = 0u; w < MASK_WORDS; w++) {
-        n += countOneBits(atomicLoad(&hits[w]));
+        n += countOneBits(atomicLoad(&hits[h][w]));
     }
     return n;
 }
@@ -440,41 +519,38 @@ fn light_touches_tile(
 }
 
 // The coarse stage: one workgroup per coarse tile of COARSE×COARSE tiles; each
-// invocation covers COARSE×COARSE pixels for the depth range. No depth mask: every
-// fine tile applies its own.
+// invocation folds COARSE×COARSE pixels into its part of the depth range. No depth mask:
+// every fine tile applies its own.
 @compute @workgroup_size(TILE, TILE, 1)
 fn coarse(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
     @builtin(local_invocation_id) lid: vec3<u32>,
 ) {
-    if (local == 0u) {
-        atomicStore(&z_min_bits, FAR_BITS);
-        atomicStore(&z_max_bits, 0u);
+    // Ordered before its first use by the depth range's barriers.
+    if (local < MASK_WORDS) {
+        atomicStore(&hits[0][local], 0u);
     }
-    workgroupBarrier();
     let span = TILE * COARSE;
     let origin = group.xy * span;
+    var acc = vec2<u32>(FAR_BITS, 0u);
     for (var dy = 0u; dy < COARSE; dy++) {
         for (var dx = 0u; dx < COARSE; dx++) {
-            add_depth_sample(origin + lid.xy * COARSE + vec2<u32>(dx, dy));
+            acc = add_depth_sample(acc, origin + lid.xy * COARSE + vec2<u32>(dx, dy));
         }
     }
-    workgroupBarrier();
-    let lo = bitcast<f32>(atomicLoad(&z_min_bits));
-    let hi = bitcast<f32>(atomicLoad(&z_max_bits));
-    let empty = atomicLoad(&z_max_bits) == 0u;
+    let range = workgroup_depth_range(local, acc);
+    let lo = bitcast<f32>(range.x);
+    let hi = bitcast<f32>(range.y);
+    let empty = range.y == 0u;
     let bounds = tile_bounds(origin, span, lo, hi, empty);
     let coarse_x = (list_params.tiles_x + COARSE - 1u) / COARSE;
     let base_word = (group.y * coarse_x + group.x) * COARSE_STRIDE;
 
     let count = frame.light_count;
     var total = 0u;
+    var h = 0u;
     for (var base = 0u; base < count; base += THREADS) {
-        if (local < MASK_WORDS) {
-            atomicStore(&hits[local], 0u);
-        }
-        workgroupBarrier();
         let i = base + local;
         var hit = false;
         if (!empty && i < count) {
@@ -482,15 +558,20 @@ fn coarse(
             hit = light_touches_tile(light_geometry[i], bounds, lo, hi, 0xffffffffu, lo, hi, COARSE_REACH);
         }
         if (hit) {
-            atomicOr(&hits[local / 32u], 1u << (local % 32u));
+            atomicOr(&hits[h][local / 32u], 1u << (local % 32u));
         }
         workgroupBarrier();
-        let slot = total + rank_in_batch(local);
+        let slot = total + rank_in_batch(h, local);
         if (hit && slot < COARSE_CAPACITY) {
             coarse_lists[base_word + 1u + slot] = i;
         }
-        total += hits_in_batch();
+        total += hits_in_batch(h);
+        // The next batch's set, last read before the previous barrier.
+        if (local < MASK_WORDS) {
+            atomicStore(&hits[1u - h][local], 0u);
+        }
         workgroupBarrier();
+        h = 1u - h;
     }
     if (local == 0u) {
         coarse_lists[base_word] = total;
@@ -543,8 +624,8 @@ fn group_exclusive_scan(local: u32, v: u32) -> u32 {
     return before;
 }
 
-// One workgroup: block sums → each block's first offset; header word 0 → the indices
-// all lists want.
+// One workgroup: block sums → each block's first offset in the pool; header word 0 → the
+// indices the lists longer than their scratch slot want (all lists' without scratch).
 @compute @workgroup_size(SCAN_THREADS, 1, 1)
 fn scan_blocks(@builtin(local_invocation_index) local: u32) {
     let blocks = (list_count() + SCAN_BLOCK - 1u) / SCAN_BLOCK;
@@ -570,13 +651,17 @@ fn scan_blocks(@builtin(local_invocation_index) local: u32) {
 }
 
 // A workgroup per block of SCAN_BLOCK lists, SCAN_PER_THREAD consecutive lists an
-// invocation: each list's offset and the count it keeps under the bound.
+// invocation: each list's offset and the count it keeps under the bound. A list that
+// fits its scratch slot (1..=scratch lights) stays there, whole; the others lie in the
+// pool after every slot, back to back in list order (empty ones too, holding nothing,
+// so that without scratch every offset is the sum of the counts before it).
 @compute @workgroup_size(SCAN_THREADS, 1, 1)
 fn scan_lists(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
 ) {
     let lists = list_count();
+    let scratch = compact.scratch;
     let first = group.x * SCAN_BLOCK + local * SCAN_PER_THREAD;
     var counts: array<u32, SCAN_PER_THREAD>;
     var sum = 0u;
@@ -587,24 +672,35 @@ fn scan_lists(
             c = atomicLoad(&light_lists[HEADER_WORDS + ENTRY_WORDS * l + 1u]);
         }
         counts[j] = c;
-        sum = add_sat(sum, c);
+        if (c > scratch) {
+            sum = add_sat(sum, c);
+        }
     }
     let before = group_exclusive_scan(local, sum);
+    // At most half the index array (`ListLayout::scratch_per_list`): no overflow.
+    let pool_start = scratch * lists;
     var offset = add_sat(atomicLoad(&list_block_sums[2u * group.x]), before);
     let pool = list_params.pool_indices;
     for (var j = 0u; j < SCAN_PER_THREAD; j++) {
         let l = first + j;
+        let c = counts[j];
         if (l < lists) {
-            let start = min(offset, pool);
-            let kept = min(counts[j], pool - start);
             let e = HEADER_WORDS + ENTRY_WORDS * l;
-            atomicStore(&light_lists[e], start);
-            atomicStore(&light_lists[e + 1u], kept);
-            if (kept < counts[j]) {
-                atomicAdd(&light_lists[1], 1u);
+            if (c > 0u && c <= scratch) {
+                atomicStore(&light_lists[e], l * scratch);
+            } else {
+                let start = min(add_sat(pool_start, offset), pool);
+                let kept = min(c, pool - start);
+                atomicStore(&light_lists[e], start);
+                atomicStore(&light_lists[e + 1u], kept);
+                if (kept < c) {
+                    atomicAdd(&light_lists[1], 1u);
+                }
             }
         }
-        offset = add_sat(offset, counts[j]);
+        if (c > scratch) {
+            offset = add_sat(offset, c);
+        }
     }
 }
 #endif

@@ -35,7 +35,10 @@ pub(super) fn set_list_columns(row: &mut BenchRow, c: &CullingReport) {
     row.overflow_tiles = Some(c.overflowed_lists);
     row.list_storage = Some(match c.layout.storage {
         graph::ListStorage::Fixed { capacity } => format!("fixed:{capacity}"),
-        graph::ListStorage::Compact { max_indices } => format!("compact:{max_indices}"),
+        graph::ListStorage::Compact { max_indices, .. } => match c.layout.scratch_per_list() {
+            0 => format!("compact:{max_indices}"),
+            s => format!("compact:{max_indices}:scratch:{s}"),
+        },
     });
     row.list_mib = Some(c.bytes() as f64 / MIB);
     row.list_indices = Some(c.listed());

@@ -93,11 +93,15 @@ pub struct FrameSize {
 /// every reader through `shaders/common/light_lists.wgsl`: a header of 4 u32, then
 /// (offset, count, z_min, z_max) per list, then the index pool. A list's lights are
 /// `pool[offset .. offset + count]`, in ascending light order, in both storages.
+/// `Compact` pools start with a scratch slot of [`Self::scratch_per_list`] indices per
+/// list, in list order: a list of 1 to that many lights lies in its own slot, every other
+/// list after all slots, back to back in list order.
 ///
 /// Header, `Fixed`: pool cursor, lists cut at the capacity, longest list wanted, unused.
-/// Header, `Compact`: indices all lists wanted (saturating at u32::MAX), lists cut at
-/// the bound, longest list wanted, lists whose fill found other lights than their count
-/// (0 unless the two dispatches disagree; counted so it is never silent).
+/// Header, `Compact`: indices the lists past their slot wanted (all lists without
+/// scratch; saturating at u32::MAX), lists cut at the bound, longest list wanted, lists
+/// whose fill found other lights than their count (0 unless the two dispatches disagree;
+/// counted so it is never silent).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ListLayout {
     /// Pixels per tile side.
@@ -111,11 +115,12 @@ pub struct ListLayout {
 
 /// How a culling pass stores its lists: room for `capacity` lights in every list, or
 /// one flat array of at most `max_indices` for all lists together, filled by count →
-/// prefix sum → fill.
+/// prefix sum → fill, with slots of `scratch` indices per list (as the graph asks; see
+/// [`ListLayout::scratch_per_list`]) for the lists that need no fill.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ListStorage {
     Fixed { capacity: u32 },
-    Compact { max_indices: u32 },
+    Compact { max_indices: u32, scratch: u32 },
 }
 
 impl ListLayout {
@@ -155,8 +160,27 @@ impl ListLayout {
     pub fn pool_indices(&self) -> u64 {
         match self.storage {
             ListStorage::Fixed { capacity } => self.lists() as u64 * capacity as u64,
-            ListStorage::Compact { max_indices } => max_indices as u64,
+            ListStorage::Compact { max_indices, .. } => max_indices as u64,
         }
+    }
+    /// Compact lists: each list's scratch slot, in light indices. The graph's `scratch`,
+    /// lowered where the slots would take more than half of `max_indices` (to
+    /// ⌊max_indices / 2L⌋ for L lists), so the pool keeps at least half; 0 for fixed lists.
+    pub fn scratch_per_list(&self) -> u32 {
+        match self.storage {
+            ListStorage::Fixed { .. } => 0,
+            ListStorage::Compact {
+                max_indices,
+                scratch,
+            } => {
+                let half_per_list = max_indices as u64 / (2 * self.lists().max(1) as u64);
+                scratch.min(half_per_list as u32)
+            }
+        }
+    }
+    /// Compact lists: the indices all scratch slots take at the start of the pool.
+    pub fn scratch_indices(&self) -> u64 {
+        self.scratch_per_list() as u64 * self.lists() as u64
     }
     /// Scan blocks of the compact layout (0 for fixed lists).
     pub fn scan_blocks(&self) -> u32 {
@@ -428,11 +452,44 @@ mod tests {
 
     #[test]
     fn compact_lists_are_bounded_by_the_graph_alone() {
-        let compact = ListStorage::Compact { max_indices: 5000 };
+        let compact = ListStorage::Compact {
+            max_indices: 5000,
+            scratch: 256,
+        };
         let c = ListLayout::new(8, CullVariant::Clustered { slices: 16 }, compact, 333, 197);
         assert_eq!(c.lists(), 42 * 25 * 16);
-        // Header, one entry a list, then exactly the bound: no per-list room.
+        // Header, one entry a list, then exactly the bound: scratch slots come out of it.
         assert_eq!(c.bytes(), 4 * (4 + 4 * 16_800 + 5000));
         assert_eq!(c.scan_blocks(), 17);
+        // 16,800 slots of 256 would take 860 times the bound: none fit in half of it.
+        assert_eq!(c.scratch_per_list(), 0);
+    }
+
+    #[test]
+    fn scratch_slots_take_at_most_half_the_bound() {
+        let compact = |max_indices, scratch| ListStorage::Compact {
+            max_indices,
+            scratch,
+        };
+        let frustum = |storage| ListLayout::new(16, CullVariant::Frustum, storage, 1920, 1080);
+        // The shipped bound at 1920×1080: 8,160 slots of 256 (8 MiB of 64).
+        let shipped = frustum(compact(16_777_216, 256));
+        assert_eq!(shipped.scratch_per_list(), 256);
+        assert_eq!(shipped.scratch_indices(), 8_160 * 256);
+        assert_eq!(shipped.bytes(), 4 * (4 + 4 * 8_160 + 16_777_216));
+        // 2 · 8,160 · 100 = 1,632,000 indices: 100 fits, 101 does not.
+        assert_eq!(frustum(compact(1_632_000, 256)).scratch_per_list(), 100);
+        assert_eq!(frustum(compact(1_631_999, 256)).scratch_per_list(), 99);
+        assert_eq!(frustum(compact(16_777_216, 0)).scratch_per_list(), 0);
+        let clustered = ListLayout::new(
+            16,
+            CullVariant::Clustered { slices: 16 },
+            compact(16_777_216, 256),
+            1920,
+            1080,
+        );
+        assert_eq!(clustered.scratch_per_list(), 64);
+        let fixed = frustum(ListStorage::Fixed { capacity: 256 });
+        assert_eq!(fixed.scratch_per_list(), 0);
     }
 }

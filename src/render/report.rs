@@ -12,9 +12,12 @@ pub struct CullingReport {
     pub overflowed_lists: u32,
     /// The longest list wanted (before any cut).
     pub longest_list: u32,
-    /// Compact lists: the indices all lists wanted together (what `max_indices` must
-    /// hold for this frame; saturates at u32::MAX). `None` for fixed lists.
+    /// Compact lists: the indices all lists wanted together (those past their scratch
+    /// slots saturate at u32::MAX). `None` for fixed lists.
     pub wanted: Option<u64>,
+    /// Compact lists: the indices held by lists that lie whole in their scratch slot
+    /// (0 without scratch slots); the rest of `wanted` is what the pool had to hold.
+    pub scratch_held: u64,
     /// Compact lists whose fill found other lights than their count: 0 unless the two
     /// runs of the culling shader disagree (a driver or shader bug; never silent).
     pub mismatched_lists: u32,
@@ -48,12 +51,16 @@ impl CullingReport {
         let avg = per_tile.iter().map(|&x| x as f64).sum::<f64>() / per_tile.len().max(1) as f64;
         let storage = match self.layout.storage {
             ListStorage::Fixed { capacity } => format!("fixed, capacity {capacity}"),
-            ListStorage::Compact { max_indices } => {
+            ListStorage::Compact { max_indices, .. } => {
                 format!("compact, {} of max_indices {max_indices}", self.listed())
             }
         };
+        let slots = match self.layout.scratch_per_list() {
+            0 => String::new(),
+            s => format!("; {} in scratch slots of {s}", self.scratch_held),
+        };
         format!(
-            "{}: {} tiles x {} lists, lights per tile avg {avg:.1} max {}, longest list wanted {} ({storage}; {:.2} MiB)",
+            "{}: {} tiles x {} lists, lights per tile avg {avg:.1} max {}, longest list wanted {} ({storage}; {:.2} MiB{slots})",
             self.pass,
             self.layout.tiles_x * self.layout.tiles_y,
             self.layout.lists_per_tile,
@@ -68,12 +75,31 @@ impl CullingReport {
         let mut w = Vec::new();
         if self.overflowed_lists > 0 {
             w.push(match self.layout.storage {
-                ListStorage::Compact { max_indices } => {
+                ListStorage::Compact {
+                    max_indices,
+                    scratch,
+                } => {
                     let wanted = self.wanted.unwrap_or_default();
-                    format!(
-                        "{}: the lists wanted {wanted} light indices, over max_indices {max_indices}: {} lists lost lights (max_indices: {wanted} fits this frame)",
-                        self.pass, self.overflowed_lists
-                    )
+                    let slots = self.layout.scratch_indices();
+                    if slots == 0 {
+                        format!(
+                            "{}: the lists wanted {wanted} light indices, over max_indices {max_indices}: {} lists lost lights (max_indices: {wanted} fits this frame)",
+                            self.pass, self.overflowed_lists
+                        )
+                    } else {
+                        // At 2·L·scratch the slots are the graph's whole `scratch` (not
+                        // lowered), and no more lists spill into the pool than now.
+                        let pooled = wanted - self.scratch_held;
+                        let full_slots = self.layout.lists() as u64 * scratch as u64;
+                        let fits = (2 * full_slots).max(full_slots + pooled);
+                        format!(
+                            "{}: the lists wanted {wanted} light indices, {pooled} of them in lists longer than their scratch slot of {}, over the {} the pool holds (max_indices {max_indices} less {slots} in scratch slots): {} lists lost lights (max_indices: {fits} fits this frame)",
+                            self.pass,
+                            self.layout.scratch_per_list(),
+                            max_indices as u64 - slots,
+                            self.overflowed_lists
+                        )
+                    }
                 }
                 ListStorage::Fixed { capacity } => format!(
                     "{} lists overflowed their capacity of {capacity} (worst wanted {}): lights were dropped there",

@@ -1,6 +1,7 @@
 //! `LightCulling`: per-tile light lists, with an optional coarse stage first in the same
 //! compute pass; reports each frame's overflows and longest list. Compact lists run
-//! count → scan → fill in that pass too (see `shaders/cull/light_culling.wgsl`).
+//! count → scan → fill in that pass too, the fill only for lists longer than their
+//! scratch slot (see `shaders/cull/light_culling.wgsl`).
 
 use super::{defines, PrepareCtx, PreparedPass, Timestamps};
 use crate::gpu::readback::read_buffer;
@@ -33,7 +34,7 @@ pub(super) struct LightCullingPass {
 }
 
 /// What compact lists add: the fill's bind group (the same pipeline as the count, with
-/// `cull_phase` 1), the two scan pipelines and the block sums they share.
+/// `compact.phase` 1), the two scan pipelines and the block sums they share.
 struct Compact {
     fill: wgpu::BindGroup,
     scan_blocks: Arc<wgpu::ComputePipeline>,
@@ -111,12 +112,14 @@ pub(super) fn prepare(
             ));
         }
     }
-    // Compact lists: a (sum, wrapped) pair per scan block, and the phase uniforms.
+    // Compact lists: a (sum, wrapped) pair per scan block, and per run the uniforms
+    // (`CompactParams`: phase, scratch slot).
+    let scratch = layout.scratch_per_list();
     let phase = |p: u32| {
         use wgpu::util::DeviceExt;
         device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("cull phase"),
-            contents: bytemuck::cast_slice(&[p, 0u32, 0, 0]),
+            label: Some("compact list params"),
+            contents: bytemuck::cast_slice(&[p, scratch, 0, 0]),
             usage: wgpu::BufferUsages::UNIFORM,
         })
     };
@@ -130,7 +133,7 @@ pub(super) fn prepare(
     });
     if let Some(b) = &block_sums {
         offered.buffer("list_block_sums", b);
-        offered.buffer("cull_phase", &phase(0));
+        offered.buffer("compact", &phase(0));
     }
     let key = |state: &str| PipelineKey {
         shader: "cull/light_culling.wgsl".into(),
@@ -141,7 +144,7 @@ pub(super) fn prepare(
     let (pipeline, bind) = cx.compute_pipeline(&sp.name, key(""), "main", &offered)?;
     let compact = if let Some(block_sums) = block_sums {
         // The same pipeline (a cache hit) bound with the fill phase.
-        offered.buffer("cull_phase", &phase(1));
+        offered.buffer("compact", &phase(1));
         let (_, fill) = cx.compute_pipeline(&sp.name, key(""), "main", &offered)?;
         let (scan_blocks, _) =
             cx.compute_pipeline(&sp.name, key("scan_blocks"), "scan_blocks", &offered)?;
@@ -203,7 +206,8 @@ impl PreparedPass for LightCullingPass {
         pass.dispatch_workgroups(x, y, z);
         if let Some(c) = &self.compact {
             // Count (above), scan, fill. Each dispatch sees the previous one's writes:
-            // wgpu puts a barrier between dispatches that use a buffer read-write.
+            // wgpu puts a barrier between dispatches that use a buffer read-write. The
+            // fill's workgroups of lists that fit their scratch slot return at once.
             pass.set_pipeline(&c.scan_blocks);
             pass.dispatch_workgroups(1, 1, 1);
             pass.set_pipeline(&c.scan_lists);
@@ -232,14 +236,26 @@ impl PreparedPass for LightCullingPass {
             .map(|l| entry(l, 1))
             .collect();
         let compact = self.compact.is_some();
-        // Compact lists lie back to back in list order: each offset is the sum of the
-        // kept counts before it (also past the bound, where offsets stop at its end).
+        // Compact lists: a list of 1..=scratch lights lies in its own scratch slot (slot l
+        // at l·scratch); every other list lies after all slots, back to back in list
+        // order: its offset is the slots' end plus the kept counts of the lists before it
+        // there (also past the bound, where offsets stop at its end).
         let mut misplaced_lists = 0;
+        let mut scratch_held = 0u64;
         if compact {
-            let mut running = 0u64;
+            let scratch = self.layout.scratch_per_list() as u64;
+            let slots_end = self.layout.scratch_indices();
+            let mut running = slots_end;
             for (l, &c) in counts.iter().enumerate() {
-                misplaced_lists += (entry(l, 0) as u64 != running) as u32;
-                running += c as u64;
+                let (offset, c) = (entry(l, 0) as u64, c as u64);
+                if offset < slots_end {
+                    misplaced_lists +=
+                        (offset != l as u64 * scratch || c == 0 || c > scratch) as u32;
+                    scratch_held += c;
+                } else {
+                    misplaced_lists += (offset != running) as u32;
+                    running += c;
+                }
             }
             misplaced_lists += (running > self.layout.pool_indices()) as u32;
         }
@@ -248,7 +264,9 @@ impl PreparedPass for LightCullingPass {
             layout: self.layout,
             overflowed_lists: words[1],
             longest_list: words[2],
-            wanted: compact.then_some(words[0] as u64),
+            // Header word 0: what the lists past their slots wanted.
+            wanted: compact.then_some(words[0] as u64 + scratch_held),
+            scratch_held,
             mismatched_lists: if compact { words[3] } else { 0 },
             misplaced_lists,
             counts,

@@ -150,7 +150,10 @@ mod tests {
     use crate::graph::{CullVariant, ListLayout, ListStorage};
 
     fn layout(tile: u32, variant: CullVariant) -> Option<ListLayout> {
-        let storage = ListStorage::Compact { max_indices: 1024 };
+        let storage = ListStorage::Compact {
+            max_indices: 1024,
+            scratch: 256,
+        };
         Some(ListLayout::new(tile, variant, storage, 333, 197))
     }
 
