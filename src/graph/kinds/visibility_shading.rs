@@ -11,7 +11,7 @@ use crate::graph::error::GraphError;
 use crate::graph::model::{LightSource, SceneResource};
 use serde::{Deserialize, Serialize};
 
-/// `VisibilityShading(lights: Culled, light_loop: Forward)`.
+/// `VisibilityShading(lights: Culled, light_loop: RangeFirst)`.
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
 #[serde(deny_unknown_fields)]
 pub struct VisibilityShading {
@@ -25,11 +25,11 @@ pub struct VisibilityShading {
 /// differ only in speed, so a graph can time them side by side.
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
 pub enum LightLoop {
-    /// Forward shading's loop (`common/light_loop.wgsl`), per pixel. The default: the
+    /// Forward shading's loop (`common/light_loop.wgsl`), per pixel.
+    Forward,
+    /// Per pixel, a light's range tested before its properties are read. The default: the
     /// fastest of the three on an NVIDIA H200 (README "Visibility buffer").
     #[default]
-    Forward,
-    /// Per pixel, a light's range tested before its properties are read.
     RangeFirst,
     /// A workgroup whose pixels all read one tile list (Frustum and DepthMask lists)
     /// stages it in workgroup memory, a batch at a time; other lists run `RangeFirst`.
@@ -114,7 +114,7 @@ mod tests {
     }
 
     #[test]
-    fn light_loop_defaults_to_forward_and_parses_each_kind() {
+    fn light_loop_defaults_to_range_first_and_parses_each_kind() {
         use super::{LightLoop, VisibilityShading};
         let parse = |t: &str| ron::from_str::<VisibilityShading>(t).unwrap();
         assert_eq!(parse("(lights: Culled)").light_loop, LightLoop::Forward);
