@@ -117,12 +117,15 @@ mod tests {
     fn light_loop_defaults_to_range_first_and_parses_each_kind() {
         use super::{LightLoop, VisibilityShading};
         let parse = |t: &str| ron::from_str::<VisibilityShading>(t).unwrap();
-        assert_eq!(parse("(lights: Culled)").light_loop, LightLoop::Forward);
-        assert_eq!(VisibilityShading::default().light_loop, LightLoop::Forward);
+        assert_eq!(parse("(lights: Culled)").light_loop, LightLoop::RangeFirst);
+        assert_eq!(
+            VisibilityShading::default().light_loop,
+            LightLoop::RangeFirst
+        );
         assert_eq!(parse("(light_loop: Staged)").light_loop, LightLoop::Staged);
         assert_eq!(
-            parse("(light_loop: RangeFirst)").light_loop,
-            LightLoop::RangeFirst
+            parse("(light_loop: Forward)").light_loop,
+            LightLoop::Forward
         );
         assert!(ron::from_str::<VisibilityShading>("(staging: false)").is_err());
         assert!(ron::from_str::<VisibilityShading>("(light_loop: Fast)").is_err());
