@@ -164,12 +164,14 @@ impl TestLimits {
     }
 }
 
-/// Why this device cannot run the pass, if it cannot.
+/// Why this device cannot run the compute path, if it cannot. The pass kind's prepare
+/// (`compute_raster_fallback.rs`) takes the hardware path on such a device; this check
+/// keeps the compute path itself from being prepared there.
 pub fn missing_features(have: wgpu::Features, adapter: &str) -> Option<String> {
     let missing = FEATURES - have;
     (!missing.is_empty()).then(|| {
         format!(
-            "the compute rasterizer needs 64-bit atomic min on storage buffers; adapter {adapter} lacks {missing:?} (use DepthPrepass there)"
+            "the compute rasterizer needs 64-bit atomic min on storage buffers; adapter {adapter} lacks {missing:?} (the pass draws with the hardware rasterizer there)"
         )
     })
 }

@@ -151,18 +151,21 @@ impl PrepareCtx<'_> {
             .ok_or_else(|| pass_error(pass, format!("texture '{name}' is not planned")))
     }
 
+    /// The graph's declaration of resource `name`.
+    fn resource(&self, name: &str) -> Option<&ResourceDesc> {
+        self.graph
+            .checked
+            .desc
+            .resources
+            .iter()
+            .find(|r| r.name() == name)
+    }
+
     /// Whether the declared texture holds depths as R32Float (a compute resolve's)
     /// rather than in a depth format: its readers bind it as `texture_2d<f32>`
     /// (`FLOAT_DEPTH`).
     pub fn float_depth(&self, name: &str) -> bool {
-        crate::graph::kinds::is_float_depth(
-            self.graph
-                .checked
-                .desc
-                .resources
-                .iter()
-                .find(|r| r.name() == name),
-        )
+        crate::graph::kinds::is_float_depth(self.resource(name))
     }
 
     pub fn buffer(&self, pass: &str, name: &str) -> Result<wgpu::Buffer, RenderError> {
@@ -192,13 +195,7 @@ impl PrepareCtx<'_> {
     /// A declared resource as something to bind: scene imports, planned buffers and
     /// textures. `None` for scene geometry (drawn, never bound).
     fn bound(&self, pass: &str, name: &str) -> Result<Option<Bound>, RenderError> {
-        let desc = self
-            .graph
-            .checked
-            .desc
-            .resources
-            .iter()
-            .find(|r| r.name() == name);
+        let desc = self.resource(name);
         Ok(Some(match desc {
             Some(ResourceDesc::Import { from, .. }) => match from {
                 SceneResource::LightGeometry => Bound::Buffer(self.gpu.light_geometry.clone()),
@@ -223,15 +220,7 @@ impl PrepareCtx<'_> {
     /// light array, so the frame is exactly the graph without VPLs.
     fn scene_lights_instead(&self, slot: &str, name: &str) -> Option<Bound> {
         use crate::graph::slot::{LIGHT_GEOMETRY, LIGHT_PROPERTIES};
-        let is_buffer = matches!(
-            self.graph
-                .checked
-                .desc
-                .resources
-                .iter()
-                .find(|r| r.name() == name),
-            Some(ResourceDesc::Buffer { .. })
-        );
+        let is_buffer = matches!(self.resource(name), Some(ResourceDesc::Buffer { .. }));
         let written = self.graph.passes.iter().any(|p| {
             self.graph.checked.desc.passes[p.index]
                 .writes
