@@ -39,11 +39,15 @@ pub(super) fn prepare(
     Ok(Box::new(HardwareRaster::prepare(cx, sp, missing)?))
 }
 
+/// The dispatch copying the drawn Depth32Float into an R32Float depth: its pipeline,
+/// bindings and workgroup grid.
+type DepthCopy = (Arc<wgpu::ComputePipeline>, wgpu::BindGroup, [u32; 3]);
+
 struct HardwareRaster {
     name: Name,
     draws: VisibilityBuffer,
     /// An R32Float depth: the copy from the drawn Depth32Float.
-    copy: Option<(Arc<wgpu::ComputePipeline>, wgpu::BindGroup, [u32; 3])>,
+    copy: Option<DepthCopy>,
     report: FallbackReport,
 }
 
@@ -77,52 +81,14 @@ impl HardwareRaster {
         refuse_alpha_masked(cx, sp)?;
         let depth = sp.required(slot::DEPTH);
         let ids = cx.view(&sp.name, sp.required(VISIBILITY))?;
-        if !cx.float_depth(depth) {
-            let target = IdTargets {
-                depth: cx.view(&sp.name, depth)?,
-                clear_depth: true,
-                writes_depth: true,
-                ids,
-            };
-            return Ok(Self {
-                name: sp.name.clone(),
-                draws: draw_ids(cx, sp, target)?,
-                copy: None,
-                report,
-            });
-        }
-        let device = cx.device();
-        let drawn = device
-            .create_texture(&wgpu::TextureDescriptor {
-                label: Some("compute raster fallback depth"),
-                size: wgpu::Extent3d {
-                    width: cx.size.width,
-                    height: cx.size.height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Depth32Float,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            })
-            .create_view(&Default::default());
-        let mut offered = cx.declared(sp)?;
-        offered.offer("drawn_depth", Bound::View(drawn.clone()));
-        let key = PipelineKey {
-            shader: COPY_SHADER.into(),
-            defines: defines(&[]),
-            virtual_code: BTreeMap::new(),
-            state: "copy_depth".into(),
+        // A depth format is drawn into directly; an R32Float depth is drawn into an
+        // internal Depth32Float, then copied.
+        let (drawn, copy) = if cx.float_depth(depth) {
+            let (drawn, copy) = depth_copy(cx, sp)?;
+            (drawn, Some(copy))
+        } else {
+            (cx.view(&sp.name, depth)?, None)
         };
-        let (pipeline, bind) = cx.compute_pipeline(&sp.name, key, "copy_depth", &offered)?;
-        let groups = [
-            cx.size.width.div_ceil(TILE),
-            cx.size.height.div_ceil(TILE),
-            1,
-        ];
         let target = IdTargets {
             depth: drawn,
             clear_depth: true,
@@ -132,10 +98,50 @@ impl HardwareRaster {
         Ok(Self {
             name: sp.name.clone(),
             draws: draw_ids(cx, sp, target)?,
-            copy: Some((pipeline, bind, groups)),
+            copy,
             report,
         })
     }
+}
+
+/// The internal Depth32Float the draws write for an R32Float depth, and the dispatch
+/// copying it into the pass's depth.
+fn depth_copy(
+    cx: &mut PrepareCtx,
+    sp: &ScheduledPass,
+) -> Result<(wgpu::TextureView, DepthCopy), RenderError> {
+    let device = cx.device();
+    let drawn = device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some("compute raster fallback depth"),
+            size: wgpu::Extent3d {
+                width: cx.size.width,
+                height: cx.size.height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Depth32Float,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        })
+        .create_view(&Default::default());
+    let mut offered = cx.declared(sp)?;
+    offered.offer("drawn_depth", Bound::View(drawn.clone()));
+    let key = PipelineKey {
+        shader: COPY_SHADER.into(),
+        defines: defines(&[]),
+        virtual_code: BTreeMap::new(),
+        state: "copy_depth".into(),
+    };
+    let (pipeline, bind) = cx.compute_pipeline(&sp.name, key, "copy_depth", &offered)?;
+    let groups = [
+        cx.size.width.div_ceil(TILE),
+        cx.size.height.div_ceil(TILE),
+        1,
+    ];
+    Ok((drawn, (pipeline, bind, groups)))
 }
 
 /// Masked materials are refused as the compute rasterizer refuses them, naming the pass
