@@ -164,26 +164,13 @@ impl TestLimits {
     }
 }
 
-/// Why this device cannot run the compute path, if it cannot. The pass kind's prepare
-/// (`compute_raster_fallback.rs`) takes the hardware path on such a device; this check
-/// keeps the compute path itself from being prepared there.
-pub fn missing_features(have: wgpu::Features, adapter: &str) -> Option<String> {
-    let missing = FEATURES - have;
-    (!missing.is_empty()).then(|| {
-        format!(
-            "the compute rasterizer needs 64-bit atomic min on storage buffers; adapter {adapter} lacks {missing:?} (the pass draws with the hardware rasterizer there)"
-        )
-    })
-}
-
+/// The compute path, for a device with [`FEATURES`]: `compute_raster_fallback::prepare`
+/// picks the hardware path on any other.
 pub(super) fn prepare(
     cx: &mut PrepareCtx,
     sp: &ScheduledPass,
 ) -> Result<ComputeRasterPass, RenderError> {
     let device = cx.device();
-    if let Some(m) = missing_features(device.features(), &cx.renderer.ctx.adapter_name()) {
-        return Err(pass_error(&sp.name, m));
-    }
     let geometry = cx
         .gpu
         .visibility_geometry(&device, cx.scene)
@@ -430,14 +417,6 @@ impl PreparedPass for ComputeRasterPass {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn names_the_adapter_and_the_missing_feature() {
-        let m = missing_features(wgpu::Features::SHADER_INT64, "Example GPU (Vulkan)").unwrap();
-        assert!(m.contains("Example GPU (Vulkan)"), "{m}");
-        assert!(m.contains("SHADER_INT64_ATOMIC_MIN_MAX"), "{m}");
-        assert!(missing_features(FEATURES, "x").is_none());
-    }
 
     #[test]
     fn large_grids_fold_into_y() {
