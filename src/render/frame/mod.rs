@@ -3,10 +3,15 @@
 //! The loops live here: prepare every pass, record every pass between timestamps, read
 //! back. What each pass does lives in `passes/<kind>.rs`.
 
+mod parallel_builds;
+mod readback;
+
+use parallel_builds::prebuild_in_parallel;
+
 use super::light_stats::LightStatsPass;
 use super::passes::{self, PrepareCtx, PreparedPass, Timestamps};
 use super::prepare_stats::PrepareStats;
-use super::report::{CullingReport, FrameResult, LightStats, PassReport, ShadowReport};
+use super::report::{FrameResult, PassReport};
 use super::resources::FrameResources;
 use super::scene_gpu::SceneGpu;
 use super::{RenderError, Renderer};
@@ -53,106 +58,6 @@ impl Default for RenderTimings {
             image_readback: Duration::ZERO,
             reports_readback: Duration::ZERO,
         }
-    }
-}
-
-/// Builds the pipelines the passes lack on scoped threads, one per pass, before the
-/// sequential prepare: each thread prepares its pass with a fork of the pipeline cache
-/// (and its own validation error scope) and drops the prepared pass; the forks' new
-/// pipelines are adopted in pass order, and the sequential prepare then finds them,
-/// counting and naming them as if it had built them (`PipelineCache::adopt`). A pass
-/// that fails on its thread contributes nothing: the sequential prepare meets the same
-/// error and reports it as before. Drivers compile pipelines concurrently (wgpu's Device
-/// is Send + Sync), so a reload rebuilding pipelines of several passes waits for the
-/// slowest instead of the sum.
-fn prebuild_in_parallel(cx: &mut PrepareCtx<'_>) {
-    use super::pipelines::ForkMode;
-    let r = &mut *cx.renderer;
-    // One fork per pass; a pass that asked for several pipelines last time gets one fork
-    // per pipeline, each building one of them (ForkMode::Only).
-    let forks: Vec<(&crate::graph::ScheduledPass, ForkMode)> = cx
-        .graph
-        .passes
-        .iter()
-        .flat_map(|sp| {
-            let n = r.pipelines.pipelines_of_pass_last_time(&sp.name);
-            let modes: Vec<ForkMode> = match n {
-                0 | 1 => vec![ForkMode::All],
-                n => (0..n).map(ForkMode::Only).collect(),
-            };
-            modes.into_iter().map(move |m| (sp, m))
-        })
-        .collect();
-    if !r.pipelines.parallel_builds || forks.len() < 2 {
-        return;
-    }
-    // Whether earlier frames were still on the GPU, noted before any thread builds.
-    r.pipelines.note_gpu_state_now(&r.ctx.device);
-    let (graph, gpu, resources, frame_uniform, size, scene) = (
-        cx.graph,
-        cx.gpu,
-        cx.resources,
-        cx.frame_uniform,
-        cx.size,
-        cx.scene,
-    );
-    let start = Instant::now();
-    let forks: Vec<Option<super::pipelines::ForkBuilds>> = std::thread::scope(|s| {
-        let threads: Vec<_> = forks
-            .iter()
-            .map(|&(sp, mode)| {
-                let mut fork = Renderer {
-                    ctx: r.ctx.clone(),
-                    shaders: r.shaders.clone(),
-                    pipelines: r.pipelines.fork(mode),
-                    layouts: r.layouts.clone(),
-                };
-                s.spawn(move || {
-                    fork.pipelines.set_pass(&sp.name);
-                    // Error scopes are per thread: this one sees this pass's errors.
-                    let scope = fork
-                        .ctx
-                        .device
-                        .push_error_scope(wgpu::ErrorFilter::Validation);
-                    let prepared = passes::prepare(
-                        &mut PrepareCtx {
-                            renderer: &mut fork,
-                            graph,
-                            gpu,
-                            resources,
-                            frame_uniform,
-                            size,
-                            scene,
-                        },
-                        sp,
-                    )
-                    .is_ok();
-                    let clean = pollster::block_on(scope.pop()).is_none();
-                    // A fork of one build ends its pass early on purpose (and may meet
-                    // errors its stand-ins made): its build's own scope decides.
-                    let keep = match mode {
-                        ForkMode::All => prepared && clean,
-                        ForkMode::Only(_) => fork.pipelines.fork_build_clean(),
-                    };
-                    keep.then(|| fork.pipelines.into_builds())
-                })
-            })
-            .collect();
-        threads
-            .into_iter()
-            .map(|t| t.join().ok().flatten())
-            .collect()
-    });
-    let mut built = 0;
-    let mut threads = 0;
-    for f in forks.into_iter().flatten().filter(|f| !f.is_empty()) {
-        built += f.len();
-        threads += 1;
-        r.pipelines.adopt(f);
-    }
-    if built > 0 {
-        r.pipelines.add_build_wall(start.elapsed());
-        r.pipelines.build_threads = threads;
     }
 }
 
@@ -516,115 +421,6 @@ impl PreparedFrame {
         self.resources
             .texture(&self.graph.plan, self.graph.output())
             .expect("validation makes the output a planned texture")
-    }
-
-    /// Reads back what the last executed frame's passes and statistics pass counted
-    /// (not the image).
-    pub fn read_reports(
-        &self,
-        r: &Renderer,
-    ) -> Result<(Vec<CullingReport>, Option<LightStats>), RenderError> {
-        let mut culling = Vec::new();
-        for (_, pass) in &self.passes {
-            if let Some(PassReport::Culling(report)) = pass.report(r)? {
-                culling.push(report);
-            }
-        }
-        Ok((culling, self.read_light_stats(r)?))
-    }
-
-    /// What every pass that counts something counted in the last executed frame.
-    fn pass_reports(&self, r: &Renderer) -> Result<Vec<PassReport>, RenderError> {
-        let mut out = Vec::new();
-        for (_, pass) in &self.passes {
-            out.extend(pass.report(r)?);
-        }
-        Ok(out)
-    }
-
-    fn read_light_stats(&self, r: &Renderer) -> Result<Option<LightStats>, RenderError> {
-        match &self.stats {
-            Some(stats) => Ok(Some(stats.read(r)?)),
-            None => Ok(None),
-        }
-    }
-
-    /// What the last executed frame's ray-cast shadow job passes counted.
-    pub fn read_shadow_reports(&self, r: &Renderer) -> Result<Vec<ShadowReport>, RenderError> {
-        Ok(self
-            .pass_reports(r)?
-            .into_iter()
-            .filter_map(|report| match report {
-                PassReport::Shadow(s) => Some(s),
-                _ => None,
-            })
-            .collect())
-    }
-
-    /// Errs when `name` shares its physical resource with one used after it: what a
-    /// readback would see is the later resource.
-    fn check_not_reused(&self, name: &str) -> Result<(), RenderError> {
-        let plan = &self.graph.plan;
-        let later = plan
-            .get(name)
-            .and_then(|r| plan.physical[r.physical].serves.last())
-            .filter(|last| *last != name);
-        match later {
-            Some(last) => Err(RenderError::Pass {
-                pass: "readback".into(),
-                message: format!("'{name}' shares its physical resource with '{last}', used after it in the frame: it no longer holds '{name}' (make '{name}' the output, or keep its readers last)"),
-            }),
-            None => Ok(()),
-        }
-    }
-
-    /// Reads back a planned buffer of the last executed frame (tests, inspection).
-    pub fn read_buffer(&self, r: &Renderer, name: &str) -> Result<Vec<u8>, RenderError> {
-        self.check_not_reused(name)?;
-        let buffer = self
-            .resources
-            .buffer(&self.graph.plan, name)
-            .ok_or_else(|| RenderError::Pass {
-                pass: "readback".into(),
-                message: format!("'{name}' is not a planned buffer"),
-            })?;
-        Ok(read_buffer(&r.ctx.device, &r.ctx.queue, buffer)?)
-    }
-
-    /// Reads back a planned Rgba32Float texture of the last executed frame.
-    pub fn read_texture(&self, r: &Renderer, name: &str) -> Result<Vec<[f32; 4]>, RenderError> {
-        self.check_not_reused(name)?;
-        let texture = self
-            .resources
-            .texture(&self.graph.plan, name)
-            .ok_or_else(|| RenderError::Pass {
-                pass: "readback".into(),
-                message: format!("'{name}' is not a planned texture"),
-            })?;
-        Ok(read_rgba32f(&r.ctx.device, &r.ctx.queue, texture)?)
-    }
-
-    /// Reads back a planned single-sample texture of 32 bits a texel (R32Float, R32Uint,
-    /// Depth32Float) of the last executed frame, each texel's bits as they are (tests
-    /// that compare depths and ids exactly, inspection).
-    pub fn read_texture_bits(&self, r: &Renderer, name: &str) -> Result<Vec<u32>, RenderError> {
-        use wgpu::TextureFormat as F;
-        self.check_not_reused(name)?;
-        let texture = self
-            .resources
-            .texture(&self.graph.plan, name)
-            .filter(|t| {
-                t.sample_count() == 1
-                    && matches!(t.format(), F::R32Float | F::R32Uint | F::Depth32Float)
-            })
-            .ok_or_else(|| RenderError::Pass {
-                pass: "readback".into(),
-                message: format!(
-                    "'{name}' is not a planned single-sample R32Float, R32Uint or Depth32Float texture"
-                ),
-            })?;
-        let bytes = crate::gpu::readback::read_texture(&r.ctx.device, &r.ctx.queue, texture, 4)?;
-        Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 
     /// Moves the camera without re-preparing (benchmarks, the viewer).
