@@ -31,6 +31,10 @@ pub(super) struct LightCullingPass {
     /// since a later pass may reuse the lists' memory (aliasing) before it is read.
     report_copy: wgpu::Buffer,
     layout: ListLayout,
+    /// Diagnosis: the one dispatch the pass's timestamps bracket (`LIGHTGRAPH_TIME_DISPATCH`:
+    /// 0 coarse, then count, scan_blocks, scan_lists, fill; counted without the coarse
+    /// stage when there is none).
+    timed_dispatch: Option<usize>,
 }
 
 /// What compact lists add: the fill's bind group (the same pipeline as the count, with
@@ -173,6 +177,9 @@ pub(super) fn prepare(
         mapped_at_creation: false,
     });
     Ok(LightCullingPass {
+        timed_dispatch: std::env::var("LIGHTGRAPH_TIME_DISPATCH")
+            .ok()
+            .and_then(|v| v.parse().ok()),
         name: sp.name.clone(),
         report_copy,
         coarse,
@@ -192,31 +199,46 @@ impl PreparedPass for LightCullingPass {
         if let Some(c) = &self.compact {
             encoder.clear_buffer(&c.block_sums, 0, None);
         }
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(&self.name),
-            timestamp_writes: ts.compute(),
-        });
-        pass.set_bind_group(0, &self.bind, &[]);
-        if let Some((coarse, [x, y, z])) = &self.coarse {
-            pass.set_pipeline(coarse);
-            pass.dispatch_workgroups(*x, *y, *z);
-        }
-        pass.set_pipeline(&self.pipeline);
+        // Coarse, count, then (compact) scan, scan, fill. Each dispatch sees the previous
+        // one's writes: wgpu puts a barrier between dispatches that use a buffer
+        // read-write. The fill's workgroups of lists that fit their scratch slot return
+        // at once.
         let [x, y, z] = self.groups;
-        pass.dispatch_workgroups(x, y, z);
-        if let Some(c) = &self.compact {
-            // Count (above), scan, fill. Each dispatch sees the previous one's writes:
-            // wgpu puts a barrier between dispatches that use a buffer read-write. The
-            // fill's workgroups of lists that fit their scratch slot return at once.
-            pass.set_pipeline(&c.scan_blocks);
-            pass.dispatch_workgroups(1, 1, 1);
-            pass.set_pipeline(&c.scan_lists);
-            pass.dispatch_workgroups(c.blocks, 1, 1);
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &c.fill, &[]);
-            pass.dispatch_workgroups(x, y, z);
+        let mut steps: Vec<(&wgpu::ComputePipeline, &wgpu::BindGroup, [u32; 3])> = Vec::new();
+        if let Some((coarse, groups)) = &self.coarse {
+            steps.push((coarse, &self.bind, *groups));
         }
-        drop(pass);
+        steps.push((&self.pipeline, &self.bind, [x, y, z]));
+        if let Some(c) = &self.compact {
+            steps.push((&c.scan_blocks, &self.bind, [1, 1, 1]));
+            steps.push((&c.scan_lists, &self.bind, [c.blocks, 1, 1]));
+            steps.push((&self.pipeline, &c.fill, [x, y, z]));
+        }
+        // One compute pass, timed; or (diagnosis, `LIGHTGRAPH_TIME_DISPATCH=n`) three,
+        // the timestamps around dispatch n alone.
+        let timed = self.timed_dispatch.filter(|&n| n < steps.len());
+        let runs = match timed {
+            None => vec![(0..steps.len(), Some(ts))],
+            Some(n) => vec![
+                (0..n, None),
+                (n..n + 1, Some(ts)),
+                (n + 1..steps.len(), None),
+            ],
+        };
+        for (range, ts) in runs {
+            if range.is_empty() {
+                continue;
+            }
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(&self.name),
+                timestamp_writes: ts.and_then(|t| t.compute()),
+            });
+            for (pipeline, bind, [x, y, z]) in &steps[range] {
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, *bind, &[]);
+                pass.dispatch_workgroups(*x, *y, *z);
+            }
+        }
         encoder.copy_buffer_to_buffer(
             &self.lists,
             0,
