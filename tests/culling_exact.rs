@@ -316,3 +316,71 @@ fn tiled_deferred_matches_forward_brute_force() {
     println!("packed G-buffer: worst relative error {worst:e}");
     assert!(worst <= 1e-3, "packed: relative error {worst:e}");
 }
+
+/// The coarse stage's test hook (`light_culling.rs`): lights per coarse slice and indices
+/// per slice list, read when the pass is prepared.
+const COARSE_TEST: &str = "LIGHTGRAPH_COARSE_TEST_SLICES";
+
+/// Sets the coarse stage's test hook while alive.
+struct CoarseHook;
+impl CoarseHook {
+    fn set(value: &str) -> Self {
+        std::env::set_var(COARSE_TEST, value);
+        CoarseHook
+    }
+}
+impl Drop for CoarseHook {
+    fn drop(&mut self) {
+        std::env::remove_var(COARSE_TEST);
+    }
+}
+
+#[test]
+fn coarse_slices_and_their_overflow_change_no_list() {
+    // 1,100 lights cut into slices of 256 (five slices, the last of 76), and slice lists
+    // of 8 indices: most coarse tiles overflow some slices and not others, so a tile's
+    // candidates mix slice lists with whole slices. Every list, and so the image, must be
+    // exactly that of culling without the coarse stage.
+    let scene = random_scene(1100, 17);
+    for tile in TILES {
+        for hook in ["slice=256,capacity=8", "slice=256"] {
+            // The renderer's lock keeps the other tests of this binary from preparing
+            // while the variable is set (dropped after `_hook`).
+            let mut r = renderer();
+            let direct = render_text(
+                &mut r,
+                &graph_text(tile, "Frustum", 1024, Some(0)),
+                &scene,
+                W,
+                H,
+            );
+            let _hook = CoarseHook::set(hook);
+            let sliced = render_text(
+                &mut r,
+                &graph_text(tile, "Frustum", 1024, None),
+                &scene,
+                W,
+                H,
+            );
+            drop(_hook);
+            let (a, b) = (&sliced.culling[0], &direct.culling[0]);
+            assert_eq!(a.counts.len(), b.counts.len());
+            let longer = a
+                .counts
+                .iter()
+                .zip(&b.counts)
+                .filter(|(x, y)| x > y)
+                .count();
+            assert_eq!(longer, 0, "tile {tile}, {hook}: {longer} lists grew");
+            assert!(
+                a.counts.iter().sum::<u32>() > 1000,
+                "tile {tile}: the scene lists too few lights to test slices"
+            );
+            assert_eq!(sliced.image.len(), (W * H) as usize);
+            assert!(
+                sliced.image == direct.image,
+                "tile {tile}, {hook}: the sliced coarse stage changed the image"
+            );
+        }
+    }
+}

@@ -30,6 +30,15 @@ fn add_reached(color: vec3<f32>, g: LightGeometry, props: LightProperties, r: Li
     return color;
 }
 
+// A squared distance past which range_window is surely zero: dist_sq over
+// fl(range²)·1.001 rounded down is over range² by 1e-3 at least, so the quotient r in
+// range_window, within 2.5 ulp (Vulkan's OpFDiv), is over 1, r² rounds to 1 or more, and
+// 1 − r² clamps to 0, fused or not. A NaN or infinite range rejects nothing here; the
+// exact test after it decides.
+fn reject_beyond(range: f32) -> f32 {
+    return range * range * 1.001;
+}
+
 #if RANGE_FIRST
 fn shade_range_first(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f32) -> vec3<f32> {
     var color = surface_unlit(p, m);
@@ -39,6 +48,12 @@ fn shade_range_first(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_
         }
         let i = light_index(c);
         let g = light_geometry[i];
+        // Far out of range: no division (reject_beyond's bound; the exact window decides
+        // the rest).
+        let d = g.position - p.position;
+        if (dot(d, d) > reject_beyond(g.range)) {
+            continue;
+        }
         let r = light_reach(g, p.position);
         if (r.window <= 0.0) {
             continue;
@@ -59,14 +74,6 @@ var<workgroup> staged_reach: array<vec4<f32>, 128>;
 var<workgroup> staged_geometry: array<LightGeometry, 128>;
 var<workgroup> staged_properties: array<LightProperties, 128>;
 
-// A squared distance past which range_window is surely zero: dist_sq over
-// fl(range²)·1.001 rounded down is over range² by 1e-3 at least, so the quotient r in
-// range_window, within 2.5 ulp (Vulkan's OpFDiv), is over 1, r² rounds to 1 or more, and
-// 1 − r² clamps to 0, fused or not. A NaN or infinite range rejects nothing here; the
-// exact test after it decides.
-fn reject_beyond(range: f32) -> f32 {
-    return range * range * 1.001;
-}
 
 // The tile list of the workgroup at `group` (8×8 pixels from group × 8): with one list
 // per tile and the tile a multiple of 8, the list of each of its pixels.
