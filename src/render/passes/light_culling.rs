@@ -376,7 +376,7 @@ mod tests {
         // Past 64 slices the slices grow instead; every light lies in one.
         let c = CoarseSlices::for_lights(1_000_000);
         assert_eq!(c.slices, 64);
-        assert!(c.slice * c.slices >= 1_000_000 && c.slice % 256 == 0);
+        assert!(c.slice * c.slices >= 1_000_000 && c.slice.is_multiple_of(256));
         assert_eq!(c.capacity, 256);
         // The test hook overrides either value.
         let h = CoarseSlices::with_test_overrides(1100, Some("slice=256,capacity=8"));
