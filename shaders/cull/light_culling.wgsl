@@ -7,11 +7,7 @@
 // COARSE×COARSE tiles; each tile then tests only its coarse tile's lights. Reading every
 // light in every tile is what bounds culling at high light counts (memory traffic).
 // The coarse test is the same conservative test on a larger frustum and depth range,
-// so the tiles' lists are exactly those without it. The lights are cut into
-// COARSE_SLICES slices of COARSE_SLICE, a coarse workgroup per coarse tile and slice (one
-// workgroup walking 65,536 lights in batches was most of culling's time); a tile reads
-// its coarse tile's slice lists in order, so its candidates still ascend. A slice list
-// over COARSE_CAPACITY sends the tile back to every light of that slice only.
+// so the tiles' lists are exactly those without it.
 // MSAA: the depth is multisampled and every one of its SAMPLES samples bounds the tile.
 // FLOAT_DEPTH: the depth is single-sample R32Float (a compute resolve's; the same values
 // a depth texture holds), read as texture_2d<f32>. Not with MSAA or TRANSPARENT.
@@ -29,8 +25,8 @@
 // offsets in the pool after the slots. A list runs past the index array's end
 // (`list_params.pool_indices`, the graph's max_indices) only when the long lists
 // together want more than the pool: its count is cut to what fits, and the cut is counted.
-// Defines: TILE (8 or 16), CAPACITY, VARIANT (see types.wgsl), COARSE, COARSE_SLICE,
-// COARSE_SLICES, COARSE_CAPACITY (per slice), SAMPLES, MSAA, FLOAT_DEPTH, TRANSPARENT, COMPACT, SCAN_BLOCK.
+// Defines: TILE (8 or 16), CAPACITY, VARIANT (see types.wgsl), COARSE, COARSE_CAPACITY,
+// SAMPLES, MSAA, FLOAT_DEPTH, TRANSPARENT, COMPACT, SCAN_BLOCK.
 
 #include "common/types.wgsl"
 #include "common/view_space.wgsl"
@@ -48,9 +44,8 @@
 #endif
 @group(0) @binding(3) var<storage, read_write> light_lists: array<atomic<u32>>;
 @group(0) @binding(4) var<uniform> list_params: ListParams;
-// Per coarse tile and slice (slices of a coarse tile next to each other): its light
-// count, then up to COARSE_CAPACITY light indices ascending. A count over the capacity
-// sends the tiles back to testing every light of the slice.
+// Per coarse tile: its light count, then up to COARSE_CAPACITY light indices ascending.
+// A count over the capacity sends its tiles back to testing every light.
 @group(0) @binding(5) var<storage, read_write> coarse_lists: array<u32>;
 #if TRANSPARENT
 #if MSAA
@@ -88,9 +83,7 @@ var<workgroup> depth_mask: atomic<u32>;
 // Hit bits of a batch of candidates, two sets: a batch clears the next batch's set while
 // it reads its own, so a batch needs two barriers, not three.
 var<workgroup> hits: array<array<atomic<u32>, MASK_WORDS>, 2>;
-// Where each slice's candidates start among the tile's (an exclusive prefix sum of the
-// slices' candidate counts; the last entry is the total).
-var<workgroup> slice_start: array<u32, COARSE_SLICES + 1u>;
+var<workgroup> coarse_count: u32;
 #if COMPACT
 // The fill's list entry: (offset, kept count), and the light after its slot's last.
 var<workgroup> fill_entry: vec2<u32>;
@@ -102,34 +95,6 @@ var<workgroup> pool_base: u32;
 #endif
 
 const COARSE_STRIDE: u32 = COARSE_CAPACITY + 1u;
-
-// The lights of slice `s`: [s·COARSE_SLICE, ..); the last slice takes every light left.
-fn slice_lights(s: u32) -> vec2<u32> {
-    let first = min(s * COARSE_SLICE, frame.light_count);
-    var end = min(first + COARSE_SLICE, frame.light_count);
-    if (s + 1u == COARSE_SLICES) {
-        end = frame.light_count;
-    }
-    return vec2<u32>(first, end);
-}
-
-// Candidate k of a tile (k < slice_start[COARSE_SLICES]): its slice by binary search
-// over the prefix sums, then the slice list's entry, or the slice's light when its list
-// overflowed.
-fn coarse_candidate(coarse_base: u32, k: u32) -> u32 {
-    var lo = 0u;
-    var hi = COARSE_SLICES - 1u;
-    while (lo < hi) {
-        let mid = (lo + hi + 1u) / 2u;
-        if (slice_start[mid] <= k) { lo = mid; } else { hi = mid - 1u; }
-    }
-    let j = k - slice_start[lo];
-    let base = coarse_base + lo * COARSE_STRIDE;
-    if (coarse_lists[base] > COARSE_CAPACITY) {
-        return slice_lights(lo).x + j;
-    }
-    return coarse_lists[base + 1u + j];
-}
 // 1e-4 of the distance: a thousand times the rounding it covers, and still far below
 // a tile's width at any distance (a 64-pixel coarse tile spans ~5e-2 of it at 60°).
 const COARSE_REACH: f32 = 1e-4;
@@ -265,14 +230,12 @@ fn main(
     // Ordered before their first use by the depth range's barriers. The coarse tile's
     // count is read now, so the read overlaps the depth's instead of following it.
     let coarse_x = (list_params.tiles_x + COARSE - 1u) / COARSE;
-    let coarse_base = ((group.y / COARSE) * coarse_x + group.x / COARSE) * COARSE_SLICES * COARSE_STRIDE;
+    let coarse_base = ((group.y / COARSE) * coarse_x + group.x / COARSE) * COARSE_STRIDE;
     if (local == 0u) {
         atomicStore(&depth_mask, 0u);
-    }
-    if (COARSE > 1u && local < COARSE_SLICES) {
-        let n = coarse_lists[coarse_base + local * COARSE_STRIDE];
-        let lights = slice_lights(local);
-        slice_start[local + 1u] = select(n, lights.y - lights.x, n > COARSE_CAPACITY);
+        if (COARSE > 1u) {
+            coarse_count = coarse_lists[coarse_base];
+        }
     }
     if (local < MASK_WORDS) {
         atomicStore(&hits[0][local], 0u);
@@ -312,20 +275,16 @@ fn main(
         tile_mask = atomicLoad(&depth_mask);
     }
 
-    // 4. Candidates: the coarse tile's lights (slice by slice), or every light. In
-    //    batches of THREADS; ranks within a batch from a bit mask keep the list in
-    //    ascending light order.
+    // 4. Candidates: the coarse tile's lights, or every light. In batches of THREADS;
+    //    ranks within a batch from a bit mask keep the list in ascending light order.
     var count = frame.light_count;
-    let from_coarse = COARSE > 1u;
-    if (from_coarse) {
-        // The slices' counts, stored before the depth range's barriers, summed in order.
-        if (local == 0u) {
-            slice_start[0] = 0u;
-            for (var j = 0u; j < COARSE_SLICES; j++) {
-                slice_start[j + 1u] += slice_start[j];
-            }
+    var from_coarse = false;
+    if (COARSE > 1u) {
+        let n = workgroupUniformLoad(&coarse_count);
+        if (n <= COARSE_CAPACITY) {
+            count = n;
+            from_coarse = true;
         }
-        count = workgroupUniformLoad(&slice_start[COARSE_SLICES]);
     }
     var total = 0u;
     // Candidates from `first` on; lights below `below` are not tested.
@@ -355,7 +314,7 @@ fn main(
         var hit = false;
         if (!empty && k < count) {
             if (from_coarse) {
-                i = coarse_candidate(coarse_base, k);
+                i = coarse_lists[coarse_base + 1u + k];
             }
             hit = i >= below && light_touches_tile(light_geometry[i], bounds, lo, hi, tile_mask, tile_min, tile_max, 0.0);
         }
@@ -559,10 +518,9 @@ fn light_touches_tile(
     return true;
 }
 
-// The coarse stage: one workgroup per coarse tile of COARSE×COARSE tiles and slice of
-// lights (z); each invocation folds COARSE×COARSE pixels into its part of the depth
-// range (every slice's workgroup finds the same range). No depth mask: every fine tile
-// applies its own.
+// The coarse stage: one workgroup per coarse tile of COARSE×COARSE tiles; each
+// invocation folds COARSE×COARSE pixels into its part of the depth range. No depth mask:
+// every fine tile applies its own.
 @compute @workgroup_size(TILE, TILE, 1)
 fn coarse(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -587,15 +545,15 @@ fn coarse(
     let empty = range.y == 0u;
     let bounds = tile_bounds(origin, span, lo, hi, empty);
     let coarse_x = (list_params.tiles_x + COARSE - 1u) / COARSE;
-    let base_word = ((group.y * coarse_x + group.x) * COARSE_SLICES + group.z) * COARSE_STRIDE;
+    let base_word = (group.y * coarse_x + group.x) * COARSE_STRIDE;
 
-    let lights = slice_lights(group.z);
+    let count = frame.light_count;
     var total = 0u;
     var h = 0u;
-    for (var base = lights.x; base < lights.y; base += THREADS) {
+    for (var base = 0u; base < count; base += THREADS) {
         let i = base + local;
         var hit = false;
-        if (!empty && i < lights.y) {
+        if (!empty && i < count) {
             // An all-ones mask: the depth-mask test passes here.
             hit = light_touches_tile(light_geometry[i], bounds, lo, hi, 0xffffffffu, lo, hi, COARSE_REACH);
         }

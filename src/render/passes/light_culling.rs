@@ -13,62 +13,9 @@ use crate::render::{RenderError, Renderer};
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-/// Most light indices a coarse culling tile lists, over all its slices; a slice list
-/// over its share sends the fine tiles back to testing every light of the slice.
-const COARSE_CAPACITY: u32 = 8192;
-/// Lights per coarse slice at least, and at most this many slices (each a coarse
-/// workgroup per coarse tile; a fine tile sums the slices' counts in one invocation).
-const COARSE_SLICE_MIN: u32 = 1024;
-const COARSE_SLICES_MAX: u32 = 64;
-
-/// Test hook: `slice=N,capacity=N` (either) overrides the lights per coarse slice and the
-/// indices a slice list holds, so tests can cut small scenes into many slices and fill
-/// their lists. Read when the pass is prepared.
-pub const COARSE_TEST_VAR: &str = "LIGHTGRAPH_COARSE_TEST_SLICES";
-
-/// How the coarse stage cuts the lights: `slices` workgroups per coarse tile of `slice`
-/// lights each (the last takes the rest), each listing up to `capacity` indices.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct CoarseSlices {
-    slice: u32,
-    slices: u32,
-    capacity: u32,
-}
-
-impl CoarseSlices {
-    fn for_lights(lights: u32) -> CoarseSlices {
-        let slices = lights
-            .div_ceil(COARSE_SLICE_MIN)
-            .clamp(1, COARSE_SLICES_MAX);
-        // Whole batches of the coarse workgroup's 256 (or 64) invocations.
-        let slice = lights.div_ceil(slices).next_multiple_of(256).max(256);
-        let capacity = (COARSE_CAPACITY / slices).clamp(256, slice);
-        CoarseSlices {
-            slice,
-            slices,
-            capacity,
-        }
-    }
-
-    /// `for_lights`, with the test hook's overrides.
-    fn with_test_overrides(lights: u32, hook: Option<&str>) -> CoarseSlices {
-        let mut c = CoarseSlices::for_lights(lights);
-        for part in hook.unwrap_or("").split(',') {
-            match part
-                .split_once('=')
-                .map(|(k, v)| (k.trim(), v.trim().parse::<u32>()))
-            {
-                Some(("slice", Ok(n))) if n > 0 => {
-                    c.slice = n;
-                    c.slices = lights.div_ceil(n).clamp(1, COARSE_SLICES_MAX);
-                }
-                Some(("capacity", Ok(n))) => c.capacity = n,
-                _ => {}
-            }
-        }
-        c
-    }
-}
+/// Most lights a coarse culling tile lists; a tile with more sends its fine tiles back
+/// to testing every light.
+const COARSE_CAPACITY: u64 = 8192;
 
 pub(super) struct LightCullingPass {
     name: Name,
@@ -109,17 +56,15 @@ pub(super) fn prepare(
     let layout = p.list_layout(cx.size.width, cx.size.height);
     let lists = cx.buffer(&sp.name, sp.required(slot::LIGHT_LISTS))?;
     let coarse = p.coarse.max(1);
-    let slices = CoarseSlices::with_test_overrides(
-        cx.gpu.light_count,
-        std::env::var(COARSE_TEST_VAR).ok().as_deref(),
-    );
-    // Each coarse tile and slice: a count and up to `capacity` indices (a single unused
-    // word without a coarse stage).
+    let coarse_groups = [
+        layout.tiles_x.div_ceil(coarse),
+        layout.tiles_y.div_ceil(coarse),
+        1,
+    ];
+    // Each coarse tile: a count and up to COARSE_CAPACITY indices (a single unused word
+    // without a coarse stage).
     let coarse_words = if coarse > 1 {
-        layout.tiles_x.div_ceil(coarse) as u64
-            * layout.tiles_y.div_ceil(coarse) as u64
-            * slices.slices as u64
-            * (slices.capacity as u64 + 1)
+        coarse_groups[0] as u64 * coarse_groups[1] as u64 * (COARSE_CAPACITY + 1)
     } else {
         1
     };
@@ -139,9 +84,7 @@ pub(super) fn prepare(
         ("TILE", format!("{}u", p.tile)),
         ("VARIANT", format!("{}u", p.variant.code())),
         ("COARSE", format!("{coarse}u")),
-        ("COARSE_SLICE", format!("{}u", slices.slice)),
-        ("COARSE_SLICES", format!("{}u", slices.slices)),
-        ("COARSE_CAPACITY", format!("{}u", slices.capacity)),
+        ("COARSE_CAPACITY", format!("{COARSE_CAPACITY}u")),
         // Every sample of a multisampled depth bounds the tile.
         ("SAMPLES", format!("{}u", sp.samples)),
     ];
@@ -223,11 +166,6 @@ pub(super) fn prepare(
     };
     let coarse = if coarse > 1 {
         let (pipeline, _) = cx.compute_pipeline(&sp.name, key("coarse"), "coarse", &offered)?;
-        let coarse_groups = [
-            layout.tiles_x.div_ceil(coarse),
-            layout.tiles_y.div_ceil(coarse),
-            slices.slices,
-        ];
         Some((pipeline, coarse_groups))
     } else {
         None
@@ -355,31 +293,5 @@ impl PreparedPass for LightCullingPass {
             misplaced_lists,
             counts,
         })))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::CoarseSlices;
-
-    #[test]
-    fn slices_grow_with_the_lights_and_stay_bounded() {
-        let at = |n| {
-            let c = CoarseSlices::for_lights(n);
-            (c.slice, c.slices, c.capacity)
-        };
-        assert_eq!(at(0), (256, 1, 256));
-        assert_eq!(at(1024), (1024, 1, 1024));
-        // Slices of whole batches; a slice list can hold every light of its slice.
-        assert_eq!(at(3072), (1024, 3, 1024));
-        assert_eq!(at(65536), (1024, 64, 256));
-        // Past 64 slices the slices grow instead; every light lies in one.
-        let c = CoarseSlices::for_lights(1_000_000);
-        assert_eq!(c.slices, 64);
-        assert!(c.slice * c.slices >= 1_000_000 && c.slice.is_multiple_of(256));
-        assert_eq!(c.capacity, 256);
-        // The test hook overrides either value.
-        let h = CoarseSlices::with_test_overrides(1100, Some("slice=256,capacity=8"));
-        assert_eq!((h.slice, h.slices, h.capacity), (256, 5, 8));
     }
 }
