@@ -23,7 +23,7 @@ for scene in harada atrium_amd; do
     $lg compare "$img/${scene}_visibility_compute_raster.exr" "$img/${scene}_visibility_buffer.exr" 2>&1 | tee "$out/compare_${scene}_raster_vs_hw.txt"
 done
 rm -rf $img
-for s in visibility_headline visibility_atrium visibility_textured visibility_staging diag_culling; do
+for s in visibility_headline visibility_atrium visibility_textured visibility_staging; do
     timeout 200 $lg bench --sweep benches/sweeps/$s.ron --out "$out/$s" > "$out/$s.log" 2>&1
     echo "== $s"; tail -n 2 "$out/$s.log"
     sed -n '/^| scene | technique | params | lights | size/,/^$/p;/^Per-pass GPU time/,/^$/p' "$out/$s/results.md" | cut -c1-400

@@ -226,14 +226,14 @@ fn graph_edits_keep_unchanged_resources_and_pipelines() {
     // 48 lights never fill 65,536 indices: the same image.
     assert_eq!(image(&s), first);
 
-    // 1b. Fixed lists of 128: a define changes, so only the culling pass's two pipelines
-    //     (its coarse and fine stages share the module) are built.
+    // 1b. Fixed lists of 128: a define changes, so only the culling pass's three
+    //     pipelines (its bounds, coarse and fine stages share the module) are built.
     std::fs::write(&graph, text.replace(bound, "capacity: 128")).unwrap();
     let r = reload_of(&mut s, &graph);
     r.outcome.as_ref().expect("the edited graph compiles");
     let stats = s.prepared().unwrap().stats().clone();
     assert_eq!((stats.resources_reused, stats.resources_created), (2, 1));
-    assert_eq!(stats.pipelines_built.len(), 2, "{stats:?}");
+    assert_eq!(stats.pipelines_built.len(), 3, "{stats:?}");
     assert!(
         stats
             .pipelines_built

@@ -1,6 +1,8 @@
 //! CPU versions of the culling tests in `shaders/cull/light_culling.wgsl`, line for line, for
 //! property tests (a light that reaches any point of a tile's depth range is never
-//! culled) and for tools that want to reason about lists without a GPU.
+//! culled) and for tools that want to reason about lists without a GPU. (The shader
+//! computes a light's view-space sphere once a frame in its `bounds` dispatch and tests
+//! it per tile in `light_touches_tile`; the arithmetic is the same as here in one piece.)
 
 use glam::{Mat4, Vec2, Vec3};
 

@@ -31,6 +31,13 @@ impl BindingSet {
     pub fn buffer(&mut self, name: &str, buffer: &wgpu::Buffer) {
         self.offer(name, Bound::Buffer(buffer.clone()));
     }
+    /// The size in bytes of the buffer offered under `name`.
+    pub fn buffer_size(&self, name: &str) -> Option<u64> {
+        match self.get(name) {
+            Some(Bound::Buffer(b)) => Some(b.size()),
+            _ => None,
+        }
+    }
     fn get(&self, name: &str) -> Option<&Bound> {
         self.named.iter().find(|(n, _)| n == name).map(|(_, b)| b)
     }
