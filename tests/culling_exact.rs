@@ -316,3 +316,45 @@ fn tiled_deferred_matches_forward_brute_force() {
     println!("packed G-buffer: worst relative error {worst:e}");
     assert!(worst <= 1e-3, "packed: relative error {worst:e}");
 }
+
+#[test]
+fn the_subgroup_depth_range_gives_the_same_lists() {
+    // Where the device has SUBGROUP, culling finds each tile's depth range by subgroup
+    // reductions; without it, through workgroup memory. Min and max are exact, so every
+    // list (DepthMask's cells included) and the image must be the same to the bit.
+    let with = renderer();
+    if !with
+        .ctx
+        .device
+        .features()
+        .contains(wgpu::Features::SUBGROUP)
+    {
+        eprintln!("this adapter has no SUBGROUP: only the workgroup-memory depth range ran");
+        return;
+    }
+    drop(with);
+    let mut without =
+        lightgraph::render::Renderer::headless_with(&lightgraph::gpu::ContextOptions {
+            disabled_features: wgpu::Features::SUBGROUP,
+        })
+        .expect("a wgpu adapter (lavapipe on CI)");
+    let mut scene = pillar_scene(500);
+    scene.name = "depth_discontinuities".into();
+    for tile in TILES {
+        for variant in ["Frustum", "DepthMask", "HalfZ"] {
+            let text = graph_text(tile, variant, 1024, None);
+            let a = render_text(&mut renderer(), &text, &scene, W, H);
+            let b = render_text(&mut without, &text, &scene, W, H);
+            assert_eq!(
+                a.culling[0].counts, b.culling[0].counts,
+                "tile {tile} {variant}: lists differ"
+            );
+            assert!(
+                a.culling[0].counts.iter().any(|&c| c > 0),
+                "tile {tile} {variant}: nothing listed"
+            );
+            assert_eq!(a.image.len(), (W * H) as usize);
+            assert!(a.image == b.image, "tile {tile} {variant}: images differ");
+        }
+    }
+}

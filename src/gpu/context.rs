@@ -113,6 +113,8 @@ impl GpuContext {
             | wgpu::Features::PRIMITIVE_INDEX
             | wgpu::Features::SHADER_INT64
             | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX
+            // Light culling finds a tile's depth range by subgroup reductions where offered.
+            | wgpu::Features::SUBGROUP
             // Compiled pipelines kept on disk between runs (see `pipeline_cache`).
             | wgpu::Features::PIPELINE_CACHE;
         let disabled_features = adapter.features() & wanted & options.disabled_features;

@@ -113,6 +113,10 @@ pub(super) fn prepare(
     if sp.samples > 1 {
         d.push(("MSAA", "1".into()));
     }
+    // The tile's depth range by subgroup reductions (one barrier instead of two).
+    if device.features().contains(wgpu::Features::SUBGROUP) {
+        d.push(("SUBGROUPS", "1".into()));
+    }
     // A compute resolve's R32Float depth (validation keeps it single-sample and opaque).
     if cx.float_depth(sp.required(slot::DEPTH)) {
         d.push(("FLOAT_DEPTH", "1".into()));
