@@ -7,9 +7,11 @@
 #   C     B with plain dot and cross for lg_dot and lg_cross (inexact)
 #   D     no BRDF per light (radiance times a constant)
 #   E     no light loop
-# B and C change shaders/material/lobes.wgsl, which is built into the binary (the generated
-# material code includes it as text), so they come as their own binaries: .gpu/lg_B.xz and
-# .gpu/lg_C.xz, built from the tree with that file edited as the perl lines below edit it.
+# B and C change shaders/material/lobes.wgsl, which was built into the binary when this ran
+# (the generated material code carried it as text), so they came as their own binaries:
+# .gpu/lg_B.xz and .gpu/lg_C.xz, built from the tree with that file edited as the perl lines
+# below edit it. Since the renderer includes the library from the root, the B and C folders
+# made below would do on their own.
 # Usage from the project root after ../shared/gpu/prepare.sh target/release/lightgraph.
 set -u
 source "$(dirname "$0")/gpu_env.sh"

@@ -153,6 +153,67 @@ fn shader_and_graph_edits_reload_and_errors_keep_the_last_frame() {
     );
 }
 
+/// The lobe library (`shaders/material/lobes.wgsl`) is a shader file like any other: the
+/// generated material code includes it from the root, so an edit reloads every
+/// material's pipelines, and a broken edit names the library's line.
+#[test]
+fn lobe_library_edits_reload_the_materials() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = tempfile::tempdir().unwrap();
+    let shaders = dir.path().join("shaders");
+    copy_dir(&root.join("shaders"), &shaders);
+    let graph: PathBuf = dir.path().join("forward_plus.ron");
+    std::fs::copy(root.join("graphs/forward_plus.ron"), &graph).unwrap();
+    let renderer = Renderer::new(
+        lightgraph::gpu::GpuContext::new_headless().unwrap(),
+        ShaderLibrary::new(&shaders),
+    );
+    let mut s = ReloadSession::new(
+        renderer,
+        &graph,
+        SceneSource::Fixed(Box::new(random_scene(48, 3))),
+        96,
+        64,
+        &[],
+    )
+    .unwrap();
+    let first = s.frame.as_ref().unwrap().image.clone();
+    assert!(first.iter().any(|p| p[0] > 0.0), "the scene is lit");
+
+    // Twice the Lambert lobe: every lit pixel brightens, none darkens.
+    let lobes = shaders.join("material/lobes.wgsl");
+    let original = std::fs::read_to_string(&lobes).unwrap();
+    let doubled = original.replace(
+        "    return color * LG_INV_PI;",
+        "    return 2.0 * color * LG_INV_PI;",
+    );
+    assert_ne!(doubled, original);
+    std::fs::write(&lobes, &doubled).unwrap();
+    reload_of(&mut s, &lobes).expect("the edited library compiles");
+    let second = s.frame.as_ref().unwrap().image.clone();
+    assert_eq!(second.len(), first.len());
+    let brighter = second
+        .iter()
+        .zip(&first)
+        .filter(|(a, b)| a[0] > b[0] * 1.01)
+        .count();
+    assert!(brighter > 100, "only {brighter} pixels brightened");
+    assert!(second.iter().zip(&first).all(|(a, b)| a[0] >= b[0]));
+
+    // Broken: the error names the library's file and line; the frame stays.
+    let broken = doubled.replace("fn lg_lambert(", "fn lg_lambert(oops ");
+    let line = broken.lines().position(|l| l.contains("oops")).unwrap() + 1;
+    std::fs::write(&lobes, &broken).unwrap();
+    let err = reload_of(&mut s, &lobes).expect_err("a broken library must not load");
+    assert!(err.contains(&format!("lobes.wgsl:{line}:")), "{err}");
+    assert_eq!(s.frame.as_ref().unwrap().image, second);
+
+    // Back to the original: the first frame again.
+    std::fs::write(&lobes, &original).unwrap();
+    reload_of(&mut s, &lobes).expect("the restored library loads");
+    assert_eq!(s.frame.as_ref().unwrap().image, first);
+}
+
 /// Reloads leave nothing behind on the GPU: over the reload benchmark's edits (a shader,
 /// a material and a graph, each with a new value, every one rebuilding pipelines and the
 /// graph edit re-planning resources), the number of live GPU memory allocations stays

@@ -181,9 +181,24 @@ impl Material {
     pub fn wgsl(&self) -> Result<String, MaterialError> {
         self.wgsl_with(&WgslOptions::default())
     }
+    /// With `include_library` the code is validated with the built-in lobe library in
+    /// place of its `#include` (the renderer's composer resolves the include, from the
+    /// root first).
     pub fn wgsl_with(&self, options: &WgslOptions) -> Result<String, MaterialError> {
         let code = wgsl::generate(self, options);
-        wgsl::validate(&code, self.name())?;
+        if options.include_library {
+            let standalone = code.replacen(wgsl::LOBE_LIBRARY_INCLUDE, wgsl::LOBE_LIBRARY, 1);
+            wgsl::validate(&standalone, self.name())?;
+        } else {
+            wgsl::validate(&code, self.name())?;
+        }
         Ok(code)
+    }
+    /// The material's code as the renderer composes it: the lobe library by `#include`.
+    pub fn renderer_wgsl(&self, options: &WgslOptions) -> Result<String, MaterialError> {
+        self.wgsl_with(&WgslOptions {
+            include_library: true,
+            ..options.clone()
+        })
     }
 }

@@ -12,6 +12,10 @@ use std::fmt::Write;
 /// The lobe library (`shaders/material/lobes.wgsl`), included textually.
 pub const LOBE_LIBRARY: &str = include_str!("../../shaders/material/lobes.wgsl");
 
+/// The line that stands for the lobe library in code generated with
+/// `WgslOptions::include_library`.
+pub const LOBE_LIBRARY_INCLUDE: &str = "#include \"material/lobes.wgsl\"";
+
 /// What the forward shader declares before including a material (the contract).
 pub const SHADING_POINT_WGSL: &str = "struct ShadingPoint {
     position: vec3<f32>,
@@ -33,6 +37,12 @@ pub struct WgslOptions {
     /// buffer, where implicit derivatives do not exist). Takes precedence over
     /// `sample_level_zero`.
     pub sample_grad: bool,
+    /// Include the lobe library with `#include "material/lobes.wgsl"` instead of its
+    /// text: the renderer composes material code with its shaders, so the library is
+    /// read from the root like any shader file and an edit to it reloads every
+    /// material's pipelines. Standalone code (validation, `material --wgsl`, tests)
+    /// leaves it off.
+    pub include_library: bool,
 }
 
 fn lit(x: f32) -> String {
@@ -121,7 +131,12 @@ pub fn generate(m: &Material, opts: &WgslOptions) -> String {
         m.path().display(),
         desc.name
     );
-    o.push_str(LOBE_LIBRARY);
+    if opts.include_library {
+        o.push_str(LOBE_LIBRARY_INCLUDE);
+        o.push('\n');
+    } else {
+        o.push_str(LOBE_LIBRARY);
+    }
     o.push_str("\n// ---- material ----\n\n");
     if !slots.is_empty() {
         o.push_str("@group(2) @binding(0) var material_sampler: sampler;\n");

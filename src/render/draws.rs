@@ -445,7 +445,7 @@ fn neutral_material_wgsl() -> Option<&'static str> {
             ..Default::default()
         };
         crate::material::Material::from_surface(&neutral)
-            .wgsl()
+            .renderer_wgsl(&Default::default())
             .ok()
     })
     .as_deref()

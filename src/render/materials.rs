@@ -37,12 +37,12 @@ impl MaterialProgram {
         alpha_mode: AlphaMode,
         double_sided: bool,
     ) -> Result<Self, MaterialError> {
-        let wgsl = material.wgsl()?;
+        let wgsl = material.renderer_wgsl(&Default::default())?;
         let slots = material.texture_slots();
         let compute_wgsl = if slots.is_empty() {
             None
         } else {
-            Some(material.wgsl_with(&crate::material::WgslOptions {
+            Some(material.renderer_wgsl(&crate::material::WgslOptions {
                 sample_grad: true,
                 ..Default::default()
             })?)
