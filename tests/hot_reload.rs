@@ -38,23 +38,22 @@ fn reload_of(s: &mut ReloadSession, file: &Path) -> Result<Duration, String> {
     panic!("no reload of {} within 100 s", file.display());
 }
 
-#[test]
-fn shader_and_graph_edits_reload_and_errors_keep_the_last_frame() {
+/// A reload session over a copy of the project's shaders and `forward_plus.ron` in
+/// `dir` (a renderer of its own reading that copy), 48 random lights at 96×64: the
+/// session, the shaders folder and the graph file, for the test to edit.
+fn session_on_copy(dir: &Path) -> (ReloadSession, PathBuf, PathBuf) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let dir = tempfile::tempdir().unwrap();
-    let shaders = dir.path().join("shaders");
+    let shaders = dir.join("shaders");
     copy_dir(&root.join("shaders"), &shaders);
-    let graph: PathBuf = dir.path().join("forward_plus.ron");
+    let graph: PathBuf = dir.join("forward_plus.ron");
     std::fs::copy(root.join("graphs/forward_plus.ron"), &graph).unwrap();
-
-    // A renderer of its own, reading this test's copy of the shaders.
-    let ctx_renderer = Renderer::new(
+    let renderer = Renderer::new(
         lightgraph::gpu::GpuContext::new_headless().unwrap(),
         ShaderLibrary::new(&shaders),
     );
     let scene = random_scene(48, 3);
-    let mut s = ReloadSession::new(
-        ctx_renderer,
+    let s = ReloadSession::new(
+        renderer,
         &graph,
         SceneSource::Fixed(Box::new(scene)),
         96,
@@ -62,6 +61,13 @@ fn shader_and_graph_edits_reload_and_errors_keep_the_last_frame() {
         &[],
     )
     .unwrap();
+    (s, shaders, graph)
+}
+
+#[test]
+fn shader_and_graph_edits_reload_and_errors_keep_the_last_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mut s, shaders, graph) = session_on_copy(dir.path());
     let first = s.frame.as_ref().unwrap().image.clone();
     assert_eq!(first.len(), 96 * 64);
     assert!(first.iter().any(|p| p[0] > 0.0), "the scene is lit");
@@ -158,25 +164,8 @@ fn shader_and_graph_edits_reload_and_errors_keep_the_last_frame() {
 /// material's pipelines, and a broken edit names the library's line.
 #[test]
 fn lobe_library_edits_reload_the_materials() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let dir = tempfile::tempdir().unwrap();
-    let shaders = dir.path().join("shaders");
-    copy_dir(&root.join("shaders"), &shaders);
-    let graph: PathBuf = dir.path().join("forward_plus.ron");
-    std::fs::copy(root.join("graphs/forward_plus.ron"), &graph).unwrap();
-    let renderer = Renderer::new(
-        lightgraph::gpu::GpuContext::new_headless().unwrap(),
-        ShaderLibrary::new(&shaders),
-    );
-    let mut s = ReloadSession::new(
-        renderer,
-        &graph,
-        SceneSource::Fixed(Box::new(random_scene(48, 3))),
-        96,
-        64,
-        &[],
-    )
-    .unwrap();
+    let (mut s, shaders, _graph) = session_on_copy(dir.path());
     let first = s.frame.as_ref().unwrap().image.clone();
     assert!(first.iter().any(|p| p[0] > 0.0), "the scene is lit");
 

@@ -9,7 +9,7 @@
 //! See `shaders/visibility/compute_raster.wgsl`.
 
 use super::compute_raster_resolve::Resolve;
-use super::{defines, pass_error, PrepareCtx, PreparedPass, Timestamps};
+use super::{defines, grid, pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::gpu::readback::read_buffer;
 use crate::graph::{Name, ScheduledPass};
 use crate::render::pipelines::PipelineKey;
@@ -76,17 +76,6 @@ pub(super) struct ComputeRasterPass {
     counters: wgpu::Buffer,
     capacity: ListCapacity,
     resolve: Resolve,
-}
-
-/// A 1D grid of `items` threads in groups of `per_group`, folded into y past the
-/// device's per-dimension limit (the shaders flatten it back).
-fn grid(items: u32, per_group: u32, max: u32) -> [u32; 3] {
-    let groups = items.div_ceil(per_group).max(1);
-    if groups <= max {
-        [groups, 1, 1]
-    } else {
-        [max, groups.div_ceil(max), 1]
-    }
 }
 
 /// Entries of the three work lists.

@@ -193,8 +193,9 @@ pub(super) fn prepare(
     let (bounds_pipeline, _) = cx.compute_pipeline(&sp.name, key("bounds"), "bounds", &offered)?;
     let bounds = (
         bounds_pipeline,
-        bounds_grid(
+        super::grid(
             u32::try_from(light_capacity).unwrap_or(u32::MAX),
+            BOUNDS_GROUP,
             device.limits().max_compute_workgroups_per_dimension,
         ),
     );
@@ -225,17 +226,6 @@ pub(super) fn prepare(
         lists,
         layout,
     })
-}
-
-/// Workgroups of BOUNDS_GROUP for one invocation per light, folded into y past the
-/// device's per-dimension limit (the shader flattens them back).
-fn bounds_grid(lights: u32, max: u32) -> [u32; 3] {
-    let groups = lights.div_ceil(BOUNDS_GROUP).max(1);
-    if groups <= max {
-        [groups, 1, 1]
-    } else {
-        [max, groups.div_ceil(max), 1]
-    }
 }
 
 impl PreparedPass for LightCullingPass {

@@ -449,6 +449,17 @@ pub(super) fn comparison_sampler(device: &wgpu::Device) -> Bound {
     }))
 }
 
+/// A 1D grid of `items` threads in groups of `per_group`, folded into y past the
+/// device's per-dimension limit (the shaders flatten it back).
+pub(super) fn grid(items: u32, per_group: u32, max: u32) -> [u32; 3] {
+    let groups = items.div_ceil(per_group).max(1);
+    if groups <= max {
+        [groups, 1, 1]
+    } else {
+        [max, groups.div_ceil(max), 1]
+    }
+}
+
 pub(super) fn pass_error(pass: &str, message: String) -> RenderError {
     RenderError::Pass {
         pass: pass.to_string(),
