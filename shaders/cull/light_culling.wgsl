@@ -378,15 +378,7 @@ fn main(
             list[slot] = i;
         }
 #endif
-        total += hits_in_batch(h);
-        // The next batch's set, last read before the previous barrier.
-        if (local < MASK_WORDS) {
-            atomicStore(&hits[1u - h][local], 0u);
-        }
-        // After the last batch nothing reads or clears the sets again.
-        if (base + THREADS < count) {
-            workgroupBarrier();
-        }
+        total += close_batch(h, local, base + THREADS < count);
         h = 1u - h;
     }
 
@@ -498,6 +490,21 @@ fn rank_in_batch(h: u32, local: u32) -> u32 {
         rank += countOneBits(atomicLoad(&hits[h][w]));
     }
     return rank + countOneBits(atomicLoad(&hits[h][word]) & ((1u << (local % 32u)) - 1u));
+}
+
+// Ends a batch of hit set `h`: its hit count. Clears the next batch's set (last read
+// before the previous barrier) and, when another batch follows (`more`, uniform), waits
+// for every invocation to be done with this one's; after the last batch nothing reads or
+// clears the sets again.
+fn close_batch(h: u32, local: u32, more: bool) -> u32 {
+    let n = hits_in_batch(h);
+    if (local < MASK_WORDS) {
+        atomicStore(&hits[1u - h][local], 0u);
+    }
+    if (more) {
+        workgroupBarrier();
+    }
+    return n;
 }
 
 fn hits_in_batch(h: u32) -> u32 {
@@ -654,15 +661,7 @@ fn coarse(
         if (hit && slot < COARSE_CAPACITY) {
             coarse_lists[base_word + 1u + slot] = i;
         }
-        total += hits_in_batch(h);
-        // The next batch's set, last read before the previous barrier.
-        if (local < MASK_WORDS) {
-            atomicStore(&hits[1u - h][local], 0u);
-        }
-        // After the last batch nothing reads or clears the sets again.
-        if (base + THREADS < count) {
-            workgroupBarrier();
-        }
+        total += close_batch(h, local, base + THREADS < count);
         h = 1u - h;
     }
     if (local == 0u) {
