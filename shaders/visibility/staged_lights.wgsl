@@ -77,8 +77,12 @@ fn shade_range_first(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_
 // against 4.03 one at a time, 3,072 lights 0.234 against 0.251; four a step was slower
 // at 3,072, the registers it holds cost warps). Lights are still added in list order.
 fn shade_range_first(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f32) -> vec3<f32> {
+    return shade_list(p, m, light_range(pixel, view_z));
+}
+
+// The lights of list `r` added to the surface's unlit colour, two a step.
+fn shade_list(p: ShadingPoint, m: MaterialSample, r: LightRange) -> vec3<f32> {
     var color = surface_unlit(p, m);
-    let r = light_range(pixel, view_z);
     var k = 0u;
     for (; k + 2u <= r.count; k += 2u) {
         let i0 = light_at(r, k);
@@ -97,6 +101,16 @@ fn shade_range_first(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_
 #endif
 #endif
 
+#if LIGHT_LISTS
+// The tile list of the workgroup at `group` (SHADING_GROUP² pixels from group ×
+// SHADING_GROUP): with one list per tile and the tile a multiple of SHADING_GROUP, the
+// list of each of its pixels.
+fn group_list(group: vec2<u32>) -> LightRange {
+    let t = group * SHADING_GROUP / list_params.tile;
+    return list_entry(t.y * list_params.tiles_x + t.x);
+}
+#endif
+
 #if STAGED_LIGHTS
 // One light per invocation of the 8×8 workgroup, two batches (the one shaded, the one
 // stored): 2 × 64 × 80 bytes of workgroup memory.
@@ -107,13 +121,6 @@ var<workgroup> staged_reach: array<vec4<f32>, 128>;
 var<workgroup> staged_geometry: array<LightGeometry, 128>;
 var<workgroup> staged_properties: array<LightProperties, 128>;
 
-
-// The tile list of the workgroup at `group` (8×8 pixels from group × 8): with one list
-// per tile and the tile a multiple of 8, the list of each of its pixels.
-fn group_list(group: vec2<u32>) -> LightRange {
-    let t = group * 8u / list_params.tile;
-    return list_entry(t.y * list_params.tiles_x + t.x);
-}
 
 struct ListedLight {
     g: LightGeometry,

@@ -4,11 +4,13 @@
 // the surface at the pixel centre and shades it with the same material code and light
 // loop as forward shading. Ids: src/render/visibility_geometry.rs (NO_TRIANGLE where
 // nothing was drawn).
-// Defines: MATERIAL_INDEX, CLEARS (this dispatch stores black where nothing was drawn),
+// Defines: SHADING_GROUP (the workgroup's side in pixels; 8 with STAGED_LIGHTS),
+// MATERIAL_INDEX, CLEARS (this dispatch stores black where nothing was drawn),
 // LIGHT_LISTS (tile lists) or LINKED_LISTS (a light linked list), and the light loop:
 // STAGED_LIGHTS (the workgroup's one tile list staged in workgroup memory, in
 // visibility/staged_lights.wgsl), RANGE_FIRST (the per-pixel cursor with the range test
-// before the light's properties), or neither (common/light_loop.wgsl's shade_surface,
+// before the light's properties; with UNIFORM_LIST the workgroup's one tile list, found
+// from the workgroup id, so the compiler sees the walk as uniform), or neither (common/light_loop.wgsl's shade_surface,
 // as forward shading runs it).
 
 #include "common/types.wgsl"
@@ -184,8 +186,18 @@ fn main(
     }
 }
 #else
-@compute @workgroup_size(8, 8, 1)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+// Invocation `lane`'s pixel in its workgroup: each run of 32 invocations (a warp on
+// NVIDIA) covers an 8×4 block, the most compact, so its pixels mostly see the same lights
+// in range and take the same branches of the light loop.
+fn block_pixel(lane: u32) -> vec2<u32> {
+    let block = lane / 32u;
+    let across = SHADING_GROUP / 8u;
+    return vec2<u32>(lane % 8u + 8u * (block % across), (lane / 8u) % 4u + 4u * (block / across));
+}
+
+@compute @workgroup_size(SHADING_GROUP, SHADING_GROUP, 1)
+fn main(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group: vec3<u32>) {
+    let id = group.xy * SHADING_GROUP + block_pixel(lane);
     if (any(id.xy >= frame.size)) {
         return;
     }
@@ -202,7 +214,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let s = rebuild(id.xy, tri);
 #if RANGE_FIRST
+#if UNIFORM_LIST
+    let color = shade_list(s.p, s.m, group_list(group.xy));
+#else
     let color = shade_range_first(s.p, s.m, s.pixel, s.view_z);
+#endif
 #else
     let color = shade_surface(s.p, s.m, s.pixel, s.view_z);
 #endif

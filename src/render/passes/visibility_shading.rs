@@ -31,7 +31,9 @@ pub(super) fn prepare(
 ) -> Result<VisibilityShadingPass, RenderError> {
     let mut offered = cx.declared(sp)?;
     let lists = cx.shading_lists(sp, p.lights, &mut offered)?;
-    let light_loop = light_loop(cx, sp, p, lists);
+    let layout = tile_layout(cx, sp, lists);
+    let light_loop = choose_light_loop(p.light_loop, layout);
+    let group = shading_group(light_loop, layout);
     let ranges = cx.merged(&sp.name)?.material_ranges.clone();
     // Only materials that own triangles get a dispatch (blended ones never do); the first
     // also clears pixels nothing covers, so one runs even for a scene without triangles.
@@ -54,6 +56,10 @@ pub(super) fn prepare(
         }
         d.extend(lists.define());
         d.extend(loop_define(light_loop));
+        d.push(("SHADING_GROUP", format!("{}u", group.side)));
+        if group.uniform_list {
+            d.push(("UNIFORM_LIST", "1".into()));
+        }
         let key = PipelineKey {
             shader: "visibility/visibility_shading.wgsl".into(),
             defines: defines(&d),
@@ -76,15 +82,47 @@ pub(super) fn prepare(
         dispatches,
         bind: bind.ok_or_else(|| super::pass_error(&sp.name, "no material to shade".into()))?,
         groups: [
-            cx.size.width.div_ceil(WORKGROUP_SIDE),
-            cx.size.height.div_ceil(WORKGROUP_SIDE),
+            cx.size.width.div_ceil(group.side),
+            cx.size.height.div_ceil(group.side),
             1,
         ],
     })
 }
 
-/// Pixels per side of the shader's workgroup (`@workgroup_size(8, 8, 1)`).
+/// Pixels per side of the staged loop's workgroup (its batches are one light per
+/// invocation of 8×8).
 const WORKGROUP_SIDE: u32 = 8;
+
+/// The shader's workgroup (`@workgroup_size(SHADING_GROUP, SHADING_GROUP, 1)`) and
+/// whether its pixels all read one tile list, found from the workgroup id.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct ShadingGroup {
+    side: u32,
+    uniform_list: bool,
+}
+
+/// Diagnosis hooks (benchmarks compare them in one binary): LIGHTGRAPH_SHADING_GROUP=8|16
+/// and LIGHTGRAPH_UNIFORM_LIST=0|1.
+fn shading_group(l: LightLoop, layout: Option<ListLayout>) -> ShadingGroup {
+    let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<u32>().ok());
+    if l == LightLoop::Staged {
+        return ShadingGroup {
+            side: WORKGROUP_SIDE,
+            uniform_list: false,
+        };
+    }
+    let side = match env("LIGHTGRAPH_SHADING_GROUP") {
+        Some(16) => 16,
+        _ => WORKGROUP_SIDE,
+    };
+    let one_list = layout.is_some_and(|t| t.lists_per_tile == 1 && t.tile % side == 0);
+    ShadingGroup {
+        side,
+        uniform_list: l == LightLoop::RangeFirst
+            && one_list
+            && env("LIGHTGRAPH_UNIFORM_LIST") == Some(1),
+    }
+}
 
 /// The define that picks the shader's light loop (shaders/visibility/staged_lights.wgsl).
 fn loop_define(l: LightLoop) -> Option<(&'static str, String)> {
@@ -95,21 +133,15 @@ fn loop_define(l: LightLoop) -> Option<(&'static str, String)> {
     }
 }
 
-/// The loop the graph asked for, for `lights` read from `lists`.
-fn light_loop(
-    cx: &PrepareCtx,
-    sp: &ScheduledPass,
-    p: &VisibilityShading,
-    lists: ShadeLists,
-) -> LightLoop {
-    let layout = match lists {
+/// The tile lists' layout when the pass reads tile lists.
+fn tile_layout(cx: &PrepareCtx, sp: &ScheduledPass, lists: ShadeLists) -> Option<ListLayout> {
+    match lists {
         ShadeLists::Tiles => cx
             .graph
             .plan
             .list_layout(sp.required(crate::graph::slot::LIGHT_LISTS)),
         ShadeLists::AllLights | ShadeLists::Links => None,
-    };
-    choose_light_loop(p.light_loop, layout)
+    }
 }
 
 /// `Staged` only for tile lists with one list per tile (Frustum, DepthMask) whose tile is
