@@ -497,7 +497,7 @@ fn ids_cover_exactly_the_prepass_depth_and_name_the_triangle_there() {
 }
 
 /// `graph_text` with its VisibilityShading pass set to light loop `kind` (`Staged`,
-/// `RangeFirst`, `Forward`; the shipped graphs leave the default, `RangeFirst`).
+/// `RangeFirst`, `GroupList`, `Forward`, optionally followed by `, workgroup: 16`).
 fn with_loop(graph_text: &str, kind: &str) -> String {
     let on = [
         "VisibilityShading(lights: Culled)",
@@ -549,14 +549,22 @@ fn bit_differences(a: &[[f32; 4]], b: &[[f32; 4]]) -> (usize, Option<usize>) {
     (n, a.iter().zip(b).position(differs))
 }
 
-/// Renders `scene` through every staging graph with each light loop (Staged, RangeFirst)
-/// against forward shading's loop (Forward); the failures where the images differ in any bit. Staging only reorders loads and skips lights
-/// that add nothing, so the sums are the same floats in the same order.
+/// Renders `scene` through every staging graph with each light loop (Staged, RangeFirst,
+/// GroupList; the last with workgroups of 8 and 16) against forward shading's loop
+/// (Forward); the failures where the images differ in any bit. Staging only reorders loads
+/// and skips lights that add nothing, so the sums are the same floats in the same order.
 fn check_staging_is_exact(r: &mut lightgraph::render::Renderer, scene: &Scene) -> Vec<String> {
     let mut failures = Vec::new();
     for (graph, text) in staging_graphs() {
         let plain = render_text(r, &with_loop(&text, "Forward"), scene, W, H);
-        for kind in ["Staged", "RangeFirst"] {
+        for kind in [
+            "Staged",
+            "RangeFirst",
+            "GroupList",
+            // RangeFirst on 16×16 too: GroupList falls back to it on every graph without one
+            // list per 16-pixel tile (tiles of 8, HalfZ, Clustered, linked lists, all lights).
+            "GroupList, workgroup: 16",
+        ] {
             let name = format!("{graph} {kind}");
             let staged = render_text(r, &with_loop(&text, kind), scene, W, H);
             assert!(

@@ -11,14 +11,35 @@ use crate::graph::error::GraphError;
 use crate::graph::model::{LightSource, SceneResource};
 use serde::{Deserialize, Serialize};
 
-/// `VisibilityShading(lights: Culled, light_loop: RangeFirst)`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
+/// `VisibilityShading(lights: Culled, light_loop: RangeFirst, workgroup: 8)`.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
 #[serde(deny_unknown_fields)]
 pub struct VisibilityShading {
     #[serde(default)]
     pub lights: LightSource,
     #[serde(default)]
     pub light_loop: LightLoop,
+    /// Pixels per side of the shading workgroup: 8 or 16 (`Staged` takes 8). Its
+    /// invocations run in 8×4-pixel blocks of 32 (a warp on NVIDIA) either way.
+    #[serde(default = "default_workgroup")]
+    pub workgroup: u32,
+}
+
+/// Workgroup sides the shader is built for.
+pub const WORKGROUP_SIDES: [u32; 2] = [8, 16];
+
+fn default_workgroup() -> u32 {
+    8
+}
+
+impl Default for VisibilityShading {
+    fn default() -> Self {
+        Self {
+            lights: LightSource::default(),
+            light_loop: LightLoop::default(),
+            workgroup: default_workgroup(),
+        }
+    }
 }
 
 /// How a pixel walks its lights. All three give the same image to the bit (tested); they
@@ -34,6 +55,10 @@ pub enum LightLoop {
     /// A workgroup whose pixels all read one tile list (Frustum and DepthMask lists)
     /// stages it in workgroup memory, a batch at a time; other lists run `RangeFirst`.
     Staged,
+    /// `RangeFirst` over the workgroup's one tile list, found from the workgroup id, so
+    /// the compiler sees the walk as uniform (Frustum and DepthMask lists whose tile is a
+    /// multiple of the workgroup); other lists run `RangeFirst`.
+    GroupList,
 }
 
 pub const VERTICES: &str = "vertices";
@@ -66,6 +91,16 @@ pub const SLOTS: &[SlotSpec] = &[
 
 pub fn check(p: &VisibilityShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     check_light_source(ctx, p.lights, errors);
+    if !WORKGROUP_SIDES.contains(&p.workgroup) {
+        errors.push(ctx.bad(format!(
+            "workgroup {} must be 8 or 16 (pixels per side)",
+            p.workgroup
+        )));
+    } else if p.light_loop == LightLoop::Staged && p.workgroup != 8 {
+        errors.push(ctx.bad(
+            "light_loop Staged stages one light per invocation of an 8×8 workgroup: use workgroup 8",
+        ));
+    }
     super::visibility_buffer::check_ids(ctx, errors);
     ctx.require_single_rgba32f(
         &[HDR],
@@ -127,6 +162,12 @@ mod tests {
             parse("(light_loop: Forward)").light_loop,
             LightLoop::Forward
         );
+        assert_eq!(
+            parse("(light_loop: GroupList)").light_loop,
+            LightLoop::GroupList
+        );
+        assert_eq!(parse("()").workgroup, 8);
+        assert_eq!(parse("(workgroup: 16)").workgroup, 16);
         assert!(ron::from_str::<VisibilityShading>("(staging: false)").is_err());
         assert!(ron::from_str::<VisibilityShading>("(light_loop: Fast)").is_err());
     }

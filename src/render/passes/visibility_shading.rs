@@ -32,8 +32,11 @@ pub(super) fn prepare(
     let mut offered = cx.declared(sp)?;
     let lists = cx.shading_lists(sp, p.lights, &mut offered)?;
     let layout = tile_layout(cx, sp, lists);
-    let light_loop = choose_light_loop(p.light_loop, layout);
-    let group = shading_group(light_loop, layout);
+    let light_loop = choose_light_loop(p.light_loop, layout, p.workgroup);
+    let group = ShadingGroup {
+        side: p.workgroup,
+        uniform_list: light_loop == LightLoop::GroupList,
+    };
     let ranges = cx.merged(&sp.name)?.material_ranges.clone();
     // Only materials that own triangles get a dispatch (blended ones never do); the first
     // also clears pixels nothing covers, so one runs even for a scene without triangles.
@@ -89,10 +92,6 @@ pub(super) fn prepare(
     })
 }
 
-/// Pixels per side of the staged loop's workgroup (its batches are one light per
-/// invocation of 8×8).
-const WORKGROUP_SIDE: u32 = 8;
-
 /// The shader's workgroup (`@workgroup_size(SHADING_GROUP, SHADING_GROUP, 1)`) and
 /// whether its pixels all read one tile list, found from the workgroup id.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -101,34 +100,11 @@ struct ShadingGroup {
     uniform_list: bool,
 }
 
-/// Diagnosis hooks (benchmarks compare them in one binary): LIGHTGRAPH_SHADING_GROUP=8|16
-/// and LIGHTGRAPH_UNIFORM_LIST=0|1.
-fn shading_group(l: LightLoop, layout: Option<ListLayout>) -> ShadingGroup {
-    let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<u32>().ok());
-    if l == LightLoop::Staged {
-        return ShadingGroup {
-            side: WORKGROUP_SIDE,
-            uniform_list: false,
-        };
-    }
-    let side = match env("LIGHTGRAPH_SHADING_GROUP") {
-        Some(16) => 16,
-        _ => WORKGROUP_SIDE,
-    };
-    let one_list = layout.is_some_and(|t| t.lists_per_tile == 1 && t.tile % side == 0);
-    ShadingGroup {
-        side,
-        uniform_list: l == LightLoop::RangeFirst
-            && one_list
-            && env("LIGHTGRAPH_UNIFORM_LIST") == Some(1),
-    }
-}
-
 /// The define that picks the shader's light loop (shaders/visibility/staged_lights.wgsl).
 fn loop_define(l: LightLoop) -> Option<(&'static str, String)> {
     match l {
         LightLoop::Forward => None,
-        LightLoop::RangeFirst => Some(("RANGE_FIRST", "1".into())),
+        LightLoop::RangeFirst | LightLoop::GroupList => Some(("RANGE_FIRST", "1".into())),
         LightLoop::Staged => Some(("STAGED_LIGHTS", "1".into())),
     }
 }
@@ -144,16 +120,15 @@ fn tile_layout(cx: &PrepareCtx, sp: &ScheduledPass, lists: ShadeLists) -> Option
     }
 }
 
-/// `Staged` only for tile lists with one list per tile (Frustum, DepthMask) whose tile is
-/// a multiple of the workgroup's side, so no workgroup straddles two tiles (`RangeFirst`
-/// otherwise); `layout` is `None` for linked lists and all lights.
-fn choose_light_loop(asked: LightLoop, layout: Option<ListLayout>) -> LightLoop {
-    match (asked, layout) {
-        (LightLoop::Staged, Some(l)) if l.lists_per_tile == 1 && l.tile % WORKGROUP_SIDE == 0 => {
-            LightLoop::Staged
-        }
-        (LightLoop::Staged, _) => LightLoop::RangeFirst,
-        (other, _) => other,
+/// `Staged` and `GroupList` only for tile lists with one list per tile (Frustum,
+/// DepthMask) whose tile is a multiple of the workgroup's side `side`, so no workgroup
+/// straddles two tiles (`RangeFirst` otherwise); `layout` is `None` for linked lists and
+/// all lights.
+fn choose_light_loop(asked: LightLoop, layout: Option<ListLayout>, side: u32) -> LightLoop {
+    let one_list = layout.is_some_and(|l| l.lists_per_tile == 1 && l.tile % side == 0);
+    match asked {
+        LightLoop::Staged | LightLoop::GroupList if !one_list => LightLoop::RangeFirst,
+        other => other,
     }
 }
 
@@ -178,7 +153,9 @@ impl PreparedPass for VisibilityShadingPass {
 #[cfg(test)]
 mod tests {
     use super::choose_light_loop;
-    use crate::graph::kinds::visibility_shading::LightLoop::{Forward, RangeFirst, Staged};
+    use crate::graph::kinds::visibility_shading::LightLoop::{
+        Forward, GroupList, RangeFirst, Staged,
+    };
     use crate::graph::{CullVariant, ListLayout, ListStorage};
 
     fn layout(tile: u32, variant: CullVariant) -> Option<ListLayout> {
@@ -194,19 +171,27 @@ mod tests {
         for tile in [8, 16] {
             for variant in [CullVariant::Frustum, CullVariant::DepthMask] {
                 let l = layout(tile, variant);
-                assert_eq!(choose_light_loop(Staged, l), Staged, "{l:?}");
-                assert_eq!(choose_light_loop(Forward, l), Forward, "{l:?}");
-                assert_eq!(choose_light_loop(RangeFirst, l), RangeFirst, "{l:?}");
+                assert_eq!(choose_light_loop(Staged, l, 8), Staged, "{l:?}");
+                assert_eq!(choose_light_loop(GroupList, l, 8), GroupList, "{l:?}");
+                assert_eq!(choose_light_loop(Forward, l, 8), Forward, "{l:?}");
+                assert_eq!(choose_light_loop(RangeFirst, l, 8), RangeFirst, "{l:?}");
             }
             for variant in [CullVariant::HalfZ, CullVariant::Clustered { slices: 16 }] {
                 let l = layout(tile, variant);
-                assert_eq!(choose_light_loop(Staged, l), RangeFirst, "{l:?}");
+                assert_eq!(choose_light_loop(Staged, l, 8), RangeFirst, "{l:?}");
+                assert_eq!(choose_light_loop(GroupList, l, 8), RangeFirst, "{l:?}");
             }
         }
+        // A 16-pixel workgroup straddles two 8-pixel tiles.
+        let l = layout(8, CullVariant::Frustum);
+        assert_eq!(choose_light_loop(GroupList, l, 16), RangeFirst);
+        let l = layout(16, CullVariant::Frustum);
+        assert_eq!(choose_light_loop(GroupList, l, 16), GroupList);
         // A tile the workgroup would straddle (the culling pass refuses it today).
         let l = layout(12, CullVariant::Frustum);
-        assert_eq!(choose_light_loop(Staged, l), RangeFirst);
-        assert_eq!(choose_light_loop(Staged, None), RangeFirst);
-        assert_eq!(choose_light_loop(Forward, None), Forward);
+        assert_eq!(choose_light_loop(Staged, l, 8), RangeFirst);
+        assert_eq!(choose_light_loop(Staged, None, 8), RangeFirst);
+        assert_eq!(choose_light_loop(GroupList, None, 8), RangeFirst);
+        assert_eq!(choose_light_loop(Forward, None, 8), Forward);
     }
 }
