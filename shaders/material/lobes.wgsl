@@ -19,8 +19,9 @@ const LG_COS_MIN: f32 = 1e-4;
 // transformations do not survive every Vulkan driver (lavapipe does not fuse `fma`; NIR's
 // algebraic passes fold TwoSum away and factor a·b + a·c), so the inputs (|x| ≤ 1) are
 // split instead: hi = x rounded to a 2^-11 grid, lo = x − hi (exact). The hi·hi products
-// are done in i32 (integers below 2^22, sums below 2^24): exact, and out of reach of float
-// reassociation. Only the small hi·lo and lo·b terms are rounded (≤ ~1e-11 absolute).
+// are done in i32 (integers up to 2^22, sums below 2^24, taken to f32 exactly): exact, and
+// out of reach of float reassociation. Only the small hi·lo and lo·b terms are rounded
+// (≤ ~1e-11 absolute).
 
 // x split as hi + lo, with hi · 2048 as an integer (`steps`). x + (6 + 2^-12) lies in
 // [4, 8) for |x| ≤ 2, where f32 steps by 2^-21: clearing its 10 low mantissa bits puts it
@@ -42,11 +43,19 @@ fn lg_split(x: vec3<f32>) -> LgSplit {
     return LgSplit(hi, x - hi, steps);
 }
 
+// An integer of magnitude at most 2^22 as f32, exactly, without a conversion: added to the
+// bits of 1.5·2^23 (where f32 steps by 1, and which 2^23 ± 2^22 keep in [2^23, 2^24]) it
+// lands on 1.5·2^23 + i. A product of two splits' steps (|steps| ≤ 2048) is such an
+// integer, and sums of up to four of them are exact in f32 in any order (below 2^24).
+fn lg_exact_f32(i: vec3<i32>) -> vec3<f32> {
+    return bitcast<vec3<f32>>(vec3<i32>(0x4b400000) + i) - 12582912.0;
+}
+
 fn lg_dot(a: vec3<f32>, b: vec3<f32>) -> f32 {
     let sa = lg_split(a);
     let sb = lg_split(b);
-    let p = sa.steps * sb.steps;
-    let hh = f32(p.x + p.y + p.z) * (1.0 / 4194304.0);
+    let p = lg_exact_f32(sa.steps * sb.steps);
+    let hh = (p.x + p.y + p.z) * (1.0 / 4194304.0);
     return hh + (dot(sa.hi, sb.lo) + dot(sa.lo, b));
 }
 
@@ -56,12 +65,8 @@ fn lg_cross(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
     let sb = lg_split(b);
     let ia = sa.steps;
     let ib = sb.steps;
-    let ic = vec3<i32>(
-        ia.y * ib.z - ia.z * ib.y,
-        ia.z * ib.x - ia.x * ib.z,
-        ia.x * ib.y - ia.y * ib.x,
-    );
-    return vec3<f32>(ic) * (1.0 / 4194304.0) + (cross(sa.hi, sb.lo) + cross(sa.lo, b));
+    let ic = lg_exact_f32(ia.yzx * ib.zxy) - lg_exact_f32(ia.zxy * ib.yzx);
+    return ic * (1.0 / 4194304.0) + (cross(sa.hi, sb.lo) + cross(sa.lo, b));
 }
 
 // What the lobes need about (n, v, l). `s2` is |n × h|² = 1 − (n·h)², from an accurate
