@@ -10,8 +10,7 @@
 #        a light); .gpu/lobes_old.wgsl is `git show 354a123:shaders/material/lobes.wgsl`
 #   C    plain dot and cross for the accurate products (inexact: what they still cost)
 #   D    no BRDF per light (radiance times a constant: what the walk and radiance cost)
-# and culling's coarse and count dispatches alone (LIGHTGRAPH_TIME_DISPATCH), shipped and
-# cull. The results are packed after every stage, so a cut-off run still brings back
+# and culling's coarse dispatch alone (LIGHTGRAPH_TIME_DISPATCH=1), shipped and cull. The results are packed after every stage, so a cut-off run still brings back
 # what it finished. Usage from the project root after ../shared/gpu/prepare.sh
 # target/release/lightgraph.
 set -u
@@ -19,7 +18,7 @@ source "$(dirname "$0")/gpu_env.sh"
 pack() { tar -czf "$final/results.tar.gz" -C "$final" r; }
 sweep() { # name [root]
     local s=$1 root=${2:-}
-    timeout 100 $lg ${root:+--root $root} bench --sweep benches/sweeps/$s.ron --out "$out/$s" > "$out/$s.log" 2>&1
+    timeout 60 $lg ${root:+--root $root} bench --sweep benches/sweeps/$s.ron --out "$out/$s" > "$out/$s.log" 2>&1
     echo "== $s"; tail -n 1 "$out/$s.log"
     sed -n '/^| scene | technique | params | lights | size/,/^$/p;/^Per-pass GPU time/,/^$/p' "$out/$s/results.md" | cut -c1-230
     pack
@@ -36,21 +35,19 @@ perl -0pe 's/return color \+ inc.radiance \* material_eval\(m, inc.dir\);/return
 { diff $L $roots/old/$L; diff $L $roots/C/$L; diff $S $roots/D/$S; diff shaders/cull/light_culling.wgsl $roots/cull/shaders/cull/light_culling.wgsl; } > "$out/variants.diff"
 diag() { # n variant [env]
     local d="diag$1_$2"
-    env ${3:-} timeout 40 $lg --root $roots/$2 bench --sweep benches/sweeps/diag_session10.ron --out "$out/$d" > "$out/$d.log" 2>&1
+    env ${3:-} timeout 25 $lg --root $roots/$2 bench --sweep benches/sweeps/diag_session10.ron --out "$out/$d" > "$out/$d.log" 2>&1
     echo "== $d ${3:-}"; sed -n '/^Per-pass GPU time/,/^$/p' "$out/$d/results.md" | cut -c1-200
     pack
 }
+# In order of what matters most: the device time left (about 5 minutes) may cut the run.
 diag 1 shipped
 diag 2 cull
 diag 3 old
-diag 4 shipped LIGHTGRAPH_TIME_DISPATCH=1
-diag 5 cull LIGHTGRAPH_TIME_DISPATCH=1
-diag 6 shipped LIGHTGRAPH_TIME_DISPATCH=2
-diag 7 cull LIGHTGRAPH_TIME_DISPATCH=2
 sweep session10_atrium
 sweep session10_textured
-diag 8 C
-diag 9 D
-diag 10 shipped
+diag 4 shipped LIGHTGRAPH_TIME_DISPATCH=1
+diag 5 cull LIGHTGRAPH_TIME_DISPATCH=1
+diag 6 C
+diag 7 D
 nvidia-smi --query-gpu=clocks.sm --format=csv >> "$out/gpu.txt" 2>&1
 gpu_pack
