@@ -362,13 +362,14 @@ fn main(
     let idx0 = candidate_or_none(!empty && k0 < count, from_coarse, coarse_base, k0);
     var idx1 = candidate_or_none(!empty && k0 + THREADS < count, from_coarse, coarse_base, k0 + THREADS);
     var idx2 = candidate_or_none(!empty && k0 + 2u * THREADS < count, from_coarse, coarse_base, k0 + 2u * THREADS);
-    var current = candidate_in_flight(!empty && k0 < count && idx0 >= below, idx0, sphere_or_none(!empty && k0 < count, idx0), bounds, lo, hi, tile_mask, tile_min, tile_max);
+    let tile_test = TileTest(bounds, lo, hi, tile_mask, tile_min, tile_max);
+    var current = candidate_in_flight(!empty && k0 < count && idx0 >= below, idx0, sphere_or_none(!empty && k0 < count, idx0), tile_test);
     var sphere1 = sphere_or_none(!empty && k0 + THREADS < count, idx1);
     for (var base = first; base < count; base += THREADS) {
         let k = base + local;
         let this_batch = current;
         let k1 = k + THREADS;
-        current = candidate_in_flight(!empty && k1 < count && idx1 >= below, idx1, sphere1, bounds, lo, hi, tile_mask, tile_min, tile_max);
+        current = candidate_in_flight(!empty && k1 < count && idx1 >= below, idx1, sphere1, tile_test);
         sphere1 = sphere_or_none(!empty && k1 + THREADS < count, idx2);
         idx1 = idx2;
         idx2 = candidate_or_none(!empty && k1 + 2u * THREADS < count, from_coarse, coarse_base, k1 + 2u * THREADS);
@@ -588,31 +589,34 @@ fn light_sphere(i: u32, coarse: bool) -> vec4<f32> {
 // same planes as its tiles' edges, but computed from other corners, so they round
 // differently (about 1e-7 of the distance).
 
-// The sphere tests: depth range, side planes, depth mask; `sphere` is light_sphere's.
-fn sphere_touches_tile(
-    sphere: vec4<f32>,
+// What the sphere tests take of a (coarse) tile: its side planes, the list's depth range
+// [lo, hi], and (DepthMask) the tile's occupied depth cells over [tile_min, tile_max].
+struct TileTest {
     bounds: TileBounds,
     lo: f32,
     hi: f32,
-    tile_mask: u32,
+    mask: u32,
     tile_min: f32,
     tile_max: f32,
-) -> bool {
+}
+
+// The sphere tests: depth range, side planes, depth mask; `sphere` is light_sphere's.
+fn sphere_touches_tile(sphere: vec4<f32>, t: TileTest) -> bool {
     let center = sphere.xyz;
     let radius = abs(sphere.w);
     let z = -center.z;
-    if (z + radius < lo || z - radius > hi) {
+    if (z + radius < t.lo || z - radius > t.hi) {
         return false;
     }
     for (var p = 0u; p < 4u; p++) {
-        if (dot(bounds.planes[p], center) < -radius) {
+        if (dot(t.bounds.planes[p], center) < -radius) {
             return false;
         }
     }
     if (VARIANT == VARIANT_DEPTH_MASK) {
-        let a = cell_of(z - radius, tile_min, tile_max);
-        let b = cell_of(z + radius, tile_min, tile_max);
-        if ((cells_between(a, b) & tile_mask) == 0u) {
+        let a = cell_of(z - radius, t.tile_min, t.tile_max);
+        let b = cell_of(z + radius, t.tile_min, t.tile_max);
+        if ((cells_between(a, b) & t.mask) == 0u) {
             return false;
         }
     }
@@ -655,21 +659,11 @@ struct Candidate {
 
 // The candidate of light i with sphere `sphere` (`valid` false: none): its sphere tests
 // done, its cone loaded when it needs one.
-fn candidate_in_flight(
-    valid: bool,
-    i: u32,
-    sphere: vec4<f32>,
-    bounds: TileBounds,
-    lo: f32,
-    hi: f32,
-    tile_mask: u32,
-    tile_min: f32,
-    tile_max: f32,
-) -> Candidate {
+fn candidate_in_flight(valid: bool, i: u32, sphere: vec4<f32>, t: TileTest) -> Candidate {
     var c: Candidate;
     c.i = i;
     c.sphere = sphere;
-    c.near = valid && sphere_touches_tile(sphere, bounds, lo, hi, tile_mask, tile_min, tile_max);
+    c.near = valid && sphere_touches_tile(sphere, t);
     if (c.near && sphere.w < 0.0) {
         c.cone = spot_cone(i);
     }
@@ -715,8 +709,8 @@ fn coarse(
     var h = 0u;
     // Each batch's spheres are loaded two batches ahead and tested one ahead, where a
     // spot that passes loads its cone (an all-ones mask: the depth-mask test passes here).
-    let valid = !empty && local < count;
-    var current = candidate_in_flight(valid, local, light_sphere(local, true), bounds, lo, hi, 0xffffffffu, lo, hi);
+    let tile_test = TileTest(bounds, lo, hi, 0xffffffffu, lo, hi);
+    var current = candidate_in_flight(!empty && local < count, local, light_sphere(local, true), tile_test);
     var next_sphere = vec4<f32>(0.0);
     if (local + THREADS < count) {
         next_sphere = light_sphere(local + THREADS, true);
@@ -725,7 +719,7 @@ fn coarse(
         let i = base + local;
         let this_batch = current;
         let next = i + THREADS;
-        current = candidate_in_flight(!empty && next < count, next, next_sphere, bounds, lo, hi, 0xffffffffu, lo, hi);
+        current = candidate_in_flight(!empty && next < count, next, next_sphere, tile_test);
         if (next + THREADS < count) {
             next_sphere = light_sphere(next + THREADS, true);
         }
