@@ -356,25 +356,14 @@ fn main(
     }
 #endif
     var h = 0u;
-    // Loads run ahead of the tests: a batch's candidate indices are loaded three batches
-    // early, their spheres two, the sphere tests (and a passing spot's cone load) one.
-    let k0 = first + local;
-    let idx0 = candidate_or_none(!empty && k0 < count, from_coarse, coarse_base, k0);
-    var idx1 = candidate_or_none(!empty && k0 + THREADS < count, from_coarse, coarse_base, k0 + THREADS);
-    var idx2 = candidate_or_none(!empty && k0 + 2u * THREADS < count, from_coarse, coarse_base, k0 + 2u * THREADS);
-    let tile_test = TileTest(bounds, lo, hi, tile_mask, tile_min, tile_max);
-    var current = candidate_in_flight(!empty && k0 < count && idx0 >= below, idx0, sphere_or_none(!empty && k0 < count, idx0), tile_test);
-    var sphere1 = sphere_or_none(!empty && k0 + THREADS < count, idx1);
     for (var base = first; base < count; base += THREADS) {
         let k = base + local;
-        let this_batch = current;
-        let k1 = k + THREADS;
-        current = candidate_in_flight(!empty && k1 < count && idx1 >= below, idx1, sphere1, tile_test);
-        sphere1 = sphere_or_none(!empty && k1 + THREADS < count, idx2);
-        idx1 = idx2;
-        idx2 = candidate_or_none(!empty && k1 + 2u * THREADS < count, from_coarse, coarse_base, k1 + 2u * THREADS);
-        let i = this_batch.i;
-        let hit = candidate_hits(this_batch, bounds, 0.0);
+        var i = k;
+        var hit = false;
+        if (!empty && k < count) {
+            i = candidate(from_coarse, coarse_base, k);
+            hit = i >= below && light_touches_tile(i, light_sphere(i, false), bounds, lo, hi, tile_mask, tile_min, tile_max, 0.0);
+        }
         if (hit) {
             atomicOr(&hits[h][local / 32u], 1u << (local % 32u));
         }
@@ -447,22 +436,6 @@ fn candidate(from_coarse: bool, coarse_base: u32, k: u32) -> u32 {
         return coarse_lists[coarse_base + 1u + k];
     }
     return k;
-}
-
-// Candidate k where `valid` (k is one of the tile's candidates), else k (never tested).
-fn candidate_or_none(valid: bool, from_coarse: bool, coarse_base: u32, k: u32) -> u32 {
-    if (valid) {
-        return candidate(from_coarse, coarse_base, k);
-    }
-    return k;
-}
-
-// Light i's fine sphere where `valid`, else nothing is read.
-fn sphere_or_none(valid: bool, i: u32) -> vec4<f32> {
-    if (valid) {
-        return light_sphere(i, false);
-    }
-    return vec4<f32>(0.0);
 }
 
 // Side planes through the eye and a (coarse) tile's edges, normals pointing inwards, and
@@ -582,97 +555,57 @@ fn light_sphere(i: u32, coarse: bool) -> vec4<f32> {
     return light_bounds[select(i, bounds_capacity() + i, coarse)];
 }
 
-// Conservative: a light that reaches any point of the tile between lo and hi is kept,
-// by sphere_touches_tile, then for a spot (sphere.w < 0) cone_touches_tile. `reach`
-// widens the tile's sphere for the cone test by that fraction of its distance from the
-// eye (the light's sphere is widened in `bounds`): the coarse stage's planes are the
-// same planes as its tiles' edges, but computed from other corners, so they round
-// differently (about 1e-7 of the distance).
-
-// What the sphere tests take of a (coarse) tile: its side planes, the list's depth range
-// [lo, hi], and (DepthMask) the tile's occupied depth cells over [tile_min, tile_max].
-struct TileTest {
+// Conservative: a light that reaches any point of the tile between lo and hi is kept.
+// `sphere` is light i's (light_sphere). `reach` widens the tile's sphere for the cone
+// test by that fraction of its distance from the eye (the light's sphere is widened in
+// `bounds`): the coarse stage's planes are the same planes as its tiles' edges, but
+// computed from other corners, so they round differently (about 1e-7 of the distance).
+fn light_touches_tile(
+    i: u32,
+    sphere: vec4<f32>,
     bounds: TileBounds,
     lo: f32,
     hi: f32,
-    mask: u32,
+    tile_mask: u32,
     tile_min: f32,
     tile_max: f32,
-}
-
-// The sphere tests: depth range, side planes, depth mask; `sphere` is light_sphere's.
-fn sphere_touches_tile(sphere: vec4<f32>, t: TileTest) -> bool {
+    reach: f32,
+) -> bool {
     let center = sphere.xyz;
     let radius = abs(sphere.w);
     let z = -center.z;
-    if (z + radius < t.lo || z - radius > t.hi) {
+    if (z + radius < lo || z - radius > hi) {
         return false;
     }
     for (var p = 0u; p < 4u; p++) {
-        if (dot(t.bounds.planes[p], center) < -radius) {
+        if (dot(bounds.planes[p], center) < -radius) {
             return false;
         }
     }
     if (VARIANT == VARIANT_DEPTH_MASK) {
-        let a = cell_of(z - radius, t.tile_min, t.tile_max);
-        let b = cell_of(z + radius, t.tile_min, t.tile_max);
-        if ((cells_between(a, b) & t.mask) == 0u) {
+        let a = cell_of(z - radius, tile_min, tile_max);
+        let b = cell_of(z + radius, tile_min, tile_max);
+        if ((cells_between(a, b) & tile_mask) == 0u) {
+            return false;
+        }
+    }
+    if (sphere.w < 0.0) {
+        // Cone against the tile's bounding sphere.
+        let cone = 2u * bounds_capacity() + 2u * i;
+        let pos_range = light_bounds[cone];
+        let dir_cos = light_bounds[cone + 1u];
+        let c = dir_cos.w;
+        let v = bounds.center - pos_range.xyz;
+        let v_len_sq = dot(v, v);
+        let v1 = dot(v, dir_cos.xyz);
+        let s = sqrt(max(1.0 - c * c, 0.0));
+        let closest = c * sqrt(max(v_len_sq - v1 * v1, 0.0)) - v1 * s;
+        let r = bounds.radius * 1.0001 + 1e-5 + reach * length(bounds.center);
+        if (closest > r || v1 > r + pos_range.w || v1 < -r) {
             return false;
         }
     }
     return true;
-}
-
-// A spot light's position and range, direction and cos_outer (from `bounds`).
-struct SpotCone {
-    pos_range: vec4<f32>,
-    dir_cos: vec4<f32>,
-}
-
-fn spot_cone(i: u32) -> SpotCone {
-    let cone = 2u * bounds_capacity() + 2u * i;
-    return SpotCone(light_bounds[cone], light_bounds[cone + 1u]);
-}
-
-// The cone test: a spot's cone against the tile's bounding sphere.
-fn cone_touches_tile(cone: SpotCone, bounds: TileBounds, reach: f32) -> bool {
-    let c = cone.dir_cos.w;
-    let v = bounds.center - cone.pos_range.xyz;
-    let v_len_sq = dot(v, v);
-    let v1 = dot(v, cone.dir_cos.xyz);
-    let s = sqrt(max(1.0 - c * c, 0.0));
-    let closest = c * sqrt(max(v_len_sq - v1 * v1, 0.0)) - v1 * s;
-    let r = bounds.radius * 1.0001 + 1e-5 + reach * length(bounds.center);
-    return !(closest > r || v1 > r + cone.pos_range.w || v1 < -r);
-}
-
-// A batch's candidate in flight: its light index, sphere, whether the sphere tests
-// passed, and (a spot that passed them) its cone. The loops run the loads a batch or two
-// ahead of the tests that use them, so no batch waits for a chain of dependent loads
-// (list entry → sphere → cone); the tests are the same, in the same order.
-struct Candidate {
-    i: u32,
-    sphere: vec4<f32>,
-    near: bool,
-    cone: SpotCone,
-}
-
-// The candidate of light i with sphere `sphere` (`valid` false: none): its sphere tests
-// done, its cone loaded when it needs one.
-fn candidate_in_flight(valid: bool, i: u32, sphere: vec4<f32>, t: TileTest) -> Candidate {
-    var c: Candidate;
-    c.i = i;
-    c.sphere = sphere;
-    c.near = valid && sphere_touches_tile(sphere, t);
-    if (c.near && sphere.w < 0.0) {
-        c.cone = spot_cone(i);
-    }
-    return c;
-}
-
-// Whether a candidate in flight touches the tile.
-fn candidate_hits(c: Candidate, bounds: TileBounds, reach: f32) -> bool {
-    return c.near && (c.sphere.w >= 0.0 || cone_touches_tile(c.cone, bounds, reach));
 }
 
 // The coarse stage: one workgroup per coarse tile of COARSE×COARSE tiles; each
@@ -707,23 +640,19 @@ fn coarse(
     let count = frame.light_count;
     var total = 0u;
     var h = 0u;
-    // Each batch's spheres are loaded two batches ahead and tested one ahead, where a
-    // spot that passes loads its cone (an all-ones mask: the depth-mask test passes here).
-    let tile_test = TileTest(bounds, lo, hi, 0xffffffffu, lo, hi);
-    var current = candidate_in_flight(!empty && local < count, local, light_sphere(local, true), tile_test);
-    var next_sphere = vec4<f32>(0.0);
-    if (local + THREADS < count) {
-        next_sphere = light_sphere(local + THREADS, true);
-    }
+    // Each batch's spheres are loaded a batch ahead.
+    var next_sphere = light_sphere(local, true);
     for (var base = 0u; base < count; base += THREADS) {
         let i = base + local;
-        let this_batch = current;
-        let next = i + THREADS;
-        current = candidate_in_flight(!empty && next < count, next, next_sphere, tile_test);
-        if (next + THREADS < count) {
-            next_sphere = light_sphere(next + THREADS, true);
+        let sphere = next_sphere;
+        if (i + THREADS < count) {
+            next_sphere = light_sphere(i + THREADS, true);
         }
-        let hit = candidate_hits(this_batch, bounds, COARSE_REACH);
+        var hit = false;
+        if (!empty && i < count) {
+            // An all-ones mask: the depth-mask test passes here.
+            hit = light_touches_tile(i, sphere, bounds, lo, hi, 0xffffffffu, lo, hi, COARSE_REACH);
+        }
         if (hit) {
             atomicOr(&hits[h][local / 32u], 1u << (local % 32u));
         }

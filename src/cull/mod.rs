@@ -2,8 +2,7 @@
 //! property tests (a light that reaches any point of a tile's depth range is never
 //! culled) and for tools that want to reason about lists without a GPU. (The shader
 //! computes a light's view-space sphere once a frame in its `bounds` dispatch and tests
-//! it per tile in `sphere_touches_tile` and `cone_touches_tile`; the arithmetic is the same as
-//! here in one piece.)
+//! it per tile in `light_touches_tile`; the arithmetic is the same as here in one piece.)
 
 use glam::{Mat4, Vec2, Vec3};
 
