@@ -21,7 +21,8 @@ sweep() { # name [root]
     local s=$1 root=${2:-}
     timeout 60 $lg ${root:+--root $root} bench --sweep benches/sweeps/$s.ron --out "$out/$s" > "$out/$s.log" 2>&1
     echo "== $s"; tail -n 1 "$out/$s.log"
-    sed -n '/^| scene | technique | params | lights | size/,/^$/p;/^Per-pass GPU time/,/^$/p' "$out/$s/results.md" | cut -c1-230
+    sed -n '/^| scene | technique | params | lights | size/,/^$/p' "$out/$s/results.md" | cut -c1-230
+    grep -A12 '^Per-pass GPU time' "$out/$s/results.md" | grep '^|' | cut -c1-230
     pack
 }
 sweep session10_shading
@@ -39,7 +40,7 @@ perl -0pe 's/return color \+ inc.radiance \* material_eval\(m, inc.dir\);/return
 diag() { # n variant [env]
     local d="diag$1_$2"
     env ${3:-} timeout 25 $lg --root $roots/$2 bench --sweep benches/sweeps/diag_session10.ron --out "$out/$d" > "$out/$d.log" 2>&1
-    echo "== $d ${3:-}"; sed -n '/^Per-pass GPU time/,/^$/p' "$out/$d/results.md" | cut -c1-200
+    echo "== $d ${3:-}"; grep -A8 '^Per-pass GPU time' "$out/$d/results.md" | grep '^|' | cut -c1-200
     pack
 }
 # In order of what matters most: a short device budget may cut the run.
