@@ -633,3 +633,138 @@ fn textured_gltf_matches_f64_reference() {
     assert!(worst_n < 1e-6, "perturbed normal off by {worst_n:e}");
     assert!(worst_t < 1e-6, "tangent off by {worst_t:e}");
 }
+
+const PRODUCT_HARNESS: &str = "
+struct Pair {
+    a: vec4<f32>,
+    b: vec4<f32>,
+};
+@group(0) @binding(0) var<storage, read> pairs: array<Pair>;
+@group(0) @binding(1) var<storage, read_write> out: array<vec4<f32>>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if (i >= arrayLength(&pairs)) {
+        return;
+    }
+    let a = pairs[i].a.xyz;
+    let b = pairs[i].b.xyz;
+    let s = lg_split(a);
+    let o = i * 4u;
+    out[o] = vec4<f32>(s.hi, 0.0);
+    out[o + 1u] = vec4<f32>(s.lo, 0.0);
+    out[o + 2u] = vec4<f32>(vec3<f32>(s.steps), lg_dot(a, b));
+    out[o + 3u] = vec4<f32>(lg_cross(a, b), 0.0);
+}
+";
+
+/// The accurate products' parts on the GPU: `lg_split` gives hi on the 2^-11 grid with
+/// hi · 2048 its steps, |lo| under one step and hi + lo equal to the input exactly, for
+/// random unit vectors and for components at and around grid points and half steps (an
+/// x just under 2^-12 is where rounding to the nearest grid point loses a bit of lo), ±1,
+/// 0 and tiny values; `lg_dot` and `lg_cross` come within their result's rounding (half an
+/// ulp of the f32 result, 2^-24 relative) plus 4e-10 of the f64 products: the rounded
+/// terms are two small dot products (hi·lo and lo·b) of at most √3·2^-11 each, rounded
+/// three times at 2^-24 relative (≤ 1.6e-10 each), then summed. Also for nearly parallel
+/// and nearly perpendicular pairs, where plain f32 products leave ~6e-8 absolute.
+#[test]
+fn accurate_products_split_exactly_and_match_f64() {
+    let gpu = GpuContext::new_headless().expect("GPU (lavapipe) needed");
+    let mut rng = Rng(0x0dd_5eed);
+    let grid = 1.0f64 / 2048.0;
+    let edges: Vec<f64> = [
+        0.0,
+        1.0,
+        0.5,
+        grid,
+        grid / 2.0,
+        grid / 2.0 + 1e-9,
+        grid / 2.0 - 1e-9,
+        1.5 * grid,
+        1e-30,
+        1e-8,
+        1.0 - 1e-7,
+        0.999_999_94,
+    ]
+    .iter()
+    .flat_map(|&x| [x, -x])
+    .collect();
+    let mut pairs: Vec<([f64; 3], [f64; 3])> = Vec::new();
+    for _ in 0..20_000 {
+        let a = f32v(rng.unit());
+        let b = f32v(match rng.pick(&[0, 1, 2]) {
+            0 => rng.unit(),
+            // Nearly parallel and nearly perpendicular to a: cancellation in the cross
+            // product and in the dot product.
+            1 => norm([a[0] + 1e-4 * rng.f(), a[1] - 1e-4 * rng.f(), a[2]]),
+            _ => norm(r::cross(a, [a[1] + 1e-3 * rng.f(), a[2], a[0]])),
+        });
+        pairs.push((a, b));
+    }
+    for &x in &edges {
+        for &y in &edges {
+            let a = [x, y, rng.pick(&edges)];
+            pairs.push((f32v(a), f32v(rng.unit())));
+        }
+    }
+    let mut input = Vec::with_capacity(pairs.len() * 8);
+    for (a, b) in &pairs {
+        input.extend([a[0], a[1], a[2], 0.0, b[0], b[1], b[2], 0.0].map(|x| x as f32));
+    }
+    let wgsl = format!("{LOBE_LIBRARY}\n{PRODUCT_HARNESS}");
+    let out = f32s(&run_compute(
+        &gpu,
+        &wgsl,
+        &to_bytes(&input),
+        (pairs.len() * 4 * 16) as u64,
+        pairs.len() as u32,
+    ));
+    let bound = |exact: f64| exact.abs() * 2f64.powi(-24) + 4e-10;
+    let (mut worst_dot, mut worst_cross) = (0.0f64, 0.0f64);
+    for (i, (a, b)) in pairs.iter().enumerate() {
+        let row = |k: usize| &out[(i * 4 + k) * 4..(i * 4 + k) * 4 + 4];
+        let (hi, lo, steps, cross) = (row(0), row(1), row(2), row(3));
+        for c in 0..3 {
+            let (h, l, s) = (hi[c] as f64, lo[c] as f64, steps[c] as f64);
+            assert_eq!(
+                h + l,
+                a[c],
+                "pair {i} component {c}: hi {h:e} + lo {l:e} != {:e}",
+                a[c]
+            );
+            assert_eq!(
+                h * 2048.0,
+                s,
+                "pair {i} component {c}: hi {h:e} is not steps {s} / 2048"
+            );
+            assert!(
+                l.abs() < grid,
+                "pair {i} component {c}: |lo| {l:e} past the grid's step"
+            );
+        }
+        let dot = r::dot(*a, *b);
+        let e = (steps[3] as f64 - dot).abs();
+        assert!(
+            e <= bound(dot),
+            "pair {i} {a:?}·{b:?}: {} against {dot:e}",
+            steps[3]
+        );
+        worst_dot = worst_dot.max(e - dot.abs() * 2f64.powi(-24));
+        let exact = r::cross(*a, *b);
+        for c in 0..3 {
+            let e = (cross[c] as f64 - exact[c]).abs();
+            assert!(
+                e <= bound(exact[c]),
+                "pair {i} {a:?}×{b:?} component {c}: {} against {:e}",
+                cross[c],
+                exact[c]
+            );
+            worst_cross = worst_cross.max(e - exact[c].abs() * 2f64.powi(-24));
+        }
+    }
+    println!(
+        "{} pairs: worst error past the result's rounding: dot {worst_dot:.2e}, cross {worst_cross:.2e}",
+        pairs.len()
+    );
+}

@@ -18,18 +18,21 @@ const LG_COS_MIN: f32 = 1e-4;
 // leave an absolute error of ~1e-7 there: a large relative error. FMA-based error-free
 // transformations do not survive every Vulkan driver (lavapipe does not fuse `fma`; NIR's
 // algebraic passes fold TwoSum away and factor a·b + a·c), so the inputs (|x| ≤ 1) are
-// split instead: hi = x rounded to a 2^-11 grid, lo = x − hi (exact). The hi·hi products
+// split instead: hi = x cut to a 2^-11 grid, lo = x − hi (exact). The hi·hi products
 // are done in i32 (integers up to 2^22, sums below 2^24, taken to f32 exactly): exact, and
 // out of reach of float reassociation. Only the small hi·lo and lo·b terms are rounded
-// (≤ ~1e-11 absolute).
+// (≤ ~3e-10 absolute, tests/material_gpu.rs).
 
-// x split as hi + lo, with hi · 2048 as an integer (`steps`). x + (6 + 2^-12) lies in
-// [4, 8) for |x| ≤ 2, where f32 steps by 2^-21: clearing its 10 low mantissa bits puts it
-// on the 2^-11 grid (x + 2^-12 rounded down: hi within 2^-12 + 2^-21 of x, so lo = x − hi
-// is exact), and its top 13 mantissa bits count the grid steps above 4. Only adds and bit
-// operations: no float-integer conversions (a quarter-rate unit on NVIDIA GPUs, where the
-// round-and-convert split of before cost ~20 conversions a light) and nothing float
-// reassociation can fold.
+// x split as hi + lo, with hi · 2048 as an integer (`steps`): hi is |x| cut to the 2^-11
+// grid, with x's sign. |x| + 4 lies in [4, 8) for |x| < 4, where f32 steps by 2^-21:
+// clearing its 10 low mantissa bits cuts it to the grid, and its top 13 mantissa bits
+// count the grid steps above 4. lo = x − hi is exact: where hi is 0 it is x, else |x| is
+// at least 2^-11 − 2^-22 (the add rounds up by at most 2^-22) and |lo| < 2^-11 fits x's
+// precision. (Rounding to the nearest grid point instead is not exact: an x just under
+// 2^-12 goes to 2^-11, and lo, just over 2^-12, needs a bit x does not have.) Only adds
+// and bit operations: no float-integer conversions (a quarter-rate unit on NVIDIA GPUs,
+// where the round-and-convert split of before cost ~20 conversions a light) and nothing
+// float reassociation can fold.
 struct LgSplit {
     hi: vec3<f32>,
     lo: vec3<f32>,
@@ -37,10 +40,12 @@ struct LgSplit {
 };
 
 fn lg_split(x: vec3<f32>) -> LgSplit {
-    let bits = bitcast<vec3<u32>>(x + 6.000244140625);
-    let hi = bitcast<vec3<f32>>(bits & vec3<u32>(0xfffffc00u)) - 6.0;
-    let steps = vec3<i32>((bits >> vec3<u32>(10u)) & vec3<u32>(0x1fffu)) - 4096;
-    return LgSplit(hi, x - hi, steps);
+    let bits = bitcast<vec3<u32>>(abs(x) + 4.0);
+    let cut = bitcast<vec3<f32>>(bits & vec3<u32>(0xfffffc00u)) - 4.0;
+    let count = vec3<i32>((bits >> vec3<u32>(10u)) & vec3<u32>(0x1fffu));
+    let negative = x < vec3<f32>(0.0);
+    let hi = select(cut, -cut, negative);
+    return LgSplit(hi, x - hi, select(count, -count, negative));
 }
 
 // An integer of magnitude at most 2^22 as f32, exactly, without a conversion: added to the
@@ -59,7 +64,7 @@ fn lg_dot(a: vec3<f32>, b: vec3<f32>) -> f32 {
     return hh + (dot(sa.hi, sb.lo) + dot(sa.lo, b));
 }
 
-// a × b for |components| ≤ 1, each component accurate to ~1e-11 absolute.
+// a × b for |components| ≤ 1, each component accurate to ~3e-10 absolute.
 fn lg_cross(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
     let sa = lg_split(a);
     let sb = lg_split(b);
