@@ -10,8 +10,8 @@
 // STAGED_LIGHTS (the workgroup's one tile list staged in workgroup memory, in
 // visibility/staged_lights.wgsl), RANGE_FIRST (the per-pixel cursor with the range test
 // before the light's properties; with UNIFORM_LIST the workgroup's one tile list, found
-// from the workgroup id, so the compiler sees the walk as uniform), or neither (common/light_loop.wgsl's shade_surface,
-// as forward shading runs it).
+// from the workgroup id, so the compiler sees the walk as uniform), or neither
+// (common/light_loop.wgsl's shade_surface, as forward shading runs it).
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"

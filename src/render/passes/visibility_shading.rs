@@ -33,10 +33,6 @@ pub(super) fn prepare(
     let lists = cx.shading_lists(sp, p.lights, &mut offered)?;
     let layout = tile_layout(cx, sp, lists);
     let light_loop = choose_light_loop(p.light_loop, layout, p.workgroup);
-    let group = ShadingGroup {
-        side: p.workgroup,
-        uniform_list: light_loop == LightLoop::GroupList,
-    };
     let ranges = cx.merged(&sp.name)?.material_ranges.clone();
     // Only materials that own triangles get a dispatch (blended ones never do); the first
     // also clears pixels nothing covers, so one runs even for a scene without triangles.
@@ -59,8 +55,9 @@ pub(super) fn prepare(
         }
         d.extend(lists.define());
         d.extend(loop_define(light_loop));
-        d.push(("SHADING_GROUP", format!("{}u", group.side)));
-        if group.uniform_list {
+        // The shader's `@workgroup_size(SHADING_GROUP, SHADING_GROUP, 1)`.
+        d.push(("SHADING_GROUP", format!("{}u", p.workgroup)));
+        if light_loop == LightLoop::GroupList {
             d.push(("UNIFORM_LIST", "1".into()));
         }
         let key = PipelineKey {
@@ -85,19 +82,11 @@ pub(super) fn prepare(
         dispatches,
         bind: bind.ok_or_else(|| super::pass_error(&sp.name, "no material to shade".into()))?,
         groups: [
-            cx.size.width.div_ceil(group.side),
-            cx.size.height.div_ceil(group.side),
+            cx.size.width.div_ceil(p.workgroup),
+            cx.size.height.div_ceil(p.workgroup),
             1,
         ],
     })
-}
-
-/// The shader's workgroup (`@workgroup_size(SHADING_GROUP, SHADING_GROUP, 1)`) and
-/// whether its pixels all read one tile list, found from the workgroup id.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct ShadingGroup {
-    side: u32,
-    uniform_list: bool,
 }
 
 /// The define that picks the shader's light loop (shaders/visibility/staged_lights.wgsl).
