@@ -724,7 +724,9 @@ fn accurate_products_split_exactly_and_match_f64() {
     let (mut worst_dot, mut worst_cross) = (0.0f64, 0.0f64);
     for (i, (a, b)) in pairs.iter().enumerate() {
         let row = |k: usize| &out[(i * 4 + k) * 4..(i * 4 + k) * 4 + 4];
+        // Rows: hi, lo, the steps with lg_dot in w, lg_cross.
         let (hi, lo, steps, cross) = (row(0), row(1), row(2), row(3));
+        let gpu_dot = steps[3] as f64;
         for c in 0..3 {
             let (h, l, s) = (hi[c] as f64, lo[c] as f64, steps[c] as f64);
             assert_eq!(
@@ -744,11 +746,10 @@ fn accurate_products_split_exactly_and_match_f64() {
             );
         }
         let dot = r::dot(*a, *b);
-        let e = (steps[3] as f64 - dot).abs();
+        let e = (gpu_dot - dot).abs();
         assert!(
             e <= bound(dot),
-            "pair {i} {a:?}·{b:?}: {} against {dot:e}",
-            steps[3]
+            "pair {i} {a:?}·{b:?}: {gpu_dot:e} against {dot:e}"
         );
         worst_dot = worst_dot.max(e - dot.abs() * 2f64.powi(-24));
         let exact = r::cross(*a, *b);

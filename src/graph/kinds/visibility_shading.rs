@@ -173,6 +173,31 @@ mod tests {
     }
 
     #[test]
+    fn refuses_other_workgroups_and_staging_on_16() {
+        let pass = |kind: &str| {
+            format!(
+                r#"{VIS} Pass(name: "s", kind: VisibilityShading({kind}), reads: [{READS}], writes: ["hdr"])"#
+            )
+        };
+        for ok in [
+            "workgroup: 8",
+            "workgroup: 16",
+            "light_loop: GroupList, workgroup: 16",
+        ] {
+            validate(&pass(ok), "hdr").unwrap();
+        }
+        let e = errors(&pass("workgroup: 12"), "hdr");
+        assert!(e.contains("pass 's': workgroup 12 must be 8 or 16"), "{e}");
+        let e = errors(&pass("light_loop: Staged, workgroup: 16"), "hdr");
+        assert!(
+            e.contains(
+                "pass 's': light_loop Staged stages one light per invocation of an 8×8 workgroup"
+            ),
+            "{e}"
+        );
+    }
+
+    #[test]
     fn refuses_shadows_and_multisampled_ids() {
         let e = errors(
             &format!(
