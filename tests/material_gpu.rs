@@ -661,9 +661,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
 
 /// The accurate products' parts on the GPU: `lg_split` gives hi on the 2^-11 grid with
 /// hi · 2048 its steps, |lo| under one step and hi + lo equal to the input exactly, for
-/// random unit vectors and for components at and around grid points and half steps (an
-/// x just under 2^-12 is where rounding to the nearest grid point loses a bit of lo), ±1,
-/// 0 and tiny values; `lg_dot` and `lg_cross` come within their result's rounding (half an
+/// random unit vectors and for components at and around grid points and half steps (where
+/// rounding ties and lo is largest), ±1, 0 and tiny values; `lg_dot` and `lg_cross` come within their result's rounding (half an
 /// ulp of the f32 result, 2^-24 relative) plus 4e-10 of the f64 products: the rounded
 /// terms are two small dot products (hi·lo and lo·b) of at most √3·2^-11 each, rounded
 /// three times at 2^-24 relative (≤ 1.6e-10 each), then summed. Also for nearly parallel

@@ -18,21 +18,18 @@ const LG_COS_MIN: f32 = 1e-4;
 // leave an absolute error of ~1e-7 there: a large relative error. FMA-based error-free
 // transformations do not survive every Vulkan driver (lavapipe does not fuse `fma`; NIR's
 // algebraic passes fold TwoSum away and factor a·b + a·c), so the inputs (|x| ≤ 1) are
-// split instead: hi = x cut to a 2^-11 grid, lo = x − hi (exact). The hi·hi products
-// are done in i32 (integers up to 2^22, sums below 2^24, taken to f32 exactly): exact, and
-// out of reach of float reassociation. Only the small hi·lo and lo·b terms are rounded
+// split instead: hi = x rounded to a 2^-11 grid, lo = x − hi (exact). The hi·hi products
+// are done in i32 (integers up to 2^22, sums below 2^24, converted to f32 exactly): exact,
+// and out of reach of float reassociation. Only the small hi·lo and lo·b terms are rounded
 // (≤ ~3e-10 absolute, tests/material_gpu.rs).
+// The conversions cost: plain products shade harada's 65,536 lights in 2.80 ms against
+// 3.63 (H200, 2026-12-03). A split without conversions (|x| + 4 with its low mantissa bits
+// cleared, the integer products taken to f32 through the bits of 1.5·2^23) measured slower
+// there, 3.83 ms: more instructions than the conversions saved.
 
-// x split as hi + lo, with hi · 2048 as an integer (`steps`): hi is |x| cut to the 2^-11
-// grid, with x's sign. |x| + 4 lies in [4, 8) for |x| < 4, where f32 steps by 2^-21:
-// clearing its 10 low mantissa bits cuts it to the grid, and its top 13 mantissa bits
-// count the grid steps above 4. lo = x − hi is exact: where hi is 0 it is x, else |x| is
-// at least 2^-11 − 2^-22 (the add rounds up by at most 2^-22) and |lo| < 2^-11 fits x's
-// precision. (Rounding to the nearest grid point instead is not exact: an x just under
-// 2^-12 goes to 2^-11, and lo, just over 2^-12, needs a bit x does not have.) Only adds
-// and bit operations: no float-integer conversions (a quarter-rate unit on NVIDIA GPUs,
-// where the round-and-convert split of before cost ~20 conversions a light) and nothing
-// float reassociation can fold.
+// x split as hi + lo, with hi · 2048 as an integer (`steps`). lo = x − hi is exact: where
+// hi is 0 it is x; else |x| ≥ 2^-12 makes x and hi multiples of 2^-35, and |lo| ≤ 2^-12
+// is at most 2^23 of those (24 bits).
 struct LgSplit {
     hi: vec3<f32>,
     lo: vec3<f32>,
@@ -40,27 +37,16 @@ struct LgSplit {
 };
 
 fn lg_split(x: vec3<f32>) -> LgSplit {
-    let bits = bitcast<vec3<u32>>(abs(x) + 4.0);
-    let cut = bitcast<vec3<f32>>(bits & vec3<u32>(0xfffffc00u)) - 4.0;
-    let count = vec3<i32>((bits >> vec3<u32>(10u)) & vec3<u32>(0x1fffu));
-    let negative = x < vec3<f32>(0.0);
-    let hi = select(cut, -cut, negative);
-    return LgSplit(hi, x - hi, select(count, -count, negative));
-}
-
-// An integer of magnitude at most 2^22 as f32, exactly, without a conversion: added to the
-// bits of 1.5·2^23 (where f32 steps by 1, and which 2^23 ± 2^22 keep in [2^23, 2^24]) it
-// lands on 1.5·2^23 + i. A product of two splits' steps (|steps| ≤ 2048) is such an
-// integer, and sums of up to four of them are exact in f32 in any order (below 2^24).
-fn lg_exact_f32(i: vec3<i32>) -> vec3<f32> {
-    return bitcast<vec3<f32>>(vec3<i32>(0x4b400000) + i) - 12582912.0;
+    let steps = vec3<i32>(round(x * 2048.0));
+    let hi = vec3<f32>(steps) * (1.0 / 2048.0);
+    return LgSplit(hi, x - hi, steps);
 }
 
 fn lg_dot(a: vec3<f32>, b: vec3<f32>) -> f32 {
     let sa = lg_split(a);
     let sb = lg_split(b);
-    let p = lg_exact_f32(sa.steps * sb.steps);
-    let hh = (p.x + p.y + p.z) * (1.0 / 4194304.0);
+    let p = sa.steps * sb.steps;
+    let hh = f32(p.x + p.y + p.z) * (1.0 / 4194304.0);
     return hh + (dot(sa.hi, sb.lo) + dot(sa.lo, b));
 }
 
@@ -70,8 +56,8 @@ fn lg_cross(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
     let sb = lg_split(b);
     let ia = sa.steps;
     let ib = sb.steps;
-    let ic = lg_exact_f32(ia.yzx * ib.zxy) - lg_exact_f32(ia.zxy * ib.yzx);
-    return ic * (1.0 / 4194304.0) + (cross(sa.hi, sb.lo) + cross(sa.lo, b));
+    let ic = ia.yzx * ib.zxy - ia.zxy * ib.yzx;
+    return vec3<f32>(ic) * (1.0 / 4194304.0) + (cross(sa.hi, sb.lo) + cross(sa.lo, b));
 }
 
 // What the lobes need about (n, v, l). `s2` is |n × h|² = 1 − (n·h)², from an accurate
