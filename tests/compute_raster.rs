@@ -4,6 +4,7 @@
 //! large triangles, and depth ties (the later triangle wins, as LessEqual keeps it).
 
 mod common;
+use common::textured::*;
 use common::*;
 use glam::{Vec2, Vec3};
 use lightgraph::graph::{self, FrameSize};
@@ -170,24 +171,6 @@ fn lavapipe_has_the_64_bit_atomics() {
         drop(r);
         let frame = render_text(&mut renderer(), COMPARE, &random_scene(4, 1), 64, 36);
         assert_eq!(frame.fallbacks.len(), 1, "the fallback says so");
-    }
-}
-
-/// The error preparing `graph` for `scene` (panics if it prepares).
-fn prepare_error(scene: &Scene, graph: &str) -> String {
-    let mut r = renderer();
-    let checked = graph::check_text(Path::new("<test>"), graph, &ShaderLibrary::builtin())
-        .expect("valid graph");
-    let size = FrameSize {
-        width: 64,
-        height: 36,
-        lights: scene.lights.len() as u32,
-    };
-    let compiled = graph::compile(checked, &scene.features(), size);
-    let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, scene).expect("materials");
-    match r.prepare(compiled, scene, &gpu, size, false) {
-        Ok(_) => panic!("expected the graph to be refused"),
-        Err(e) => e.to_string(),
     }
 }
 
@@ -578,17 +561,79 @@ fn shipped_graph_matches_the_hardware_visibility_buffer() {
     );
 }
 
-/// Alpha-masked materials are refused, naming the pass, the file:line and the material.
+/// Alpha-masked materials against the prepass's alpha test (DepthPrepass discards below
+/// the cutoff): the textured scene's striped panels (the alpha of a mip-mapped texture,
+/// a front face and a double-sided back face) and a panel whose alpha is under the cutoff
+/// everywhere, in front of the camera. Coverage as for opaque scenes (`assert_matches`:
+/// both rebuild the uv at the pixel centre and pick the mip level from the quad's coarse
+/// derivatives, so a cut edge moves only where the filtered alpha is within rounding of
+/// the cutoff); the list-full paths (setup's and bin's serial walks) alpha-test alike,
+/// bit for bit.
 #[test]
-fn masked_materials_are_refused() {
+fn masked_materials_match_the_prepass_alpha_test() {
     if !has_atomics() {
         return;
     }
-    let mut s = random_scene(2, 5);
-    s.materials[1].alpha_mode = AlphaMode::Mask(0.5);
-    let e = prepare_error(&s, COMPARE);
-    assert!(e.contains("<test>:") && e.contains("pass 'cr'"), "{e}");
-    assert!(e.contains("material 'orange' is alpha-masked"), "{e}");
+    let mut s = textured_scene();
+    let striped = s.materials.len() - 1;
+    let mut faint = lightgraph::scene::SurfaceMaterial {
+        name: "faint".into(),
+        alpha_mode: AlphaMode::Mask(0.5),
+        ..Default::default()
+    };
+    faint.base_color.w = 0.2;
+    s.materials.push(faint);
+    s.meshes.push(quad(
+        "faint_panel",
+        Vec3::new(0.0, 2.0, -5.0),
+        Vec3::X * 1.5,
+        Vec3::Y * 1.0,
+        s.materials.len() - 1,
+    ));
+    let (w, h) = (333, 197);
+    let (px, report) = rasterize_limited(&s, w, h, "");
+    let d = diff(&s, &px);
+    eprintln!("masked: {d:?}, {report:?}");
+    assert_eq!(report.serial(), 0);
+    assert_matches("masked", &d);
+    // What the alpha test decides: the panels opaque cover these pixels more.
+    let mut solid = s.clone();
+    for m in [striped, s.materials.len() - 1] {
+        solid.materials[m].alpha_mode = AlphaMode::Opaque;
+    }
+    let opaque = rasterize(&solid, w, h);
+    let cut = bit_differences(&px, &opaque);
+    let faint_first = triangles(&s) - 2;
+    let kept_faint = px
+        .iter()
+        .filter(|p| p.id >= faint_first && p.id != NO_TRIANGLE)
+        .count();
+    let solid_faint = opaque
+        .iter()
+        .filter(|p| p.id >= faint_first && p.id != NO_TRIANGLE)
+        .count();
+    let kept_striped = px
+        .iter()
+        .filter(|p| p.id >= faint_first - 4 && p.id < faint_first)
+        .count();
+    eprintln!("{cut} pixels cut out; faint panel {kept_faint} of {solid_faint}, striped panels {kept_striped}");
+    assert!(
+        solid_faint > 1000 && kept_faint == 0,
+        "the faint panel is cut out whole"
+    );
+    assert!(
+        cut > solid_faint + 500,
+        "the stripes cut pixels out too: {cut}"
+    );
+    assert!(
+        kept_striped > 500,
+        "the stripes keep pixels: {kept_striped}"
+    );
+    for limits in ["records=0", "blocks=40"] {
+        let (serial, r) = rasterize_limited(&s, w, h, limits);
+        assert!(r.serial() > 0, "{limits}: {r:?}");
+        assert_eq!(bit_differences(&serial, &px), 0, "{limits}");
+    }
 }
 
 /// A triangle covering the whole viewport behind a field of small triangles (some under

@@ -6,11 +6,12 @@
 //! nothing.
 
 mod common;
+use common::textured::*;
 use common::*;
 use lightgraph::gpu::{ContextOptions, GpuContext};
 use lightgraph::graph::{self, FrameSize};
 use lightgraph::render::{FrameResult, Renderer, SceneGpu};
-use lightgraph::scene::{AlphaMode, Scene};
+use lightgraph::scene::Scene;
 use lightgraph::shader::ShaderLibrary;
 use std::path::Path;
 use std::sync::{Mutex, MutexGuard, OnceLock};
@@ -96,16 +97,22 @@ fn the_masked_device_lacks_the_atomics() {
 /// Without the atomics, ComputeRaster's depth, ids and image are exactly the hardware
 /// visibility buffer's (the same draws), for an R32Float depth (drawn into a Depth32Float
 /// and copied) and a Depth32Float one (drawn into directly); the report names the pass,
-/// the adapter and the missing feature.
+/// the adapter and the missing feature. On harada and on the textured scene, whose
+/// alpha-masked panels the draws alpha-test.
 #[test]
 fn without_the_atomics_it_draws_the_hardware_visibility_buffer() {
-    let scene = harada();
+    for scene in [harada(), textured_scene()] {
+        draws_the_hardware_visibility_buffer(&scene);
+    }
+}
+
+fn draws_the_hardware_visibility_buffer(scene: &Scene) {
     let mut r = masked_renderer();
     let adapter = r.ctx.adapter_name();
     let (reference, want) = render_reading(
         &mut r,
         &graph_text("visibility_buffer.ron"),
-        &scene,
+        scene,
         &["depth", "visibility"],
     )
     .unwrap();
@@ -117,7 +124,7 @@ fn without_the_atomics_it_draws_the_hardware_visibility_buffer() {
     );
     assert_eq!(want[0].len(), 333 * 197);
     for (what, graph) in compute_raster_graphs() {
-        let (frame, got) = render_reading(&mut r, &graph, &scene, &["depth", "visibility"])
+        let (frame, got) = render_reading(&mut r, &graph, scene, &["depth", "visibility"])
             .unwrap_or_else(|e| panic!("{what}: {e}"));
         let differ = |a: &[u32], b: &[u32]| {
             assert_eq!(a.len(), b.len());
@@ -168,25 +175,6 @@ fn with_the_atomics_nothing_falls_back() {
         let (frame, _) = render_reading(&mut r, &graph, &scene, &[]).unwrap();
         assert!(frame.fallbacks.is_empty(), "{what}: {:?}", frame.fallbacks);
     }
-}
-
-/// Masked materials are refused by the fallback as by the compute rasterizer.
-#[test]
-fn the_fallback_refuses_masked_materials_too() {
-    let mut s = random_scene(2, 5);
-    s.materials[1].alpha_mode = AlphaMode::Mask(0.5);
-    let mut r = masked_renderer();
-    let e = render_reading(
-        &mut r,
-        &graph_text("visibility_compute_raster.ron"),
-        &s,
-        &[],
-    )
-    .err()
-    .expect("refused");
-    assert!(e.contains("pass 'compute_raster'"), "{e}");
-    assert!(e.contains("material 'orange' is alpha-masked"), "{e}");
-    assert!(e.contains("hardware fallback"), "{e}");
 }
 
 /// `lightgraph render --disable-features` opens the device without them and prints the

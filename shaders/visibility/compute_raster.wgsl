@@ -29,6 +29,14 @@
 // path runs the same per-pixel code (`cover`), and an atomic min is order-independent,
 // so the image does not depend on which path drew a pixel.
 // RESOLVE: the full-screen draw writing the id and frag_depth.
+//
+// Alpha-masked materials: setup, bin and raster run once for the opaque triangles (those
+// marked in `alpha_tested` skipped), then once per masked material (ALPHA_TEST, with
+// MATERIAL_INDEX and its material code): its triangles only, each covered pixel nearer
+// than what the buffer holds rebuilt (visibility/surface.wgsl, as visibility shading
+// rebuilds it) and kept only where the material's alpha reaches its cutoff, as the depth
+// prepass discards. A masked run starts from a lists-only clear (LISTS_ONLY), keeping the
+// buffer. Each run counts into its own `counters`.
 
 #include "common/types.wgsl"
 
@@ -63,6 +71,20 @@
 @group(0) @binding(2) var<storage, read> vertices: array<f32>;
 @group(0) @binding(3) var<storage, read> triangles: array<u32>;
 @group(0) @binding(4) var<storage, read> single_sided: array<u32>;
+#if ALPHA_TEST
+@group(0) @binding(13) var<storage, read> material_triangles: array<vec2<u32>>;
+#else
+// Bit t set: triangle t is alpha-tested, drawn by its material's own run.
+@group(0) @binding(13) var<storage, read> alpha_tested: array<u32>;
+#endif
+#else
+#if ALPHA_TEST
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(2) var<storage, read> vertices: array<f32>;
+@group(0) @binding(3) var<storage, read> triangles: array<u32>;
+#endif
+#endif
+#if SETUP
 @group(0) @binding(6) var<storage, read_write> tiles: array<vec2<u32>>;
 // The bin dispatch's arguments (so the bin dispatch, which reads them, binds nothing it
 // could write them with).
@@ -167,9 +189,12 @@ fn clear(
         tile_args[i] = arg;
         block_args[i] = arg;
     }
+#if LISTS_ONLY
+#else
     if (i < raster_params.z * raster_params.w) {
         vis[i] = vec2<u32>(0xffffffffu, 0xffffffffu);
     }
+#endif
 }
 #else
 
@@ -191,6 +216,18 @@ struct Tri {
     flags: u32,
 };
 
+#if ALPHA_TEST
+#include "visibility/surface.wgsl"
+#include <material>
+
+// Whether triangle `tri`'s material keeps pixel (px, py): its alpha there reaches the
+// cutoff (forward.wgsl's prepass discards below it).
+fn alpha_keeps(tri: u32, px: i32, py: i32) -> bool {
+    let p = surface_point(vec2<u32>(u32(px), u32(py)), tri);
+    return material_alpha(material_setup(p)) >= MATERIAL_ALPHA_CUTOFF;
+}
+#endif
+
 fn edge(a: vec2<i32>, b: vec2<i32>, p: vec2<i32>) -> i64 {
     return i64(b.x - a.x) * i64(p.y - a.y) - i64(b.y - a.y) * i64(p.x - a.x);
 }
@@ -207,7 +244,15 @@ fn cover(t: Tri, px: i32, py: i32) {
         return;
     }
     let key = (u64(bitcast<u32>(max(z, 0.0))) << 32u) | u64(~t.id);
-    atomicMin(&vis[u32(py) * raster_params.z + u32(px)], key);
+    let at = u32(py) * raster_params.z + u32(px);
+#if ALPHA_TEST
+    // The material only where it could win: behind what the buffer holds, the min
+    // would keep that anyway.
+    if (atomicLoad(&vis[at]) <= key || !alpha_keeps(t.id, px, py)) {
+        return;
+    }
+#endif
+    atomicMin(&vis[at], key);
 }
 
 // Pixels x..x+7 of row y, those up to `last`.
@@ -511,10 +556,18 @@ fn setup(
     @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
 ) {
-    let id = flat_index(wg, groups, local, GROUP);
-    if (id >= raster_params.x) {
+#if ALPHA_TEST
+    let range = material_triangles[MATERIAL_INDEX];
+    let id = range.x + flat_index(wg, groups, local, GROUP);
+    if (id >= range.y) {
         return;
     }
+#else
+    let id = flat_index(wg, groups, local, GROUP);
+    if (id >= raster_params.x || (alpha_tested[id / 32u] & (1u << (id % 32u))) != 0u) {
+        return;
+    }
+#endif
     let t = 3u * id;
     let a = clip_position(triangles[t]);
     let b = clip_position(triangles[t + 1u]);

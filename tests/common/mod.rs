@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod msaa;
+pub mod textured;
 
 use glam::{Vec2, Vec3, Vec4};
 use lightgraph::graph::{self, FrameSize};

@@ -5,7 +5,9 @@
 //! of a tile, appends the tile's 8×8-pixel blocks the triangle may cover; `raster`
 //! (indirect), a thread per pixel of a block. A resolve then writes the buffer into the
 //! depth texture and the R32Uint visibility texture (a draw or a dispatch, by the depth's
-//! format: `compute_raster_resolve.rs`).
+//! format: `compute_raster_resolve.rs`). Alpha-masked materials: setup, bin and raster
+//! run again per masked material, with its material code testing alpha per pixel; the
+//! first run draws the opaque triangles.
 //! See `shaders/visibility/compute_raster.wgsl`.
 
 use super::compute_raster_resolve::Resolve;
@@ -66,16 +68,43 @@ pub const FEATURES: wgpu::Features =
 
 pub(super) struct ComputeRasterPass {
     name: Name,
-    clear: (Arc<wgpu::ComputePipeline>, wgpu::BindGroup, [u32; 3]),
-    setup: (Arc<wgpu::ComputePipeline>, wgpu::BindGroup, [u32; 3]),
-    bin: (Arc<wgpu::ComputePipeline>, wgpu::BindGroup),
-    raster: (Arc<wgpu::ComputePipeline>, wgpu::BindGroup),
+    /// The opaque triangles' run (its clear also clears the per-pixel buffer), then one
+    /// per alpha-masked material.
+    runs: Vec<RasterRun>,
     /// Indirect arguments of `bin` and `raster`, written by the dispatch before each.
     tile_args: wgpu::Buffer,
     block_args: wgpu::Buffer,
-    counters: wgpu::Buffer,
     capacity: ListCapacity,
     resolve: Resolve,
+}
+
+/// One pass of the rasterizer over some triangles: its dispatches and its own counters.
+struct RasterRun {
+    clear: Dispatch,
+    setup: Dispatch,
+    bin: Dispatch,
+    raster: Dispatch,
+    /// Workgroups of `clear` and `setup` (`bin` and `raster` are indirect).
+    grids: [[u32; 3]; 2],
+    counters: wgpu::Buffer,
+}
+
+/// A pipeline with its bind groups: group 0, and the material's textures (group 2) in an
+/// alpha-tested run.
+struct Dispatch {
+    pipeline: Arc<wgpu::ComputePipeline>,
+    bind: wgpu::BindGroup,
+    textures: Option<wgpu::BindGroup>,
+}
+
+impl Dispatch {
+    fn bind(&self, pass: &mut wgpu::ComputePass<'_>) {
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bind, &[]);
+        if let Some(t) = &self.textures {
+            pass.set_bind_group(2, t, &[]);
+        }
+    }
 }
 
 /// Entries of the three work lists.
@@ -164,26 +193,29 @@ pub(super) fn prepare(
         .gpu
         .visibility_geometry(&device, cx.scene)
         .map_err(|m| pass_error(&sp.name, m))?;
-    // Bit t set: triangle t is culled when it faces away (its material is single-sided).
-    let mut single_sided = vec![0u32; (geometry.triangle_count.div_ceil(32)).max(1) as usize];
+    // Bit t set: triangle t is culled when it faces away (its material is single-sided);
+    // in `alpha_tested`, its masked material's run draws it.
+    let words = (geometry.triangle_count.div_ceil(32)).max(1) as usize;
+    let mut single_sided = vec![0u32; words];
+    let mut alpha_tested = vec![0u32; words];
+    // (material, triangles) of each masked material's run.
+    let mut masked = Vec::new();
     for (m, &[first, end]) in geometry.material_ranges.iter().enumerate() {
         let material = &cx.gpu.materials[m];
         if first == end {
             continue;
         }
+        let mark = |bits: &mut [u32]| {
+            for t in first..end {
+                bits[(t / 32) as usize] |= 1 << (t % 32);
+            }
+        };
         if let AlphaMode::Mask(_) = material.alpha_mode {
-            return Err(pass_error(
-                &sp.name,
-                format!(
-                    "material '{}' is alpha-masked: ComputeRaster has no alpha test and would cover its cut-out pixels (use DepthPrepass for scenes with masked materials)",
-                    material.name
-                ),
-            ));
+            mark(&mut alpha_tested);
+            masked.push((m, end - first));
         }
         if !material.double_sided {
-            for t in first..end {
-                single_sided[(t / 32) as usize] |= 1 << (t % 32);
-            }
+            mark(&mut single_sided);
         }
     }
     let (width, height) = (cx.size.width, cx.size.height);
@@ -252,11 +284,6 @@ pub(super) fn prepare(
         ENTRY_BYTES * capacity.blocks.max(1) as u64,
         none,
     );
-    let counters = storage(
-        "compute raster counters",
-        4 * COUNTERS as u64,
-        wgpu::BufferUsages::COPY_SRC,
-    );
     let tile_args = storage(
         "compute raster bin dispatch",
         16,
@@ -289,6 +316,11 @@ pub(super) fn prepare(
         bytemuck::cast_slice(&single_sided),
         wgpu::BufferUsages::STORAGE,
     );
+    let alpha_tested = init(
+        "alpha-tested triangles",
+        bytemuck::cast_slice(&alpha_tested),
+        wgpu::BufferUsages::STORAGE,
+    );
     let mut offered = cx.declared(sp)?;
     offered.buffer("raster_params", &params);
     offered.buffer("list_capacity", &list_capacity);
@@ -297,49 +329,117 @@ pub(super) fn prepare(
     offered.buffer("records", &records);
     offered.buffer("tiles", &tiles);
     offered.buffer("blocks", &blocks);
-    offered.buffer("counters", &counters);
+    offered.buffer("alpha_tested", &alpha_tested);
     offered.buffer("tile_args", &tile_args);
     offered.buffer("block_args", &block_args);
-    let key = |d: &[(&str, String)], state: &str| PipelineKey {
+    let key = |d: &[(&str, String)], state: &str, material: Option<&str>| PipelineKey {
         shader: SHADER.into(),
         defines: defines(d),
-        virtual_code: BTreeMap::new(),
+        virtual_code: material
+            .map(|code| BTreeMap::from([("material".to_string(), code.to_string())]))
+            .unwrap_or_default(),
         state: state.into(),
     };
-    let mut pipeline = |stage: &str, entry: &str| {
-        let d = [
-            ("GROUP", format!("{GROUP}u")),
-            ("CLEAR_GROUP", format!("{CLEAR_GROUP}u")),
-            ("BLOCK", format!("{BLOCK}u")),
-            ("BLOCKS_PER_GROUP", format!("{BLOCKS_PER_GROUP}u")),
-            ("TILE_BLOCKS", format!("{TILE_BLOCKS}u")),
-            ("TILES_PER_GROUP", format!("{TILES_PER_GROUP}u")),
-            (stage, "1".into()),
-        ];
-        cx.compute_pipeline(&sp.name, key(&d, entry), entry, &offered)
-    };
-    let (clear, clear_bind) = pipeline("CLEAR", "clear")?;
-    let (setup, setup_bind) = pipeline("SETUP", "setup")?;
-    let bin = pipeline("BIN", "bin")?;
-    let raster = pipeline("RASTER", "raster")?;
-    let resolve = Resolve::prepare(cx, sp, key(&[("RESOLVE", "1".into())], "resolve"), &offered)?;
+    let sizes = [
+        ("GROUP", format!("{GROUP}u")),
+        ("CLEAR_GROUP", format!("{CLEAR_GROUP}u")),
+        ("BLOCK", format!("{BLOCK}u")),
+        ("BLOCKS_PER_GROUP", format!("{BLOCKS_PER_GROUP}u")),
+        ("TILE_BLOCKS", format!("{TILE_BLOCKS}u")),
+        ("TILES_PER_GROUP", format!("{TILES_PER_GROUP}u")),
+    ];
+    let mut runs = Vec::new();
+    // `None`: the opaque run over every triangle; else (material, its triangle count).
+    for run in std::iter::once(None).chain(masked.into_iter().map(Some)) {
+        let counters = storage(
+            "compute raster counters",
+            4 * COUNTERS as u64,
+            wgpu::BufferUsages::COPY_SRC,
+        );
+        let mut offered = offered.clone();
+        offered.buffer("counters", &counters);
+        let mut material_defines = Vec::new();
+        let mut material = None;
+        if let Some((index, _)) = run {
+            let m = &cx.gpu.materials[index];
+            material_defines.push(("ALPHA_TEST", "1".to_string()));
+            material_defines.push(("MATERIAL_INDEX", index.to_string()));
+            if m.textures.is_some() {
+                material_defines.push(("MATERIAL_TEXTURED", "1".to_string()));
+            }
+            material = Some((
+                m.wgsl_for_compute().to_string(),
+                m.textures.clone(),
+                &m.name,
+            ));
+        }
+        let label = match &material {
+            Some((_, _, name)) => format!("{} (alpha test of material '{name}')", sp.name),
+            None => sp.name.to_string(),
+        };
+        let mut pipeline = |stage: &str, entry: &str, extra: &[(&str, String)]| {
+            let mut d = sizes.to_vec();
+            d.push((stage, "1".into()));
+            d.extend_from_slice(extra);
+            let (code, set) = match &material {
+                Some((code, set, _)) if stage != "CLEAR" => (Some(code.as_str()), set.as_ref()),
+                _ => (None, None),
+            };
+            let (pipeline, bind, textures) = cx.compute_pipeline_with_material(
+                &label,
+                key(&d, entry, code),
+                entry,
+                &offered,
+                set,
+            )?;
+            Ok::<_, RenderError>(Dispatch {
+                pipeline,
+                bind,
+                textures,
+            })
+        };
+        let (clear, setup, bin, raster) = match run {
+            None => (
+                pipeline("CLEAR", "clear", &[])?,
+                pipeline("SETUP", "setup", &[])?,
+                pipeline("BIN", "bin", &[])?,
+                pipeline("RASTER", "raster", &[])?,
+            ),
+            Some(_) => (
+                pipeline("CLEAR", "clear", &[("LISTS_ONLY", "1".into())])?,
+                pipeline("SETUP", "setup", &material_defines)?,
+                pipeline("BIN", "bin", &material_defines)?,
+                pipeline("RASTER", "raster", &material_defines)?,
+            ),
+        };
+        let (clear_items, setup_items) = match run {
+            None => (pixels.min(u32::MAX as u64) as u32, geometry.triangle_count),
+            // The counters and arguments only.
+            Some((_, triangles)) => (COUNTERS as u32, triangles),
+        };
+        runs.push(RasterRun {
+            clear,
+            setup,
+            bin,
+            raster,
+            grids: [
+                grid(clear_items, CLEAR_GROUP, max_groups),
+                grid(setup_items, GROUP, max_groups),
+            ],
+            counters,
+        });
+    }
+    let resolve = Resolve::prepare(
+        cx,
+        sp,
+        key(&[("RESOLVE", "1".into())], "resolve", None),
+        &offered,
+    )?;
     Ok(ComputeRasterPass {
         name: sp.name.clone(),
-        clear: (
-            clear,
-            clear_bind,
-            grid(pixels.min(u32::MAX as u64) as u32, CLEAR_GROUP, max_groups),
-        ),
-        setup: (
-            setup,
-            setup_bind,
-            grid(geometry.triangle_count, GROUP, max_groups),
-        ),
-        bin,
-        raster,
+        runs,
         tile_args,
         block_args,
-        counters,
         capacity,
         resolve,
     })
@@ -349,38 +449,45 @@ impl ComputeRasterPass {
     /// The rasterizing dispatches, in one compute pass (wgpu orders dispatches that use a
     /// buffer read-write, or as indirect arguments after writing it, with barriers).
     fn record_raster(&self, pass: &mut wgpu::ComputePass<'_>) {
-        for (pipeline, bind, [x, y, z]) in [&self.clear, &self.setup] {
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, bind, &[]);
-            pass.dispatch_workgroups(*x, *y, *z);
-        }
-        for ((pipeline, bind), args) in [
-            (&self.bin, &self.tile_args),
-            (&self.raster, &self.block_args),
-        ] {
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, bind, &[]);
-            pass.dispatch_workgroups_indirect(args, 0);
+        for run in &self.runs {
+            for (dispatch, [x, y, z]) in [(&run.clear, run.grids[0]), (&run.setup, run.grids[1])] {
+                dispatch.bind(pass);
+                pass.dispatch_workgroups(x, y, z);
+            }
+            for (dispatch, args) in [(&run.bin, &self.tile_args), (&run.raster, &self.block_args)] {
+                dispatch.bind(pass);
+                pass.dispatch_workgroups_indirect(args, 0);
+            }
         }
     }
 
-    /// The lists' fill and the serial fallbacks of the last frame.
+    /// The lists' fill (the fullest run's) and the serial fallbacks (all runs') of the
+    /// last frame.
     fn raster_report(&self, r: &Renderer) -> Result<RasterReport, RenderError> {
-        let bytes = read_buffer(&r.ctx.device, &r.ctx.queue, &self.counters)?;
-        let c: &[u32] = bytemuck::cast_slice(&bytes);
         let cap = self.capacity;
-        Ok(RasterReport {
+        let mut report = RasterReport {
             pass: self.name.to_string(),
-            records: c[0].min(cap.records),
+            records: 0,
             records_capacity: cap.records,
-            tiles: c[1].min(cap.tiles),
+            tiles: 0,
             tiles_capacity: cap.tiles,
-            blocks: c[2].min(cap.blocks),
+            blocks: 0,
             blocks_capacity: cap.blocks,
-            serial_triangles: c[3],
-            serial_tiles: c[4],
-            serial_blocks: c[5],
-        })
+            serial_triangles: 0,
+            serial_tiles: 0,
+            serial_blocks: 0,
+        };
+        for run in &self.runs {
+            let bytes = read_buffer(&r.ctx.device, &r.ctx.queue, &run.counters)?;
+            let c: &[u32] = bytemuck::cast_slice(&bytes);
+            report.records = report.records.max(c[0].min(cap.records));
+            report.tiles = report.tiles.max(c[1].min(cap.tiles));
+            report.blocks = report.blocks.max(c[2].min(cap.blocks));
+            report.serial_triangles += c[3];
+            report.serial_tiles += c[4];
+            report.serial_blocks += c[5];
+        }
+        Ok(report)
     }
 }
 

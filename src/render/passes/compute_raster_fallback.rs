@@ -5,8 +5,7 @@
 //! R32Float depth is drawn into an internal Depth32Float texture (outside the graph's
 //! memory plan) and copied into it by one compute dispatch
 //! (`shaders/visibility/compute_raster_depth_copy.wgsl`, bit-exact).
-//! Alpha-masked materials stay refused: the draws could alpha-test them, but a graph
-//! should draw the same pixels on every adapter.
+//! Alpha-masked materials are alpha-tested by those draws as the compute path tests them.
 
 use super::compute_raster::{self, FEATURES};
 use super::visibility_buffer::{draw_ids, IdTargets, VisibilityBuffer};
@@ -17,7 +16,6 @@ use crate::render::bind::Bound;
 use crate::render::pipelines::PipelineKey;
 use crate::render::report::{FallbackReport, PassReport};
 use crate::render::{RenderError, Renderer};
-use crate::scene::AlphaMode;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
@@ -78,7 +76,6 @@ impl HardwareRaster {
                 ),
             ));
         }
-        refuse_alpha_masked(cx, sp)?;
         let depth = sp.required(slot::DEPTH);
         let ids = cx.view(&sp.name, sp.required(VISIBILITY))?;
         // A depth format is drawn into directly; an R32Float depth is drawn into an
@@ -142,24 +139,6 @@ fn depth_copy(
         1,
     ];
     Ok((drawn, (pipeline, bind, groups)))
-}
-
-/// Masked materials are refused as the compute rasterizer refuses them, naming the pass
-/// and the material.
-fn refuse_alpha_masked(cx: &PrepareCtx, sp: &ScheduledPass) -> Result<(), RenderError> {
-    for mesh in cx.gpu.opaque_draws() {
-        let material = &cx.gpu.materials[cx.gpu.meshes[mesh].material];
-        if let AlphaMode::Mask(_) = material.alpha_mode {
-            return Err(pass_error(
-                &sp.name,
-                format!(
-                    "material '{}' is alpha-masked: ComputeRaster has no alpha test, and its hardware fallback on this adapter ({INSTEAD}) refuses it alike so a graph draws the same everywhere (use DepthPrepass or VisibilityBuffer for scenes with masked materials)",
-                    material.name
-                ),
-            ));
-        }
-    }
-    Ok(())
 }
 
 impl PreparedPass for HardwareRaster {

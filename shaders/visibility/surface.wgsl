@@ -1,0 +1,99 @@
+// A pixel's surface point rebuilt from its triangle in the merged geometry
+// (src/render/visibility_geometry.rs): the shading point at the pixel centre and, for
+// textured materials (MATERIAL_TEXTURED), the uv derivatives the material samples with.
+// Shared by visibility shading and the compute rasterizer's alpha test, so both see the
+// same surface. Needs `frame`, `vertices` and `triangles` bound, and the material code
+// (which declares material_uv_ddx and material_uv_ddy) in the module.
+
+struct ShadingPoint {
+    position: vec3<f32>,
+    normal: vec3<f32>,
+    tangent: vec4<f32>,
+    uv: vec2<f32>,
+    view: vec3<f32>,
+};
+
+const VERTEX_FLOATS: u32 = 12u;
+
+struct Vertex {
+    position: vec3<f32>,
+    normal: vec3<f32>,
+    uv: vec2<f32>,
+    tangent: vec4<f32>,
+};
+
+fn fetch(v: u32) -> Vertex {
+    let b = v * VERTEX_FLOATS;
+    var out: Vertex;
+    out.position = vec3<f32>(vertices[b], vertices[b + 1u], vertices[b + 2u]);
+    out.normal = vec3<f32>(vertices[b + 3u], vertices[b + 4u], vertices[b + 5u]);
+    out.uv = vec2<f32>(vertices[b + 6u], vertices[b + 7u]);
+    out.tangent = vec4<f32>(vertices[b + 8u], vertices[b + 9u], vertices[b + 10u], vertices[b + 11u]);
+    return out;
+}
+
+// Perspective-correct barycentrics by 2D homogeneous rasterization (Olano & Greer 1997):
+// the surface point b0 p0 + b1 p1 + b2 p2 projects to the NDC point q where its clip
+// position (x, y, w), linear in b, is a multiple of (q, 1): b = s H⁻¹ (q, 1) with H's
+// columns the vertices' clip (x, y, w), H⁻¹'s rows the cross products of pairs. No
+// division by w, so it holds for triangles crossing the camera plane too.
+struct Edges {
+    e0: vec3<f32>,
+    e1: vec3<f32>,
+    e2: vec3<f32>,
+};
+
+fn bary_at(e: Edges, q: vec2<f32>) -> vec3<f32> {
+    let h = vec3<f32>(q, 1.0);
+    let b = vec3<f32>(dot(e.e0, h), dot(e.e1, h), dot(e.e2, h));
+    return b / (b.x + b.y + b.z);
+}
+
+// Triangle `tri`'s surface at pixel `id`'s centre (the triangle's plane extended where
+// the centre lies outside it).
+fn surface_point(id: vec2<u32>, tri: u32) -> ShadingPoint {
+    let a = fetch(triangles[3u * tri]);
+    let b = fetch(triangles[3u * tri + 1u]);
+    let c = fetch(triangles[3u * tri + 2u]);
+    let ca = frame.view_proj * vec4<f32>(a.position, 1.0);
+    let cb = frame.view_proj * vec4<f32>(b.position, 1.0);
+    let cc = frame.view_proj * vec4<f32>(c.position, 1.0);
+    let h0 = ca.xyw;
+    let h1 = cb.xyw;
+    let h2 = cc.xyw;
+    let e = Edges(cross(h1, h2), cross(h2, h0), cross(h0, h1));
+    // The pixel centre in NDC, and one pixel's step along x and y (NDC y points up).
+    let size = vec2<f32>(frame.size);
+    let pixel = vec2<f32>(id) + 0.5;
+    let q = vec2<f32>(pixel.x / size.x * 2.0 - 1.0, 1.0 - pixel.y / size.y * 2.0);
+    let step = vec2<f32>(2.0 / size.x, -2.0 / size.y);
+    let w = bary_at(e, q);
+
+    var p: ShadingPoint;
+    p.position = w.x * a.position + w.y * b.position + w.z * c.position;
+    p.view = normalize(frame.camera_pos.xyz - p.position);
+    // Front faces wind counter-clockwise in NDC (the pipelines' FrontFace::Ccw): the
+    // sign of det(H); back faces (double-sided materials) flip the normal as
+    // forward.wgsl's shading_point does.
+    let front = dot(h0, e.e0) > 0.0;
+    var n = normalize(w.x * a.normal + w.y * b.normal + w.z * c.normal);
+    if (!front) {
+        n = -n;
+    }
+    p.normal = n;
+    p.tangent = w.x * a.tangent + w.y * b.tangent + w.z * c.tangent;
+    let uv = mat3x2<f32>(a.uv, b.uv, c.uv);
+    p.uv = uv * w;
+#if MATERIAL_TEXTURED
+    // The footprint textureSampleGrad filters over (its mip level): the uv one pixel
+    // right and one down, taken as the rasterizer's coarse derivatives are, across the
+    // pixel's 2×2 quad from its top-left pixel (the triangle's plane extended there, as
+    // helper invocations do), so the level matches textureSample in forward shading.
+    let corner = vec2<f32>(id & vec2<u32>(~1u)) + 0.5;
+    let q0 = vec2<f32>(corner.x / size.x * 2.0 - 1.0, 1.0 - corner.y / size.y * 2.0);
+    let uv0 = uv * bary_at(e, q0);
+    material_uv_ddx = uv * bary_at(e, q0 + vec2<f32>(step.x, 0.0)) - uv0;
+    material_uv_ddy = uv * bary_at(e, q0 + vec2<f32>(0.0, step.y)) - uv0;
+#endif
+    return p;
+}
