@@ -403,7 +403,7 @@ fn ids_cover_exactly_the_prepass_depth_and_name_the_triangle_there() {
 }
 
 /// `graph_text` with its VisibilityShading pass set to light loop `kind` (`Staged`,
-/// `RangeFirst`, `GroupList`, `Forward`, optionally followed by `, workgroup: 16`).
+/// `RangeFirst`, `GroupList`, `Forward`, optionally followed by `, workgroup: 8`).
 fn with_loop(graph_text: &str, kind: &str) -> String {
     let on = [
         "VisibilityShading(lights: Culled)",
@@ -456,7 +456,7 @@ fn bit_differences(a: &[[f32; 4]], b: &[[f32; 4]]) -> (usize, Option<usize>) {
 }
 
 /// Renders `scene` through every staging graph with each light loop (Staged, RangeFirst,
-/// GroupList; the last with workgroups of 8 and 16) against forward shading's loop
+/// GroupList; the last with workgroups of 16 and 8) against forward shading's loop
 /// (Forward); the failures where the images differ in any bit. Staging only reorders loads
 /// and skips lights that add nothing, so the sums are the same floats in the same order.
 fn check_staging_is_exact(r: &mut lightgraph::render::Renderer, scene: &Scene) -> Vec<String> {
@@ -464,12 +464,13 @@ fn check_staging_is_exact(r: &mut lightgraph::render::Renderer, scene: &Scene) -
     for (graph, text) in staging_graphs() {
         let plain = render_text(r, &with_loop(&text, "Forward"), scene, W, H);
         for kind in [
+            // 8×8 workgroups (Staged's side), the others 16×16 by default.
             "Staged",
             "RangeFirst",
             "GroupList",
-            // RangeFirst on 16×16 too: GroupList falls back to it on every graph without one
-            // list per 16-pixel tile (tiles of 8, HalfZ, Clustered, linked lists, all lights).
-            "GroupList, workgroup: 16",
+            // GroupList and RangeFirst on 8×8 too: GroupList falls back to RangeFirst on every
+            // graph without one list per tile (HalfZ, Clustered, linked lists, all lights).
+            "GroupList, workgroup: 8",
         ] {
             let name = format!("{graph} {kind}");
             let staged = render_text(r, &with_loop(&text, kind), scene, W, H);

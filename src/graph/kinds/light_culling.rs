@@ -39,7 +39,7 @@ pub struct LightCulling {
     /// 256). Written as a plain number; `None` where the graph gives none.
     #[serde(
         default,
-        deserialize_with = "plain_some",
+        deserialize_with = "super::plain_some",
         serialize_with = "plain_or_default",
         skip_serializing_if = "Option::is_none"
     )]
@@ -93,10 +93,6 @@ fn default_scratch() -> u32 {
 
 fn is_default_scratch(s: &u32) -> bool {
     *s == DEFAULT_SCRATCH
-}
-
-fn plain_some<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
-    u32::deserialize(d).map(Some)
 }
 
 fn plain_or_default<S: serde::Serializer>(v: &Option<u32>, s: S) -> Result<S::Ok, S::Error> {

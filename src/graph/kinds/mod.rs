@@ -513,6 +513,16 @@ pub fn check_light_source(
     }
 }
 
+/// An optional number written plainly (`capacity: 4096`, not `Some(4096)`).
+pub(crate) fn plain_some<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
+    <u32 as serde::Deserialize>::deserialize(d).map(Some)
+}
+
+/// Writes a set optional number plainly; pair with `skip_serializing_if = "Option::is_none"`.
+pub(crate) fn plain_u32<S: serde::Serializer>(v: &Option<u32>, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_u32(v.unwrap_or_default())
+}
+
 #[cfg(test)]
 pub(crate) mod test_support {
     //! Validates a one-pass graph around a pass declaration, for the kinds' unit tests.

@@ -32,7 +32,8 @@ pub(super) fn prepare(
     let mut offered = cx.declared(sp)?;
     let lists = cx.shading_lists(sp, p.lights, &mut offered)?;
     let layout = tile_layout(cx, sp, lists);
-    let light_loop = choose_light_loop(p.light_loop, layout, p.workgroup);
+    let side = p.workgroup_side();
+    let light_loop = choose_light_loop(p.light_loop, layout, side);
     let ranges = cx.merged(&sp.name)?.material_ranges.clone();
     // Only materials that own triangles get a dispatch (blended ones never do); the first
     // also clears pixels nothing covers, so one runs even for a scene without triangles.
@@ -56,7 +57,7 @@ pub(super) fn prepare(
         d.extend(lists.define());
         d.extend(loop_define(light_loop));
         // The shader's `@workgroup_size(SHADING_GROUP, SHADING_GROUP, 1)`.
-        d.push(("SHADING_GROUP", format!("{}u", p.workgroup)));
+        d.push(("SHADING_GROUP", format!("{side}u")));
         if light_loop == LightLoop::GroupList {
             d.push(("UNIFORM_LIST", "1".into()));
         }
@@ -82,8 +83,8 @@ pub(super) fn prepare(
         dispatches,
         bind: bind.ok_or_else(|| super::pass_error(&sp.name, "no material to shade".into()))?,
         groups: [
-            cx.size.width.div_ceil(p.workgroup),
-            cx.size.height.div_ceil(p.workgroup),
+            cx.size.width.div_ceil(side),
+            cx.size.height.div_ceil(side),
             1,
         ],
     })
