@@ -249,6 +249,67 @@ fn over_a_thousand_lights() {
     check_scene(&random_scene(1100, 17), true);
 }
 
+/// The coarse stage takes lights 65,536 at a time (its hit bits fill 8 KB of workgroup
+/// memory), so the lights past the first chunk must reach the coarse lists after it, in
+/// order. 70,001 lights, every 16th in view (4,376, 280 of them past 65,536), the rest
+/// behind the camera, out of every tile and of reach of every surface: the image must be
+/// the one of the in-view lights alone, to the bit (the lists then hold the same lights
+/// in the same order, so shading sums the same terms in the same order). Without the
+/// in-view lights past 65,536 it must differ, or the second chunk would be untested.
+/// Coarse lists stay far under their 8,192 capacity, past which tiles test every light.
+#[test]
+fn more_lights_than_one_coarse_chunk() {
+    let (w, h) = (192, 108);
+    let mut all = random_scene(0, 31);
+    let mut rng = Rng(5);
+    all.lights = (0..70_001)
+        .map(|i| {
+            let (lo, hi) = if i % 16 == 0 {
+                (Vec3::new(-15.0, 0.0, -38.0), Vec3::new(15.0, 8.0, 4.0))
+            } else {
+                (Vec3::new(-15.0, 0.0, 12.0), Vec3::new(15.0, 8.0, 20.0))
+            };
+            random_light(&mut rng, lo, hi, 0.2, 1.0)
+        })
+        .collect();
+    let in_view = |below: usize| {
+        let mut s = all.clone();
+        s.lights = (0..all.lights.len().min(below))
+            .step_by(16)
+            .map(|i| all.lights[i].clone())
+            .collect();
+        s
+    };
+    let mut r = renderer();
+    let graph = graph_text(16, "Frustum", 1024, None);
+    let out = render_text_with(&mut r, &graph, &all, w, h, false);
+    let alone = render_text(&mut r, &graph, &in_view(usize::MAX), w, h);
+    let first_chunk = render_text(&mut r, &graph, &in_view(65_536), w, h);
+    assert_eq!(out.culling[0].overflowed_lists, 0);
+    assert_eq!(out.image.len(), (w * h) as usize);
+    assert_eq!(alone.image.len(), out.image.len());
+    let differ = out
+        .image
+        .iter()
+        .zip(&alone.image)
+        .filter(|(a, b)| a != b)
+        .count();
+    assert_eq!(
+        differ, 0,
+        "{differ} pixels differ from the in-view lights alone"
+    );
+    let second = first_chunk
+        .image
+        .iter()
+        .zip(&alone.image)
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(
+        second > 100,
+        "only {second} pixels lit by lights past 65,536"
+    );
+}
+
 #[test]
 fn overflow_is_counted_and_reported() {
     let mut r = renderer();

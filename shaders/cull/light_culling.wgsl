@@ -114,6 +114,13 @@ var<workgroup> depth_mask: atomic<u32>;
 // it reads its own, so a batch needs two barriers, not three.
 var<workgroup> hits: array<array<atomic<u32>, MASK_WORDS>, 2>;
 var<workgroup> coarse_count: u32;
+// The coarse stage's hit bits for a chunk of COARSE_CHUNK lights (8 KB), and its prefix
+// sum over invocations.
+const COARSE_CHUNK_WORDS: u32 = 2048u;
+const COARSE_CHUNK: u32 = COARSE_CHUNK_WORDS * 32u;
+const COARSE_WORDS_PER_THREAD: u32 = COARSE_CHUNK_WORDS / THREADS;
+var<workgroup> coarse_hits: array<atomic<u32>, COARSE_CHUNK_WORDS>;
+var<workgroup> coarse_sums: array<u32, THREADS>;
 #if COMPACT
 // The fill's list entry: (offset, kept count), and the light after its slot's last.
 var<workgroup> fill_entry: vec2<u32>;
@@ -610,16 +617,21 @@ fn light_touches_tile(
 
 // The coarse stage: one workgroup per coarse tile of COARSE×COARSE tiles; each
 // invocation folds COARSE×COARSE pixels into its part of the depth range. No depth mask:
-// every fine tile applies its own.
+// every fine tile applies its own. Lights are taken a chunk of COARSE_CHUNK at a time:
+// every invocation tests one light a step and sets the hits' bits in workgroup memory,
+// with no barrier inside the chunk (per-batch ranks cost two barriers and a dozen
+// workgroup loads a batch, which bound this stage at high light counts); then each
+// invocation counts the bits of its own run of words, a prefix sum over the invocations
+// places the runs, and each writes its hits in ascending light order.
 @compute @workgroup_size(TILE, TILE, 1)
 fn coarse(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
     @builtin(local_invocation_id) lid: vec3<u32>,
 ) {
-    // Ordered before its first use by the depth range's barriers.
-    if (local < MASK_WORDS) {
-        atomicStore(&hits[0][local], 0u);
+    // Ordered before the first chunk's bits by the depth range's barriers.
+    for (var k = 0u; k < COARSE_WORDS_PER_THREAD; k++) {
+        atomicStore(&coarse_hits[local * COARSE_WORDS_PER_THREAD + k], 0u);
     }
     let span = TILE * COARSE;
     let origin = group.xy * span;
@@ -639,34 +651,70 @@ fn coarse(
 
     let count = frame.light_count;
     var total = 0u;
-    var h = 0u;
-    // Each batch's spheres are loaded a batch ahead.
+    // Each step's sphere is loaded a step ahead (COARSE_CHUNK is a multiple of THREADS,
+    // so the next step is the same invocation's next light across chunks too).
     var next_sphere = light_sphere(local, true);
-    for (var base = 0u; base < count; base += THREADS) {
-        let i = base + local;
-        let sphere = next_sphere;
-        if (i + THREADS < count) {
-            next_sphere = light_sphere(i + THREADS, true);
-        }
-        var hit = false;
-        if (!empty && i < count) {
-            // An all-ones mask: the depth-mask test passes here.
-            hit = light_touches_tile(i, sphere, bounds, lo, hi, 0xffffffffu, lo, hi, COARSE_REACH);
-        }
-        if (hit) {
-            atomicOr(&hits[h][local / 32u], 1u << (local % 32u));
+    for (var chunk = 0u; chunk < count; chunk += COARSE_CHUNK) {
+        let end = min(count, chunk + COARSE_CHUNK);
+        if (!empty) {
+            for (var i = chunk + local; i < end; i += THREADS) {
+                let sphere = next_sphere;
+                if (i + THREADS < count) {
+                    next_sphere = light_sphere(i + THREADS, true);
+                }
+                // An all-ones mask: the depth-mask test passes here.
+                if (light_touches_tile(i, sphere, bounds, lo, hi, 0xffffffffu, lo, hi, COARSE_REACH)) {
+                    let bit = i - chunk;
+                    atomicOr(&coarse_hits[bit / 32u], 1u << (bit % 32u));
+                }
+            }
         }
         workgroupBarrier();
-        let slot = total + rank_in_batch(h, local);
-        if (hit && slot < COARSE_CAPACITY) {
-            coarse_lists[base_word + 1u + slot] = i;
+        let first_word = local * COARSE_WORDS_PER_THREAD;
+        var mine = 0u;
+        for (var k = 0u; k < COARSE_WORDS_PER_THREAD; k++) {
+            mine += countOneBits(atomicLoad(&coarse_hits[first_word + k]));
         }
-        total += close_batch(h, local, base + THREADS < count);
-        h = 1u - h;
+        let placed = coarse_exclusive_scan(local, mine);
+        var slot = total + placed.x;
+        for (var k = 0u; k < COARSE_WORDS_PER_THREAD; k++) {
+            // Only this invocation reads or clears its words until the next barrier.
+            var bits = atomicLoad(&coarse_hits[first_word + k]);
+            atomicStore(&coarse_hits[first_word + k], 0u);
+            let first_light = chunk + (first_word + k) * 32u;
+            while (bits != 0u) {
+                if (slot < COARSE_CAPACITY) {
+                    coarse_lists[base_word + 1u + slot] = first_light + firstTrailingBit(bits);
+                }
+                slot += 1u;
+                bits &= bits - 1u;
+            }
+        }
+        // At most the light count: no overflow.
+        total += placed.y;
+        // The next chunk sets bits other invocations have just cleared.
+        workgroupBarrier();
     }
     if (local == 0u) {
         coarse_lists[base_word] = total;
     }
+}
+
+// Exclusive prefix sum of `v` over the coarse workgroup's invocations (Hillis–Steele):
+// (the sum of the invocations' before this one, the sum of all).
+fn coarse_exclusive_scan(local: u32, v: u32) -> vec2<u32> {
+    coarse_sums[local] = v;
+    workgroupBarrier();
+    for (var d = 1u; d < THREADS; d *= 2u) {
+        var add = 0u;
+        if (local >= d) {
+            add = coarse_sums[local - d];
+        }
+        workgroupBarrier();
+        coarse_sums[local] += add;
+        workgroupBarrier();
+    }
+    return vec2<u32>(coarse_sums[local] - v, coarse_sums[THREADS - 1u]);
 }
 
 #if COMPACT

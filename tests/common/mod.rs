@@ -241,6 +241,19 @@ pub fn render_text(
     width: u32,
     height: u32,
 ) -> FrameResult {
+    render_text_with(r, graph_text, scene, width, height, true)
+}
+
+/// `render_text` with light statistics on or off (they test every light at every pixel:
+/// with tens of thousands of lights on lavapipe, most of a frame's time).
+pub fn render_text_with(
+    r: &mut Renderer,
+    graph_text: &str,
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    light_stats: bool,
+) -> FrameResult {
     let checked = graph::check_text(Path::new("<test>"), graph_text, &ShaderLibrary::builtin())
         .expect("valid graph");
     let size = FrameSize {
@@ -250,7 +263,7 @@ pub fn render_text(
     };
     let compiled = graph::compile(checked, &scene.features(), size);
     let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, scene).expect("materials");
-    let stats = compiled.has_forward_shading();
+    let stats = light_stats && compiled.has_forward_shading();
     let prepared = r
         .prepare(compiled, scene, &gpu, size, stats)
         .expect("prepare");
