@@ -276,7 +276,7 @@ fn more_lights_than_one_coarse_chunk() {
         let mut s = all.clone();
         s.lights = (0..all.lights.len().min(below))
             .step_by(16)
-            .map(|i| all.lights[i].clone())
+            .map(|i| all.lights[i])
             .collect();
         s
     };
