@@ -30,8 +30,8 @@ run a4_old session12_culling 80 old
 run d1_new diag_session10 30 new LIGHTGRAPH_TIME_DISPATCH=1
 run d2_old diag_session10 30 old LIGHTGRAPH_TIME_DISPATCH=1
 run visibility_headline visibility_headline 200 new
-# Without a root: their scene paths are relative to the sweep file's folder, which a
-# root moves.
+# Without a root: their graphs (../benches/graphs/...) are found from the graphs/ folder,
+# which a root moves.
 for s in session10_atrium session10_textured; do
     timeout 80 $lg bench --sweep benches/sweeps/$s.ron --out "$out/$s" > "$out/$s.log" 2>&1
     echo "== $s (rc $?)"; sed -n '/^| scene | technique | params | lights | size/,/^$/p' "$out/$s/results.md" | cut -c1-200
