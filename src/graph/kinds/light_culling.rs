@@ -40,7 +40,7 @@ pub struct LightCulling {
     #[serde(
         default,
         deserialize_with = "super::plain_some",
-        serialize_with = "plain_or_default",
+        serialize_with = "super::plain_u32",
         skip_serializing_if = "Option::is_none"
     )]
     pub capacity: Option<u32>,
@@ -93,10 +93,6 @@ fn default_scratch() -> u32 {
 
 fn is_default_scratch(s: &u32) -> bool {
     *s == DEFAULT_SCRATCH
-}
-
-fn plain_or_default<S: serde::Serializer>(v: &Option<u32>, s: S) -> Result<S::Ok, S::Error> {
-    s.serialize_u32(v.unwrap_or(DEFAULT_CAPACITY))
 }
 
 impl LightCulling {
