@@ -60,13 +60,43 @@ fn lg_cross(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(ic) * (1.0 / 4194304.0) + (cross(sa.hi, sb.lo) + cross(sa.lo, b));
 }
 
-// What the lobes need about (n, v, l). `s2` is |n × h|² = 1 − (n·h)², from an accurate
-// cross product with the unnormalised l + v (exact where l ≈ −v, by Sterbenz's lemma), so
-// it keeps its precision where n·h ≈ 1.
+// Plain f32 products where they are accurate enough, the split ones where they are not.
+// A plain dot product of a unit vector with one of length ≤ √3 (h unnormalised) is within
+// 3·2^-24·√3 ≈ 3.1e-7 of the exact one, fused or not: at a magnitude of LG_PLAIN_MIN =
+// 2^-4 or more that is 5e-6 relative. Only near-grazing cosines (n·l, n·v, n·h under
+// 1/16) take the split product, so a warp mostly runs one side of the branch (on the H200
+// plain products shade harada's 65,536 lights 0.83 ms faster than split ones).
+const LG_PLAIN_MIN: f32 = 0.0625;
+
+fn lg_dot_guarded(a: vec3<f32>, b: vec3<f32>) -> f32 {
+    let p = dot(a, b);
+    if (abs(p) >= LG_PLAIN_MIN) {
+        return p;
+    }
+    return lg_dot(a, b);
+}
+
+// How small |n × h|² may be and still come from plain products, by what reads it. A plain
+// cross product of those vectors is within 2·2^-24·√3·√3 ≈ 3.6e-7 per unit of |h|, so
+// |n × h|² is within 7.2e-7 / |n × h| relative: at |n × h|² / |h|² ≥ 1/16 (with |h| ≥ 1/2,
+// |n × h| ≥ 1/8) that is 5.8e-6.
+// - LG_S2_GUARDED: only GGX lobes read it; their D = α²/(π (|n×h|² + (n·h)²α²)²) is
+//   within twice its relative error.
+// - LG_S2_EXACT: a sheen lobe reads it; its D raises it to 1/(2α) (up to 50). Where
+//   that D is large enough to be judged relatively (≥ 1e-3: |n × h|² ≥ 0.82 at α =
+//   0.01) the bound gives 50 × 1.6e-6 = 8e-5, too near the 1e-4 the material tests allow
+//   (measured: 3.8e-7 for |n × h|², so 2e-5), so sheen always takes the split product
+//   (|n × h|² / |h|² never reaches 2).
+const LG_S2_GUARDED: f32 = 0.0625;
+const LG_S2_EXACT: f32 = 2.0;
+
+// What the lobes need about (n, v, l). `s2` is |n × h|² = 1 − (n·h)², from a cross product
+// with the unnormalised l + v (exact where l ≈ −v, by Sterbenz's lemma), so it keeps its
+// precision where n·h ≈ 1. `s2_plain_min`: LG_S2_GUARDED or LG_S2_EXACT, above.
 struct LgDirs {
     h: vec3<f32>,
-    // h − n (n·h) = (n × h) × n, from the accurate cross product: t·h and b·h from it do
-    // not pick up the f32 tilt of the tangent frame out of the tangent plane.
+    // h − n (n·h) = (n × h) × n, from the same cross product: t·h and b·h from it do not
+    // pick up the f32 tilt of the tangent frame out of the tangent plane.
     hp: vec3<f32>,
     nl: f32,
     nv: f32,
@@ -76,10 +106,10 @@ struct LgDirs {
     lv: f32,
 };
 
-fn lg_dirs(n: vec3<f32>, v: vec3<f32>, l: vec3<f32>) -> LgDirs {
+fn lg_dirs(n: vec3<f32>, v: vec3<f32>, l: vec3<f32>, s2_plain_min: f32) -> LgDirs {
     var d: LgDirs;
     // l + v is exact where l ≈ −v (Sterbenz). Scale it by a power of two (exact) so its
-    // largest component is in [0.5, 1): lg_dot and lg_cross then stay accurate relative to
+    // largest component is in [0.5, 1): the products then stay accurate relative to
     // their results even when l + v is tiny (grazing mirror configurations).
     var hq = n;
     let hs = l + v;
@@ -92,14 +122,18 @@ fn lg_dirs(n: vec3<f32>, v: vec3<f32>, l: vec3<f32>) -> LgDirs {
     let len2 = dot(hq, hq);
     let len = sqrt(len2);
     d.h = hq / len;
-    d.nl = clamp(lg_dot(n, l), LG_COS_MIN, 1.0);
-    d.nv = clamp(lg_dot(n, v), LG_COS_MIN, 1.0);
-    d.nh = clamp(lg_dot(n, hq) / len, 0.0, 1.0);
-    let c = lg_cross(n, hq);
+    d.nl = clamp(lg_dot_guarded(n, l), LG_COS_MIN, 1.0);
+    d.nv = clamp(lg_dot_guarded(n, v), LG_COS_MIN, 1.0);
+    d.nh = clamp(lg_dot_guarded(n, hq) / len, 0.0, 1.0);
+    var c = cross(n, hq);
+    if (dot(c, c) < s2_plain_min * len2) {
+        c = lg_cross(n, hq);
+    }
     d.s2 = min(dot(c, c) / len2, 1.0);
     d.hp = cross(c, n) / len;
     // v·h = l·h = |l + v| / 2 for unit l, v: symmetric in l and v, and no cancellation.
     d.vh = clamp(0.5 * ldexp(len, e), 0.0, 1.0);
+    // Oren-Nayar's l·v − (n·l)(n·v) cancels: always the split product (only it reads lv).
     d.lv = clamp(lg_dot(l, v), -1.0, 1.0);
     return d;
 }

@@ -277,10 +277,25 @@ pub fn generate(m: &Material, opts: &WgslOptions) -> String {
         .iter()
         .flat_map(|l| &l.lobes)
         .any(|l| matches!(l, Lobe::Clearcoat { .. }));
-    o.push_str("fn material_eval(m: MaterialSample, l: vec3<f32>) -> vec3<f32> {\n    let cos_l = lg_dot(m.n, l);\n    if (!(cos_l > 0.0)) {\n        return vec3<f32>(0.0);\n    }\n    let d = lg_dirs(m.n, m.v, l);\n");
+    // A sheen lobe's D magnifies the error of |n × h|² up to 50×: it needs the split
+    // product there everywhere (lobes.wgsl, LG_S2_EXACT).
+    let has_sheen = desc
+        .layers
+        .iter()
+        .flat_map(|l| &l.lobes)
+        .any(|l| matches!(l, Lobe::Sheen { .. }));
+    let s2 = if has_sheen {
+        "LG_S2_EXACT"
+    } else {
+        "LG_S2_GUARDED"
+    };
+    let _ = write!(
+        o,
+        "fn material_eval(m: MaterialSample, l: vec3<f32>) -> vec3<f32> {{\n    let cos_l = lg_dot_guarded(m.n, l);\n    if (!(cos_l > 0.0)) {{\n        return vec3<f32>(0.0);\n    }}\n    let d = lg_dirs(m.n, m.v, l, {s2});\n"
+    );
     if has_clearcoat {
         if desc.normal_map.is_some() {
-            o.push_str("    let dg = lg_dirs(m.ng, m.v, l);\n    let cc_on = select(0.0, 1.0, dot(m.ng, l) > 0.0);\n");
+            let _ = write!(o, "    let dg = lg_dirs(m.ng, m.v, l, {s2});\n    let cc_on = select(0.0, 1.0, dot(m.ng, l) > 0.0);\n");
         } else {
             o.push_str("    let dg = d;\n    let cc_on = 1.0;\n");
         }
