@@ -138,7 +138,11 @@ fn lobe_errors(gpu: &GpuContext, cases: &[(Geo, [f64; 4], r::V3)]) -> ([Worst; 7
 }
 
 fn print_worst(gpu: &GpuContext, cases: &[(Geo, [f64; 4], r::V3)], worst: &[Worst; 7]) {
-    println!("GPU vs f64 over {} samples ({}):", cases.len(), gpu.adapter_name());
+    println!(
+        "GPU vs f64 over {} samples ({}):",
+        cases.len(),
+        gpu.adapter_name()
+    );
     for (k, w) in worst.iter().enumerate() {
         let (g, p, _) = &cases[w.1];
         println!(
@@ -323,7 +327,13 @@ fn dirs_take_plain_products_only_where_they_are_accurate() {
             for k in 0..4 {
                 let floor = if k == 3 { alpha_min_sq } else { 1e-3 };
                 let e = (got[k] as f64 - want[k]).abs() / want[k].abs().max(floor);
-                assert!(e.is_finite(), "sample {i} {}: {} against {}", names[k], got[k], want[k]);
+                assert!(
+                    e.is_finite(),
+                    "sample {i} {}: {} against {}",
+                    names[k],
+                    got[k],
+                    want[k]
+                );
                 if e > w[k].0 {
                     w[k] = (e, i);
                 }

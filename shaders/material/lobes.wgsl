@@ -111,13 +111,18 @@ fn lg_dirs(n: vec3<f32>, v: vec3<f32>, l: vec3<f32>, s2_plain_min: f32) -> LgDir
     // l + v is exact where l ≈ −v (Sterbenz). Scale it by a power of two (exact) so its
     // largest component is in [0.5, 1): the products then stay accurate relative to
     // their results even when l + v is tiny (grazing mirror configurations).
+    // The powers of two from big's exponent bits: big is normal here (1e-30 < big ≤ 2),
+    // so with b its biased exponent, frexp would give e = b − 126, and 2^-e has the bits
+    // (253 − b) << 23, 2^(e−1) the bits b << 23. Multiplying by them is exact, so this is
+    // frexp and ldexp's result bit for bit, in fewer instructions.
     var hq = n;
+    var half_scale = 0.5;
     let hs = l + v;
     let big = max(max(abs(hs.x), abs(hs.y)), abs(hs.z));
-    var e = 0;
     if (big > 1e-30) {
-        e = frexp(big).exp;
-        hq = ldexp(hs, vec3<i32>(-e));
+        let b = (bitcast<u32>(big) >> 23u) & 0xffu;
+        hq = hs * bitcast<f32>((253u - b) << 23u);
+        half_scale = bitcast<f32>(b << 23u);
     }
     let len2 = dot(hq, hq);
     let len = sqrt(len2);
@@ -132,7 +137,7 @@ fn lg_dirs(n: vec3<f32>, v: vec3<f32>, l: vec3<f32>, s2_plain_min: f32) -> LgDir
     d.s2 = min(dot(c, c) / len2, 1.0);
     d.hp = cross(c, n) / len;
     // v·h = l·h = |l + v| / 2 for unit l, v: symmetric in l and v, and no cancellation.
-    d.vh = clamp(0.5 * ldexp(len, e), 0.0, 1.0);
+    d.vh = clamp(half_scale * len, 0.0, 1.0);
     // Oren-Nayar's l·v − (n·l)(n·v) cancels: always the split product (only it reads lv).
     d.lv = clamp(lg_dot(l, v), -1.0, 1.0);
     return d;
