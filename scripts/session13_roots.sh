@@ -5,7 +5,10 @@
 #                  the material code now calls (lg_dot_guarded, lg_dirs's fourth argument,
 #                  both ignored);
 #   guarded_frexp: the guarded products with frexp and ldexp (af36a36), before their
-#                  exponent came from the float's bits.
+#                  exponent came from the float's bits;
+#   spot_divide:   common/lighting.wgsl before spot_scale (the division per pixel);
+#                  spot_scale (cd539f4) measured slower and was reverted, so today this
+#                  root is the shipped file.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 LOBES=shaders/material/lobes.wgsl
@@ -22,3 +25,5 @@ SHIM
 } > .gpu/roots/split/$LOBES
 grep -q 's2_plain_min: f32) -> LgDirs' .gpu/roots/split/$LOBES
 git show af36a36:$LOBES > .gpu/roots/guarded_frexp/$LOBES
+mkdir -p .gpu/roots/spot_divide/shaders/common
+git show 580b0b6:shaders/common/lighting.wgsl > .gpu/roots/spot_divide/shaders/common/lighting.wgsl

@@ -14,7 +14,8 @@ fn spot_factor(g: LightGeometry, p: LightProperties, to_light_dir: vec3<f32>) ->
         return 1.0;
     }
     let cd = dot(g.direction, -to_light_dir);
-    let a = clamp((cd - g.cos_outer) * p.spot_scale, 0.0, 1.0);
+    let scale = 1.0 / max(0.001, p.cos_inner - g.cos_outer);
+    let a = clamp((cd - g.cos_outer) * scale, 0.0, 1.0);
     return a * a;
 }
 

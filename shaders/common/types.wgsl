@@ -31,10 +31,8 @@ struct LightProperties {
     cos_inner: f32,
     flags: u32,
     material_mask: u32,
-    // A spot's 1 / max(0.001, cos_inner − cos_outer), found once on the CPU instead of
-    // for every pixel it reaches (0 for the others).
-    spot_scale: f32,
     _pad0: u32,
+    _pad1: u32,
 };
 
 // How a culling pass laid out its light lists (see ListLayout in src/graph/plan.rs).

@@ -64,10 +64,7 @@ pub struct GpuLightProperties {
     pub cos_inner: f32,
     pub flags: u32,
     pub material_mask: u32,
-    /// A spot's 1 / max(0.001, cos_inner − cos_outer) (`spot_factor` in
-    /// shaders/common/lighting.wgsl), 0 for other lights.
-    pub spot_scale: f32,
-    pub _pad: u32,
+    pub _pad: [u32; 2],
 }
 
 /// How a culling pass laid out its lists; see [`crate::graph::ListLayout`].
@@ -166,7 +163,7 @@ pub fn light_buffers(lights: &[Light]) -> (Vec<GpuLightGeometry>, Vec<GpuLightPr
     lights
         .iter()
         .map(|l| {
-            let (direction, cos_outer, cos_inner): (Vec3, f32, f32) = match l.shape {
+            let (direction, cos_outer, cos_inner) = match l.shape {
                 LightShape::Point => (Vec3::ZERO, -1.0, -1.0),
                 LightShape::Spot {
                     direction,
@@ -190,11 +187,7 @@ pub fn light_buffers(lights: &[Light]) -> (Vec<GpuLightGeometry>, Vec<GpuLightPr
                     cos_inner,
                     flags: l.flags,
                     material_mask: l.material_mask,
-                    spot_scale: match l.shape {
-                        LightShape::Point => 0.0,
-                        LightShape::Spot { .. } => 1.0 / (cos_inner - cos_outer).max(0.001),
-                    },
-                    _pad: 0,
+                    _pad: [0; 2],
                 },
             )
         })
