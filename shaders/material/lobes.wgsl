@@ -22,10 +22,10 @@ const LG_COS_MIN: f32 = 1e-4;
 // are done in i32 (integers up to 2^22, sums below 2^24, converted to f32 exactly): exact,
 // and out of reach of float reassociation. Only the small hi·lo and lo·b terms are rounded
 // (≤ ~3e-10 absolute, tests/material_gpu.rs).
-// The conversions cost: plain products shade harada's 65,536 lights in 2.80 ms against
-// 3.63 (H200, 2026-12-03). A split without conversions (|x| + 4 with its low mantissa bits
-// cleared, the integer products taken to f32 through the bits of 1.5·2^23) measured slower
-// there, 3.83 ms: more instructions than the conversions saved.
+// The conversions cost, so the lobes split only where a plain product would be inaccurate
+// (lg_dot_guarded, lg_dirs). A split without conversions (|x| + 4 with its low mantissa
+// bits cleared, the integer products taken to f32 through the bits of 1.5·2^23) measured
+// slower on the H200: more instructions than the conversions saved.
 
 // x split as hi + lo, with hi · 2048 as an integer (`steps`). lo = x − hi is exact: where
 // hi is 0 it is x; else |x| ≥ 2^-12 makes x and hi multiples of 2^-35, and |lo| ≤ 2^-12
