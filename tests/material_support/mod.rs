@@ -136,6 +136,41 @@ pub fn geo(rng: &mut Rng, below: bool) -> Geo {
     }
 }
 
+/// (n, v, l) with l within `max_angle` rad of v's mirror direction about n and n·v ≥ 0.05,
+/// no mesh tangent: the specular peak, sampled densely.
+pub fn near_mirror_geo(rng: &mut Rng, max_angle: f64) -> Geo {
+    loop {
+        let n = rng.unit();
+        let v = norm(add(n, sc(rng.unit(), rng.range(0.0, 1.5))));
+        if dot(n, v) < 0.05 {
+            continue;
+        }
+        let mirror = add(sc(n, 2.0 * dot(n, v)), sc(v, -1.0));
+        let l = norm(add(mirror, sc(rng.unit(), max_angle * rng.f())));
+        return Geo {
+            n: f32v(n),
+            t: [0.0; 4],
+            v: f32v(v),
+            l: f32v(l),
+        };
+    }
+}
+
+/// A configuration as the GPU harnesses read it: n, t, v, l as four vec4s (w 0 but t's).
+pub fn geo_floats(g: &Geo) -> [f32; 16] {
+    let mut out = [0.0f32; 16];
+    for (k, x) in [g.n[0], g.n[1], g.n[2], 0.0]
+        .iter()
+        .chain(&g.t)
+        .chain(&[g.v[0], g.v[1], g.v[2], 0.0])
+        .chain(&[g.l[0], g.l[1], g.l[2], 0.0])
+        .enumerate()
+    {
+        out[k] = *x as f32;
+    }
+    out
+}
+
 /// Error of a GPU value against the reference: |g − r| / max(|r|, 1e-3), i.e. relative
 /// where the reference is ≥ 1e-3 and absolute (scaled by 1e-3) below.
 pub fn err(g: f32, r: f64) -> f64 {
