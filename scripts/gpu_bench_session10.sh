@@ -16,7 +16,6 @@
 # target/release/lightgraph.
 set -u
 source "$(dirname "$0")/gpu_env.sh"
-pack() { tar -czf "$final/results.tar.gz" -C "$final" r; }
 sweep() { # name [root]
     local s=$1 root=${2:-}
     timeout 60 $lg ${root:+--root $root} bench --sweep benches/sweeps/$s.ron --out "$out/$s" > "$out/$s.log" 2>&1

@@ -8,7 +8,6 @@
 # `xz -c .gpu/lightgraph > .gpu/lightgraph.xz && rm .gpu/lightgraph`.
 set -u
 source "$(dirname "$0")/gpu_env.sh"
-pack() { tar -czf "$final/results.tar.gz" -C "$final" r; }
 sweep() { # name limit_s
     timeout "$2" $lg bench --sweep benches/sweeps/$1.ron --out "$out/$1" > "$out/$1.log" 2>&1
     echo "== $1 (rc $?)"; tail -n 2 "$out/$1.log"

@@ -10,19 +10,11 @@
 # and copying the old shader to .gpu/light_culling_old.wgsl.
 set -u
 source "$(dirname "$0")/gpu_env.sh"
-pack() { tar -czf "$final/results.tar.gz" -C "$final" r; }
 roots=/tmp/lg_roots
 CULL=shaders/cull/light_culling.wgsl
 mkdir -p $roots/new/shaders/cull $roots/old/shaders/cull
 cp .gpu/light_culling_old.wgsl $roots/old/$CULL
-run() { # label sweep limit_s root [env]
-    local d="$1"
-    env ${5:-} timeout "$3" $lg --root $roots/$4 bench --sweep benches/sweeps/$2.ron --out "$out/$d" > "$out/$d.log" 2>&1
-    echo "== $d (rc $?) ${5:-}"; tail -n 1 "$out/$d.log"
-    sed -n '/^| scene | technique | params | lights | size/,/^$/p' "$out/$d/results.md" | cut -c1-200
-    grep -A12 '^Per-pass GPU time' "$out/$d/results.md" | grep '^|' | cut -c1-200
-    pack
-}
+run() { run_sweep "$1" "$2" "$3" "$roots/$4" "${5:-}"; }
 run a1_new session12_culling 80 new
 run a2_old session12_culling 80 old
 run a3_new session12_culling 80 new
@@ -33,9 +25,7 @@ run visibility_headline visibility_headline 200 new
 # Without a root: their graphs (../benches/graphs/...) are found from the graphs/ folder,
 # which a root moves.
 for s in session10_atrium session10_textured; do
-    timeout 80 $lg bench --sweep benches/sweeps/$s.ron --out "$out/$s" > "$out/$s.log" 2>&1
-    echo "== $s (rc $?)"; sed -n '/^| scene | technique | params | lights | size/,/^$/p' "$out/$s/results.md" | cut -c1-200
-    pack
+    run_sweep $s $s 80
 done
 nvidia-smi --query-gpu=clocks.sm --format=csv >> "$out/gpu.txt" 2>&1
 gpu_pack

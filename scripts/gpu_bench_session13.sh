@@ -17,27 +17,11 @@
 # .gpu/lightgraph`) and scripts/session13_roots.sh.
 set -u
 source "$(dirname "$0")/gpu_env.sh"
-pack() { tar -czf "$final/results.tar.gz" -C "$final" r; }
 roots=/tmp/lg_roots
 mkdir -p $roots/shipped
 cp -r .gpu/roots/* $roots/
 stages=" ${STAGES:-products spot loops headline} "
-run() { # label sweep limit_s root [env]
-    local d="$1"
-    env ${5:-} timeout "$3" $lg --root $roots/$4 bench --sweep benches/sweeps/$2.ron --out "$out/$d" > "$out/$d.log" 2>&1
-    echo "== $d (rc $?) ${5:-}"; tail -n 1 "$out/$d.log"
-    sed -n '/^| scene | technique | params | lights | size/,/^$/p' "$out/$d/results.md" | cut -c1-220
-    grep -A12 '^Per-pass GPU time' "$out/$d/results.md" | grep '^|' | cut -c1-200
-    pack
-}
-# Without a root: graphs named ../benches/graphs/... are found from the graphs/ folder,
-# which a root moves.
-run_plain() { # label sweep limit_s
-    timeout "$3" $lg bench --sweep benches/sweeps/$2.ron --out "$out/$1" > "$out/$1.log" 2>&1
-    echo "== $1 (rc $?)"; sed -n '/^| scene | technique | params | lights | size/,/^$/p' "$out/$1/results.md" | cut -c1-220
-    grep -A12 '^Per-pass GPU time' "$out/$1/results.md" | grep '^|' | cut -c1-200
-    pack
-}
+run() { run_sweep "$1" "$2" "$3" "$roots/$4" "${5:-}"; }
 if [[ $stages == *" products "* ]]; then
     for r in 1 2; do
         for v in shipped split guarded_frexp; do
@@ -54,12 +38,13 @@ if [[ $stages == *" spot "* ]]; then
     done
 fi
 if [[ $stages == *" loops "* ]]; then
-    run_plain loops session13_loops 60
+    run_sweep loops session13_loops 60
 fi
 if [[ $stages == *" headline "* ]]; then
     run visibility_headline visibility_headline 200 shipped
-    run_plain session10_atrium session10_atrium 80
-    run_plain session10_textured session10_textured 80
+    # Without a root (see run_sweep).
+    run_sweep session10_atrium session10_atrium 80
+    run_sweep session10_textured session10_textured 80
 fi
 nvidia-smi --query-gpu=clocks.sm --format=csv >> "$out/gpu.txt" 2>&1
 gpu_pack

@@ -18,7 +18,23 @@ if [ ! -x "$lg" ] && [ -f .gpu/lightgraph.xz ]; then
 fi
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv > "$out/gpu.txt" 2>&1
 
-# The device tool brings back few files: everything goes back as one archive.
+# The device tool brings back few files: everything goes back as one archive. `pack`
+# after every stage, so a cut-off run still brings back what it finished; `gpu_pack` at
+# the end.
+pack() { tar -czf "$final/results.tar.gz" -C "$final" r; }
 gpu_pack() {
-    tar -czf "$final/results.tar.gz" -C "$final" r && rm -rf "$out"
+    pack && rm -rf "$out"
+}
+
+# run_sweep LABEL SWEEP LIMIT_S [ROOT] [ENV]: benches/sweeps/SWEEP.ron into $out/LABEL
+# under the shader root folder ROOT (none where empty: graphs named ../benches/graphs/...
+# are found from the graphs/ folder, which a root moves), with ENV (NAME=value) set;
+# prints its tables and packs.
+run_sweep() {
+    local label=$1 sweep=$2 limit=$3 root=${4:-} vars=${5:-}
+    env $vars timeout "$limit" $lg ${root:+--root $root} bench --sweep "benches/sweeps/$sweep.ron" --out "$out/$label" > "$out/$label.log" 2>&1
+    echo "== $label (rc $?) $vars"; tail -n 1 "$out/$label.log"
+    sed -n '/^| scene | technique | params | lights | size/,/^$/p' "$out/$label/results.md" | cut -c1-220
+    grep -A12 '^Per-pass GPU time' "$out/$label/results.md" | grep '^|' | cut -c1-200
+    pack
 }
