@@ -759,8 +759,8 @@ fn mutations_are_caught() {
     {
         let m = Mutated::new(
             &mut r,
-            "carry = add_sat(carry, workgroupUniformLoad(&scan_total));",
-            "carry = workgroupUniformLoad(&scan_total);",
+            "carry = add_sat(carry, placed.y);",
+            "carry = placed.y;",
         );
         caught("block carry dropped", many_lists_failures(m.r, 0));
     }
@@ -768,8 +768,8 @@ fn mutations_are_caught() {
     {
         let m = Mutated::new(
             &mut r,
-            "atomicStore(&list_block_sums[2u * b], add_sat(carry, before));",
-            "atomicStore(&list_block_sums[2u * b], before);",
+            "atomicStore(&list_block_sums[2u * b], add_sat(carry, placed.x));",
+            "atomicStore(&list_block_sums[2u * b], placed.x);",
         );
         caught(
             "block offsets without the carry",

@@ -114,13 +114,11 @@ var<workgroup> depth_mask: atomic<u32>;
 // it reads its own, so a batch needs two barriers, not three.
 var<workgroup> hits: array<array<atomic<u32>, MASK_WORDS>, 2>;
 var<workgroup> coarse_count: u32;
-// The coarse stage's hit bits for a chunk of COARSE_CHUNK lights (8 KB), and its prefix
-// sum over invocations.
+// The coarse stage's hit bits for a chunk of COARSE_CHUNK lights (8 KB).
 const COARSE_CHUNK_WORDS: u32 = 2048u;
 const COARSE_CHUNK: u32 = COARSE_CHUNK_WORDS * 32u;
 const COARSE_WORDS_PER_THREAD: u32 = COARSE_CHUNK_WORDS / THREADS;
 var<workgroup> coarse_hits: array<atomic<u32>, COARSE_CHUNK_WORDS>;
-var<workgroup> coarse_sums: array<u32, THREADS>;
 #if COMPACT
 // The fill's list entry: (offset, kept count), and the light after its slot's last.
 var<workgroup> fill_entry: vec2<u32>;
@@ -675,7 +673,7 @@ fn coarse(
         for (var k = 0u; k < COARSE_WORDS_PER_THREAD; k++) {
             mine += countOneBits(atomicLoad(&coarse_hits[first_word + k]));
         }
-        let placed = coarse_exclusive_scan(local, mine);
+        let placed = exclusive_scan(local, mine, THREADS);
         var slot = total + placed.x;
         for (var k = 0u; k < COARSE_WORDS_PER_THREAD; k++) {
             // Only this invocation reads or clears its words until the next barrier.
@@ -700,50 +698,24 @@ fn coarse(
     }
 }
 
-// Exclusive prefix sum of `v` over the coarse workgroup's invocations (Hillis–Steele):
-// (the sum of the invocations' before this one, the sum of all).
-fn coarse_exclusive_scan(local: u32, v: u32) -> vec2<u32> {
-    coarse_sums[local] = v;
-    workgroupBarrier();
-    for (var d = 1u; d < THREADS; d *= 2u) {
-        var add = 0u;
-        if (local >= d) {
-            add = coarse_sums[local - d];
-        }
-        workgroupBarrier();
-        coarse_sums[local] += add;
-        workgroupBarrier();
-    }
-    return vec2<u32>(coarse_sums[local] - v, coarse_sums[THREADS - 1u]);
-}
-
-#if COMPACT
-// The prefix sum between the two runs of `main`: blocked, not decoupled look-back (WGSL
-// promises no forward progress between workgroups, so a workgroup spinning on another's
-// flag may never see it), and not one workgroup over every list (at 1920×1080 with 16
-// clusters that is 130,560 lists in one workgroup's loop). Sums saturate at u32::MAX,
-// which is associative, so a saturated total is still exact below the bound.
-const SCAN_THREADS: u32 = 256u;
-const SCAN_PER_THREAD: u32 = SCAN_BLOCK / SCAN_THREADS;
-
-var<workgroup> scan_sums: array<u32, SCAN_THREADS>;
-var<workgroup> scan_total: u32;
+// Exclusive prefix sum of `v` over the workgroup's `n` invocations (n ≤ SCAN_MAX, a
+// power of two: THREADS for the coarse stage, SCAN_THREADS for the list scans;
+// Hillis–Steele): (the sum of the invocations' before this one, the sum of all). Sums
+// saturate at u32::MAX, which is associative, so a saturated total is still exact below
+// the bound (the coarse stage's sums, at most the light count, never saturate). Ends with
+// a barrier: the next call may store into scan_sums at once.
+const SCAN_MAX: u32 = 256u;
+var<workgroup> scan_sums: array<u32, SCAN_MAX>;
 
 fn add_sat(a: u32, b: u32) -> u32 {
     let s = a + b;
     return select(s, 0xffffffffu, s < a);
 }
 
-fn list_count() -> u32 {
-    return list_params.tiles_x * list_params.tiles_y * list_params.lists_per_tile;
-}
-
-// Exclusive prefix sum of `v` over the workgroup (Hillis–Steele), leaving the group's
-// total in `scan_total`.
-fn group_exclusive_scan(local: u32, v: u32) -> u32 {
+fn exclusive_scan(local: u32, v: u32, n: u32) -> vec2<u32> {
     scan_sums[local] = v;
     workgroupBarrier();
-    for (var d = 1u; d < SCAN_THREADS; d *= 2u) {
+    for (var d = 1u; d < n; d *= 2u) {
         var add = 0u;
         if (local >= d) {
             add = scan_sums[local - d];
@@ -756,11 +728,21 @@ fn group_exclusive_scan(local: u32, v: u32) -> u32 {
     if (local > 0u) {
         before = scan_sums[local - 1u];
     }
-    if (local == SCAN_THREADS - 1u) {
-        scan_total = scan_sums[local];
-    }
+    let total = scan_sums[n - 1u];
     workgroupBarrier();
-    return before;
+    return vec2<u32>(before, total);
+}
+
+#if COMPACT
+// The prefix sum between the two runs of `main`: blocked, not decoupled look-back (WGSL
+// promises no forward progress between workgroups, so a workgroup spinning on another's
+// flag may never see it), and not one workgroup over every list (at 1920×1080 with 16
+// clusters that is 130,560 lists in one workgroup's loop); `exclusive_scan` above.
+const SCAN_THREADS: u32 = 256u;
+const SCAN_PER_THREAD: u32 = SCAN_BLOCK / SCAN_THREADS;
+
+fn list_count() -> u32 {
+    return list_params.tiles_x * list_params.tiles_y * list_params.lists_per_tile;
 }
 
 // One workgroup: block sums → each block's first offset in the pool; header word 0 → the
@@ -778,11 +760,11 @@ fn scan_blocks(@builtin(local_invocation_index) local: u32) {
                 v = 0xffffffffu;
             }
         }
-        let before = group_exclusive_scan(local, v);
+        let placed = exclusive_scan(local, v, SCAN_THREADS);
         if (b < blocks) {
-            atomicStore(&list_block_sums[2u * b], add_sat(carry, before));
+            atomicStore(&list_block_sums[2u * b], add_sat(carry, placed.x));
         }
-        carry = add_sat(carry, workgroupUniformLoad(&scan_total));
+        carry = add_sat(carry, placed.y);
     }
     if (local == 0u) {
         atomicStore(&light_lists[0], carry);
@@ -815,7 +797,7 @@ fn scan_lists(
             sum = add_sat(sum, c);
         }
     }
-    let before = group_exclusive_scan(local, sum);
+    let before = exclusive_scan(local, sum, SCAN_THREADS).x;
     // At most half the index array (`ListLayout::scratch_per_list`): no overflow.
     let pool_start = scratch * lists;
     var offset = add_sat(atomicLoad(&list_block_sums[2u * group.x]), before);
