@@ -1,18 +1,43 @@
 #!/usr/bin/env bash
-# Runs the benchmark sweeps and the hot-reload latency benchmark on the GPU machine (see
-# ../shared/gpu/README.md); results go to $OUT (or results/). Usage from the project root
-# after ../shared/gpu/prepare.sh target/release/lightgraph:
-#   scripts/gpu_bench.sh
+# The benchmarks the docs quote, on the GPU machine (see docs/benchmarks.md). Stages
+# (STAGES, default all, in this order):
+#   frames    every frame kind on harada, AMD's atrium and the textured Cornell box glTF
+#             (frame_kinds_*.ron), and Forward+'s tile tests (forward_plus_culling.ron);
+#   features  ray-cast shadows, the shadow atlas, transparency, MSAA, VPL indirect light
+#             and the light linked list (their sweeps);
+#   extras    the VPL bounce against its path-traced reference (vpl-error) and hot-reload
+#             latency (reload-bench).
+# Each sweep's CSV, Markdown and plots go to $OUT/r/<sweep>/ (or results/r/), packed into
+# results.tar.gz after every sweep, so a cut-off run still brings back what it finished.
+# Usage from the project root, after `../shared/gpu/prepare.sh target/release/lightgraph`
+# and `xz -T2 -c .gpu/lightgraph > .gpu/lightgraph.xz && rm .gpu/lightgraph`:
+#   STAGES=frames scripts/gpu_bench.sh
+# then copy the CSVs into bench/results/ and regenerate the docs' tables:
+#   LIGHTGRAPH_BLESS=1 cargo test --release --test docs_tables
 set -u
 source "$(dirname "$0")/gpu_env.sh"
-$lg render --out "$out/atrium.png" --heatmap "$out/atrium_heat.png" > "$out/render_atrium.txt" 2>&1
-for v in forward_plus forward_plus_depth_mask forward_plus_half_z forward_plus_clustered; do
-    $lg render --scene scenes/depth_discontinuity.ron --graph graphs/$v.ron > "$out/dd_$v.txt" 2>&1
-done
-for s in coarse seeds stress; do
-    $lg bench --sweep benches/sweeps/$s.ron --out "$out/$s" > "$out/$s.log" 2>&1
-done
-$lg reload-bench --out "$out/reload_1080p" --width 1920 --height 1080 --lights 3072 --repeats 20 > "$out/reload_1080p.log" 2>&1
-$lg reload-bench --out "$out/reload_160x90" --width 160 --height 90 --lights 1024 --repeats 10 > "$out/reload_160x90.log" 2>&1
-cat "$out"/gpu.txt "$out"/coarse/results.md "$out"/reload_1080p/reload_latency.md
+stages=" ${STAGES:-frames features extras} "
+if [[ $stages == *" frames "* ]]; then
+    run_sweep frame_kinds_harada frame_kinds_harada 300
+    run_sweep frame_kinds_atrium frame_kinds_atrium 120
+    run_sweep frame_kinds_textured frame_kinds_textured 120
+    run_sweep forward_plus_culling forward_plus_culling 150
+fi
+if [[ $stages == *" features "* ]]; then
+    for s in raycast_shadows shadow_atlas transparency msaa indirect_vpl light_linked_list; do
+        run_sweep $s $s 150
+    done
+fi
+if [[ $stages == *" extras "* ]]; then
+    timeout 200 $lg vpl-error --scene scenes/cornell_indirect.ron scenes/atrium_indirect.ron \
+        --out "$out/vpl_error" > "$out/vpl_error.log" 2>&1
+    echo "== vpl_error (rc $?)"; cat "$out/vpl_error/results.md" 2>/dev/null | head -20
+    timeout 150 $lg reload-bench --out "$out/reload_latency" --width 1920 --height 1080 \
+        --lights 3072 --repeats 20 > "$out/reload_latency.log" 2>&1
+    echo "== reload_latency (rc $?)"; cat "$out/reload_latency/reload_latency.md" 2>/dev/null | head -20
+    pack
+fi
+nvidia-smi --query-gpu=clocks.sm --format=csv >> "$out/gpu.txt" 2>&1
+# The commit the binary was built from (written by the caller: git has no copy here).
+cp .gpu/commit.txt "$out/" 2>/dev/null || true
 gpu_pack

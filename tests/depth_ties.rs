@@ -3,7 +3,7 @@
 //! so of two fragments at the same depth the one drawn last is the one left in the colour
 //! target. A G-buffer that writes its own depth must then also keep the last one
 //! (`LessEqual` with depth writes); with `Less` it kept the first, and the deferred graphs
-//! without a prepass showed the other surface's colour (issue 19: the atrium's
+//! without a prepass showed the other surface's colour (the atrium's
 //! `deferred_brute_force` differed from forward brute force by 4.3e-4 of the peak there).
 
 mod common;

@@ -1,4 +1,4 @@
-// Tiled light culling (Forward+, seed 000): one workgroup per tile and list. The
+// Tiled light culling (Harada, McKee, Yang, "Forward+"): one workgroup per tile and list. The
 // workgroup finds the tile's depth range as the min and max of the float bits (depths
 // are non-negative, so their bits order like integers), tests every light against the
 // tile's frustum, builds the list in workgroup memory in ascending light order, then
@@ -11,7 +11,7 @@
 // MSAA: the depth is multisampled and every one of its SAMPLES samples bounds the tile.
 // FLOAT_DEPTH: the depth is single-sample R32Float (a compute resolve's; the same values
 // a depth texture holds), read as texture_2d<f32>. Not with MSAA or TRANSPARENT.
-// TRANSPARENT: lists for transparent surfaces (seed 004). A sample where a transparent
+// TRANSPARENT: lists for transparent surfaces (AMD's TiledLighting11 sample). A sample where a transparent
 // surface lies in front of the opaque one contributes the range from the nearest
 // transparent depth to the opaque depth (the far plane over the background): every
 // visible transparent fragment lies in it. Samples without one contribute nothing.

@@ -1,4 +1,4 @@
-// Light linked list build (seed 001) in compute: one invocation per list pixel (a
+// Light linked list build (Bezrati, "Real-Time Lighting via Light Linked List") in compute: one invocation per list pixel (a
 // SCALE×SCALE block of the output). The seed rasterises light shells (front faces give
 // the near depth, back faces the far depth and a link); here the list pixel's centre
 // ray is intersected with each light's bounding sphere directly, which gives the same

@@ -1,4 +1,4 @@
-// VplSpawn (seed 000, Leo demo): virtual point lights from the reflective shadow maps,
+// VplSpawn (Harada, McKee, Yang, "Forward+"; AMD's Leo demo): virtual point lights from the reflective shadow maps,
 // appended after the scene's lights. Entry points, one dispatch each, in order:
 //   copy:   the scene's lights into the light arrays the later passes read;
 //   gather: one candidate per n×n block of each view: the block's summed flux at its

@@ -283,7 +283,7 @@ pub enum PassKind {
     DepthPrepass,
     /// Tiled light culling against the prepass depth.
     LightCulling(LightCulling),
-    /// Per-pixel light linked lists (seed 001) at full or reduced resolution.
+    /// Per-pixel light linked lists (Bezrati, "Real-Time Lighting via Light Linked List") at full or reduced resolution.
     LightLinkedList(LightLinkedList),
     /// Forward shading of the scene's materials through the light loop.
     ForwardShading(ForwardShading),

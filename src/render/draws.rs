@@ -234,7 +234,7 @@ impl Renderer {
                 ),
             };
             // Shadow views draw both faces (any surface occludes, as for a ray) and their
-            // triangles in spatial chunks. Transparent surfaces show both faces (seed 004:
+            // triangles in spatial chunks. Transparent surfaces show both faces (AMD's TiledLighting11 sample:
             // shaded two-sided; the normal flips on back faces in `shading_point`).
             let shadow_view = matches!(mode, DrawMode::AtlasDepth { .. });
             let two_sided = m.double_sided

@@ -84,8 +84,8 @@ pub enum ShadowError {
 /// How hard the PLOC builder works (after obvhs's presets of the same names).
 /// How hard the builder works for a cheaper tree. On an NVIDIA H200 the chairs scene's
 /// 11.2 M shadow rays at 1280×720 cast in 2.99 ms (`Fastest`), 2.75 (`VeryFast`), 1.90
-/// (`Fast`, the default) and 1.76 ms (`Medium`); one-core builds on the 2-core dev VM
-/// take 58, 72, 104 and 117 ms (bench/results/2026-12-01-h200-shadows/, benches/bvh_build.rs).
+/// (`Fast`, the default) and 1.76 ms (`Medium`); one-core builds on a 2-core x86-64
+/// machine take 58, 72, 104 and 117 ms (`benches/sweeps/bvh_quality.ron`, `benches/bvh_build.rs`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum BuildQuality {
     /// PLOC search distance 1, no reinsertion: the quickest rebuild.

@@ -5,7 +5,7 @@
 //! (`FLOAT_DEPTH`); not with transparent lists. With a `transparent_depth` (a
 //! TransparentDepth pass's) the lists are for transparent surfaces: a tile spans, over
 //! its pixels that hold one, from the nearest transparent depth to the opaque depth
-//! behind it (seed 004).
+//! behind it (AMD's TiledLighting11 sample).
 //!
 //! Two list layouts (`lists:`), read alike through `shaders/common/light_lists.wgsl`:
 //! `Fixed` gives every list room for `capacity` lights (a longer list is cut, counted

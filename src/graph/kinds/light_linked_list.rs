@@ -1,5 +1,5 @@
 //! `LightLinkedList`: per-pixel linked lists of the lights whose volume a pixel's view
-//! ray crosses in front of the scene (seed 001), at 1/1, 1/2, 1/4 or 1/8 of the output
+//! ray crosses in front of the scene (Bezrati, "Real-Time Lighting via Light Linked List"), at 1/1, 1/2, 1/4 or 1/8 of the output
 //! per side. Built in compute from a LightCulling pass's tile lists (or from every
 //! light); runs `shaders/cull/light_linked_list.wgsl`. The depth is a depth texture or
 //! R32Float depths (ComputeRaster's compute resolve; `FLOAT_DEPTH`), single-sample.

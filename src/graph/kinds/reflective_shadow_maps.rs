@@ -1,5 +1,5 @@
 //! `ReflectiveShadowMaps`: every indirect light's reflective shadow map in one atlas
-//! (seed 000, Leo demo; seed 004: 32×32 a light): depth, normal, reflected flux and
+//! (Harada, McKee, Yang, "Forward+"; AMD's TiledLighting11 sample: 32×32 a light): depth, normal, reflected flux and
 //! world position, a tile per spot light and six cube faces per point light, all views
 //! in one render pass. Writes the four textures and the view table the `VplSpawn` pass
 //! reads (`src/indirect/rsm_views.rs` allocates the tiles).

@@ -1,6 +1,6 @@
 //! `TransparentDepth`: the nearest depth of the scene's blended meshes (glTF
 //! `alphaMode: BLEND`), both faces, into its own depth texture: the near end of the
-//! transparent culling range (seed 004). Runs `shaders/forward/forward.wgsl` with
+//! transparent culling range (AMD's TiledLighting11 sample). Runs `shaders/forward/forward.wgsl` with
 //! `DEPTH_ONLY`.
 
 use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};

@@ -96,8 +96,8 @@ impl WatchConfig {
     /// The default [`settle`](Self::settle), 5 ms: long enough to join the steps of one
     /// save that each look complete (an atomic save's rename, then the chmod that keeps
     /// the file's mode; "save all" writing one file after another), a quarter of the
-    /// debounce. `event_traces` in `tests/reload_watcher.rs` measured those pauses on the
-    /// 2-core dev VM, 500 saves each: with load ~1-4 a median of 0.27 ms (rename, chmod;
+    /// debounce. `event_traces` in `tests/reload_watcher.rs` measured those pauses on a
+    /// 2-core Linux machine, 500 saves each: with load ~1-4 a median of 0.27 ms (rename, chmod;
     /// at most 0.7 ms) and 0.13 ms (two files; 1 over 5 ms); loaded ~8 deep, 0.4 ms and
     /// 2.4 ms (the writer loses its core when its close wakes the watcher), 6% and 13%
     /// over 5 ms, none over 20 ms. A split burst costs one more batch, whose files are

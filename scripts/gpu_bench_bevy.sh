@@ -5,7 +5,7 @@
 # the machine moved). Usage from the project root after
 #   ../shared/gpu/prepare.sh target/release/lightgraph; xz -9 -c peer_bevy > .gpu/peer_bevy.xz
 #   xz -c .gpu/lightgraph > .gpu/lightgraph.xz && rm .gpu/lightgraph   (both fit 64 MiB only so)
-#   scripts/gpu_bench_peer.sh
+#   scripts/gpu_bench_bevy.sh
 set -u
 source "$(dirname "$0")/gpu_env.sh"
 bevy=/tmp/peer_bevy
