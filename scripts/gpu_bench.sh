@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The benchmarks the docs quote, on the GPU machine (see docs/benchmarks.md). Stages
 # (STAGES, default all, in this order):
-#   frames    every frame kind on harada, AMD's atrium and the textured Cornell box glTF
+#   frames    every frame kind on harada, AMD's atrium and the Cornell box glTF
 #             (frame_kinds_*.ron), and Forward+'s tile tests (forward_plus_culling.ron);
 #   features  ray-cast shadows, the shadow atlas, transparency, MSAA, VPL indirect light
 #             and the light linked list (their sweeps);
@@ -20,7 +20,7 @@ stages=" ${STAGES:-frames features extras} "
 if [[ $stages == *" frames "* ]]; then
     run_sweep frame_kinds_harada frame_kinds_harada 300
     run_sweep frame_kinds_atrium frame_kinds_atrium 120
-    run_sweep frame_kinds_textured frame_kinds_textured 120
+    run_sweep frame_kinds_cornell frame_kinds_cornell 120
     run_sweep forward_plus_culling forward_plus_culling 150
 fi
 if [[ $stages == *" features "* ]]; then
@@ -29,8 +29,8 @@ if [[ $stages == *" features "* ]]; then
     done
 fi
 if [[ $stages == *" extras "* ]]; then
-    timeout 200 $lg vpl-error --scene scenes/cornell_indirect.ron scenes/atrium_indirect.ron \
-        --out "$out/vpl_error" > "$out/vpl_error.log" 2>&1
+    timeout 330 $lg vpl-error --scene scenes/cornell_indirect.ron scenes/atrium_indirect.ron \
+        --width 1920 --height 1080 --samples 256 --frames 10 --out "$out/vpl_error" > "$out/vpl_error.log" 2>&1
     echo "== vpl_error (rc $?)"; cat "$out/vpl_error/results.md" 2>/dev/null | head -20
     timeout 150 $lg reload-bench --out "$out/reload_latency" --width 1920 --height 1080 \
         --lights 3072 --repeats 20 > "$out/reload_latency.log" 2>&1

@@ -11,7 +11,8 @@
 //!
 //! `table:` names a folder of `bench/results/` (its `results.csv`, else `<folder>.csv`),
 //! `columns:` the keys below in order, `where:` optional filters (`key=value`, `|` between
-//! alternatives). `cargo test --test docs_tables` checks every table; with
+//! alternatives), `group:` optional, a key whose every value becomes one row of medians.
+//! `cargo test --test docs_tables` checks every table; with
 //! `LIGHTGRAPH_BLESS=1` it rewrites them from the CSVs instead.
 
 use std::collections::BTreeSet;
@@ -49,6 +50,8 @@ struct Spec {
     table: String,
     columns: Vec<String>,
     filters: Vec<(String, Vec<String>)>,
+    /// One row per value of this key, each numeric cell the median over its rows.
+    group: Option<String>,
 }
 
 fn parse_spec(line: &str) -> Result<Spec, String> {
@@ -61,6 +64,7 @@ fn parse_spec(line: &str) -> Result<Spec, String> {
         table: String::new(),
         columns: Vec::new(),
         filters: Vec::new(),
+        group: None,
     };
     for part in body.split(" | ") {
         let (key, value) = part
@@ -69,6 +73,7 @@ fn parse_spec(line: &str) -> Result<Spec, String> {
         let value = value.trim();
         match key.trim() {
             "table" => spec.table = value.to_string(),
+            "group" => spec.group = Some(value.to_string()),
             "columns" => spec.columns = value.split(',').map(|c| c.trim().to_string()).collect(),
             "where" => {
                 for f in value.split(',') {
@@ -145,7 +150,8 @@ fn error(s: &str) -> String {
     }
 }
 
-/// Any other number: integers as they are, others to four significant digits.
+/// Any other number: integers as they are, others to three decimals without trailing
+/// zeros (tiny ones in scientific notation).
 fn plain(s: &str) -> String {
     if s.is_empty() {
         return "–".into();
@@ -156,10 +162,10 @@ fn plain(s: &str) -> String {
     match number(s) {
         Some(v) if v.is_infinite() => "∞".into(),
         Some(v) if v == 0.0 => "0".into(),
-        Some(v) if v.abs() >= 1e6 || v.abs() < 1e-3 => format!("{v:.3e}"),
+        Some(v) if v.abs() < 1e-3 => format!("{v:.1e}"),
         Some(v) => {
-            let digits = (3 - v.abs().log10().floor() as i32).clamp(0, 6) as usize;
-            format!("{v:.digits$}")
+            let text = format!("{v:.3}");
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
         }
         None => s.to_string(),
     }
@@ -173,7 +179,8 @@ fn cell(csv: &Csv, row: &[String], key: &str) -> Result<(String, bool), String> 
     };
     Ok(match key {
         "scene" => (get("scene")?.to_string(), false),
-        "graph" => (get("technique")?.to_string(), false),
+        // Benchmark-only variants are named by path (`../benches/graphs/x`): the stem.
+        "graph" => (get("technique")?.rsplit('/').next().unwrap_or("").to_string(), false),
         "reference" => (get("reference")?.to_string(), false),
         "lights" => (plain(get("light_count")?), true),
         "size" => (format!("{}×{}", get("width")?, get("height")?), true),
@@ -237,11 +244,31 @@ fn label(key: &str) -> String {
     }
 }
 
+/// The median of each numeric column over `rows` (the first row's text elsewhere).
+fn median_row(rows: &[&Vec<String>]) -> Vec<String> {
+    (0..rows[0].len())
+        .map(|i| {
+            let mut values: Vec<f64> = rows.iter().filter_map(|r| number(&r[i])).collect();
+            if values.len() < rows.len() {
+                return rows[0][i].clone();
+            }
+            values.sort_by(f64::total_cmp);
+            let n = values.len();
+            let median = if n % 2 == 1 {
+                values[n / 2]
+            } else {
+                (values[n / 2 - 1] + values[n / 2]) / 2.0
+            };
+            median.to_string()
+        })
+        .collect()
+}
+
 /// The table a marker asks for, as Markdown lines.
 fn render(spec: &Spec) -> Result<Vec<String>, String> {
     let path = csv_path(&spec.table);
     let csv = Csv::load(&path)?;
-    let mut rows = Vec::new();
+    let mut kept = Vec::new();
     'rows: for row in &csv.rows {
         for (key, alts) in &spec.filters {
             let (value, _) = cell(&csv, row, key)?;
@@ -249,6 +276,26 @@ fn render(spec: &Spec) -> Result<Vec<String>, String> {
                 continue 'rows;
             }
         }
+        kept.push(row);
+    }
+    let merged: Vec<Vec<String>>;
+    let table_rows: Vec<&Vec<String>> = match &spec.group {
+        None => kept,
+        Some(key) => {
+            let mut groups: Vec<(String, Vec<&Vec<String>>)> = Vec::new();
+            for row in kept {
+                let (value, _) = cell(&csv, row, key)?;
+                match groups.iter_mut().find(|(v, _)| *v == value) {
+                    Some((_, members)) => members.push(row),
+                    None => groups.push((value, vec![row])),
+                }
+            }
+            merged = groups.iter().map(|(_, members)| median_row(members)).collect();
+            merged.iter().collect()
+        }
+    };
+    let mut rows = Vec::new();
+    for row in table_rows {
         let mut cells = Vec::new();
         for key in &spec.columns {
             cells.push(cell(&csv, row, key)?);
@@ -375,6 +422,7 @@ fn a_table_is_generated_from_its_csv() {
         .map(|k| cell(&csv, row, k).unwrap().0)
         .collect();
     assert_eq!(cells, ["forward_plus", "1024", "3.110", "3.107–3.111", "2.1e-2", "0.139"]);
+    assert_eq!([plain("0.0980"), plain("151.72"), plain("2.0"), plain("0.00004")], ["0.098", "151.72", "2", "4.0e-5"]);
     assert!(cell(&csv, row, "flip").is_err(), "a missing column is an error");
     let spec = parse_spec("<!-- table: x | columns: graph, ms | where: graph=a|b -->").unwrap();
     assert_eq!(spec.filters, vec![("graph".to_string(), vec!["a".to_string(), "b".to_string()])]);
