@@ -2,7 +2,7 @@
 //! one (`tiled_deferred.ron`, itself within 2e-6 of forward brute force: culling_exact.rs)
 //! on every shipped scene. Not exact: it rebuilds each position on the pixel's view ray
 //! while the rasterizer interpolates it over the snapped triangle, so its error is
-//! measured here and held to the bound the README states. Against the exact G-buffer, not
+//! measured here and held to the bound docs/deferred.md states. Against the exact G-buffer, not
 //! brute force: the same culled lighting, so the test stays fast, and what differs is the
 //! packing alone (deferred shading's own limits, such as no tangents for anisotropic
 //! materials, are in both).

@@ -38,7 +38,7 @@ impl VisibilityShading {
     /// The workgroup's side in pixels: as asked, else 16 (8 for `Staged`, which needs
     /// it). 16 is never slower than 8 for `RangeFirst` on the H200 and much faster on
     /// textured materials (the Cornell box at 3,072 lights: 0.163 against 0.208 ms of
-    /// shading), its tile's texels and lights read by one SM (README "Visibility buffer").
+    /// shading), its tile's texels and lights read by one SM (docs/visibility_buffer.md).
     pub fn workgroup_side(&self) -> u32 {
         match (self.workgroup, self.light_loop) {
             (Some(side), _) => side,
@@ -55,7 +55,7 @@ pub enum LightLoop {
     /// Forward shading's loop (`common/light_loop.wgsl`), per pixel.
     Forward,
     /// Per pixel, a light's range tested before its properties are read. The default: the
-    /// fastest of the three on an NVIDIA H200 (README "Visibility buffer").
+    /// fastest of the three on an NVIDIA H200 (docs/visibility_buffer.md).
     #[default]
     RangeFirst,
     /// A workgroup whose pixels all read one tile list (Frustum and DepthMask lists)
