@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# How the pass-kinds refactor was checked: run with the binary built before and after into two
-# folders, then `cmp` every EXR pair (84 renders, 12 graphs x 7 scenes, were byte-identical).
-# Renders every shipped graph x scene at 333x197 with binary $1 into dir $2.
+# Renders every shipped graph x scene at 333x197 with binary $1 into dir $2, for checking
+# that a change leaves every image as it was: run it with the binaries built before and
+# after into two folders, then `cmp` every EXR pair.
 # Runs from the source tree $3 (graphs/scenes/shaders read from there).
 bin=$1; out=$2; src=$3
 mkdir -p "$out"
