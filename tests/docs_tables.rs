@@ -100,7 +100,8 @@ struct Csv {
 
 impl Csv {
     fn load(path: &Path) -> Result<Csv, String> {
-        let mut reader = csv::Reader::from_path(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let mut reader =
+            csv::Reader::from_path(path).map_err(|e| format!("{}: {e}", path.display()))?;
         let header = reader
             .headers()
             .map_err(|e| format!("{}: {e}", path.display()))?
@@ -144,7 +145,7 @@ fn ms(s: &str) -> String {
 fn error(s: &str) -> String {
     match number(s) {
         None => "–".into(),
-        Some(v) if v == 0.0 => "0".into(),
+        Some(0.0) => "0".into(),
         Some(v) if v.is_infinite() => "∞".into(),
         Some(v) => format!("{v:.1e}"),
     }
@@ -161,7 +162,7 @@ fn plain(s: &str) -> String {
     }
     match number(s) {
         Some(v) if v.is_infinite() => "∞".into(),
-        Some(v) if v == 0.0 => "0".into(),
+        Some(0.0) => "0".into(),
         Some(v) if v.abs() < 1e-3 => format!("{v:.1e}"),
         Some(v) => {
             let text = format!("{v:.3}");
@@ -180,7 +181,14 @@ fn cell(csv: &Csv, row: &[String], key: &str) -> Result<(String, bool), String> 
     Ok(match key {
         "scene" => (get("scene")?.to_string(), false),
         // Benchmark-only variants are named by path (`../benches/graphs/x`): the stem.
-        "graph" => (get("technique")?.rsplit('/').next().unwrap_or("").to_string(), false),
+        "graph" => (
+            get("technique")?
+                .rsplit('/')
+                .next()
+                .unwrap_or("")
+                .to_string(),
+            false,
+        ),
         "reference" => (get("reference")?.to_string(), false),
         "lights" => (plain(get("light_count")?), true),
         "size" => (format!("{}×{}", get("width")?, get("height")?), true),
@@ -290,7 +298,10 @@ fn render(spec: &Spec) -> Result<Vec<String>, String> {
                     None => groups.push((value, vec![row])),
                 }
             }
-            merged = groups.iter().map(|(_, members)| median_row(members)).collect();
+            merged = groups
+                .iter()
+                .map(|(_, members)| median_row(members))
+                .collect();
             merged.iter().collect()
         }
     };
@@ -306,7 +317,14 @@ fn render(spec: &Spec) -> Result<Vec<String>, String> {
         return Err(format!("no row of {} passes the filters", path.display()));
     }
     let mut out = vec![
-        format!("| {} |", spec.columns.iter().map(|k| label(k)).collect::<Vec<_>>().join(" | ")),
+        format!(
+            "| {} |",
+            spec.columns
+                .iter()
+                .map(|k| label(k))
+                .collect::<Vec<_>>()
+                .join(" | ")
+        ),
         format!(
             "|{}|",
             rows[0]
@@ -317,7 +335,10 @@ fn render(spec: &Spec) -> Result<Vec<String>, String> {
         ),
     ];
     for cells in rows {
-        let text: Vec<String> = cells.into_iter().map(|(c, _)| c.replace('|', "\\|")).collect();
+        let text: Vec<String> = cells
+            .into_iter()
+            .map(|(c, _)| c.replace('|', "\\|"))
+            .collect();
         out.push(format!("| {} |", text.join(" | ")));
     }
     Ok(out)
@@ -325,7 +346,11 @@ fn render(spec: &Spec) -> Result<Vec<String>, String> {
 
 /// Every table of one file regenerated: the new text and the problems found.
 fn regenerate(path: &Path, text: &str, tables: &mut BTreeSet<String>) -> (String, Vec<String>) {
-    let name = path.strip_prefix(root()).unwrap_or(path).display().to_string();
+    let name = path
+        .strip_prefix(root())
+        .unwrap_or(path)
+        .display()
+        .to_string();
     let lines: Vec<&str> = text.lines().collect();
     let mut out: Vec<String> = Vec::new();
     let mut problems = Vec::new();
@@ -338,8 +363,14 @@ fn regenerate(path: &Path, text: &str, tables: &mut BTreeSet<String>) -> (String
             continue;
         }
         let marker_line = i;
-        let Some(end) = lines[i..].iter().position(|l| l.trim() == END).map(|p| p + i) else {
-            problems.push(format!("{name}:{marker_line}: table marker without `{END}`"));
+        let Some(end) = lines[i..]
+            .iter()
+            .position(|l| l.trim() == END)
+            .map(|p| p + i)
+        else {
+            problems.push(format!(
+                "{name}:{marker_line}: table marker without `{END}`"
+            ));
             continue;
         };
         match parse_spec(line).and_then(|spec| {
@@ -379,13 +410,20 @@ fn docs_tables_match_the_results_they_quote() {
             }
         }
     }
-    assert!(problems.is_empty(), "bad table markers:\n{}", problems.join("\n"));
+    assert!(
+        problems.is_empty(),
+        "bad table markers:\n{}",
+        problems.join("\n")
+    );
     assert!(
         stale.is_empty(),
         "these docs' tables differ from bench/results (rerun with LIGHTGRAPH_BLESS=1 to \
          regenerate them): {stale:?}"
     );
-    assert!(!tables.is_empty(), "no generated table found in README.md or docs/");
+    assert!(
+        !tables.is_empty(),
+        "no generated table found in README.md or docs/"
+    );
 }
 
 /// bench/results keeps only what the docs quote: every folder there is a table's source.
@@ -397,33 +435,86 @@ fn every_kept_result_is_quoted() {
         regenerate(&path, &text, &mut tables);
     }
     let mut unquoted = Vec::new();
-    for e in std::fs::read_dir(root().join("bench/results")).unwrap().flatten() {
+    for e in std::fs::read_dir(root().join("bench/results"))
+        .unwrap()
+        .flatten()
+    {
         let name = e.file_name().to_string_lossy().to_string();
         if e.path().is_dir() && !tables.contains(&name) {
             unquoted.push(name);
         }
     }
-    assert!(unquoted.is_empty(), "bench/results folders no doc table quotes: {unquoted:?}");
+    assert!(
+        unquoted.is_empty(),
+        "bench/results folders no doc table quotes: {unquoted:?}"
+    );
 }
 
 #[test]
 fn a_table_is_generated_from_its_csv() {
     let csv = Csv {
-        header: ["technique", "light_count", "frame_ms_median", "round_ms_min", "round_ms_max", "max_rel", "pass_ms:light_culling"]
-            .map(String::from)
-            .to_vec(),
-        rows: vec![["forward_plus", "1024", "3.1097919", "3.10696", "3.11104", "0.0213", "0.139216"]
-            .map(String::from)
-            .to_vec()],
+        header: [
+            "technique",
+            "light_count",
+            "frame_ms_median",
+            "round_ms_min",
+            "round_ms_max",
+            "max_rel",
+            "pass_ms:light_culling",
+        ]
+        .map(String::from)
+        .to_vec(),
+        rows: vec![[
+            "forward_plus",
+            "1024",
+            "3.1097919",
+            "3.10696",
+            "3.11104",
+            "0.0213",
+            "0.139216",
+        ]
+        .map(String::from)
+        .to_vec()],
     };
     let row = &csv.rows[0];
-    let cells: Vec<String> = ["graph", "lights", "ms", "range", "max_rel", "pass:light_culling"]
-        .iter()
-        .map(|k| cell(&csv, row, k).unwrap().0)
-        .collect();
-    assert_eq!(cells, ["forward_plus", "1024", "3.110", "3.107–3.111", "2.1e-2", "0.139"]);
-    assert_eq!([plain("0.0980"), plain("151.72"), plain("2.0"), plain("0.00004")], ["0.098", "151.72", "2", "4.0e-5"]);
-    assert!(cell(&csv, row, "flip").is_err(), "a missing column is an error");
+    let cells: Vec<String> = [
+        "graph",
+        "lights",
+        "ms",
+        "range",
+        "max_rel",
+        "pass:light_culling",
+    ]
+    .iter()
+    .map(|k| cell(&csv, row, k).unwrap().0)
+    .collect();
+    assert_eq!(
+        cells,
+        [
+            "forward_plus",
+            "1024",
+            "3.110",
+            "3.107–3.111",
+            "2.1e-2",
+            "0.139"
+        ]
+    );
+    assert_eq!(
+        [
+            plain("0.0980"),
+            plain("151.72"),
+            plain("2.0"),
+            plain("0.00004")
+        ],
+        ["0.098", "151.72", "2", "4.0e-5"]
+    );
+    assert!(
+        cell(&csv, row, "flip").is_err(),
+        "a missing column is an error"
+    );
     let spec = parse_spec("<!-- table: x | columns: graph, ms | where: graph=a|b -->").unwrap();
-    assert_eq!(spec.filters, vec![("graph".to_string(), vec!["a".to_string(), "b".to_string()])]);
+    assert_eq!(
+        spec.filters,
+        vec![("graph".to_string(), vec!["a".to_string(), "b".to_string()])]
+    );
 }

@@ -1,11 +1,15 @@
-// Visibility-buffer shading in a compute shader: one dispatch per material over the whole
-// frame; each invocation whose pixel holds a triangle of this material (its id in
+// Visibility-buffer shading in a compute shader: one dispatch per material, over the
+// whole frame or (CLASSIFIED) over the tiles visibility/classify_materials.wgsl listed
+// for it; each invocation whose pixel holds a triangle of this material (its id in
 // `material_triangles[MATERIAL_INDEX]`) fetches the triangle's three vertices, rebuilds
 // the surface at the pixel centre and shades it with the same material code and light
 // loop as forward shading. Ids: src/render/visibility_geometry.rs (NO_TRIANGLE where
 // nothing was drawn).
 // Defines: SHADING_GROUP (the workgroup's side in pixels; 8 with STAGED_LIGHTS),
 // MATERIAL_INDEX, CLEARS (this dispatch stores black where nothing was drawn),
+// CLASSIFIED with MATERIAL_SLOT and TILES (this material's tiles are the workgroups:
+// `material_tiles[MATERIAL_SLOT * TILES + n]`, n from the workgroup id, folded into y
+// past 65,535),
 // LIGHT_LISTS (tile lists) or LINKED_LISTS (a light linked list), and the light loop:
 // STAGED_LIGHTS (the workgroup's one tile list staged in workgroup memory, in
 // visibility/staged_lights.wgsl), RANGE_FIRST (the per-pixel cursor with the range test
@@ -32,6 +36,10 @@
 @group(0) @binding(7) var<storage, read> triangles: array<u32>;
 @group(0) @binding(8) var<storage, read> material_triangles: array<vec2<u32>>;
 @group(0) @binding(9) var hdr: texture_storage_2d<rgba32float, write>;
+#if CLASSIFIED
+@group(0) @binding(11) var<storage, read> material_tiles: array<u32>;
+@group(0) @binding(12) var<storage, read> material_tile_counts: array<u32>;
+#endif
 
 #include "common/light_lists.wgsl"
 
@@ -44,6 +52,36 @@
 #include "visibility/staged_lights.wgsl"
 
 const NO_TRIANGLE: u32 = 0xffffffffu;
+// A workgroup past the end of its material's tile list.
+const NO_TILE: u32 = 0xffffffffu;
+
+#if CLASSIFIED
+var<workgroup> listed_tile: u32;
+
+// The tile this workgroup shades, in workgroups across the frame: the n-th of this
+// material's list (NO_TILE past its end). Read once and shared, so the result is
+// uniform across the workgroup and the staged loop's barriers stay legal.
+fn shading_tile(lane: u32, group: vec3<u32>) -> vec2<u32> {
+    if (lane == 0u) {
+        let n = group.y * 65535u + group.x;
+        var t = NO_TILE;
+        if (n < material_tile_counts[MATERIAL_SLOT]) {
+            t = material_tiles[MATERIAL_SLOT * TILES + n];
+        }
+        listed_tile = t;
+    }
+    let t = workgroupUniformLoad(&listed_tile);
+    if (t == NO_TILE) {
+        return vec2<u32>(NO_TILE);
+    }
+    let across = (frame.size.x + SHADING_GROUP - 1u) / SHADING_GROUP;
+    return vec2<u32>(t % across, t / across);
+}
+#else
+fn shading_tile(lane: u32, group: vec3<u32>) -> vec2<u32> {
+    return group.xy;
+}
+#endif
 
 // A pixel's surface, rebuilt from its triangle, with what the light loop takes.
 struct Surface {
@@ -70,10 +108,15 @@ var<workgroup> group_shades: atomic<u32>;
 // before loading anything.
 @compute @workgroup_size(8, 8, 1)
 fn main(
-    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(local_invocation_id) local: vec3<u32>,
     @builtin(local_invocation_index) lane: u32,
     @builtin(workgroup_id) group: vec3<u32>,
 ) {
+    let tile = shading_tile(lane, group);
+    if (tile.x == NO_TILE) {
+        return;
+    }
+    let id = tile * 8u + local.xy;
     let inside = all(id.xy < frame.size);
     var tri = NO_TRIANGLE;
     if (inside) {
@@ -98,7 +141,7 @@ fn main(
     // pixels on lavapipe (the compiler fuses the arithmetic differently). A warp with
     // any pixel of this material pays for the rebuild anyway.
     let s = rebuild(id.xy, select(range.x, tri, shades));
-    let color = staged_lights(surface_unlit(s.p, s.m), shades, s.p, s.m, lane, group_list(group.xy));
+    let color = staged_lights(surface_unlit(s.p, s.m), shades, s.p, s.m, lane, group_list(tile));
     if (shades) {
         textureStore(hdr, id.xy, vec4<f32>(color, material_alpha(s.m)));
     }
@@ -115,7 +158,11 @@ fn block_pixel(lane: u32) -> vec2<u32> {
 
 @compute @workgroup_size(SHADING_GROUP, SHADING_GROUP, 1)
 fn main(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group: vec3<u32>) {
-    let id = group.xy * SHADING_GROUP + block_pixel(lane);
+    let tile = shading_tile(lane, group);
+    if (tile.x == NO_TILE) {
+        return;
+    }
+    let id = tile * SHADING_GROUP + block_pixel(lane);
     if (any(id.xy >= frame.size)) {
         return;
     }
@@ -133,7 +180,7 @@ fn main(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group
     let s = rebuild(id.xy, tri);
 #if RANGE_FIRST
 #if UNIFORM_LIST
-    let color = shade_list(s.p, s.m, group_list(group.xy));
+    let color = shade_list(s.p, s.m, group_list(tile));
 #else
     let color = shade_range_first(s.p, s.m, s.pixel, s.view_z);
 #endif

@@ -1,7 +1,10 @@
 //! `VisibilityShading`: every material shaded in a compute shader from a visibility
 //! buffer, one dispatch per material: each pixel whose triangle id lies in the material's
 //! range fetches the triangle, rebuilds its attributes at the pixel centre and runs the
-//! light loop. Runs `shaders/visibility/visibility_shading.wgsl`.
+//! light loop. With more than one material the frame is first classified: each
+//! workgroup-sized tile is listed under every material it holds, and each material's
+//! dispatch runs over its own tiles only. Runs `shaders/visibility/visibility_shading.wgsl`
+//! (and `classify_materials.wgsl`).
 
 use super::deferred_shading::HDR;
 use super::shadow_ray_jobs::SHADOW_MASK;
@@ -11,7 +14,7 @@ use crate::graph::error::GraphError;
 use crate::graph::model::{LightSource, SceneResource};
 use serde::{Deserialize, Serialize};
 
-/// `VisibilityShading(lights: Culled, light_loop: RangeFirst, workgroup: 16)`.
+/// `VisibilityShading(lights: Culled, light_loop: RangeFirst, workgroup: 16, materials: Classified)`.
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
 #[serde(deny_unknown_fields)]
 pub struct VisibilityShading {
@@ -29,6 +32,22 @@ pub struct VisibilityShading {
         skip_serializing_if = "Option::is_none"
     )]
     pub workgroup: Option<u32>,
+    #[serde(default)]
+    pub materials: MaterialDispatch,
+}
+
+/// Which tiles each material's dispatch covers.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
+pub enum MaterialDispatch {
+    /// The default: a classification dispatch lists each tile (a workgroup's pixels)
+    /// under every material it holds, then each material runs an indirect dispatch over
+    /// its tiles only, so a material that covers no pixel costs nothing. With one shaded
+    /// material the frame is one dispatch, as `PerMaterial`.
+    #[default]
+    Classified,
+    /// Every material's dispatch covers the whole frame (its invocations skip pixels of
+    /// other materials): the reference the classified image is tested against.
+    PerMaterial,
 }
 
 /// Workgroup sides the shader is built for.

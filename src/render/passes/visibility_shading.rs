@@ -1,10 +1,13 @@
-//! `VisibilityShading`: one compute dispatch per material with triangles over the frame,
-//! rebuilding each pixel's surface from its triangle id (shaders/visibility/
-//! visibility_shading.wgsl). Textured materials sample with explicit derivatives
-//! (`MaterialProgram::compute_wgsl`) and bind their textures in group 2.
+//! `VisibilityShading`: one compute dispatch per material with triangles, rebuilding each
+//! pixel's surface from its triangle id (shaders/visibility/visibility_shading.wgsl).
+//! Textured materials sample with explicit derivatives (`MaterialProgram::compute_wgsl`)
+//! and bind their textures in group 2. With more than one material (and `materials:
+//! Classified`) a classification dispatch first lists every tile under the materials it
+//! holds (shaders/visibility/classify_materials.wgsl) and each material's dispatch is
+//! indirect, over its own tiles; otherwise each covers the whole frame.
 
 use super::{defines, PrepareCtx, PreparedPass, ShadeLists, Timestamps};
-use crate::graph::kinds::visibility_shading::LightLoop;
+use crate::graph::kinds::visibility_shading::{LightLoop, MaterialDispatch};
 use crate::graph::Name;
 use crate::graph::{ListLayout, ScheduledPass, VisibilityShading};
 use crate::render::pipelines::PipelineKey;
@@ -12,15 +15,29 @@ use crate::render::RenderError;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-struct MaterialDispatch {
+struct ShadeDispatch {
     pipeline: Arc<wgpu::ComputePipeline>,
+    bind: wgpu::BindGroup,
     textures: Option<wgpu::BindGroup>,
+}
+
+/// The classification's buffers and dispatches (see the module doc).
+struct Classification {
+    classify: Arc<wgpu::ComputePipeline>,
+    classify_bind: wgpu::BindGroup,
+    args: Arc<wgpu::ComputePipeline>,
+    args_bind: wgpu::BindGroup,
+    /// Tiles listed per slot, zeroed before every frame.
+    counts: wgpu::Buffer,
+    /// Three u32 a slot: the indirect arguments of its shading dispatch.
+    dispatch: wgpu::Buffer,
+    args_groups: u32,
 }
 
 pub(super) struct VisibilityShadingPass {
     name: Name,
-    dispatches: Vec<MaterialDispatch>,
-    bind: wgpu::BindGroup,
+    dispatches: Vec<ShadeDispatch>,
+    classification: Option<Classification>,
     groups: [u32; 3],
 }
 
@@ -43,12 +60,35 @@ pub(super) fn prepare(
     if shaded.is_empty() {
         shaded.push(0);
     }
+    let groups = [
+        cx.size.width.div_ceil(side),
+        cx.size.height.div_ceil(side),
+        1,
+    ];
+    let classified = p.materials == MaterialDispatch::Classified && shaded.len() > 1;
+    let tiles = groups[0] * groups[1];
+    let classification = if classified {
+        Some(classification(
+            cx,
+            sp,
+            &shaded,
+            &ranges,
+            side,
+            tiles,
+            &mut offered,
+        )?)
+    } else {
+        None
+    };
     let mut dispatches = Vec::new();
-    let mut bind = None;
-    for (k, &index) in shaded.iter().enumerate() {
+    for (slot, &index) in shaded.iter().enumerate() {
         let m = &cx.gpu.materials[index];
         let mut d = vec![("MATERIAL_INDEX", index.to_string())];
-        if k == 0 {
+        if classified {
+            d.push(("CLASSIFIED", "1".into()));
+            d.push(("MATERIAL_SLOT", format!("{slot}u")));
+            d.push(("TILES", format!("{tiles}u")));
+        } else if slot == 0 {
             d.push(("CLEARS", "1".into()));
         }
         if m.textures.is_some() {
@@ -72,21 +112,103 @@ pub(super) fn prepare(
         };
         let label = format!("{} (material '{}')", sp.name, m.name);
         let textures = m.textures.clone();
-        let (pipeline, b, textures) =
+        let (pipeline, bind, textures) =
             cx.compute_pipeline_with_material(&label, key, "main", &offered, textures.as_ref())?;
-        dispatches.push(MaterialDispatch { pipeline, textures });
-        // Every material's shader declares the same group-0 bindings: one group serves all.
-        bind.get_or_insert(b);
+        dispatches.push(ShadeDispatch {
+            pipeline,
+            bind,
+            textures,
+        });
     }
     Ok(VisibilityShadingPass {
         name: sp.name.clone(),
         dispatches,
-        bind: bind.ok_or_else(|| super::pass_error(&sp.name, "no material to shade".into()))?,
-        groups: [
-            cx.size.width.div_ceil(side),
-            cx.size.height.div_ceil(side),
-            1,
-        ],
+        classification,
+        groups,
+    })
+}
+
+/// The classification of `shaded` materials (slot k: `shaded[k]`) over `tiles` tiles of
+/// `side` pixels; offers its buffers to the shading dispatches in `offered`.
+fn classification(
+    cx: &mut PrepareCtx,
+    sp: &ScheduledPass,
+    shaded: &[usize],
+    ranges: &[[u32; 2]],
+    side: u32,
+    tiles: u32,
+    offered: &mut crate::render::bind::BindingSet,
+) -> Result<Classification, RenderError> {
+    let device = cx.device();
+    let slots = shaded.len() as u32;
+    let list_bytes = u64::from(slots) * u64::from(tiles) * 4;
+    let limit = device.limits().max_storage_buffer_binding_size;
+    if list_bytes > limit {
+        return Err(super::pass_error(
+            &sp.name,
+            format!(
+                "classifying {slots} materials over {tiles} tiles takes {list_bytes} bytes of tile lists; this device binds at most {limit} bytes (use materials: PerMaterial, or a larger workgroup)"
+            ),
+        ));
+    }
+    // Ascending by first triangle: draws are sorted by material, so shaded[] is too.
+    let slot_triangles: Vec<u32> = shaded.iter().flat_map(|&m| ranges[m]).collect();
+    let storage = wgpu::BufferUsages::STORAGE;
+    let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: size.max(4),
+            usage,
+            mapped_at_creation: false,
+        })
+    };
+    let slot_buffer = wgpu::util::DeviceExt::create_buffer_init(
+        &device,
+        &wgpu::util::BufferInitDescriptor {
+            label: Some("material slot triangles"),
+            contents: bytemuck::cast_slice(&slot_triangles),
+            usage: storage,
+        },
+    );
+    let material_tiles = buffer("material tiles", list_bytes, storage);
+    let counts = buffer(
+        "material tile counts",
+        u64::from(slots) * 4,
+        storage | wgpu::BufferUsages::COPY_DST,
+    );
+    let dispatch = buffer(
+        "material dispatch arguments",
+        u64::from(slots) * 12,
+        storage | wgpu::BufferUsages::INDIRECT,
+    );
+    offered.buffer("slot_triangles", &slot_buffer);
+    offered.buffer("material_tiles", &material_tiles);
+    offered.buffer("material_tile_counts", &counts);
+    offered.buffer("material_dispatch", &dispatch);
+    let d = [
+        ("SHADING_GROUP", format!("{side}u")),
+        ("SLOTS", format!("{slots}u")),
+        ("TILES", format!("{tiles}u")),
+    ];
+    let key = |entry: &str| PipelineKey {
+        shader: "visibility/classify_materials.wgsl".into(),
+        defines: defines(&d),
+        virtual_code: BTreeMap::new(),
+        state: entry.to_string(),
+    };
+    let label = format!("{} (classification)", sp.name);
+    let (classify, classify_bind) =
+        cx.compute_pipeline(&label, key("classify"), "classify", offered)?;
+    let (args, args_bind) =
+        cx.compute_pipeline(&label, key("dispatch_args"), "dispatch_args", offered)?;
+    Ok(Classification {
+        classify,
+        classify_bind,
+        args,
+        args_bind,
+        counts,
+        dispatch,
+        args_groups: slots.div_ceil(64),
     })
 }
 
@@ -124,18 +246,32 @@ fn choose_light_loop(asked: LightLoop, layout: Option<ListLayout>, side: u32) ->
 
 impl PreparedPass for VisibilityShadingPass {
     fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
+        if let Some(c) = &self.classification {
+            encoder.clear_buffer(&c.counts, 0, None);
+        }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some(&self.name),
             timestamp_writes: ts.compute(),
         });
-        pass.set_bind_group(0, &self.bind, &[]);
         let [x, y, z] = self.groups;
-        for d in &self.dispatches {
+        if let Some(c) = &self.classification {
+            pass.set_pipeline(&c.classify);
+            pass.set_bind_group(0, &c.classify_bind, &[]);
+            pass.dispatch_workgroups(x, y, z);
+            pass.set_pipeline(&c.args);
+            pass.set_bind_group(0, &c.args_bind, &[]);
+            pass.dispatch_workgroups(c.args_groups, 1, 1);
+        }
+        for (slot, d) in self.dispatches.iter().enumerate() {
             pass.set_pipeline(&d.pipeline);
+            pass.set_bind_group(0, &d.bind, &[]);
             if let Some(t) = &d.textures {
                 pass.set_bind_group(2, t, &[]);
             }
-            pass.dispatch_workgroups(x, y, z);
+            match &self.classification {
+                Some(c) => pass.dispatch_workgroups_indirect(&c.dispatch, slot as u64 * 12),
+                None => pass.dispatch_workgroups(x, y, z),
+            }
         }
     }
 }
