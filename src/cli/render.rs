@@ -529,15 +529,8 @@ pub fn write_image(out: &Path, result: &FrameResult) -> Result<()> {
 }
 
 pub fn compare(a: &Path, b: &Path) -> Result<()> {
-    let ia = bench::read_exr(a)?;
-    let ib = bench::read_exr(b)?;
-    let m = bench::compare(
-        &ia.pixels,
-        &ib.pixels,
-        ia.width,
-        ia.height,
-        &Default::default(),
-    )?;
+    // Both sizes are checked, not only the pixel counts: 64×36 against 36×64 is refused.
+    let m = bench::compare_files(a, b, &Default::default())?;
     println!("{}", compare_summary(&m));
     println!("{m}");
     Ok(())
