@@ -508,7 +508,17 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
         }
         Some(CameraSpec::FitBounds) => bounds.map(fit_camera).unwrap_or_default(),
         Some(CameraSpec::AmdBounds) => bounds.map(amd_camera).unwrap_or_default(),
-        None => camera.unwrap_or_else(|| bounds.map(fit_camera).unwrap_or_default()),
+        None => match (camera, bounds) {
+            (Some(c), _) => c,
+            (None, Some(b)) => {
+                warnings.push(format!(
+                    "{}: no camera (none given, and no built-in or model has one); one was fitted to the scene bounds",
+                    file.display()
+                ));
+                fit_camera(b)
+            }
+            (None, None) => Camera::default(),
+        },
     };
 
     for (name, path) in &spec.material_overrides {
