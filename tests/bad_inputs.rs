@@ -228,6 +228,20 @@ const HOSTILE_GLTF: &[(&str, Gltf)] = &[
         "dag_cycle.gltf",
         Refused("node hierarchy contains a cycle: its child node"),
     ),
+    // Coverage lies in 0..=1: a cutoff outside keeps every fragment or none, and one that
+    // is infinite as an f32 is no WGSL literal.
+    (
+        "alpha_cutoff_2.gltf",
+        Refused("alpha_cutoff_2.gltf:50:4: material 0 (\"tri_mat\"): alphaCutoff 2 must be a finite number in 0..=1"),
+    ),
+    (
+        "alpha_cutoff_neg1.gltf",
+        Refused("alpha_cutoff_neg1.gltf:50:4: material 0 (\"tri_mat\"): alphaCutoff -1 must be a finite number in 0..=1"),
+    ),
+    (
+        "alpha_cutoff_1e39.gltf",
+        Refused("alpha_cutoff_1e39.gltf:50:4: material 0 (\"tri_mat\"): alphaCutoff inf must be a finite number in 0..=1"),
+    ),
     ("wide_texture.gltf", Warns("is 40000×1, over the device's limit of")),
     ("bom.gltf", Warns("")),
 ];

@@ -105,3 +105,9 @@ with open("models/wide.png", "wb") as f:
 # glTF JSON with a UTF-8 byte-order mark: accepted as in every other format.
 with open("bom.gltf", "wb") as f:
     f.write(b"\xef\xbb\xbf" + json.dumps(tri_doc(extra=with_light), indent=1).encode())
+# Alpha cutoffs outside 0..=1 (JSON has no NaN or infinity; 1e39 is one as an f32).
+for name, cutoff in [("alpha_cutoff_2", 2), ("alpha_cutoff_neg1", -1), ("alpha_cutoff_1e39", 1e39)]:
+    def mask(d, cutoff=cutoff):
+        with_light(d)
+        d["materials"][0].update({"alphaMode": "MASK", "alphaCutoff": cutoff})
+    write(name + ".gltf", tri_doc(extra=mask))
