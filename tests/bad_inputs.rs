@@ -97,6 +97,8 @@ enum Input {
     Scene,
     /// Checked by `validate` only (materials, shaders: they render through a scene or graph).
     ValidateOnly,
+    /// Checked by `validate` and `bench --sweep`.
+    Sweep,
 }
 
 #[derive(Clone, Debug)]
@@ -121,6 +123,13 @@ fn check(file: &Path, input: Input, expect: &Expect, failures: &mut Vec<String>)
             "render",
             lightgraph(&os(&[&["render"][..], &size, &["--scene"]].concat(), file)),
         )),
+        Input::Sweep => {
+            let out = tempfile::tempdir().unwrap();
+            let mut args = os(&["bench", "--out"], out.path());
+            args.push("--sweep".into());
+            args.push(file.into());
+            runs.push(("bench", lightgraph(&args)));
+        }
         Input::ValidateOnly => {}
     }
     for (command, o) in runs {
@@ -181,6 +190,19 @@ fn every_bad_graph_is_refused_by_validate_and_render() {
         check(g, Input::Graph, &expectation(g), &mut failures);
     }
     assert!(graphs.len() >= 25, "only {} bad graphs", graphs.len());
+    assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
+}
+
+/// Sweep files whose counts would allocate or loop without bound: refused at the line of
+/// the field, before any GPU work.
+#[test]
+fn bad_sweeps_are_refused_by_validate_and_bench() {
+    let mut failures = Vec::new();
+    let sweeps = files(&root().join("tests/bad/sweeps"), "ron");
+    for f in &sweeps {
+        check(f, Input::Sweep, &expectation(f), &mut failures);
+    }
+    assert!(sweeps.len() >= 5, "only {} bad sweeps", sweeps.len());
     assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
 }
 

@@ -72,6 +72,12 @@ fn validate_one(f: &Path, shaders: &ShaderLibrary) -> Result<(), String> {
             }
             Ok(())
         }
+        FileKind::Sweep => {
+            let text = read_text(f, caps::RON).map_err(|e| format!("{}: {e}", f.display()))?;
+            lightgraph::bench::sweep::Sweep::parse(&text, f)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        }
         FileKind::Material => lightgraph::material::Material::load(f)
             .and_then(|m| m.wgsl().map(|_| ()))
             .map_err(|e| e.to_string()),
