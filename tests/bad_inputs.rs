@@ -530,3 +530,48 @@ fn device_limits_are_checked_at_prepare() {
     );
     assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
 }
+
+/// A pass's own buffers (not planned by the graph) are checked against the device before
+/// they are created: at 4100×4100 the culling's coarse lists of Forward+ and tiled deferred
+/// are 138,461,700 bytes, over a 128 MiB storage binding (wgpu's raw
+/// `max_*_buffer_binding_size` text before). Refused where the device's limit is lower,
+/// rendered where it is not.
+#[test]
+fn internal_buffers_are_checked_against_the_device() {
+    const COARSE_BYTES: u64 = 138_461_700;
+    let limit = lightgraph::render::Renderer::headless()
+        .unwrap()
+        .ctx
+        .device
+        .limits()
+        .max_storage_buffer_binding_size as u64;
+    let tmp = tempfile::tempdir().unwrap();
+    let mut failures = Vec::new();
+    for (graph, at) in [
+        ("forward_plus.ron", "forward_plus.ron:25:19"),
+        ("tiled_deferred.ron", "tiled_deferred.ron:19:19"),
+    ] {
+        let mut args = os(
+            &["render", "--width", "4100", "--height", "4100", "--graph"],
+            &root().join("graphs").join(graph),
+        );
+        args.push(OsString::from("--out"));
+        args.push(tmp.path().join("x.png").into());
+        let o = lightgraph(&args);
+        let want = format!(
+            "{at}: pass 'light_culling': its buffer 'coarse light lists' of {COARSE_BYTES} bytes is over the device's limit of {limit} bytes for a storage buffer binding"
+        );
+        let ok = if COARSE_BYTES > limit {
+            o.code == Some(1) && o.output.contains(&want) && !o.output.contains("wgpu")
+        } else {
+            o.code == Some(0)
+        };
+        if !ok {
+            failures.push(format!(
+                "{graph}: want {want:?} (limit {limit}), got:\n{}",
+                o.output
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
+}

@@ -127,3 +127,42 @@ pub fn check_dispatch(
         ),
     })
 }
+
+/// Creates a buffer a pass makes for itself (not planned by the graph, so not seen by
+/// [`check_plan`]), checked first against the device's limits for its size and, as it is
+/// bound whole, for a storage or uniform binding of it: wgpu would report an oversized one
+/// as raw validation text (`max_*_buffer_binding_size`) at bind-group creation. The error
+/// names `pass` (located at its declaration by the caller) and the buffer's label.
+pub fn create_internal_buffer(
+    device: &wgpu::Device,
+    pass: &str,
+    desc: &wgpu::BufferDescriptor,
+) -> Result<wgpu::Buffer, RenderError> {
+    let limits = device.limits();
+    let mut max = (limits.max_buffer_size, "buffer");
+    if desc.usage.contains(wgpu::BufferUsages::STORAGE) {
+        max = max.min((
+            limits.max_storage_buffer_binding_size as u64,
+            "storage buffer binding",
+        ));
+    }
+    if desc.usage.contains(wgpu::BufferUsages::UNIFORM) {
+        max = max.min((
+            limits.max_uniform_buffer_binding_size as u64,
+            "uniform buffer binding",
+        ));
+    }
+    if desc.size > max.0 {
+        return Err(RenderError::Pass {
+            pass: pass.to_string(),
+            message: format!(
+                "its buffer '{}' of {} bytes is over the device's limit of {} bytes for a {} (it grows with the frame size and the light count)",
+                desc.label.unwrap_or("unnamed"),
+                desc.size,
+                max.0,
+                max.1
+            ),
+        });
+    }
+    Ok(device.create_buffer(desc))
+}

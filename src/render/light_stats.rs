@@ -85,12 +85,16 @@ impl LightStatsPass {
         let Pipeline::Compute(pipeline) = pipeline else {
             return Err(pass_error(PASS, "expected a compute pipeline".into()));
         };
-        let counts = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("light counts"),
-            size: 8 * size.width as u64 * size.height as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
+        let counts = super::device_limits::create_internal_buffer(
+            &device,
+            PASS,
+            &wgpu::BufferDescriptor {
+                label: Some("light counts"),
+                size: 8 * size.width as u64 * size.height as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            },
+        )?;
         let view_proj = glam::Mat4::from_cols_array_2d(&gpu_frame.view_proj);
         let inv = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("inverse view-projection"),
