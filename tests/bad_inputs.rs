@@ -531,6 +531,55 @@ fn device_limits_are_checked_at_prepare() {
     assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
 }
 
+/// A light loop that may run longer than the adapter lets one loop run: llvmpipe leaves a
+/// loop after 65,535 iterations without a word, and brute force over 70,000 lights lost
+/// every light past the 65,535th (black where only those reach). Refused there, naming
+/// the graph line and pass; rendered where the adapter has no such limit.
+#[test]
+fn light_loops_are_checked_against_the_adapter() {
+    let info = lightgraph::render::Renderer::headless()
+        .unwrap()
+        .ctx
+        .adapter
+        .get_info();
+    let limited = info.name.contains("llvmpipe");
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = tmp.path().join("lights_70000.ron");
+    write(
+        &scene,
+        "Scene(builtin: \"atrium\", keep_model_lights: false, light_sets: [Random(count: 70000, spot_fraction: 0, placement: SceneBounds(margin: 0), range: (0.2, 0.6), intensity: (0.5, 2), seed: 7)])",
+    );
+    let mut failures = Vec::new();
+    for (graph, want) in [
+        (
+            "brute_force.ron",
+            "brute_force.ron:15:19: pass 'forward_shading': its light loop may visit 70000 lights at one pixel (lights: AllLights), over this adapter's limit of 65535 iterations a loop",
+        ),
+        (
+            "forward_plus.ron",
+            "forward_plus.ron:31:19: pass 'forward_shading': its light loop may visit 70000 lights at one pixel ('light_lists': a tile's list may hold up to that many), over this adapter's limit of 65535 iterations a loop",
+        ),
+    ] {
+        let mut args = os(
+            &["render", "--width", "16", "--height", "9", "--graph"],
+            &root().join("graphs").join(graph),
+        );
+        args.extend([OsString::from("--scene"), scene.clone().into()]);
+        args.push(OsString::from("--out"));
+        args.push(tmp.path().join("x.png").into());
+        let o = lightgraph(&args);
+        let ok = if limited {
+            o.code == Some(1) && o.output.contains(want)
+        } else {
+            o.code == Some(0)
+        };
+        if !ok {
+            failures.push(format!("{graph} on {}: want {want:?}, got:\n{}", info.name, o.output));
+        }
+    }
+    assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
+}
+
 /// A pass's own buffers (not planned by the graph) are checked against the device before
 /// they are created: at 4100×4100 the culling's coarse lists of Forward+ and tiled deferred
 /// are 138,461,700 bytes, over a 128 MiB storage binding (wgpu's raw
@@ -544,7 +593,7 @@ fn internal_buffers_are_checked_against_the_device() {
         .ctx
         .device
         .limits()
-        .max_storage_buffer_binding_size as u64;
+        .max_storage_buffer_binding_size;
     let tmp = tempfile::tempdir().unwrap();
     let mut failures = Vec::new();
     for (graph, at) in [

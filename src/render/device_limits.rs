@@ -142,13 +142,13 @@ pub fn create_internal_buffer(
     let mut max = (limits.max_buffer_size, "buffer");
     if desc.usage.contains(wgpu::BufferUsages::STORAGE) {
         max = max.min((
-            limits.max_storage_buffer_binding_size as u64,
+            limits.max_storage_buffer_binding_size,
             "storage buffer binding",
         ));
     }
     if desc.usage.contains(wgpu::BufferUsages::UNIFORM) {
         max = max.min((
-            limits.max_uniform_buffer_binding_size as u64,
+            limits.max_uniform_buffer_binding_size,
             "uniform buffer binding",
         ));
     }
@@ -165,4 +165,33 @@ pub fn create_internal_buffer(
         });
     }
     Ok(device.create_buffer(desc))
+}
+
+/// The most iterations one shader loop may run on this adapter, where it is known to end
+/// longer loops early and silently: llvmpipe (lavapipe) leaves any loop after 65,535
+/// iterations (gallivm's `LP_MAX_TGSI_LOOP_ITERATIONS`), so a light loop past it drops
+/// every later light without an error. None where no such limit is known.
+pub fn loop_iteration_limit(info: &wgpu::AdapterInfo) -> Option<u64> {
+    let llvmpipe = info.name.contains("llvmpipe") || info.driver.contains("llvmpipe");
+    llvmpipe.then_some(65_535)
+}
+
+/// A shading pass's light loop of up to `most` lights at one pixel, against the
+/// adapter's loop limit; `what` says where the bound comes from.
+pub fn check_light_loop(
+    info: &wgpu::AdapterInfo,
+    pass: &str,
+    most: u64,
+    what: &str,
+) -> Result<(), RenderError> {
+    match loop_iteration_limit(info) {
+        Some(limit) if most > limit => Err(RenderError::Pass {
+            pass: pass.to_string(),
+            message: format!(
+                "its light loop may visit {most} lights at one pixel ({what}), over this adapter's limit of {limit} iterations a loop ({} ends longer loops silently, losing the lights past it)",
+                info.name
+            ),
+        }),
+        _ => Ok(()),
+    }
 }

@@ -38,6 +38,13 @@ impl LightStatsPass {
         size: FrameSize,
     ) -> Result<Self, RenderError> {
         let device = r.ctx.device.clone();
+        // The exact count walks every light at every pixel.
+        super::device_limits::check_light_loop(
+            &r.ctx.adapter.get_info(),
+            PASS,
+            gpu.light_count as u64,
+            "its exact count walks every light",
+        )?;
         let after = graph
             .passes
             .iter()

@@ -184,7 +184,7 @@ impl Camera {
     /// refused, naming the field; None when it is within the limits above.
     pub fn lens_error(fov_y_deg: f32, near: f32, far: f32) -> Option<String> {
         // A perspective projection ends below 180°.
-        if !(fov_y_deg >= MIN_FOV_Y_DEG && fov_y_deg < 180.0) {
+        if !(MIN_FOV_Y_DEG..180.0).contains(&fov_y_deg) {
             return Some(format!(
                 "fov_y_deg {fov_y_deg} must be at least {MIN_FOV_Y_DEG} (narrower lenses are beyond f32 position and culling precision) and below 180"
             ));
