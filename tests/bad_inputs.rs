@@ -238,7 +238,7 @@ const HOSTILE_GLTF: &[(&str, Gltf)] = &[
     ),
     (
         "vertex_3e38.gltf",
-        Refused("mesh 0 (\"tri\") vertex 1: position Vec3(3e38, 0.0, 0.0) after the scene transform is not finite or beyond ±1e7 m"),
+        Refused("mesh 0 (\"tri\") vertex 1: position Vec3(3e38, 0.0, 0.0) after the scene transform is not finite or beyond ±1e5 m"),
     ),
     (
         "light_3e38.gltf",
@@ -263,6 +263,10 @@ const HOSTILE_GLTF: &[(&str, Gltf)] = &[
     (
         "alpha_cutoff_1e39.gltf",
         Refused("alpha_cutoff_1e39.gltf:50:4: material 0 (\"tri_mat\"): alphaCutoff inf must be a finite number in 0..=1"),
+    ),
+    (
+        "uv_3e38.gltf",
+        Refused("mesh 0 (\"tri\") vertex 1: texture coordinate Vec2(3e38, 0.0) is not finite or beyond ±4096"),
     ),
     ("wide_texture.gltf", Warns("is 40000×1, over the device's limit of")),
     ("bom.gltf", Warns("")),
