@@ -11,6 +11,7 @@ pub enum FileKind {
     Material,
     Gltf,
     Shader,
+    Sweep,
 }
 
 /// The kind of `path`; `text` is its contents, needed for `.ron` only.
@@ -27,17 +28,18 @@ pub fn detect(path: &Path, text: impl FnOnce() -> Option<String>) -> Result<File
             match top_level_name(&text) {
                 Some("Graph") => Ok(FileKind::Graph),
                 Some("Scene") => Ok(FileKind::Scene),
+                Some("Sweep") => Ok(FileKind::Sweep),
                 Some("" | "Material" | "MaterialDesc") => Ok(FileKind::Material),
                 // Empty or unreadable: let the RON parser of the likeliest kind say why.
                 None => Ok(guess_from_folder(path)),
                 Some(other) => Err(format!(
-                    "{}: top-level struct `{other}` is none of Graph(...), Scene(...) or a material's (...)",
+                    "{}: top-level struct `{other}` is none of Graph(...), Scene(...), Sweep(...) or a material's (...)",
                     path.display()
                 )),
             }
         }
         _ => Err(format!(
-            "{}: unknown file type (validate reads .ron graphs, scenes and materials, .gltf/.glb models and .wgsl shaders)",
+            "{}: unknown file type (validate reads .ron graphs, scenes, sweeps and materials, .gltf/.glb models and .wgsl shaders)",
             path.display()
         )),
     }

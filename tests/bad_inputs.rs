@@ -97,6 +97,8 @@ enum Input {
     Scene,
     /// Checked by `validate` only (materials, shaders: they render through a scene or graph).
     ValidateOnly,
+    /// Checked by `validate` and `bench --sweep`.
+    Sweep,
 }
 
 #[derive(Clone, Debug)]
@@ -121,6 +123,13 @@ fn check(file: &Path, input: Input, expect: &Expect, failures: &mut Vec<String>)
             "render",
             lightgraph(&os(&[&["render"][..], &size, &["--scene"]].concat(), file)),
         )),
+        Input::Sweep => {
+            let out = tempfile::tempdir().unwrap();
+            let mut args = os(&["bench", "--out"], out.path());
+            args.push("--sweep".into());
+            args.push(file.into());
+            runs.push(("bench", lightgraph(&args)));
+        }
         Input::ValidateOnly => {}
     }
     for (command, o) in runs {
@@ -184,6 +193,19 @@ fn every_bad_graph_is_refused_by_validate_and_render() {
     assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
 }
 
+/// Sweep files whose counts would allocate or loop without bound: refused at the line of
+/// the field, before any GPU work.
+#[test]
+fn bad_sweeps_are_refused_by_validate_and_bench() {
+    let mut failures = Vec::new();
+    let sweeps = files(&root().join("tests/bad/sweeps"), "ron");
+    for f in &sweeps {
+        check(f, Input::Sweep, &expectation(f), &mut failures);
+    }
+    assert!(sweeps.len() >= 5, "only {} bad sweeps", sweeps.len());
+    assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
+}
+
 /// What a glTF file of tests/bad/hostile/ must give.
 enum Gltf {
     Refused(&'static str),
@@ -216,7 +238,7 @@ const HOSTILE_GLTF: &[(&str, Gltf)] = &[
     ),
     (
         "vertex_3e38.gltf",
-        Refused("mesh 0 (\"tri\") vertex 1: position Vec3(3e38, 0.0, 0.0) after the scene transform is not finite or beyond ±1e7 m"),
+        Refused("mesh 0 (\"tri\") vertex 1: position Vec3(3e38, 0.0, 0.0) after the scene transform is not finite or beyond ±1e5 m"),
     ),
     (
         "light_3e38.gltf",
@@ -227,6 +249,24 @@ const HOSTILE_GLTF: &[(&str, Gltf)] = &[
         // cycle took a million node visits to refuse; now a linear search names it.
         "dag_cycle.gltf",
         Refused("node hierarchy contains a cycle: its child node"),
+    ),
+    // Coverage lies in 0..=1: a cutoff outside keeps every fragment or none, and one that
+    // is infinite as an f32 is no WGSL literal.
+    (
+        "alpha_cutoff_2.gltf",
+        Refused("alpha_cutoff_2.gltf:50:4: material 0 (\"tri_mat\"): alphaCutoff 2 must be a finite number in 0..=1"),
+    ),
+    (
+        "alpha_cutoff_neg1.gltf",
+        Refused("alpha_cutoff_neg1.gltf:50:4: material 0 (\"tri_mat\"): alphaCutoff -1 must be a finite number in 0..=1"),
+    ),
+    (
+        "alpha_cutoff_1e39.gltf",
+        Refused("alpha_cutoff_1e39.gltf:50:4: material 0 (\"tri_mat\"): alphaCutoff inf must be a finite number in 0..=1"),
+    ),
+    (
+        "uv_3e38.gltf",
+        Refused("mesh 0 (\"tri\") vertex 1: texture coordinate Vec2(3e38, 0.0) is not finite or beyond ±4096"),
     ),
     ("wide_texture.gltf", Warns("is 40000×1, over the device's limit of")),
     ("bom.gltf", Warns("")),
@@ -492,5 +532,99 @@ fn device_limits_are_checked_at_prepare() {
         args,
         "per_light.ron:8:20: pass 'count': dispatch of [70000, 1, 1] workgroups is over the device's limit of 65535 per dimension",
     );
+    assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
+}
+
+/// A light loop that may run longer than the adapter lets one loop run: llvmpipe leaves a
+/// loop after 65,535 iterations without a word, and brute force over 70,000 lights lost
+/// every light past the 65,535th (black where only those reach). Refused there, naming
+/// the graph line and pass; rendered where the adapter has no such limit.
+#[test]
+fn light_loops_are_checked_against_the_adapter() {
+    let info = lightgraph::render::Renderer::headless()
+        .unwrap()
+        .ctx
+        .adapter
+        .get_info();
+    let limited = info.name.contains("llvmpipe");
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = tmp.path().join("lights_70000.ron");
+    write(
+        &scene,
+        "Scene(builtin: \"atrium\", keep_model_lights: false, light_sets: [Random(count: 70000, spot_fraction: 0, placement: SceneBounds(margin: 0), range: (0.2, 0.6), intensity: (0.5, 2), seed: 7)])",
+    );
+    let mut failures = Vec::new();
+    for (graph, want) in [
+        (
+            "brute_force.ron",
+            "brute_force.ron:15:19: pass 'forward_shading': its light loop may visit 70000 lights at one pixel (lights: AllLights), over this adapter's limit of 65535 iterations a loop",
+        ),
+        (
+            "forward_plus.ron",
+            "forward_plus.ron:31:19: pass 'forward_shading': its light loop may visit 70000 lights at one pixel ('light_lists': a tile's list may hold up to that many), over this adapter's limit of 65535 iterations a loop",
+        ),
+    ] {
+        let mut args = os(
+            &["render", "--width", "16", "--height", "9", "--graph"],
+            &root().join("graphs").join(graph),
+        );
+        args.extend([OsString::from("--scene"), scene.clone().into()]);
+        args.push(OsString::from("--out"));
+        args.push(tmp.path().join("x.png").into());
+        let o = lightgraph(&args);
+        let ok = if limited {
+            o.code == Some(1) && o.output.contains(want)
+        } else {
+            o.code == Some(0)
+        };
+        if !ok {
+            failures.push(format!("{graph} on {}: want {want:?}, got:\n{}", info.name, o.output));
+        }
+    }
+    assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
+}
+
+/// A pass's own buffers (not planned by the graph) are checked against the device before
+/// they are created: at 4100×4100 the culling's coarse lists of Forward+ and tiled deferred
+/// are 138,461,700 bytes, over a 128 MiB storage binding (wgpu's raw
+/// `max_*_buffer_binding_size` text before). Refused where the device's limit is lower,
+/// rendered where it is not.
+#[test]
+fn internal_buffers_are_checked_against_the_device() {
+    const COARSE_BYTES: u64 = 138_461_700;
+    let limit = lightgraph::render::Renderer::headless()
+        .unwrap()
+        .ctx
+        .device
+        .limits()
+        .max_storage_buffer_binding_size;
+    let tmp = tempfile::tempdir().unwrap();
+    let mut failures = Vec::new();
+    for (graph, at) in [
+        ("forward_plus.ron", "forward_plus.ron:25:19"),
+        ("tiled_deferred.ron", "tiled_deferred.ron:19:19"),
+    ] {
+        let mut args = os(
+            &["render", "--width", "4100", "--height", "4100", "--graph"],
+            &root().join("graphs").join(graph),
+        );
+        args.push(OsString::from("--out"));
+        args.push(tmp.path().join("x.png").into());
+        let o = lightgraph(&args);
+        let want = format!(
+            "{at}: pass 'light_culling': its buffer 'coarse light lists' of {COARSE_BYTES} bytes is over the device's limit of {limit} bytes for a storage buffer binding"
+        );
+        let ok = if COARSE_BYTES > limit {
+            o.code == Some(1) && o.output.contains(&want) && !o.output.contains("wgpu")
+        } else {
+            o.code == Some(0)
+        };
+        if !ok {
+            failures.push(format!(
+                "{graph}: want {want:?} (limit {limit}), got:\n{}",
+                o.output
+            ));
+        }
+    }
     assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
 }

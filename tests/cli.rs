@@ -124,6 +124,56 @@ fn compare_prints_a_summary_line_then_a_table() {
     assert!(!out.contains("ImageMetrics {"), "{out}");
 }
 
+/// Images of different shapes but the same pixel count (64×36, 36×64, 48×48) are refused
+/// naming both files and sizes, not compared as if one were the other; so is a 1×1 image
+/// against a larger one (refused before without naming either file), while two 1×1
+/// images compare.
+#[test]
+fn compare_refuses_different_sizes_and_one_pixel_images() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, w: u32, h: u32| {
+        let px: Vec<[f32; 4]> = (0..w * h)
+            .map(|i| [i as f32 / 2304.0, 0.5, 0.25, 1.0])
+            .collect();
+        lightgraph::bench::write_exr(dir.path().join(name), &px, w, h).unwrap();
+    };
+    write("wide.exr", 64, 36);
+    write("tall.exr", 36, 64);
+    write("square.exr", 48, 48);
+    write("dot.exr", 1, 1);
+    for (a, b, says) in [
+        (
+            "wide.exr",
+            "tall.exr",
+            "wide.exr is 64x36 but tall.exr is 36x64",
+        ),
+        (
+            "wide.exr",
+            "square.exr",
+            "wide.exr is 64x36 but square.exr is 48x48",
+        ),
+        (
+            "wide.exr",
+            "dot.exr",
+            "wide.exr is 64x36 but dot.exr is 1x1",
+        ),
+        (
+            "dot.exr",
+            "square.exr",
+            "dot.exr is 1x1 but square.exr is 48x48",
+        ),
+    ] {
+        let o = lightgraph(dir.path(), &["compare", a, b]);
+        let (out, err) = text(&o);
+        assert_eq!(o.status.code(), Some(1), "compare {a} {b}: {out}{err}");
+        assert!(err.contains(says), "compare {a} {b}: {err}");
+    }
+    let o = lightgraph(dir.path(), &["compare", "dot.exr", "dot.exr"]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    assert_eq!(out.lines().next(), Some("identical (1x1)"), "{out}");
+}
+
 #[test]
 fn bench_without_sweep_says_which_it_runs() {
     let dir = tempfile::tempdir().unwrap();

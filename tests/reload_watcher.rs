@@ -653,3 +653,82 @@ fn event_traces() {
         );
     }
 }
+
+fn copy_dir(from: &Path, to: &Path) {
+    fs::create_dir(to).unwrap();
+    for e in fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        if e.file_type().unwrap().is_dir() {
+            copy_dir(&e.path(), &to.join(e.file_name()));
+        } else {
+            fs::copy(e.path(), to.join(e.file_name())).unwrap();
+        }
+    }
+}
+
+/// Every batch until none comes for longer than the grace period (what a folder's swap
+/// reports, held-back removals included), merged.
+fn drain_until_quiet(w: &FileWatcher) -> ChangeBatch {
+    let mut merged = ChangeBatch::default();
+    while let Some(b) = w.wait_for_change(GRACE + ABSENT) {
+        merged.merge(b);
+    }
+    merged
+}
+
+/// Waits (bounded) for a batch naming `path` as modified.
+fn expect_modified(w: &FileWatcher, path: &Path) {
+    let deadline = Instant::now() + PRESENT;
+    loop {
+        let left = deadline.saturating_duration_since(Instant::now());
+        let Some(b) = w.wait_for_change(left) else {
+            panic!("{} not reported within {PRESENT:?}", path.display());
+        };
+        if b.contains(path) {
+            assert_eq!(b.changes.get(path), Some(&ChangeKind::Modified), "{b:?}");
+            return;
+        }
+    }
+}
+
+/// A watched folder replaced by a copy (`cp -r shaders x; rm -rf shaders; mv x shaders`)
+/// is watched again by its path: later edits are reported.
+#[test]
+fn a_watched_folder_replaced_is_watched_again() {
+    let f = fixture();
+    let shaders = f.root.join("shaders");
+    let copy = f.root.join("x");
+    copy_dir(&shaders, &copy);
+    fs::remove_dir_all(&shaders).unwrap();
+    fs::rename(&copy, &shaders).unwrap();
+    let swap = drain_until_quiet(&f.watcher);
+    let lit = shaders.join("lit.wgsl");
+    assert_ne!(
+        swap.changes.get(&lit),
+        Some(&ChangeKind::Removed),
+        "{swap:?}"
+    );
+    fs::write(&lit, "// after the swap\n").unwrap();
+    expect_modified(&f.watcher, &lit);
+    // And once more: the new folder's watch is not a one-off.
+    fs::write(shaders.join("common.wgsl"), "// common 2\n").unwrap();
+    expect_modified(&f.watcher, &shaders.join("common.wgsl"));
+}
+
+/// A watched folder moved away and copied back: edits of the moved-away copy are not
+/// reported as the live file, edits of the copy at the watched path are.
+#[test]
+fn a_watched_folder_moved_away_and_back_follows_the_path() {
+    let f = fixture();
+    let shaders = f.root.join("shaders");
+    let away = f.root.join("away");
+    fs::rename(&shaders, &away).unwrap();
+    drain_until_quiet(&f.watcher);
+    copy_dir(&away, &shaders);
+    drain_until_quiet(&f.watcher);
+    fs::write(away.join("lit.wgsl"), "// the moved-away copy\n").unwrap();
+    expect_quiet(&f.watcher);
+    let lit = shaders.join("lit.wgsl");
+    fs::write(&lit, "// the live file\n").unwrap();
+    expect_modified(&f.watcher, &lit);
+}

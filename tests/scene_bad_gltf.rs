@@ -96,7 +96,7 @@ const CORPUS: &[(&str, Expect)] = &[
     (
         "light_negative_range.gltf",
         Error(&[
-            "light_negative_range.gltf:67:5: light 0 (\"lamp\")",
+            "light_negative_range.gltf:70:6: light 0 (\"lamp\")",
             "range",
         ]),
     ),

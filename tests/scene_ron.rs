@@ -328,3 +328,31 @@ fn bad_scene_files_give_clear_errors() {
         }
     }
 }
+
+/// A model without a camera gets a fitted one only when the scene file gives none: the
+/// warning says so once, naming the scene file, and never when a camera is given.
+#[test]
+fn fitted_camera_warning_only_when_the_scene_file_gives_none() {
+    let d = tmp("camera_warning");
+    let tri = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bad/hostile/models/tri.gltf");
+    let given = load_text(
+        &d,
+        &format!(
+            "Scene(models: [(path: {tri:?})], camera: LookAt(eye: (0, 0, 3), target: (0, 0, 0), fov_y_deg: 50, near: 0.05, far: 100))"
+        ),
+    )
+    .unwrap();
+    assert!(
+        !given.warnings.iter().any(|w| w.contains("fitted")),
+        "{:?}",
+        given.warnings
+    );
+    let fitted = load_text(&d, &format!("Scene(models: [(path: {tri:?})])")).unwrap();
+    let warned: Vec<_> = fitted
+        .warnings
+        .iter()
+        .filter(|w| w.contains("fitted"))
+        .collect();
+    assert_eq!(warned.len(), 1, "{:?}", fitted.warnings);
+    assert!(warned[0].contains("scene.ron: no camera"), "{warned:?}");
+}

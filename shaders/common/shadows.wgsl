@@ -29,6 +29,15 @@ fn shadow_origin(p: vec3<f32>, ng: vec3<f32>) -> vec3<f32> {
     return p + ng * (SHADOW_NORMAL_OFFSET * scale);
 }
 
+// The shadow ray's end, as t_max of origin + t * (light_pos - origin): short of the light
+// by the same relative offset, along the ray, so a light lying on a surface or at an
+// occluder's vertex is not hidden by that surface (its triangle is hit at t ≈ 1, either
+// side of 1 by rounding). src/shadow/mod.rs: shadow_ray is the CPU twin of both.
+fn shadow_t_max(origin: vec3<f32>, light_pos: vec3<f32>) -> f32 {
+    let scale = max(max(abs(light_pos.x), abs(light_pos.y)), max(abs(light_pos.z), 1.0));
+    return max(1.0 - SHADOW_NORMAL_OFFSET * scale / length(light_pos - origin), 0.0);
+}
+
 // A light behind the surface's face is hidden by the surface itself.
 fn shadow_faces(p: vec3<f32>, ng: vec3<f32>, light_pos: vec3<f32>) -> bool {
     return dot(ng, light_pos - p) > 0.0;
@@ -61,7 +70,7 @@ fn shadow_visible(pixel_index: u32, caster: u32, light_pos: vec3<f32>, p: vec3<f
         return false;
     }
     let origin = shadow_origin(p, shadow_ng);
-    return !bvh_occluded(origin, light_pos - origin, 1.0);
+    return !bvh_occluded(origin, light_pos - origin, shadow_t_max(origin, light_pos));
 }
 #endif
 

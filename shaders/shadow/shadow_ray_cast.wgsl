@@ -37,8 +37,8 @@ fn main(
     let p = textureLoad(g_position, xy, 0).xyz;
     let ng = textureLoad(g_geometric, xy, 0).xyz;
     let origin = shadow_origin(p, ng);
-    let to_light = light_geometry[light].position - origin;
-    if (bvh_occluded(origin, to_light, 1.0)) {
+    let light_pos = light_geometry[light].position;
+    if (bvh_occluded(origin, light_pos - origin, shadow_t_max(origin, light_pos))) {
         atomicOr(&shadow_mask[pixel * SHADOW_MASK_WORDS + caster / 32u], 1u << (caster % 32u));
     }
 }

@@ -108,11 +108,9 @@ impl SceneCase {
         }
         s.camera.near = self.near.unwrap_or(s.camera.near);
         s.camera.far = self.far.unwrap_or(s.camera.far);
-        if s.camera.near >= s.camera.far {
-            return Err(format!(
-                "near {} must be below far {}",
-                s.camera.near, s.camera.far
-            ));
+        let (c, fov) = (&s.camera, s.camera.fov_y.to_degrees());
+        if let Some(m) = crate::scene::Camera::lens_error(fov, c.near, c.far) {
+            return Err(m);
         }
         if let Some(i) = self.camera_at_light {
             let Some(light) = s.lights.get(i) else {

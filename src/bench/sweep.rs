@@ -88,6 +88,29 @@ fn default_reference() -> String {
     "brute_force.ron".into()
 }
 
+/// Most timed frames per graph and point: 100,000 frames of a 1 ms graph already take
+/// 100 s a point; the times are kept in memory (8 bytes a frame).
+pub const MAX_FRAMES: u32 = 100_000;
+/// Most warm-up frames per graph and point (warming up by time is what reaches the clocks).
+pub const MAX_WARMUP_FRAMES: u32 = 100_000;
+/// Most rounds per point: each round keeps a median; more rounds than timed frames do not
+/// run anyway (one frame a round at least).
+pub const MAX_ROUNDS: u32 = 10_000;
+
+/// `LINE: ` of the first `field:` outside comments (a whole identifier), or nothing.
+fn field_line(text: &str, field: &str) -> String {
+    text.lines()
+        .position(|l| {
+            let code = l.split("//").next().unwrap_or("");
+            code.match_indices(field).any(|(i, _)| {
+                let before = code[..i].chars().next_back();
+                let after = code[i + field.len()..].trim_start();
+                !before.is_some_and(|c| c.is_alphanumeric() || c == '_') && after.starts_with(':')
+            })
+        })
+        .map_or(String::new(), |i| format!("{}: ", i + 1))
+}
+
 #[derive(Debug, Error)]
 pub enum SweepError {
     #[error("{file}: {message}")]
@@ -135,6 +158,32 @@ impl Sweep {
                 let line = line_of(&format!("\"{}\"", c.name));
                 error(format!("{line}cases[{i}] (\"{}\"): {m}", c.name))
             })?;
+        }
+        // Counts that size allocations and loops, checked against their limits at the
+        // line of their field.
+        let counts = [
+            ("warmup", sweep.warmup, MAX_WARMUP_FRAMES),
+            ("frames", sweep.frames, MAX_FRAMES),
+            ("rounds", sweep.rounds, MAX_ROUNDS),
+        ];
+        for (field, value, limit) in counts {
+            if value > limit {
+                let line = field_line(text, field);
+                return Err(error(format!(
+                    "{line}{field} {value} is over the limit of {limit}"
+                )));
+            }
+        }
+        if let Some(&n) = sweep
+            .lights
+            .iter()
+            .find(|&&n| n as u64 > crate::scene::scene_file::MAX_SCENE_LIGHTS)
+        {
+            let line = field_line(text, "lights");
+            return Err(error(format!(
+                "{line}lights {n} is over the limit of {} (a scene file's limit)",
+                crate::scene::scene_file::MAX_SCENE_LIGHTS
+            )));
         }
         if !(0.0..=3600.0).contains(&sweep.warmup_seconds) {
             let line = line_of("warmup_seconds");

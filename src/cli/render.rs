@@ -72,6 +72,12 @@ fn validate_one(f: &Path, shaders: &ShaderLibrary) -> Result<(), String> {
             }
             Ok(())
         }
+        FileKind::Sweep => {
+            let text = read_text(f, caps::RON).map_err(|e| format!("{}: {e}", f.display()))?;
+            lightgraph::bench::sweep::Sweep::parse(&text, f)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        }
         FileKind::Material => lightgraph::material::Material::load(f)
             .and_then(|m| m.wgsl().map(|_| ()))
             .map_err(|e| e.to_string()),
@@ -529,15 +535,8 @@ pub fn write_image(out: &Path, result: &FrameResult) -> Result<()> {
 }
 
 pub fn compare(a: &Path, b: &Path) -> Result<()> {
-    let ia = bench::read_exr(a)?;
-    let ib = bench::read_exr(b)?;
-    let m = bench::compare(
-        &ia.pixels,
-        &ib.pixels,
-        ia.width,
-        ia.height,
-        &Default::default(),
-    )?;
+    // Both sizes are checked, not only the pixel counts: 64×36 against 36×64 is refused.
+    let m = bench::compare_files(a, b, &Default::default())?;
     println!("{}", compare_summary(&m));
     println!("{m}");
     Ok(())

@@ -40,6 +40,13 @@ pub enum MaterialError {
         count: usize,
         limit: usize,
     },
+    #[error("{at}: {field} {value} {rule}")]
+    OutOfRange {
+        at: Location,
+        field: &'static str,
+        value: String,
+        rule: String,
+    },
     #[error("{at}: empty lobe list: layer {layer} has no lobes")]
     EmptyLobes { at: Location, layer: usize },
     #[error("{at}: missing texture file `{path}` (looked for {resolved})", resolved = .resolved.display())]

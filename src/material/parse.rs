@@ -5,6 +5,7 @@
 use super::error::{Location, MaterialError};
 use super::model::{Lobe, MaterialDesc};
 use super::{TextureSlot, TextureSource};
+use crate::scene::AlphaMode;
 use std::path::Path;
 
 fn loc(path: &Path, line: usize, col: usize) -> Location {
@@ -136,6 +137,16 @@ fn check(desc: &MaterialDesc, src: &str, path: &Path) -> Result<(), MaterialErro
             limit: MAX_LAYERS,
         });
     }
+    if let AlphaMode::Mask(cutoff) = desc.alpha_mode {
+        if let Some(rule) = alpha_cutoff_rule(cutoff) {
+            return Err(MaterialError::OutOfRange {
+                at: locate(src, path, "Mask", 0),
+                field: "alpha_mode Mask cutoff",
+                value: format!("{cutoff}"),
+                rule: rule.to_string(),
+            });
+        }
+    }
     let lists = empty_lists(src, "lobes");
     for (i, layer) in desc.layers.iter().enumerate() {
         if layer.lobes.len() > MAX_LOBES_PER_LAYER {
@@ -181,6 +192,12 @@ fn check(desc: &MaterialDesc, src: &str, path: &Path) -> Result<(), MaterialErro
         }
     }
     Ok(())
+}
+
+/// Why an alpha cutoff is refused, if it is: coverage lies in [0, 1], so a cutoff outside
+/// it keeps every fragment or none, and a non-finite one is no WGSL literal at all.
+pub fn alpha_cutoff_rule(cutoff: f32) -> Option<&'static str> {
+    (!(0.0..=1.0).contains(&cutoff)).then_some("must be a finite number in 0..=1")
 }
 
 /// Names of the textures a lobe reads.

@@ -127,3 +127,71 @@ pub fn check_dispatch(
         ),
     })
 }
+
+/// Creates a buffer a pass makes for itself (not planned by the graph, so not seen by
+/// [`check_plan`]), checked first against the device's limits for its size and, as it is
+/// bound whole, for a storage or uniform binding of it: wgpu would report an oversized one
+/// as raw validation text (`max_*_buffer_binding_size`) at bind-group creation. The error
+/// names `pass` (located at its declaration by the caller) and the buffer's label.
+pub fn create_internal_buffer(
+    device: &wgpu::Device,
+    pass: &str,
+    desc: &wgpu::BufferDescriptor,
+) -> Result<wgpu::Buffer, RenderError> {
+    let limits = device.limits();
+    let mut max = (limits.max_buffer_size, "buffer");
+    if desc.usage.contains(wgpu::BufferUsages::STORAGE) {
+        max = max.min((
+            limits.max_storage_buffer_binding_size,
+            "storage buffer binding",
+        ));
+    }
+    if desc.usage.contains(wgpu::BufferUsages::UNIFORM) {
+        max = max.min((
+            limits.max_uniform_buffer_binding_size,
+            "uniform buffer binding",
+        ));
+    }
+    if desc.size > max.0 {
+        return Err(RenderError::Pass {
+            pass: pass.to_string(),
+            message: format!(
+                "its buffer '{}' of {} bytes is over the device's limit of {} bytes for a {} (it grows with the frame size and the light count)",
+                desc.label.unwrap_or("unnamed"),
+                desc.size,
+                max.0,
+                max.1
+            ),
+        });
+    }
+    Ok(device.create_buffer(desc))
+}
+
+/// The most iterations one shader loop may run on this adapter, where it is known to end
+/// longer loops early and silently: llvmpipe (lavapipe) leaves any loop after 65,535
+/// iterations (gallivm's `LP_MAX_TGSI_LOOP_ITERATIONS`), so a light loop past it drops
+/// every later light without an error. None where no such limit is known.
+pub fn loop_iteration_limit(info: &wgpu::AdapterInfo) -> Option<u64> {
+    let llvmpipe = info.name.contains("llvmpipe") || info.driver.contains("llvmpipe");
+    llvmpipe.then_some(65_535)
+}
+
+/// A shading pass's light loop of up to `most` lights at one pixel, against the
+/// adapter's loop limit; `what` says where the bound comes from.
+pub fn check_light_loop(
+    info: &wgpu::AdapterInfo,
+    pass: &str,
+    most: u64,
+    what: &str,
+) -> Result<(), RenderError> {
+    match loop_iteration_limit(info) {
+        Some(limit) if most > limit => Err(RenderError::Pass {
+            pass: pass.to_string(),
+            message: format!(
+                "its light loop may visit {most} lights at one pixel ({what}), over this adapter's limit of {limit} iterations a loop ({} ends longer loops silently, losing the lights past it)",
+                info.name
+            ),
+        }),
+        _ => Ok(()),
+    }
+}

@@ -38,6 +38,13 @@ impl LightStatsPass {
         size: FrameSize,
     ) -> Result<Self, RenderError> {
         let device = r.ctx.device.clone();
+        // The exact count walks every light at every pixel.
+        super::device_limits::check_light_loop(
+            &r.ctx.adapter.get_info(),
+            PASS,
+            gpu.light_count as u64,
+            "its exact count walks every light",
+        )?;
         let after = graph
             .passes
             .iter()
@@ -85,12 +92,16 @@ impl LightStatsPass {
         let Pipeline::Compute(pipeline) = pipeline else {
             return Err(pass_error(PASS, "expected a compute pipeline".into()));
         };
-        let counts = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("light counts"),
-            size: 8 * size.width as u64 * size.height as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
+        let counts = super::device_limits::create_internal_buffer(
+            &device,
+            PASS,
+            &wgpu::BufferDescriptor {
+                label: Some("light counts"),
+                size: 8 * size.width as u64 * size.height as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            },
+        )?;
         let view_proj = glam::Mat4::from_cols_array_2d(&gpu_frame.view_proj);
         let inv = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("inverse view-projection"),

@@ -6,9 +6,18 @@ use super::error::SceneError;
 use super::types::{Camera, Light, Scene};
 use std::path::Path;
 
-/// Largest coordinate of a vertex, light or camera, in metres. Past it f32 spacing is
-/// over a metre, and squared distances stay far below f32's range.
-pub const MAX_COORDINATE: f32 = 1e7;
+/// Largest coordinate of a vertex, light or camera, in metres. f32 spacing at 1e5 is
+/// 7.8 mm: vertices, lights and the eye keep sub-centimetre places, so interpolated
+/// positions, light vectors and view-space depths move by under a centimetre, and a
+/// metre-sized object keeps its shape (rendered at 1e5 or 1e6 m from the origin, a 1 m
+/// triangle differs from the same at the origin only along its edges; at 1e7 the spacing
+/// is a metre, such geometry collapses and rendered black). Squared distances stay far
+/// below f32's range.
+pub const MAX_COORDINATE: f32 = 1e5;
+/// Largest texture coordinate magnitude. f32 spacing at 4096 is 2^-11 of a texture
+/// repeat, a texel of a 2048-texel texture: interpolated UVs past it land on texels at
+/// random (3e38 overflowed to Inf in the sampling and shaded a triangle grey).
+pub const MAX_UV: f32 = 4096.0;
 /// Largest light range, in metres (the fallback light reaches twice the scene diagonal).
 pub const MAX_RANGE: f32 = 1e8;
 /// Largest intensity × colour channel of a light, in candela. A light this bright at
@@ -32,6 +41,20 @@ impl Scene {
                     format!(
                         "position {p:?} after the scene transform is not finite or beyond ±{MAX_COORDINATE:e} m"
                     ),
+                ));
+            }
+        }
+        for (mi, mesh) in self.meshes.iter().enumerate() {
+            if let Some((vi, uv)) = mesh
+                .uvs
+                .iter()
+                .enumerate()
+                .find(|(_, uv)| !(uv.is_finite() && uv.abs().max_element() <= MAX_UV))
+            {
+                return Err(SceneError::invalid(
+                    file,
+                    format!("mesh {mi} (\"{}\") vertex {vi}", mesh.name),
+                    format!("texture coordinate {uv:?} is not finite or beyond ±{MAX_UV}"),
                 ));
             }
         }

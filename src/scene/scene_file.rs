@@ -484,18 +484,16 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
                 && target.is_finite()
                 && up.is_finite()
                 && (eye - target).length_squared() > 0.0
-                && up.length_squared() > 0.0
-                && *fov_y_deg > 0.0
-                && *fov_y_deg < 180.0
-                && *near > 0.0
-                && far > near
-                && far.is_finite();
+                && up.length_squared() > 0.0;
             if !ok {
                 return Err(SceneError::invalid(
                     file,
                     "camera",
-                    "LookAt needs finite eye != target, up != 0, 0 < fov_y_deg < 180, 0 < near < far",
+                    "LookAt needs finite eye != target and up != 0",
                 ));
+            }
+            if let Some(m) = Camera::lens_error(*fov_y_deg, *near, *far) {
+                return Err(SceneError::invalid(file, "camera", m));
             }
             Camera {
                 eye: *eye,
@@ -508,7 +506,17 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
         }
         Some(CameraSpec::FitBounds) => bounds.map(fit_camera).unwrap_or_default(),
         Some(CameraSpec::AmdBounds) => bounds.map(amd_camera).unwrap_or_default(),
-        None => camera.unwrap_or_else(|| bounds.map(fit_camera).unwrap_or_default()),
+        None => match (camera, bounds) {
+            (Some(c), _) => c,
+            (None, Some(b)) => {
+                warnings.push(format!(
+                    "{}: no camera (none given, and no built-in or model has one); one was fitted to the scene bounds",
+                    file.display()
+                ));
+                fit_camera(b)
+            }
+            (None, None) => Camera::default(),
+        },
     };
 
     for (name, path) in &spec.material_overrides {

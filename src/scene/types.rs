@@ -165,7 +165,45 @@ impl Default for Camera {
     }
 }
 
+/// Narrowest vertical field of view, degrees. At 1° a pixel of a 16,384-row frame still
+/// subtends 1.07e-6 of its distance, about 9 f32 ulps (2^-23 relative): positions
+/// reconstructed from depth through the inverse view-projection differ from pixel to pixel,
+/// and the tile frustums the culling builds from neighbouring pixel rays are not degenerate.
+/// Far narrower lenses collapse them (1e-6° rendered half or all black).
+pub const MIN_FOV_Y_DEG: f32 = 1.0;
+/// Largest far / near ratio, 2^24. The depth of the projection (standard Z, f32 depth) is
+/// about 1 − near/z, and one ulp of values just under 1 is 2^-24: a surface at z keeps a
+/// depth below the far plane's only while near·(1/z − 1/far) ≥ 2^-24. At the limit every
+/// surface nearer than half the far plane does; past it depths round to the far plane, the
+/// culling's depth bounds collapse and lights are lost (near 1e-8 with far 100 kept
+/// nothing beyond 0.17 m).
+pub const MAX_FAR_OVER_NEAR: f32 = 16_777_216.0;
+
 impl Camera {
+    /// Why a lens (vertical field of view in degrees, near and far planes in metres) is
+    /// refused, naming the field; None when it is within the limits above.
+    pub fn lens_error(fov_y_deg: f32, near: f32, far: f32) -> Option<String> {
+        // A perspective projection ends below 180°.
+        if !(MIN_FOV_Y_DEG..180.0).contains(&fov_y_deg) {
+            return Some(format!(
+                "fov_y_deg {fov_y_deg} must be at least {MIN_FOV_Y_DEG} (narrower lenses are beyond f32 position and culling precision) and below 180"
+            ));
+        }
+        if !(near.is_finite() && near > 0.0) {
+            return Some(format!("near {near} must be finite and > 0"));
+        }
+        if !(far.is_finite() && far > near) {
+            return Some(format!("far {far} must be finite and > near {near}"));
+        }
+        if far / near > MAX_FAR_OVER_NEAR {
+            return Some(format!(
+                "far / near is {:e} (near {near}, far {far}), over the limit of 2^24 = {MAX_FAR_OVER_NEAR}: f32 depth cannot resolve the depth range (raise near)",
+                far / near
+            ));
+        }
+        None
+    }
+
     pub fn view(&self) -> Mat4 {
         Mat4::look_at_rh(self.eye, self.target, self.up)
     }

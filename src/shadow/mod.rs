@@ -22,3 +22,25 @@ pub use bvh::{
     BuildOptions, BuildStats, BvhNode, BvhTriangle, ShadowBvh, ShadowError, LEAF_BIT, STACK_SIZE,
 };
 pub use reference::{near_edge, occluded_reference, scene_triangles_f64, Triangle64};
+
+/// A shadow ray from a shaded point towards a light, as every tracer casts it (the twin of
+/// `shadow_origin` and `shadow_t_max` in `shaders/common/shadows.wgsl`, in the same f32
+/// steps): `(origin, dir, t_max)` for `origin + t * dir`, `0 < t < t_max`.
+///
+/// Both ends stay off surfaces by `offset` times the larger of 1 and the largest coordinate
+/// of that end (f32 positions are that much less precise): the origin along the geometric
+/// normal `ng`, the end short of the light along the ray. A light lying on a surface, or at
+/// an occluder's vertex, is then not hidden by that surface (its triangle would be hit at
+/// t ≈ 1 either side of 1 by rounding).
+pub fn shadow_ray(
+    p: glam::Vec3,
+    ng: glam::Vec3,
+    light: glam::Vec3,
+    offset: f32,
+) -> (glam::Vec3, glam::Vec3, f32) {
+    let magnitude = |v: glam::Vec3| v.x.abs().max(v.y.abs()).max(v.z.abs().max(1.0));
+    let origin = p + ng * (offset * magnitude(p));
+    let dir = light - origin;
+    let t_max = (1.0 - offset * magnitude(light) / dir.length()).max(0.0);
+    (origin, dir, t_max)
+}

@@ -21,9 +21,44 @@ pub(super) struct Shared {
     pub(super) parent_dirs: BTreeSet<PathBuf>,
     /// Files under the watch known to exist (so a vanished one can be reported as removed).
     pub(super) known: HashSet<PathBuf>,
+    /// Every directory registered with notify (`dirs` and `parent_dirs`), with how, and
+    /// which directory was at that path when it was registered. The kernel watches a
+    /// directory, not its path: one replaced, or moved away and back, is watched again.
+    pub(super) identities: HashMap<PathBuf, (Option<DirId>, notify::RecursiveMode)>,
+}
+
+/// Which directory is at a path (device and inode), if any.
+pub(super) type DirId = (u64, u64);
+
+/// The directory at `path` now, if there is one.
+pub(super) fn dir_id(path: &Path) -> Option<DirId> {
+    let m = std::fs::metadata(path).ok().filter(|m| m.is_dir())?;
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        Some((m.dev(), m.ino()))
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = m;
+        Some((0, 0))
+    }
 }
 
 impl Shared {
+    /// Whether the directory registered for `path` (its root, or a watched file's parent)
+    /// is still the one at that path: events from a directory moved away still carry the
+    /// path it was registered under, and are not the live files'.
+    fn still_registered(&self, path: &Path) -> bool {
+        self.identities
+            .iter()
+            .filter(|(dir, (_, mode))| match mode {
+                notify::RecursiveMode::Recursive => path.starts_with(dir),
+                notify::RecursiveMode::NonRecursive => path.parent() == Some(dir.as_path()),
+            })
+            .all(|(dir, (id, _))| id.is_some() && dir_id(dir) == *id)
+    }
+
     fn is_relevant(&self, path: &Path) -> bool {
         !is_editor_temp_file(path)
             && (self.files.contains(path) || self.dirs.iter().any(|d| path.starts_with(d)))
@@ -61,6 +96,9 @@ pub(super) struct Debouncer {
     pub(super) burst: Option<(Instant, Instant)>,
     /// Empty or vanished files held back, with their deadline.
     pub(super) held: HashMap<PathBuf, Instant>,
+    /// The notify watcher, to register a watched directory again where it was replaced
+    /// (`None` once the [`super::FileWatcher`] is dropped).
+    pub(super) watcher: Arc<Mutex<Option<notify::RecommendedWatcher>>>,
 }
 
 /// Longest the thread sleeps before checking for shutdown.
@@ -99,7 +137,75 @@ impl Debouncer {
                 Err(RecvTimeoutError::Timeout) => {}
                 Err(RecvTimeoutError::Disconnected) => break,
             }
+            self.follow_paths();
             self.evaluate(Instant::now());
+        }
+    }
+
+    /// Registers again every watched directory whose path now holds another directory (or
+    /// none): the old registration followed the directory, not the path. Every file under
+    /// it, known before or found now, is re-checked as after lost events.
+    pub(super) fn follow_paths(&mut self) {
+        let stale: Vec<(PathBuf, notify::RecursiveMode)> = {
+            let shared = self.shared.lock().unwrap();
+            shared
+                .identities
+                .iter()
+                .filter(|(dir, (id, _))| dir_id(dir) != *id)
+                .map(|(dir, (_, mode))| (dir.clone(), *mode))
+                .collect()
+        };
+        if stale.is_empty() {
+            return;
+        }
+        let mut watcher = self.watcher.lock().unwrap();
+        let mut shared = self.shared.lock().unwrap();
+        for (dir, mode) in stale {
+            let mut id = None;
+            if let Some(w) = watcher.as_mut() {
+                use notify::Watcher;
+                // The old directory's watch, wherever it went (an error where the kernel
+                // already dropped it with the directory).
+                let _ = w.unwatch(&dir);
+                id = dir_id(&dir);
+                if id.is_some() {
+                    if let Err(e) = w.watch(&dir, mode) {
+                        log::warn!("file watcher: {}: {e}", dir.display());
+                        id = None;
+                    }
+                }
+                // Registered while it changed again: checked once more on the next round.
+                if id != dir_id(&dir) {
+                    id = None;
+                }
+            }
+            shared.identities.insert(dir.clone(), (id, mode));
+            let mut found = HashSet::new();
+            match mode {
+                notify::RecursiveMode::Recursive => scan_dir(&dir, &mut found),
+                notify::RecursiveMode::NonRecursive => found.extend(
+                    shared
+                        .files
+                        .iter()
+                        .filter(|f| f.parent() == Some(&dir))
+                        .cloned(),
+                ),
+            }
+            let under = |p: &PathBuf| match mode {
+                notify::RecursiveMode::Recursive => p.starts_with(&dir),
+                notify::RecursiveMode::NonRecursive => p.parent() == Some(dir.as_path()),
+            };
+            found.extend(shared.known.iter().filter(|p| under(p)).cloned());
+            let now = Instant::now();
+            for path in found {
+                if shared.is_relevant(&path) {
+                    self.pending.insert(path, Progress::UNKNOWN);
+                    self.burst = Some(match self.burst {
+                        Some((first, _)) => (first, now),
+                        None => (now, now),
+                    });
+                }
+            }
         }
     }
 
@@ -137,7 +243,7 @@ impl Debouncer {
             // Editors' temp files and unwatched siblings of watched files neither reach a
             // batch nor hold one back (a swap file kept open must not).
             for path in event.paths {
-                if shared.is_relevant(&path) {
+                if shared.is_relevant(&path) && shared.still_registered(&path) {
                     let known = shared.known.contains(&path);
                     self.pending.entry(path).or_default().on(&event.kind, known);
                     touched = true;
@@ -236,6 +342,7 @@ mod tests {
             pending: HashMap::new(),
             burst: None,
             held: HashMap::new(),
+            watcher: Arc::new(Mutex::new(None)),
         };
         (dir, root, d, batches)
     }

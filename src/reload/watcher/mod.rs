@@ -40,9 +40,16 @@
 //! names files whose writers have closed them), where the debounce alone would have
 //! joined them.
 //!
+//! # Folders followed by path
+//! The kernel watches a directory, not its path. A watched directory (a root, or a
+//! watched file's parent) that is replaced, recreated, or moved away and back is found by
+//! its path again: the debounce thread checks each one's device and inode on every round
+//! (at least every 100 ms) and registers the directory now at the path, re-checking every
+//! file under it. Events from a directory no longer at its path (a moved-away copy, whose
+//! events still carry the old path) are dropped, so they are never reported as the live
+//! file.
+//!
 //! # Limits
-//! - Deleting and recreating a *watched directory root* ends its watch (inotify watches
-//!   directories by inode); watch its parent instead.
 //! - A directory moved or copied into a watched tree reports files created in it after the move;
 //!   files that came inside it are reported only when they are next touched (inotify cannot add
 //!   the new directory's watch atomically).
@@ -119,7 +126,8 @@ impl Default for WatchConfig {
 /// Watches files and directories and delivers debounced [`ChangeBatch`]es.
 /// See the [module documentation](self) for the save styles it handles.
 pub struct FileWatcher {
-    watcher: Option<notify::RecommendedWatcher>,
+    /// Shared with the debounce thread, which registers replaced directories again.
+    watcher: Arc<Mutex<Option<notify::RecommendedWatcher>>>,
     shared: Arc<Mutex<Shared>>,
     batches: Receiver<ChangeBatch>,
     shutdown: Arc<AtomicBool>,
@@ -145,6 +153,7 @@ impl FileWatcher {
                 path: PathBuf::new(),
                 source,
             })?;
+        let watcher = Arc::new(Mutex::new(Some(watcher)));
         let (batch_tx, batches) = mpsc::channel();
         let shared = Arc::new(Mutex::new(Shared::default()));
         let shutdown = Arc::new(AtomicBool::new(false));
@@ -158,6 +167,7 @@ impl FileWatcher {
                 pending: HashMap::new(),
                 burst: None,
                 held: HashMap::new(),
+                watcher: watcher.clone(),
             };
             std::thread::Builder::new()
                 .name("lightgraph-watch".into())
@@ -168,7 +178,7 @@ impl FileWatcher {
                 })?
         };
         Ok(Self {
-            watcher: Some(watcher),
+            watcher,
             shared,
             batches,
             shutdown,
@@ -185,7 +195,8 @@ impl FileWatcher {
             path: path.to_path_buf(),
             source,
         };
-        let watcher = self.watcher.as_mut().expect("watcher lives until drop");
+        let mut watcher = self.watcher.lock().unwrap();
+        let watcher = watcher.as_mut().expect("watcher lives until drop");
         let notify_err = |source| WatchError::Notify {
             path: path.to_path_buf(),
             source,
@@ -199,6 +210,12 @@ impl FileWatcher {
                         .map_err(notify_err)?;
                     shared.dirs.retain(|d| !d.starts_with(&dir));
                     shared.dirs.insert(dir.clone());
+                    // Roots now inside this one are covered by its watch.
+                    shared.identities.retain(|d, _| !d.starts_with(&dir));
+                    shared.identities.insert(
+                        dir.clone(),
+                        (debounce::dir_id(&dir), RecursiveMode::Recursive),
+                    );
                 }
                 let mut found = HashSet::new();
                 scan_dir(&dir, &mut found);
@@ -232,6 +249,10 @@ impl FileWatcher {
                     watcher
                         .watch(&parent, RecursiveMode::NonRecursive)
                         .map_err(notify_err)?;
+                    shared.identities.insert(
+                        parent.clone(),
+                        (debounce::dir_id(&parent), RecursiveMode::NonRecursive),
+                    );
                     shared.parent_dirs.insert(parent);
                 }
                 if file.is_file() {
@@ -269,7 +290,7 @@ impl FileWatcher {
 impl Drop for FileWatcher {
     fn drop(&mut self) {
         self.shutdown.store(true, Ordering::Relaxed);
-        drop(self.watcher.take());
+        drop(self.watcher.lock().unwrap().take());
         if let Some(t) = self.thread.take() {
             let _ = t.join();
         }

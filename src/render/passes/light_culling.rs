@@ -7,6 +7,7 @@ use super::{defines, PrepareCtx, PreparedPass, Timestamps};
 use crate::gpu::readback::read_buffer;
 use crate::graph::Name;
 use crate::graph::{slot, LightCulling, ListLayout, ListStorage, ScheduledPass};
+use crate::render::device_limits::create_internal_buffer;
 use crate::render::pipelines::PipelineKey;
 use crate::render::report::{CullingReport, PassReport};
 use crate::render::{RenderError, Renderer};
@@ -76,12 +77,16 @@ pub(super) fn prepare(
     } else {
         1
     };
-    let coarse_lists = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("coarse light lists"),
-        size: coarse_words * 4,
-        usage: wgpu::BufferUsages::STORAGE,
-        mapped_at_creation: false,
-    });
+    let coarse_lists = create_internal_buffer(
+        &device,
+        &sp.name,
+        &wgpu::BufferDescriptor {
+            label: Some("coarse light lists"),
+            size: coarse_words * 4,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        },
+    )?;
     let mut offered = cx.declared(sp)?;
     offered.buffer(
         "list_params",
@@ -95,12 +100,16 @@ pub(super) fn prepare(
         .buffer_size("light_geometry")
         .map_or(cx.gpu.light_count as u64, |b| b / LIGHT_GEOMETRY_BYTES)
         .max(1);
-    let light_bounds = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("light bounds (view space)"),
-        size: LIGHT_BOUNDS_BYTES * light_capacity,
-        usage: wgpu::BufferUsages::STORAGE,
-        mapped_at_creation: false,
-    });
+    let light_bounds = create_internal_buffer(
+        &device,
+        &sp.name,
+        &wgpu::BufferDescriptor {
+            label: Some("light bounds (view space)"),
+            size: LIGHT_BOUNDS_BYTES * light_capacity,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        },
+    )?;
     offered.buffer("light_bounds", &light_bounds);
     let mut d = vec![
         ("TILE", format!("{}u", p.tile)),
@@ -153,14 +162,20 @@ pub(super) fn prepare(
             usage: wgpu::BufferUsages::UNIFORM,
         })
     };
-    let block_sums = (blocks > 0).then(|| {
-        device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("light list block sums"),
-            size: 8 * blocks as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
+    let block_sums = (blocks > 0)
+        .then(|| {
+            create_internal_buffer(
+                &device,
+                &sp.name,
+                &wgpu::BufferDescriptor {
+                    label: Some("light list block sums"),
+                    size: 8 * blocks as u64,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                },
+            )
         })
-    });
+        .transpose()?;
     if let Some(b) = &block_sums {
         offered.buffer("list_block_sums", b);
         offered.buffer("compact", &phase(0));
@@ -205,12 +220,16 @@ pub(super) fn prepare(
     } else {
         None
     };
-    let report_copy = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("light list entries (report)"),
-        size: 4 * layout.pool_offset_words() as u64,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
+    let report_copy = create_internal_buffer(
+        &device,
+        &sp.name,
+        &wgpu::BufferDescriptor {
+            label: Some("light list entries (report)"),
+            size: 4 * layout.pool_offset_words() as u64,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        },
+    )?;
     Ok(LightCullingPass {
         bounds,
         timed_dispatch: std::env::var("LIGHTGRAPH_TIME_DISPATCH")

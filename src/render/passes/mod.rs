@@ -298,11 +298,24 @@ impl PrepareCtx<'_> {
         lights: crate::graph::LightSource,
         offered: &mut BindingSet,
     ) -> Result<ShadeLists, RenderError> {
+        // Every light the pass may see: the scene's, or all the bound light buffer holds
+        // (passes before it, VplSpawn, may add lights).
+        let lights_bound = offered
+            .buffer_size("light_geometry")
+            .map_or(self.gpu.light_count as u64, |b| {
+                b / std::mem::size_of::<crate::gpu::structs::GpuLightGeometry>() as u64
+            });
+        let info = self.renderer.ctx.adapter.get_info();
+        let loop_check = |most: u64, what: &str| {
+            crate::render::device_limits::check_light_loop(&info, &sp.name, most, what)
+        };
         if lights == crate::graph::LightSource::AllLights {
+            loop_check(lights_bound, "lights: AllLights")?;
             return Ok(ShadeLists::AllLights);
         }
         let lists = sp.required(crate::graph::slot::LIGHT_LISTS);
         if let Some(links) = self.graph.plan.link_layout(lists) {
+            loop_check(lights_bound, "a pixel's linked list may hold every light")?;
             let params = GpuLinkParams::new(&links).ok_or_else(|| {
                 pass_error(
                     &sp.name,
@@ -311,6 +324,16 @@ impl PrepareCtx<'_> {
             })?;
             offered.buffer("link_params", &params.buffer(&self.renderer.ctx.device));
             return Ok(ShadeLists::Links);
+        }
+        if let Some(layout) = self.graph.plan.list_layout(lists) {
+            let per_list = match layout.storage {
+                crate::graph::plan::ListStorage::Fixed { capacity } => capacity as u64,
+                crate::graph::plan::ListStorage::Compact { max_indices, .. } => max_indices as u64,
+            };
+            loop_check(
+                per_list.min(lights_bound),
+                &format!("'{lists}': a tile's list may hold up to that many"),
+            )?;
         }
         offered.buffer("list_params", &self.list_params(&sp.name, lists)?);
         Ok(ShadeLists::Tiles)

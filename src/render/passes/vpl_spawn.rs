@@ -72,12 +72,16 @@ pub(super) fn prepare(
         }
     }
     let device = cx.device();
-    let candidates = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("vpl candidates"),
-        size: CANDIDATE_BYTES * layout.candidates.max(1) as u64,
-        usage: wgpu::BufferUsages::STORAGE,
-        mapped_at_creation: false,
-    });
+    let candidates = crate::render::device_limits::create_internal_buffer(
+        &device,
+        &sp.name,
+        &wgpu::BufferDescriptor {
+            label: Some("vpl candidates"),
+            size: CANDIDATE_BYTES * layout.candidates.max(1) as u64,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        },
+    )?;
     let control = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("vpl control"),
         size: 4 * CONTROL_WORDS,

@@ -48,6 +48,9 @@ impl Importer {
                 far.max(znear * 10.0)
             }
         };
+        if let Some(m) = Camera::lens_error(yfov.to_degrees(), znear, far) {
+            return Err(self.err(element, format!("camera lens: {m}")));
+        }
         Ok(Camera {
             eye,
             target: eye + fwd,

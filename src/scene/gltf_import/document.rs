@@ -222,8 +222,9 @@ impl Importer {
                 self.make_camera(&element, world, lens, bounds)?
             }
             None => {
+                // Whether this fitted camera is used (and worth a warning) is the
+                // caller's to say: a scene file may give its own.
                 if let Some(b) = bounds {
-                    self.warn("no perspective camera; one was fitted to the scene bounds");
                     fit_camera(b)
                 } else {
                     Camera::default()

@@ -141,7 +141,20 @@ pub fn locate(text: &str, element: &str, message: &str) -> Option<Location> {
             steps.pop();
         }
     }
-    paths.extend(element_paths(element));
+    // A message that starts with a field of the element (`alphaCutoff 2 must ...`)
+    // points at that field, else at the element.
+    let field = message.split_whitespace().next().filter(|w| {
+        w.chars().all(|c| c.is_ascii_alphanumeric())
+            && w.starts_with(|c: char| c.is_ascii_lowercase())
+    });
+    for p in element_paths(element) {
+        if let Some(f) = field {
+            let mut with_field = p.clone();
+            with_field.push(Step::Key(f.to_string()));
+            paths.push(with_field);
+        }
+        paths.push(p);
+    }
     paths.iter().find_map(|p| find(&toks, root, p))
 }
 

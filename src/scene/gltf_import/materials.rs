@@ -72,7 +72,13 @@ impl Importer {
         }
         let alpha_mode = match m.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
-            gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
+            gltf::material::AlphaMode::Mask => {
+                let cutoff = m.alpha_cutoff().unwrap_or(0.5);
+                if let Some(rule) = crate::material::parse::alpha_cutoff_rule(cutoff) {
+                    return Err(self.err(element, format!("alphaCutoff {cutoff} {rule}")));
+                }
+                AlphaMode::Mask(cutoff)
+            }
             gltf::material::AlphaMode::Blend => AlphaMode::Blend,
         };
         let sm = SurfaceMaterial {

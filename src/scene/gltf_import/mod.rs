@@ -81,7 +81,20 @@ pub fn import_gltf(path: &Path) -> Result<Loaded, SceneError> {
 
 /// Imports a .gltf or .glb file. Relative URIs resolve against the file's folder.
 pub fn import_gltf_with(path: &Path, limits: &ImportLimits) -> Result<Loaded, SceneError> {
-    import_gltf_inner(path, limits).map(|(l, ..)| l)
+    import_gltf_inner(path, limits)
+        .map(|(l, has_camera, _)| with_camera_warning(l, has_camera, path))
+}
+
+/// A glTF file loaded on its own renders through its own camera, or a fitted one: the
+/// latter is worth a warning. (A scene file that places the model decides for itself.)
+fn with_camera_warning(mut loaded: Loaded, has_camera: bool, file: &Path) -> Loaded {
+    if !has_camera && loaded.scene.bounds().is_some() {
+        loaded.warnings.push(format!(
+            "{}: no perspective camera; one was fitted to the scene bounds",
+            file.display()
+        ));
+    }
+    loaded
 }
 
 /// Imports and tells whether the file had a perspective camera (else one was fitted),
@@ -103,7 +116,8 @@ pub fn import_gltf_slice(
     file: &Path,
     limits: &ImportLimits,
 ) -> Result<Loaded, SceneError> {
-    import_slice_inner(bytes, base_dir, file, limits).map(|(l, ..)| l)
+    import_slice_inner(bytes, base_dir, file, limits)
+        .map(|(l, has_camera, _)| with_camera_warning(l, has_camera, file))
 }
 
 fn import_slice_inner(

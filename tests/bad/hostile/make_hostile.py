@@ -105,3 +105,18 @@ with open("models/wide.png", "wb") as f:
 # glTF JSON with a UTF-8 byte-order mark: accepted as in every other format.
 with open("bom.gltf", "wb") as f:
     f.write(b"\xef\xbb\xbf" + json.dumps(tri_doc(extra=with_light), indent=1).encode())
+# Alpha cutoffs outside 0..=1 (JSON has no NaN or infinity; 1e39 is one as an f32).
+for name, cutoff in [("alpha_cutoff_2", 2), ("alpha_cutoff_neg1", -1), ("alpha_cutoff_1e39", 1e39)]:
+    def mask(d, cutoff=cutoff):
+        with_light(d)
+        d["materials"][0].update({"alphaMode": "MASK", "alphaCutoff": cutoff})
+    write(name + ".gltf", tri_doc(extra=mask))
+# A finite texture coordinate of 3e38 (past what f32 interpolation keeps).
+def huge_uv(d):
+    with_light(d)
+    uv = struct.pack("<6f", 0, 0, 3e38, 0, 0, 1)
+    d["bufferViews"].append({"buffer": 1, "byteLength": len(uv)})
+    d["buffers"].append({"byteLength": len(uv), "uri": b64(uv)})
+    d["accessors"].append({"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"})
+    d["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = 1
+write("uv_3e38.gltf", tri_doc(extra=huge_uv))
