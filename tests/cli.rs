@@ -372,3 +372,44 @@ fn render_reports_compact_lists_and_their_bound() {
         }
     }
 }
+
+/// Glass through a graph without transparency passes is rendered without it, and `render`
+/// says so; a graph with them says nothing.
+#[test]
+fn render_warns_when_the_graph_draws_no_blended_meshes() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = root.join("scenes/glass.ron");
+    let run = |graph: &str| {
+        let g = root.join("graphs").join(graph);
+        let out = dir.path().join("x.png");
+        let o = lightgraph(
+            dir.path(),
+            &[
+                "render",
+                "--scene",
+                scene.to_str().unwrap(),
+                "--graph",
+                g.to_str().unwrap(),
+                "--width",
+                "64",
+                "--height",
+                "36",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+        );
+        let (stdout, err) = text(&o);
+        assert!(o.status.success(), "{graph}: {stdout}\n{err}");
+        err
+    };
+    for graph in ["forward_plus.ron", "visibility_compute_raster.ron"] {
+        let err = run(graph);
+        assert!(
+            err.contains("has no TransparentShading pass: the scene's blended"),
+            "{graph}: {err}"
+        );
+    }
+    let err = run("transparent.ron");
+    assert!(!err.contains("TransparentShading"), "{err}");
+}

@@ -212,6 +212,9 @@ pub fn render(args: RenderArgs) -> Result<()> {
         bail!("output size {}x{} is empty", size.width, size.height);
     }
     let compiled = graph::compile(checked, &scene.features(), size);
+    for w in graph::coverage::undrawn(&compiled, &scene.features()) {
+        eprintln!("warning: {w}");
+    }
     if args.heatmap.is_some() && !compiled.has_light_culling() {
         bail!(
             "--heatmap needs a graph with a LightCulling pass; {} has none after culling",

@@ -3,6 +3,7 @@
 //! happens in the renderer, through its pipeline cache.
 
 mod compiled;
+pub mod coverage;
 mod deps;
 mod error;
 mod fxmap;

@@ -459,11 +459,11 @@ impl ReloadSession {
     fn compile_graph(&self, scene: &Scene) -> Result<CompiledGraph, String> {
         let checked = assets::check_graph(&self.graph_path, &self.renderer.shaders)
             .map_err(|e| e.to_string())?;
-        Ok(graph::compile(
-            checked,
-            &scene.features(),
-            self.frame_size(scene),
-        ))
+        let compiled = graph::compile(checked, &scene.features(), self.frame_size(scene));
+        for w in graph::coverage::undrawn(&compiled, &scene.features()) {
+            log::warn!("{w}");
+        }
+        Ok(compiled)
     }
 
     fn frame_size(&self, scene: &Scene) -> FrameSize {
