@@ -5,7 +5,6 @@
 mod compiled;
 mod deps;
 mod error;
-mod fxmap;
 pub mod kinds;
 mod location;
 pub mod memory;
@@ -21,10 +20,11 @@ mod validate;
 
 pub use compiled::{CompiledGraph, CulledPass, ScheduledPass};
 pub use error::{GraphError, GraphErrors};
+pub use kinds::light_culling::{ListLayout, ListStorage};
 pub use kinds::{slot, BufferLayout, SlotSpec};
 pub use location::{Location, SourceText};
 pub use model::*;
-pub use plan::{FrameSize, ListLayout, ListStorage, ResourcePlan};
+pub use plan::{FrameSize, ResourcePlan};
 pub use roles::{PassRoles, BUILTIN_BINDINGS};
 pub use specialise::CullReason;
 pub use validate::CheckedGraph;
