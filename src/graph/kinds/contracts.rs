@@ -150,31 +150,25 @@ fn check_needs(
 
 #[cfg(test)]
 mod tests {
-    use crate::graph::kinds::test_support::{errors, CULL, PREPASS};
+    use crate::graph::kinds::test_support::{errors, validate, CULL, PREPASS};
+
+    const G_BUFFER: &str = r#"Pass(name: "g", kind: GBuffer, reads: ["geometry", "depth"], writes: ["g_position=pos", "g_geometric=geo"]),"#;
 
     #[test]
-    fn a_read_buffer_needs_its_producer() {
-        // Lists no pass lays out: a generic pass writes them.
+    fn a_read_buffer_needs_the_producer_its_slot_names() {
+        // The culling pass's tile lists where the ray-cast pass reads its jobs.
         let e = errors(
             &format!(
-                r#"{PREPASS} Pass(name: "fill", kind: Compute(shader: "cull/fill.wgsl", dispatch: Fixed(1, 1, 1)), writes: ["lists"]), Pass(name: "f", kind: ForwardShading(lights: Culled), reads: ["geometry", "depth", "lg", "lp", "lists"], writes: ["hdr"])"#
-            ),
-            "hdr",
-        );
-        assert!(
-            e.contains("no LightCulling or LightLinkedList pass is declared to write 'lists'"),
-            "{e}"
-        );
-        // Tile lists where the shadow jobs are read.
-        let e = errors(
-            &format!(
-                r#"{PREPASS} {CULL} Pass(name: "rc", kind: ShadowRayCast(), reads: ["lists", "pos", "bn", "bt", "lg"], writes: ["mask"])"#
+                r#"{PREPASS} {CULL} {G_BUFFER} Pass(name: "rc", kind: ShadowRayCast(), reads: ["shadow_jobs=lists", "g_position=pos", "g_geometric=geo", "lg", "bn", "bt"], writes: ["shadow_mask=mask"])"#
             ),
             "pos",
         );
         assert!(
-            e.contains("no ShadowRayJobs pass is declared to write 'lists'; it holds the tile lists of a LightCulling pass"),
+            e.contains("pass 'rc', resource 'lists': no ShadowRayJobs pass is declared to write 'lists'; it holds the tile lists of a LightCulling pass"),
             "{e}"
         );
+        // The shading passes walk tile lists or linked lists.
+        let shade = r#"Pass(name: "f", kind: ForwardShading(lights: Culled), reads: ["geometry", "depth", "lg", "lp", "light_lists=lists"], writes: ["hdr"])"#;
+        assert!(validate(&format!("{PREPASS} {CULL} {shade}"), "hdr").is_ok());
     }
 }

@@ -71,6 +71,9 @@ macro_rules! graph_side {
     ($( $(#[$doc:meta])* $kind:ident $( ($params:ident : $ty:ident) )? => $module:ident, )*) => {
         $( pub mod $module; )*
 
+        /// Each built-in kind's module name, in registry order.
+        pub const KIND_MODULES: &[&str] = &[$( stringify!($module) ),*];
+
         /// A pass's kind and its parameters, as graph files write it (`kind: DepthPrepass`,
         /// `kind: LightCulling(tile: 16)`).
         #[derive(Clone, Debug, serde::Deserialize, serde::Serialize, PartialEq)]
@@ -635,6 +638,47 @@ pub(crate) fn plain_some<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Optio
 /// Writes a set optional number plainly; pair with `skip_serializing_if = "Option::is_none"`.
 pub(crate) fn plain_u32<S: serde::Serializer>(v: &Option<u32>, s: S) -> Result<S::Ok, S::Error> {
     s.serialize_u32(v.unwrap_or_default())
+}
+
+#[cfg(test)]
+mod registry_tests {
+    use super::KIND_MODULES;
+
+    /// Every module file beside the registered kinds is named here as shared support, so
+    /// a kind whose registry line was dropped cannot linger uncompiled.
+    #[test]
+    fn every_kind_file_is_registered() {
+        let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+        let support: [(&str, &[&str]); 2] = [
+            ("graph/kinds", &["mod", "matching", "contracts"]),
+            (
+                "render/passes",
+                &[
+                    "mod",
+                    "compute",
+                    "fullscreen",
+                    "compute_raster_fallback",
+                    "compute_raster_resolve",
+                ],
+            ),
+        ];
+        for (dir, shared) in support {
+            let mut kinds = 0;
+            for entry in std::fs::read_dir(src.join(dir)).unwrap() {
+                let path = entry.unwrap().path();
+                let stem = path.file_stem().unwrap().to_str().unwrap().to_string();
+                if KIND_MODULES.contains(&stem.as_str()) {
+                    kinds += 1;
+                } else {
+                    assert!(
+                        shared.contains(&stem.as_str()),
+                        "{dir}/{stem}.rs is neither a registered kind nor shared support"
+                    );
+                }
+            }
+            assert_eq!(kinds, KIND_MODULES.len(), "{dir}");
+        }
+    }
 }
 
 #[cfg(test)]
