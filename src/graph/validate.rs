@@ -317,14 +317,14 @@ fn generic_shader(
     if !module
         .entry_points
         .iter()
-        .any(|e| &e.name == entry && e.stage == stage)
+        .any(|e| e.name == entry && e.stage == stage)
     {
         return Err(shader_error(format!(
             "{file} has no {stage:?} entry point named '{entry}'"
         )));
     }
     if let PassKind::Compute { dispatch, .. } = &pass.kind {
-        let ep = module.entry_points.iter().find(|e| &e.name == entry);
+        let ep = module.entry_points.iter().find(|e| e.name == entry);
         let workgroup = ep.map_or([1, 1, 1], |e| e.workgroup_size);
         if let Some(e) = super::sizes::check_dispatch(pass, *dispatch, workgroup, source, file) {
             return Err(e);

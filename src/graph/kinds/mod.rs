@@ -1,7 +1,9 @@
-//! Built-in pass kinds, one file each: its parameters, its slot table and its checks.
-//! This file holds the one match from a kind to them and the rows and checks several
-//! kinds share; `matching.rs` the slot matcher they all use. Generic kinds (Compute, Fullscreen) bind by reflected shader
-//! binding names instead (see `roles.rs`).
+//! Built-in pass kinds, one file each: its parameters, its slot table and its checks
+//! (a [`KindRules`] impl). This file holds the registry of kinds (`built_in_kinds!`),
+//! which generates `PassKind` and every dispatch over it, and the rows and checks
+//! several kinds share; `matching.rs` holds the slot matcher they all use and
+//! `contracts.rs` the checks of read buffers against their writers. Generic kinds
+//! (Compute, Fullscreen) bind by reflected shader binding names instead (see `roles.rs`).
 
 /// The built-in pass kinds: one line each, in the order graph files list them. A line
 /// names the variant graph files spell, its parameters (a kind without any names

@@ -1,6 +1,7 @@
 //! Built-in and generic passes, one file per kind (named as in `graph/kinds/`): each
 //! prepares its pipelines and bind groups from a scheduled pass and records itself.
-//! This file holds the one match from a compiled pass to its prepared form.
+//! This file holds the prepare dispatch, generated from the registry of kinds
+//! (`graph::kinds::built_in_kinds!`), and what preparing any pass needs.
 
 mod compute;
 mod compute_raster_fallback;
