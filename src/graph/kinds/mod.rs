@@ -10,8 +10,10 @@
 /// none) and its module, the same name under `graph/kinds/` (parameters, slot table,
 /// checks: [`KindRules`]) and `render/passes/` (prepare and record: `PrepareKind`).
 /// `$then` is the macro that makes something of the list: the `PassKind` enum and the
-/// graph's dispatch here, the prepare dispatch in `render/passes/`. A kind missing from
-/// any of them does not compile, because each is generated from this one list.
+/// graph's dispatch here, the prepare dispatch in `render/passes/`. Each is generated
+/// from this one list, so none can miss a kind; a line without its module file, or a
+/// module without its `KindRules` or `PrepareKind` impl, does not compile, and a module
+/// file without its line fails `every_kind_file_is_registered`.
 macro_rules! built_in_kinds {
     ($then:ident) => {
         $then! {
