@@ -87,18 +87,11 @@ fn specialise_order_plan(bencher: divan::Bencher, passes: usize) {
     });
 }
 
-/// Step 1 alone, as `check_text` runs it (the fast RON-subset path).
+/// Step 1 alone, as `check_text` runs it.
 #[divan::bench(args = [100, 500])]
 fn parse_only(bencher: divan::Bencher, passes: usize) {
     let source = graph::SourceText::new("generated.ron", generated(passes));
     bencher.bench(|| graph::parse(divan::black_box(&source)).expect("valid"));
-}
-
-/// Step 1 through `ron` alone (what `parse` falls back to on anything unusual).
-#[divan::bench(args = [100, 500])]
-fn parse_ron_only(bencher: divan::Bencher, passes: usize) {
-    let source = graph::SourceText::new("generated.ron", generated(passes));
-    bencher.bench(|| graph::GraphDesc::parse_ron_only(divan::black_box(&source)).expect("valid"));
 }
 
 /// Step 2 alone: validation of an already parsed graph.

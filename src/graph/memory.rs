@@ -2,8 +2,7 @@
 //! textures and buffers of its passes, counted only where they do not share memory with
 //! another resource (aliasing), and for MSAA the samples past the first.
 
-use super::kinds::slot;
-use super::model::{PassKind, TextureFormat};
+use super::model::TextureFormat;
 use super::plan::PhysicalDesc;
 use super::CompiledGraph;
 
@@ -62,11 +61,10 @@ pub fn physical_bytes(desc: &PhysicalDesc) -> u64 {
 pub fn by_technique(graph: &CompiledGraph) -> Vec<TechniqueMemory> {
     let mut transparent: Vec<&str> = Vec::new();
     for p in &graph.passes {
-        let is_transparent = match &p.kind {
-            PassKind::TransparentDepth => true,
-            PassKind::LightCulling(_) => p.roles.slot(slot::TRANSPARENT_DEPTH).is_some(),
-            _ => false,
-        };
+        let is_transparent = p
+            .kind
+            .rules()
+            .is_some_and(|rules| rules.writes_transparency(&p.roles));
         if is_transparent {
             let desc = &graph.checked.desc.passes[p.index];
             for w in &desc.writes {

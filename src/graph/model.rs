@@ -275,96 +275,27 @@ pub enum Dispatch {
     Fixed(u32, u32, u32),
 }
 
-/// A pass's kind and its parameters: one line per kind. Built-in kinds keep their
-/// parameters, slot table and checks in `graph/kinds/<kind>.rs`.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
-pub enum PassKind {
-    /// Depth only, no colour target; alpha-masked geometry discards.
-    DepthPrepass,
-    /// Tiled light culling against the prepass depth.
-    LightCulling(LightCulling),
-    /// Per-pixel light linked lists (Bezrati, "Real-Time Lighting via Light Linked List") at full or reduced resolution.
-    LightLinkedList(LightLinkedList),
-    /// Forward shading of the scene's materials through the light loop.
-    ForwardShading(ForwardShading),
-    /// Geometry into a G-buffer: a depth texture and one packed or two Rgba32Float textures.
-    GBuffer,
-    /// Lighting in a compute shader from the G-buffer (tiled deferred with `Culled`).
-    DeferredShading(DeferredShading),
-    /// Ray-cast shadow jobs from the light lists (one per shadow-casting light a pixel sees).
-    ShadowRayJobs(ShadowRayJobs),
-    /// One any-hit ray a job against the scene BVH, into the per-pixel hit mask.
-    ShadowRayCast(ShadowRayCast),
-    /// Every shadow-casting light's depth views into one atlas, in one render pass.
-    ShadowAtlas(ShadowAtlas),
-    /// Counts (pixel, light) pairs where the atlas and ray-cast shadows disagree.
-    ShadowCompare,
-    /// The nearest depth of blended meshes, for their own light lists.
-    TransparentDepth,
-    /// Blended meshes, back to front, lit two-sided over the opaque colour.
-    TransparentShading(TransparentShading),
-    /// Reflective shadow maps of every indirect light (depth, normal, flux, position).
-    ReflectiveShadowMaps(ReflectiveShadowMaps),
-    /// Virtual point lights from the reflective shadow maps, appended to the lights.
-    VplSpawn(VplSpawn),
-    /// Depth and a 32-bit triangle id per pixel (R32Uint) for every opaque mesh.
-    VisibilityBuffer,
-    /// Every material shaded in compute from the visibility buffer's triangle ids.
-    VisibilityShading(VisibilityShading),
-    /// Opaque triangles rasterized in compute (64-bit atomic min per pixel) into a depth
-    /// texture and an R32Uint triangle-id visibility texture.
-    ComputeRaster,
-    /// A compute shader the graph file names; bindings are matched by name.
-    Compute {
-        shader: String,
-        #[serde(default = "default_entry")]
-        entry: String,
-        dispatch: Dispatch,
-    },
-    /// A full-screen triangle with a fragment shader; bindings matched by name.
-    Fullscreen {
-        shader: String,
-        #[serde(default = "default_fragment_entry")]
-        entry: String,
-    },
-}
+pub use super::kinds::PassKind;
 
-fn default_entry() -> String {
+pub(super) fn default_entry() -> String {
     "main".into()
 }
-fn default_fragment_entry() -> String {
+pub(super) fn default_fragment_entry() -> String {
     "fs_main".into()
 }
 
+/// The shader of a generic pass (`Compute`, `Fullscreen`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GenericShader<'a> {
+    /// The WGSL file, relative to the shader root.
+    pub file: &'a str,
+    pub entry: &'a str,
+    pub stage: naga::ShaderStage,
+}
+
 impl PassKind {
-    pub fn label(&self) -> &'static str {
-        match self {
-            PassKind::DepthPrepass => "DepthPrepass",
-            PassKind::LightCulling(_) => "LightCulling",
-            PassKind::LightLinkedList(_) => "LightLinkedList",
-            PassKind::ForwardShading(_) => "ForwardShading",
-            PassKind::GBuffer => "GBuffer",
-            PassKind::DeferredShading(_) => "DeferredShading",
-            PassKind::ShadowRayJobs(_) => "ShadowRayJobs",
-            PassKind::ShadowAtlas(_) => "ShadowAtlas",
-            PassKind::ShadowCompare => "ShadowCompare",
-            PassKind::ShadowRayCast(_) => "ShadowRayCast",
-            PassKind::TransparentDepth => "TransparentDepth",
-            PassKind::TransparentShading(_) => "TransparentShading",
-            PassKind::ReflectiveShadowMaps(_) => "ReflectiveShadowMaps",
-            PassKind::VplSpawn(_) => "VplSpawn",
-            PassKind::VisibilityBuffer => "VisibilityBuffer",
-            PassKind::VisibilityShading(_) => "VisibilityShading",
-            PassKind::ComputeRaster => "ComputeRaster",
-            PassKind::Compute { .. } => "Compute",
-            PassKind::Fullscreen { .. } => "Fullscreen",
-        }
-    }
     /// The WGSL file a generic pass runs, relative to the shader root.
     pub fn shader_file(&self) -> Option<&str> {
-        match self {
-            PassKind::Compute { shader, .. } | PassKind::Fullscreen { shader, .. } => Some(shader),
-            _ => None,
-        }
+        self.generic_shader().map(|g| g.file)
     }
 }

@@ -3,13 +3,12 @@
 //! descriptor whose lifetimes (first to last use in the schedule) do not overlap.
 
 use super::deps::PassIds;
-use super::fxmap::FxHashMap;
+use super::kinds::light_culling::ListLayout;
 use super::kinds::{self, BufferLayout, Usage};
-use super::model::{
-    BufferSize, CullVariant, GraphDesc, Name, ResourceDesc, TextureFormat, TextureSize,
-};
+use super::model::{BufferSize, GraphDesc, Name, ResourceDesc, TextureFormat, TextureSize};
 use super::roles::PassRoles;
 use crate::shader::BindingKind;
+use rustc_hash::FxHashMap;
 use std::sync::Arc;
 
 /// What a physical resource is; two graph resources may share one only if these are equal.
@@ -87,113 +86,6 @@ pub struct FrameSize {
     pub width: u32,
     pub height: u32,
     pub lights: u32,
-}
-
-/// Layout of a culling pass's light-list buffer, shared with `shaders/cull/*.wgsl` and
-/// every reader through `shaders/common/light_lists.wgsl`: a header of 4 u32, then
-/// (offset, count, z_min, z_max) per list, then the index pool. A list's lights are
-/// `pool[offset .. offset + count]`, in ascending light order, in both storages.
-/// `Compact` pools start with a scratch slot of [`Self::scratch_per_list`] indices per
-/// list, in list order: a list of 1 to that many lights lies in its own slot, every other
-/// list after all slots, back to back in list order.
-///
-/// Header, `Fixed`: pool cursor, lists cut at the capacity, longest list wanted, unused.
-/// Header, `Compact`: indices the lists past their slot wanted (all lists without
-/// scratch; saturating at u32::MAX), lists cut at the bound, longest list wanted, lists
-/// whose fill found other lights than their count (0 unless the two dispatches disagree;
-/// counted so it is never silent).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ListLayout {
-    /// Pixels per tile side.
-    pub tile: u32,
-    pub variant: CullVariant,
-    pub tiles_x: u32,
-    pub tiles_y: u32,
-    pub lists_per_tile: u32,
-    pub storage: ListStorage,
-}
-
-/// How a culling pass stores its lists: room for `capacity` lights in every list, or
-/// one flat array of at most `max_indices` for all lists together, filled by count →
-/// prefix sum → fill, with slots of `scratch` indices per list (as the graph asks; see
-/// [`ListLayout::scratch_per_list`]) for the lists that need no fill.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum ListStorage {
-    Fixed { capacity: u32 },
-    Compact { max_indices: u32, scratch: u32 },
-}
-
-impl ListLayout {
-    pub const HEADER_WORDS: u32 = 4;
-    /// Words per list entry: offset, count, and the view-depth range it covers (f32 bits).
-    pub const ENTRY_WORDS: u32 = 4;
-    /// Lists per workgroup of the compact layout's scan (256 invocations × 4 lists).
-    pub const SCAN_BLOCK: u32 = 1024;
-    pub fn new(
-        tile: u32,
-        variant: CullVariant,
-        storage: ListStorage,
-        width: u32,
-        height: u32,
-    ) -> Self {
-        Self {
-            tile,
-            variant,
-            tiles_x: width.div_ceil(tile),
-            tiles_y: height.div_ceil(tile),
-            lists_per_tile: match variant {
-                CullVariant::HalfZ => 2,
-                CullVariant::Clustered { slices } => slices,
-                CullVariant::Frustum | CullVariant::DepthMask => 1,
-            },
-            storage,
-        }
-    }
-    pub fn lists(&self) -> u32 {
-        self.tiles_x * self.tiles_y * self.lists_per_tile
-    }
-    pub fn pool_offset_words(&self) -> u32 {
-        Self::HEADER_WORDS + Self::ENTRY_WORDS * self.lists()
-    }
-    /// Light indices the pool holds: every list at full capacity (so only a list longer
-    /// than the capacity can overflow), or the compact bound for all lists together.
-    pub fn pool_indices(&self) -> u64 {
-        match self.storage {
-            ListStorage::Fixed { capacity } => self.lists() as u64 * capacity as u64,
-            ListStorage::Compact { max_indices, .. } => max_indices as u64,
-        }
-    }
-    /// Compact lists: each list's scratch slot, in light indices. The graph's `scratch`,
-    /// lowered where the slots would take more than half of `max_indices` (to
-    /// ⌊max_indices / 2L⌋ for L lists), so the pool keeps at least half; 0 for fixed lists.
-    pub fn scratch_per_list(&self) -> u32 {
-        match self.storage {
-            ListStorage::Fixed { .. } => 0,
-            ListStorage::Compact {
-                max_indices,
-                scratch,
-            } => {
-                let half_per_list = max_indices as u64 / (2 * self.lists().max(1) as u64);
-                scratch.min(half_per_list as u32)
-            }
-        }
-    }
-    /// Compact lists: the indices all scratch slots take at the start of the pool.
-    pub fn scratch_indices(&self) -> u64 {
-        self.scratch_per_list() as u64 * self.lists() as u64
-    }
-    /// Scan blocks of the compact layout (0 for fixed lists).
-    pub fn scan_blocks(&self) -> u32 {
-        match self.storage {
-            ListStorage::Fixed { .. } => 0,
-            ListStorage::Compact { .. } => self.lists().div_ceil(Self::SCAN_BLOCK),
-        }
-    }
-    /// The whole buffer: header, entries and pool. Overflow of any list is counted,
-    /// never silent.
-    pub fn bytes(&self) -> u64 {
-        4 * (self.pool_offset_words() as u64 + self.pool_indices())
-    }
 }
 
 fn texture_extent(size: TextureSize, frame: FrameSize) -> (u32, u32) {
@@ -431,65 +323,5 @@ fn describe(
             B::STORAGE | B::COPY_SRC | B::COPY_DST | B::UNIFORM | B::INDIRECT,
         ),
         ResourceDesc::Import { .. } => unreachable!("imports are not planned"),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn list_layout_counts_partial_tiles() {
-        let fixed = |capacity| ListStorage::Fixed { capacity };
-        let l = ListLayout::new(16, CullVariant::Frustum, fixed(256), 333, 197);
-        assert_eq!((l.tiles_x, l.tiles_y), (21, 13));
-        assert_eq!(l.lists(), 273);
-        let h = ListLayout::new(8, CullVariant::HalfZ, fixed(64), 16, 16);
-        assert_eq!(h.lists(), 8);
-        assert_eq!(h.bytes(), 4 * (4 + 32 + 8 * 64));
-        assert_eq!(h.scan_blocks(), 0);
-    }
-
-    #[test]
-    fn compact_lists_are_bounded_by_the_graph_alone() {
-        let compact = ListStorage::Compact {
-            max_indices: 5000,
-            scratch: 256,
-        };
-        let c = ListLayout::new(8, CullVariant::Clustered { slices: 16 }, compact, 333, 197);
-        assert_eq!(c.lists(), 42 * 25 * 16);
-        // Header, one entry a list, then exactly the bound: scratch slots come out of it.
-        assert_eq!(c.bytes(), 4 * (4 + 4 * 16_800 + 5000));
-        assert_eq!(c.scan_blocks(), 17);
-        // 16,800 slots of 256 would take 860 times the bound: none fit in half of it.
-        assert_eq!(c.scratch_per_list(), 0);
-    }
-
-    #[test]
-    fn scratch_slots_take_at_most_half_the_bound() {
-        let compact = |max_indices, scratch| ListStorage::Compact {
-            max_indices,
-            scratch,
-        };
-        let frustum = |storage| ListLayout::new(16, CullVariant::Frustum, storage, 1920, 1080);
-        // The shipped bound at 1920×1080: 8,160 slots of 256 (8 MiB of 64).
-        let shipped = frustum(compact(16_777_216, 256));
-        assert_eq!(shipped.scratch_per_list(), 256);
-        assert_eq!(shipped.scratch_indices(), 8_160 * 256);
-        assert_eq!(shipped.bytes(), 4 * (4 + 4 * 8_160 + 16_777_216));
-        // 2 · 8,160 · 100 = 1,632,000 indices: 100 fits, 101 does not.
-        assert_eq!(frustum(compact(1_632_000, 256)).scratch_per_list(), 100);
-        assert_eq!(frustum(compact(1_631_999, 256)).scratch_per_list(), 99);
-        assert_eq!(frustum(compact(16_777_216, 0)).scratch_per_list(), 0);
-        let clustered = ListLayout::new(
-            16,
-            CullVariant::Clustered { slices: 16 },
-            compact(16_777_216, 256),
-            1920,
-            1080,
-        );
-        assert_eq!(clustered.scratch_per_list(), 64);
-        let fixed = frustum(ListStorage::Fixed { capacity: 256 });
-        assert_eq!(fixed.scratch_per_list(), 0);
     }
 }

@@ -2,10 +2,10 @@
 //! (`kinds/`), generic kinds bind by shader binding name. No GPU here.
 
 use super::error::GraphError;
-use super::fxmap::FxHashMap;
 use super::location::SourceText;
 use super::model::{Name, PassDesc, PassKind, ResourceDesc, SceneResource};
 use crate::shader::{BindingKind, ReflectedBinding};
+use rustc_hash::FxHashMap;
 use std::collections::BTreeMap;
 
 /// Binding names every generic shader may use without declaring them.

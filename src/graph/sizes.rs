@@ -5,11 +5,11 @@
 //! texture and buffer limits, per-light dispatch counts) is checked again at prepare.
 
 use super::error::GraphError;
-use super::fxmap::FxHashMap;
 use super::kinds;
 use super::location::SourceText;
 use super::model::{BufferSize, Dispatch, GraphDesc, PassDesc, ResourceDesc, TextureSize};
 use super::roles::PassRoles;
+use rustc_hash::FxHashMap;
 use std::sync::Arc;
 
 /// Largest output side the CLI and scene files accept.

@@ -27,7 +27,7 @@ pub fn specialise(graph: &CheckedGraph, features: &SceneFeatures) -> Vec<Option<
             _ => None,
         })
         .collect();
-    let side_effects: super::fxmap::FxHashSet<&str> =
+    let side_effects: rustc_hash::FxHashSet<&str> =
         desc.side_effects.iter().map(Name::as_str).collect();
     let roots: Vec<usize> = (0..desc.passes.len())
         .filter(|&i| {

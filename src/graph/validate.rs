@@ -2,11 +2,11 @@
 
 use super::deps::{self, DepGraph, PassIds, Writers};
 use super::error::{GraphError, GraphErrors};
-use super::fxmap::{FxHashMap, FxHashSet};
 use super::location::SourceText;
-use super::model::{GraphDesc, Name, PassKind, ResourceDesc, TextureFormat};
+use super::model::{GenericShader, GraphDesc, Name, PassKind, ResourceDesc, TextureFormat};
 use super::roles::{PassRoles, RoleCtx};
 use crate::shader::{reflect_bindings, Composed, ShaderLibrary};
+use rustc_hash::{FxHashMap, FxHashSet};
 use std::collections::BTreeSet;
 use std::sync::Arc;
 
@@ -83,6 +83,7 @@ pub fn validate(
     }
     if errors.is_empty() {
         super::sizes::check_laid_out_buffers(&desc, &resources, &roles, &source, &mut errors);
+        super::kinds::contracts::check(&desc, &roles, &source, &mut errors);
     }
     if errors.is_empty() {
         Ok(CheckedGraph {
@@ -310,25 +311,20 @@ fn generic_shader(
     let module = composed
         .validate()
         .map_err(|e| shader_error(e.to_string()))?;
-    let entry = match &pass.kind {
-        PassKind::Compute { entry, .. } | PassKind::Fullscreen { entry, .. } => entry,
-        _ => unreachable!(),
-    };
-    let stage = match pass.kind {
-        PassKind::Compute { .. } => naga::ShaderStage::Compute,
-        _ => naga::ShaderStage::Fragment,
+    let Some(GenericShader { entry, stage, .. }) = pass.kind.generic_shader() else {
+        unreachable!("only generic passes name a shader")
     };
     if !module
         .entry_points
         .iter()
-        .any(|e| &e.name == entry && e.stage == stage)
+        .any(|e| e.name == entry && e.stage == stage)
     {
         return Err(shader_error(format!(
             "{file} has no {stage:?} entry point named '{entry}'"
         )));
     }
     if let PassKind::Compute { dispatch, .. } = &pass.kind {
-        let ep = module.entry_points.iter().find(|e| &e.name == entry);
+        let ep = module.entry_points.iter().find(|e| e.name == entry);
         let workgroup = ep.map_or([1, 1, 1], |e| e.workgroup_size);
         if let Some(e) = super::sizes::check_dispatch(pass, *dispatch, workgroup, source, file) {
             return Err(e);

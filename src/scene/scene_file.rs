@@ -73,7 +73,7 @@ pub struct SceneFile {
     pub ambient: Option<Vec3>,
     /// The ray-cast shadow BVH's build quality: Fastest, VeryFast, Fast (default), Medium.
     #[serde(default)]
-    pub shadow_bvh: Option<crate::shadow::bvh::BuildQuality>,
+    pub shadow_bvh: Option<super::BuildQuality>,
 }
 
 fn yes() -> bool {

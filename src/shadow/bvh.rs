@@ -81,25 +81,8 @@ pub enum ShadowError {
     TooManyNodes { count: usize },
 }
 
-/// How hard the PLOC builder works (after obvhs's presets of the same names).
-/// How hard the builder works for a cheaper tree. On an NVIDIA H200 the chairs scene's
-/// 11.2 M shadow rays at 1280×720 cast in 2.99 ms (`Fastest`), 2.75 (`VeryFast`), 1.90
-/// (`Fast`, the default) and 1.76 ms (`Medium`); one-core builds on a 2-core x86-64
-/// machine take 58, 72, 104 and 117 ms (`benches/sweeps/bvh_quality.ron`, `benches/bvh_build.rs`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum BuildQuality {
-    /// PLOC search distance 1, no reinsertion: the quickest rebuild.
-    Fastest,
-    /// PLOC search distance 1, reinsertion of 1 % of the nodes (about 10 % lower SAH
-    /// cost than `Fastest` on the chairs scene, about 10 ms more).
-    VeryFast,
-    /// PLOC search distance 6 (1 below depth 2), reinsertion of 2 %: the default, the
-    /// best casting time per build millisecond measured.
-    #[default]
-    Fast,
-    /// PLOC search distance 14 (1 below depth 3), reinsertion of 5 %.
-    Medium,
-}
+/// How hard the builder works; a scene file's choice, so it lives with the scene.
+pub use crate::scene::BuildQuality;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BuildOptions {

@@ -6,7 +6,7 @@
 //! or fragment work, read by LightCulling and LightLinkedList). Runs
 //! `shaders/visibility/compute_raster.wgsl` and `compute_raster_resolve.wgsl`.
 
-use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
+use super::{slot, Access, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 use crate::graph::model::{ResourceDesc, SceneResource, TextureFormat};
 
@@ -79,6 +79,18 @@ pub fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
                 "ComputeRaster writes one triangle id per pixel: a single-sample R32Uint texture",
             ));
         }
+    }
+}
+
+/// `ComputeRaster` has no parameters: this names it for its rules.
+pub struct ComputeRaster;
+
+impl KindRules for ComputeRaster {
+    fn slots(&self) -> &'static [SlotSpec] {
+        SLOTS
+    }
+    fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+        check(ctx, errors)
     }
 }
 

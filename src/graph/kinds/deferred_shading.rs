@@ -3,7 +3,7 @@
 
 use super::g_buffer::{G_NORMAL, G_POSITION};
 use super::shadow_ray_jobs::SHADOW_MASK;
-use super::{check_light_source, Access, KindCtx, SlotSpec, SlotType, Usage};
+use super::{check_light_source, Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 use crate::graph::model::LightSource;
 use serde::{Deserialize, Serialize};
@@ -38,7 +38,9 @@ pub const SLOTS: &[SlotSpec] = &[
     super::LIGHT_LISTS_READ,
     SlotSpec::new(HDR, SlotType::ColorTexture, Access::Write, Usage::Storage),
     // Ray-cast shadows: the hit mask of a ShadowRayCast pass.
-    SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound).optional(),
+    SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound)
+        .optional()
+        .needs(&[Contents::ShadowMask]),
     // Shadow maps: a ShadowAtlas pass's atlas and view table.
     super::SHADOW_ATLAS_READ,
     super::SHADOW_VIEWS_READ,
@@ -81,6 +83,15 @@ fn check_msaa(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
                 "the ray-cast shadow mask holds one pixel's bits, not each sample's: a multisampled G-buffer is shadowed from a shadow atlas",
             ));
         }
+    }
+}
+
+impl KindRules for DeferredShading {
+    fn slots(&self) -> &'static [SlotSpec] {
+        SLOTS
+    }
+    fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+        check(self, ctx, errors)
     }
 }
 

@@ -1,8 +1,7 @@
 //! `DepthPrepass`: the scene's opaque depth, no colour target; alpha-masked geometry
 //! discards. Runs `shaders/forward/forward.wgsl` with `DEPTH_ONLY`.
 
-use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
-use crate::graph::error::GraphError;
+use super::{slot, Access, KindRules, SlotSpec, SlotType, Usage};
 
 pub const SLOTS: &[SlotSpec] = &[
     super::GEOMETRY_READ,
@@ -14,7 +13,14 @@ pub const SLOTS: &[SlotSpec] = &[
     ),
 ];
 
-pub fn check(_ctx: &KindCtx, _errors: &mut [GraphError]) {}
+/// `DepthPrepass` has no parameters: this names it for its rules.
+pub struct DepthPrepass;
+
+impl KindRules for DepthPrepass {
+    fn slots(&self) -> &'static [SlotSpec] {
+        SLOTS
+    }
+}
 
 #[cfg(test)]
 mod tests {

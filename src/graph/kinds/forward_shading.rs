@@ -3,7 +3,7 @@
 
 use super::shadow_ray_cast::{BVH_NODES, BVH_TRIANGLES};
 use super::shadow_ray_jobs::SHADOW_MASK;
-use super::{check_light_source, slot, Access, KindCtx, SlotSpec, SlotType, Usage};
+use super::{check_light_source, slot, Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 use crate::graph::model::{LightSource, SceneResource};
 use serde::{Deserialize, Serialize};
@@ -35,7 +35,9 @@ pub const SLOTS: &[SlotSpec] = &[
     ),
     // Ray-cast shadows: the hit mask of a ShadowRayCast pass, or the BVH to trace in the
     // light loop (the naive variant).
-    SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound).optional(),
+    SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound)
+        .optional()
+        .needs(&[Contents::ShadowMask]),
     SlotSpec::new(
         BVH_NODES,
         SlotType::Import(SceneResource::BvhNodes),
@@ -111,6 +113,15 @@ pub fn check(p: &ForwardShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
                 format!("colour target has {cs} sample(s) but depth '{d}' has {ds}: MSAA needs both multisampled"),
             ));
         }
+    }
+}
+
+impl KindRules for ForwardShading {
+    fn slots(&self) -> &'static [SlotSpec] {
+        SLOTS
+    }
+    fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+        check(self, ctx, errors)
     }
 }
 

@@ -3,7 +3,7 @@
 //! normal). After a depth prepass it only tests depth. Runs `shaders/forward/forward.wgsl`
 //! with `GBUFFER`.
 
-use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
+use super::{slot, Access, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 
 pub const G_POSITION: &str = "g_position";
@@ -107,6 +107,18 @@ pub const G_GEOMETRIC_READ: SlotSpec = SlotSpec::new(
 /// Whether the pass writes the packed layout (one texture: no normals of either kind).
 pub fn packed(roles: &crate::graph::PassRoles) -> bool {
     roles.slot(G_NORMAL).is_none() && roles.slot(G_GEOMETRIC).is_none()
+}
+
+/// `GBuffer` has no parameters: this names it for its rules.
+pub struct GBuffer;
+
+impl KindRules for GBuffer {
+    fn slots(&self) -> &'static [SlotSpec] {
+        SLOTS
+    }
+    fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+        check(ctx, errors)
+    }
 }
 
 #[cfg(test)]

@@ -15,10 +15,11 @@
 //! list holds exactly its lights, and only the total is bounded (past `max_indices` the
 //! last long lists are cut, counted and reported).
 
-use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
+use super::{slot, Access, BufferLayout, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
+use crate::graph::roles::PassRoles;
+use crate::graph::plan::FrameSize;
 use crate::graph::model::CullVariant;
-use crate::graph::plan::{ListLayout, ListStorage};
 use serde::{Deserialize, Serialize};
 
 /// `LightCulling(tile: 16, variant: Frustum, capacity: 256, coarse: 4)` or
@@ -116,6 +117,113 @@ impl LightCulling {
     }
 }
 
+/// Layout of a culling pass's light-list buffer, shared with `shaders/cull/*.wgsl` and
+/// every reader through `shaders/common/light_lists.wgsl`: a header of 4 u32, then
+/// (offset, count, z_min, z_max) per list, then the index pool. A list's lights are
+/// `pool[offset .. offset + count]`, in ascending light order, in both storages.
+/// `Compact` pools start with a scratch slot of [`Self::scratch_per_list`] indices per
+/// list, in list order: a list of 1 to that many lights lies in its own slot, every other
+/// list after all slots, back to back in list order.
+///
+/// Header, `Fixed`: pool cursor, lists cut at the capacity, longest list wanted, unused.
+/// Header, `Compact`: indices the lists past their slot wanted (all lists without
+/// scratch; saturating at u32::MAX), lists cut at the bound, longest list wanted, lists
+/// whose fill found other lights than their count (0 unless the two dispatches disagree;
+/// counted so it is never silent).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ListLayout {
+    /// Pixels per tile side.
+    pub tile: u32,
+    pub variant: CullVariant,
+    pub tiles_x: u32,
+    pub tiles_y: u32,
+    pub lists_per_tile: u32,
+    pub storage: ListStorage,
+}
+
+/// How a culling pass stores its lists: room for `capacity` lights in every list, or
+/// one flat array of at most `max_indices` for all lists together, filled by count →
+/// prefix sum → fill, with slots of `scratch` indices per list (as the graph asks; see
+/// [`ListLayout::scratch_per_list`]) for the lists that need no fill.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ListStorage {
+    Fixed { capacity: u32 },
+    Compact { max_indices: u32, scratch: u32 },
+}
+
+impl ListLayout {
+    pub const HEADER_WORDS: u32 = 4;
+    /// Words per list entry: offset, count, and the view-depth range it covers (f32 bits).
+    pub const ENTRY_WORDS: u32 = 4;
+    /// Lists per workgroup of the compact layout's scan (256 invocations × 4 lists).
+    pub const SCAN_BLOCK: u32 = 1024;
+    pub fn new(
+        tile: u32,
+        variant: CullVariant,
+        storage: ListStorage,
+        width: u32,
+        height: u32,
+    ) -> Self {
+        Self {
+            tile,
+            variant,
+            tiles_x: width.div_ceil(tile),
+            tiles_y: height.div_ceil(tile),
+            lists_per_tile: match variant {
+                CullVariant::HalfZ => 2,
+                CullVariant::Clustered { slices } => slices,
+                CullVariant::Frustum | CullVariant::DepthMask => 1,
+            },
+            storage,
+        }
+    }
+    pub fn lists(&self) -> u32 {
+        self.tiles_x * self.tiles_y * self.lists_per_tile
+    }
+    pub fn pool_offset_words(&self) -> u32 {
+        Self::HEADER_WORDS + Self::ENTRY_WORDS * self.lists()
+    }
+    /// Light indices the pool holds: every list at full capacity (so only a list longer
+    /// than the capacity can overflow), or the compact bound for all lists together.
+    pub fn pool_indices(&self) -> u64 {
+        match self.storage {
+            ListStorage::Fixed { capacity } => self.lists() as u64 * capacity as u64,
+            ListStorage::Compact { max_indices, .. } => max_indices as u64,
+        }
+    }
+    /// Compact lists: each list's scratch slot, in light indices. The graph's `scratch`,
+    /// lowered where the slots would take more than half of `max_indices` (to
+    /// ⌊max_indices / 2L⌋ for L lists), so the pool keeps at least half; 0 for fixed lists.
+    pub fn scratch_per_list(&self) -> u32 {
+        match self.storage {
+            ListStorage::Fixed { .. } => 0,
+            ListStorage::Compact {
+                max_indices,
+                scratch,
+            } => {
+                let half_per_list = max_indices as u64 / (2 * self.lists().max(1) as u64);
+                scratch.min(half_per_list as u32)
+            }
+        }
+    }
+    /// Compact lists: the indices all scratch slots take at the start of the pool.
+    pub fn scratch_indices(&self) -> u64 {
+        self.scratch_per_list() as u64 * self.lists() as u64
+    }
+    /// Scan blocks of the compact layout (0 for fixed lists).
+    pub fn scan_blocks(&self) -> u32 {
+        match self.storage {
+            ListStorage::Fixed { .. } => 0,
+            ListStorage::Compact { .. } => self.lists().div_ceil(Self::SCAN_BLOCK),
+        }
+    }
+    /// The whole buffer: header, entries and pool. Overflow of any list is counted,
+    /// never silent.
+    pub fn bytes(&self) -> u64 {
+        4 * (self.pool_offset_words() as u64 + self.pool_indices())
+    }
+}
+
 pub const SLOTS: &[SlotSpec] = &[
     // A depth format, or R32Float depths (a compute-only frame's ComputeRaster).
     SlotSpec::new(
@@ -201,9 +309,27 @@ pub fn check(p: &LightCulling, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     }
 }
 
+impl KindRules for LightCulling {
+    fn slots(&self) -> &'static [SlotSpec] {
+        SLOTS
+    }
+    fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+        check(self, ctx, errors)
+    }
+    fn buffer_layout(&self, slot: &str, frame: FrameSize) -> Option<BufferLayout> {
+        (slot == slot::LIGHT_LISTS)
+            .then(|| BufferLayout::LightLists(self.list_layout(frame.width, frame.height)))
+    }
+    fn writes_transparency(&self, roles: &PassRoles) -> bool {
+        roles.slot(slot::TRANSPARENT_DEPTH).is_some()
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    use super::{ListLayout, ListStorage};
     use crate::graph::kinds::test_support::{errors, PREPASS};
+    use crate::graph::model::CullVariant;
 
     #[test]
     fn checks_parameters() {
@@ -253,7 +379,6 @@ mod tests {
     #[test]
     fn storage_follows_lists_and_capacity() {
         use super::{LightCulling, ListMode};
-        use crate::graph::plan::ListStorage;
         let text = |t: &str| ron::from_str::<LightCulling>(t).unwrap();
         let fixed = text("(tile: 16, capacity: 64)");
         assert_eq!(fixed.storage(), ListStorage::Fixed { capacity: 64 });
@@ -320,5 +445,60 @@ mod tests {
             e.contains("transparent depth has 1 sample(s) but depth 'depth4' has 4"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn list_layout_counts_partial_tiles() {
+        let fixed = |capacity| ListStorage::Fixed { capacity };
+        let l = ListLayout::new(16, CullVariant::Frustum, fixed(256), 333, 197);
+        assert_eq!((l.tiles_x, l.tiles_y), (21, 13));
+        assert_eq!(l.lists(), 273);
+        let h = ListLayout::new(8, CullVariant::HalfZ, fixed(64), 16, 16);
+        assert_eq!(h.lists(), 8);
+        assert_eq!(h.bytes(), 4 * (4 + 32 + 8 * 64));
+        assert_eq!(h.scan_blocks(), 0);
+    }
+
+    #[test]
+    fn compact_lists_are_bounded_by_the_graph_alone() {
+        let compact = ListStorage::Compact {
+            max_indices: 5000,
+            scratch: 256,
+        };
+        let c = ListLayout::new(8, CullVariant::Clustered { slices: 16 }, compact, 333, 197);
+        assert_eq!(c.lists(), 42 * 25 * 16);
+        // Header, one entry a list, then exactly the bound: scratch slots come out of it.
+        assert_eq!(c.bytes(), 4 * (4 + 4 * 16_800 + 5000));
+        assert_eq!(c.scan_blocks(), 17);
+        // 16,800 slots of 256 would take 860 times the bound: none fit in half of it.
+        assert_eq!(c.scratch_per_list(), 0);
+    }
+
+    #[test]
+    fn scratch_slots_take_at_most_half_the_bound() {
+        let compact = |max_indices, scratch| ListStorage::Compact {
+            max_indices,
+            scratch,
+        };
+        let frustum = |storage| ListLayout::new(16, CullVariant::Frustum, storage, 1920, 1080);
+        // The shipped bound at 1920×1080: 8,160 slots of 256 (8 MiB of 64).
+        let shipped = frustum(compact(16_777_216, 256));
+        assert_eq!(shipped.scratch_per_list(), 256);
+        assert_eq!(shipped.scratch_indices(), 8_160 * 256);
+        assert_eq!(shipped.bytes(), 4 * (4 + 4 * 8_160 + 16_777_216));
+        // 2 · 8,160 · 100 = 1,632,000 indices: 100 fits, 101 does not.
+        assert_eq!(frustum(compact(1_632_000, 256)).scratch_per_list(), 100);
+        assert_eq!(frustum(compact(1_631_999, 256)).scratch_per_list(), 99);
+        assert_eq!(frustum(compact(16_777_216, 0)).scratch_per_list(), 0);
+        let clustered = ListLayout::new(
+            16,
+            CullVariant::Clustered { slices: 16 },
+            compact(16_777_216, 256),
+            1920,
+            1080,
+        );
+        assert_eq!(clustered.scratch_per_list(), 64);
+        let fixed = frustum(ListStorage::Fixed { capacity: 256 });
+        assert_eq!(fixed.scratch_per_list(), 0);
     }
 }

@@ -4,8 +4,10 @@
 //! light); runs `shaders/cull/light_linked_list.wgsl`. The depth is a depth texture or
 //! R32Float depths (ComputeRaster's compute resolve; `FLOAT_DEPTH`), single-sample.
 
-use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
+use super::contracts::InputsCtx;
+use super::{slot, Access, BufferLayout, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
+use crate::graph::plan::FrameSize;
 use serde::{Deserialize, Serialize};
 
 /// `LightLinkedList(scale: 8, links_per_pixel: 32)`.
@@ -84,7 +86,7 @@ pub const SLOTS: &[SlotSpec] = &[
     ),
     super::LIGHT_GEOMETRY_READ,
     // A LightCulling pass's tile lists: only their lights are tested (else every light).
-    super::LIGHT_LISTS_READ,
+    super::LIGHT_LISTS_READ.needs(&[Contents::LightLists]),
     SlotSpec::new(LIGHT_LINKS, SlotType::Buffer, Access::Write, Usage::Bound),
 ];
 
@@ -115,6 +117,44 @@ pub fn check(p: &LightLinkedList, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
             "links_per_pixel {} must be in 1..={MAX_LINKS_PER_PIXEL}",
             p.links_per_pixel
         )));
+    }
+}
+
+impl KindRules for LightLinkedList {
+    fn slots(&self) -> &'static [SlotSpec] {
+        SLOTS
+    }
+    fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+        check(self, ctx, errors)
+    }
+    fn buffer_layout(&self, slot: &str, frame: FrameSize) -> Option<BufferLayout> {
+        (slot == LIGHT_LINKS)
+            .then(|| BufferLayout::LightLinks(self.link_layout(frame.width, frame.height)))
+    }
+    /// The candidates come from one list a tile, whose tiles a list pixel does not straddle.
+    fn check_inputs(&self, ctx: &InputsCtx, errors: &mut Vec<GraphError>) {
+        let (Some(lists), Some(BufferLayout::LightLists(tiles))) =
+            (ctx.slot(slot::LIGHT_LISTS), ctx.published(slot::LIGHT_LISTS))
+        else {
+            return;
+        };
+        if tiles.lists_per_tile != 1 {
+            errors.push(ctx.mismatch(
+                lists,
+                format!(
+                    "'{lists}' has {} lists a tile ({:?}); the linked list reads one list a tile (Frustum or DepthMask)",
+                    tiles.lists_per_tile, tiles.variant
+                ),
+            ));
+        } else if SCALES.contains(&self.scale) && tiles.tile % self.scale != 0 {
+            errors.push(ctx.mismatch(
+                lists,
+                format!(
+                    "scale {} does not divide the culling tile of {} pixels of '{lists}'",
+                    self.scale, tiles.tile
+                ),
+            ));
+        }
     }
 }
 

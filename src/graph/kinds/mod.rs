@@ -1,31 +1,174 @@
-//! Built-in pass kinds, one file each: its parameters, its slot table and its checks.
-//! This file holds the one match from a kind to them and the rows and checks several
-//! kinds share; `matching.rs` the slot matcher they all use. Generic kinds (Compute, Fullscreen) bind by reflected shader
-//! binding names instead (see `roles.rs`).
+//! Built-in pass kinds, one file each: its parameters, its slot table and its checks
+//! (a [`KindRules`] impl). This file holds the registry of kinds (`built_in_kinds!`),
+//! which generates `PassKind` and every dispatch over it, and the rows and checks
+//! several kinds share; `matching.rs` holds the slot matcher they all use and
+//! `contracts.rs` the checks of read buffers against their writers. Generic kinds
+//! (Compute, Fullscreen) bind by reflected shader binding names instead (see `roles.rs`).
 
-pub mod compute_raster;
-pub mod deferred_shading;
-pub mod depth_prepass;
-pub mod forward_shading;
-pub mod g_buffer;
-pub mod light_culling;
-pub mod light_linked_list;
+/// The built-in pass kinds: one line each, in the order graph files list them. A line
+/// names the variant graph files spell, its parameters (a kind without any names
+/// none) and its module, the same name under `graph/kinds/` (parameters, slot table,
+/// checks: [`KindRules`]) and `render/passes/` (prepare and record: `PrepareKind`).
+/// `$then` is the macro that makes something of the list: the `PassKind` enum and the
+/// graph's dispatch here, the prepare dispatch in `render/passes/`. Each is generated
+/// from this one list, so none can miss a kind; a line without its module file, or a
+/// module without its `KindRules` or `PrepareKind` impl, does not compile, and a module
+/// file without its line fails `every_kind_file_is_registered`.
+macro_rules! built_in_kinds {
+    ($then:ident) => {
+        $then! {
+            /// Depth only, no colour target; alpha-masked geometry discards.
+            DepthPrepass => depth_prepass,
+            /// Tiled light culling against the prepass depth.
+            LightCulling(params: LightCulling) => light_culling,
+            /// Per-pixel light linked lists (Bezrati, "Real-Time Lighting via Light Linked
+            /// List") at full or reduced resolution.
+            LightLinkedList(params: LightLinkedList) => light_linked_list,
+            /// Forward shading of the scene's materials through the light loop.
+            ForwardShading(params: ForwardShading) => forward_shading,
+            /// Geometry into a G-buffer: a depth texture and one packed or two Rgba32Float textures.
+            GBuffer => g_buffer,
+            /// Lighting in a compute shader from the G-buffer (tiled deferred with `Culled`).
+            DeferredShading(params: DeferredShading) => deferred_shading,
+            /// Ray-cast shadow jobs from the light lists (one per shadow-casting light a pixel sees).
+            ShadowRayJobs(params: ShadowRayJobs) => shadow_ray_jobs,
+            /// One any-hit ray a job against the scene BVH, into the per-pixel hit mask.
+            ShadowRayCast(params: ShadowRayCast) => shadow_ray_cast,
+            /// Every shadow-casting light's depth views into one atlas, in one render pass.
+            ShadowAtlas(params: ShadowAtlas) => shadow_atlas,
+            /// Counts (pixel, light) pairs where the atlas and ray-cast shadows disagree.
+            ShadowCompare => shadow_compare,
+            /// The nearest depth of blended meshes, for their own light lists.
+            TransparentDepth => transparent_depth,
+            /// Blended meshes, back to front, lit two-sided over the opaque colour.
+            TransparentShading(params: TransparentShading) => transparent_shading,
+            /// Reflective shadow maps of every indirect light (depth, normal, flux, position).
+            ReflectiveShadowMaps(params: ReflectiveShadowMaps) => reflective_shadow_maps,
+            /// Virtual point lights from the reflective shadow maps, appended to the lights.
+            VplSpawn(params: VplSpawn) => vpl_spawn,
+            /// Depth and a 32-bit triangle id per pixel (R32Uint) for every opaque mesh.
+            VisibilityBuffer => visibility_buffer,
+            /// Every material shaded in compute from the visibility buffer's triangle ids.
+            VisibilityShading(params: VisibilityShading) => visibility_shading,
+            /// Opaque triangles rasterized in compute (64-bit atomic min per pixel) into a depth
+            /// texture and an R32Uint triangle-id visibility texture.
+            ComputeRaster => compute_raster,
+        }
+    };
+}
+pub(crate) use built_in_kinds;
+
+/// What a registry line's kind is matched as: its parameters, or the unit struct its
+/// module names after a kind without any.
+macro_rules! kind_value {
+    ($params:ident ; $unit:path) => {
+        $params
+    };
+    (; $unit:path) => {
+        &$unit
+    };
+}
+pub(crate) use kind_value;
+
+/// The graph side of the registry: the kinds' modules, `PassKind` with the two generic
+/// kinds after the built-in ones, its label, and the kind's rules.
+macro_rules! graph_side {
+    ($( $(#[$doc:meta])* $kind:ident $( ($params:ident : $ty:ident) )? => $module:ident, )*) => {
+        $( pub mod $module; )*
+
+        /// Each built-in kind's module name, in registry order.
+        pub const KIND_MODULES: &[&str] = &[$( stringify!($module) ),*];
+
+        /// A pass's kind and its parameters, as graph files write it (`kind: DepthPrepass`,
+        /// `kind: LightCulling(tile: 16)`).
+        #[derive(Clone, Debug, serde::Deserialize, serde::Serialize, PartialEq)]
+        pub enum PassKind {
+            $( $(#[$doc])* $kind $( ($module::$ty) )?, )*
+            /// A compute shader the graph file names; bindings are matched by name.
+            Compute {
+                shader: String,
+                #[serde(default = "super::model::default_entry")]
+                entry: String,
+                dispatch: super::model::Dispatch,
+            },
+            /// A full-screen triangle with a fragment shader; bindings matched by name.
+            Fullscreen {
+                shader: String,
+                #[serde(default = "super::model::default_fragment_entry")]
+                entry: String,
+            },
+        }
+
+        impl PassKind {
+            pub fn label(&self) -> &'static str {
+                match self {
+                    $( PassKind::$kind { .. } => stringify!($kind), )*
+                    PassKind::Compute { .. } => "Compute",
+                    PassKind::Fullscreen { .. } => "Fullscreen",
+                }
+            }
+            /// The shader a generic pass runs; `None` for built-in kinds.
+            pub fn generic_shader(&self) -> Option<super::model::GenericShader<'_>> {
+                use super::model::GenericShader;
+                match self {
+                    $( PassKind::$kind { .. } => None, )*
+                    PassKind::Compute { shader, entry, .. } => Some(GenericShader {
+                        file: shader,
+                        entry,
+                        stage: naga::ShaderStage::Compute,
+                    }),
+                    PassKind::Fullscreen { shader, entry } => Some(GenericShader {
+                        file: shader,
+                        entry,
+                        stage: naga::ShaderStage::Fragment,
+                    }),
+                }
+            }
+            /// The rules of a built-in kind; `None` for generic kinds, which bind by
+            /// reflected shader binding names instead (see `roles.rs`).
+            pub fn rules(&self) -> Option<&dyn KindRules> {
+                Some(match self {
+                    $( PassKind::$kind $( ($params) )? => {
+                        kind_value!($($params)? ; $module::$kind)
+                    } )*
+                    PassKind::Compute { .. } | PassKind::Fullscreen { .. } => return None,
+                })
+            }
+        }
+    };
+}
+
+built_in_kinds!(graph_side);
+
+pub(crate) mod contracts;
 mod matching;
-pub mod reflective_shadow_maps;
-pub mod shadow_atlas;
-pub mod shadow_compare;
-pub mod shadow_ray_cast;
-pub mod shadow_ray_jobs;
-pub mod transparent_depth;
-pub mod transparent_shading;
-pub mod visibility_buffer;
-pub mod visibility_shading;
-pub mod vpl_spawn;
+
+/// What a built-in kind tells validation and planning, implemented by its parameters
+/// (or the unit struct its module names after a kind without any).
+pub trait KindRules {
+    /// Its slot table.
+    fn slots(&self) -> &'static [SlotSpec];
+    /// Its own checks, after its slots were matched.
+    fn check(&self, _ctx: &KindCtx, _errors: &mut Vec<GraphError>) {}
+    /// The layout it gives a buffer it writes into `slot`, published on the planned
+    /// buffer for its readers.
+    fn buffer_layout(&self, _slot: &str, _frame: FrameSize) -> Option<BufferLayout> {
+        None
+    }
+    /// Checks against what the writers of its read buffers published (after every
+    /// pass's slots were matched and each slot's `needs` was met).
+    fn check_inputs(&self, _ctx: &contracts::InputsCtx, _errors: &mut Vec<GraphError>) {}
+    /// Whether what the pass writes is memory spent on transparency (memory by technique).
+    fn writes_transparency(&self, _roles: &PassRoles) -> bool {
+        false
+    }
+}
 
 use super::error::GraphError;
-use super::model::{PassDesc, PassKind, ResourceDesc, SceneResource};
-use super::plan::{FrameSize, ListLayout};
+use super::model::{PassDesc, ResourceDesc, SceneResource};
+use super::plan::FrameSize;
 use super::roles::{PassRoles, RoleCtx};
+use light_culling::ListLayout;
 
 pub(crate) use matching::resolve;
 
@@ -137,6 +280,9 @@ pub struct SlotSpec {
     pub access: Access,
     pub optional: bool,
     pub usage: Usage,
+    /// A read buffer's contract: what its writer must publish on it (one of these);
+    /// empty: anything. Checked by validation (`contracts.rs`).
+    pub needs: &'static [Contents],
 }
 
 impl SlotSpec {
@@ -147,11 +293,19 @@ impl SlotSpec {
             access,
             optional: false,
             usage,
+            needs: &[],
         }
     }
     pub const fn optional(self) -> Self {
         Self {
             optional: true,
+            ..self
+        }
+    }
+    /// A read buffer that one of its writers must have laid out as one of `contents`.
+    pub const fn needs(self, contents: &'static [Contents]) -> Self {
+        Self {
+            needs: contents,
             ..self
         }
     }
@@ -190,7 +344,45 @@ pub enum BufferLayout {
     },
 }
 
+/// What a laid-out buffer holds: a [`BufferLayout`] without its sizes, for contracts
+/// between a buffer's writer and its readers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Contents {
+    LightLists,
+    LightLinks,
+    ShadowJobs,
+    ShadowMask,
+    Lights,
+    RsmViews,
+    ShadowViews,
+}
+
+impl Contents {
+    /// The kind whose pass lays such a buffer out, for messages.
+    pub fn producer(self) -> &'static str {
+        match self {
+            Contents::LightLists => "LightCulling",
+            Contents::LightLinks => "LightLinkedList",
+            Contents::ShadowJobs | Contents::ShadowMask => "ShadowRayJobs",
+            Contents::Lights => "VplSpawn",
+            Contents::RsmViews => "ReflectiveShadowMaps",
+            Contents::ShadowViews => "ShadowAtlas",
+        }
+    }
+}
+
 impl BufferLayout {
+    pub fn contents(&self) -> Contents {
+        match self {
+            BufferLayout::LightLists(_) => Contents::LightLists,
+            BufferLayout::LightLinks(_) => Contents::LightLinks,
+            BufferLayout::ShadowJobs { .. } => Contents::ShadowJobs,
+            BufferLayout::ShadowMask { .. } => Contents::ShadowMask,
+            BufferLayout::Lights { .. } => Contents::Lights,
+            BufferLayout::RsmViews { .. } => Contents::RsmViews,
+            BufferLayout::ShadowViews { .. } => Contents::ShadowViews,
+        }
+    }
     pub fn bytes(&self) -> u64 {
         match self {
             BufferLayout::LightLists(l) => l.bytes(),
@@ -237,95 +429,24 @@ pub const LIGHT_LISTS_READ: SlotSpec = SlotSpec::new(
     Access::Read,
     Usage::Bound,
 )
-.optional();
+.optional()
+.needs(&[Contents::LightLists, Contents::LightLinks]);
 
 /// The slot table of a built-in kind; `None` for generic kinds.
 pub fn slots(kind: &PassKind) -> Option<&'static [SlotSpec]> {
-    Some(match kind {
-        PassKind::DepthPrepass => depth_prepass::SLOTS,
-        PassKind::LightCulling(_) => light_culling::SLOTS,
-        PassKind::LightLinkedList(_) => light_linked_list::SLOTS,
-        PassKind::ForwardShading(_) => forward_shading::SLOTS,
-        PassKind::GBuffer => g_buffer::SLOTS,
-        PassKind::DeferredShading(_) => deferred_shading::SLOTS,
-        PassKind::ShadowRayJobs(_) => shadow_ray_jobs::SLOTS,
-        PassKind::ShadowRayCast(_) => shadow_ray_cast::SLOTS,
-        PassKind::ShadowAtlas(_) => shadow_atlas::SLOTS,
-        PassKind::ShadowCompare => shadow_compare::SLOTS,
-        PassKind::TransparentDepth => transparent_depth::SLOTS,
-        PassKind::TransparentShading(_) => transparent_shading::SLOTS,
-        PassKind::ReflectiveShadowMaps(_) => reflective_shadow_maps::SLOTS,
-        PassKind::VplSpawn(_) => vpl_spawn::SLOTS,
-        PassKind::VisibilityBuffer => visibility_buffer::SLOTS,
-        PassKind::VisibilityShading(_) => visibility_shading::SLOTS,
-        PassKind::ComputeRaster => compute_raster::SLOTS,
-        PassKind::Compute { .. } | PassKind::Fullscreen { .. } => return None,
-    })
+    kind.rules().map(|r| r.slots())
 }
 
 /// The kind's own checks, after its slots were matched.
 fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
-    match &ctx.pass.kind {
-        PassKind::DepthPrepass => depth_prepass::check(ctx, errors),
-        PassKind::LightCulling(p) => light_culling::check(p, ctx, errors),
-        PassKind::LightLinkedList(p) => light_linked_list::check(p, ctx, errors),
-        PassKind::ForwardShading(p) => forward_shading::check(p, ctx, errors),
-        PassKind::GBuffer => g_buffer::check(ctx, errors),
-        PassKind::DeferredShading(p) => deferred_shading::check(p, ctx, errors),
-        PassKind::ShadowRayJobs(p) => shadow_ray_jobs::check(p, ctx, errors),
-        PassKind::ShadowRayCast(p) => shadow_ray_cast::check(p, ctx, errors),
-        PassKind::ShadowAtlas(p) => shadow_atlas::check(p, ctx, errors),
-        PassKind::ShadowCompare => shadow_compare::check(ctx, errors),
-        PassKind::TransparentDepth => transparent_depth::check(ctx, errors),
-        PassKind::TransparentShading(p) => transparent_shading::check(p, ctx, errors),
-        PassKind::ReflectiveShadowMaps(p) => reflective_shadow_maps::check(p, ctx, errors),
-        PassKind::VplSpawn(p) => vpl_spawn::check(p, ctx, errors),
-        PassKind::VisibilityBuffer => visibility_buffer::check(ctx, errors),
-        PassKind::VisibilityShading(p) => visibility_shading::check(p, ctx, errors),
-        PassKind::ComputeRaster => compute_raster::check(ctx, errors),
-        PassKind::Compute { .. } | PassKind::Fullscreen { .. } => {}
+    if let Some(rules) = ctx.pass.kind.rules() {
+        rules.check(ctx, errors);
     }
 }
 
 /// The layout a built-in pass gives a buffer it writes into `slot`.
 pub fn buffer_layout(kind: &PassKind, slot: &str, frame: FrameSize) -> Option<BufferLayout> {
-    match kind {
-        PassKind::LightCulling(p) if slot == slot::LIGHT_LISTS => Some(BufferLayout::LightLists(
-            p.list_layout(frame.width, frame.height),
-        )),
-        PassKind::LightLinkedList(p) if slot == light_linked_list::LIGHT_LINKS => Some(
-            BufferLayout::LightLinks(p.link_layout(frame.width, frame.height)),
-        ),
-        PassKind::ShadowRayJobs(p) if slot == shadow_ray_jobs::SHADOW_JOBS => {
-            Some(BufferLayout::ShadowJobs {
-                capacity: p.capacity(frame.width, frame.height),
-            })
-        }
-        PassKind::ShadowRayJobs(_) if slot == shadow_ray_jobs::SHADOW_MASK => {
-            Some(BufferLayout::ShadowMask {
-                pixels: frame.width as u64 * frame.height as u64,
-            })
-        }
-        PassKind::VplSpawn(p) if slot == slot::LIGHT_GEOMETRY || slot == slot::LIGHT_PROPERTIES => {
-            Some(BufferLayout::Lights {
-                lights: frame.lights as u64 + p.max_vpls as u64,
-                stride: 32,
-            })
-        }
-        PassKind::ReflectiveShadowMaps(p) if slot == reflective_shadow_maps::RSM_VIEWS => {
-            Some(BufferLayout::RsmViews {
-                max_views: p.max_views(),
-            })
-        }
-        PassKind::ShadowAtlas(p) if slot == shadow_atlas::SHADOW_VIEWS => {
-            Some(BufferLayout::ShadowViews {
-                lights: frame.lights,
-                max_views: p.max_views(),
-                filter: p.filter,
-            })
-        }
-        _ => None,
-    }
+    kind.rules()?.buffer_layout(slot, frame)
 }
 
 /// A matched pass, for its kind's checks.
@@ -453,7 +574,8 @@ pub const SHADOW_VIEWS_READ: SlotSpec = SlotSpec::new(
     Access::Read,
     Usage::Bound,
 )
-.optional();
+.optional()
+.needs(&[Contents::ShadowViews]);
 
 /// A shading pass samples an atlas through its view table, and shadows one way only.
 pub fn check_shadow_atlas(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
@@ -521,6 +643,47 @@ pub(crate) fn plain_some<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Optio
 /// Writes a set optional number plainly; pair with `skip_serializing_if = "Option::is_none"`.
 pub(crate) fn plain_u32<S: serde::Serializer>(v: &Option<u32>, s: S) -> Result<S::Ok, S::Error> {
     s.serialize_u32(v.unwrap_or_default())
+}
+
+#[cfg(test)]
+mod registry_tests {
+    use super::KIND_MODULES;
+
+    /// Every module file beside the registered kinds is named here as shared support, so
+    /// a kind whose registry line was dropped cannot linger uncompiled.
+    #[test]
+    fn every_kind_file_is_registered() {
+        let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+        let support: [(&str, &[&str]); 2] = [
+            ("graph/kinds", &["mod", "matching", "contracts"]),
+            (
+                "render/passes",
+                &[
+                    "mod",
+                    "compute",
+                    "fullscreen",
+                    "compute_raster_fallback",
+                    "compute_raster_resolve",
+                ],
+            ),
+        ];
+        for (dir, shared) in support {
+            let mut kinds = 0;
+            for entry in std::fs::read_dir(src.join(dir)).unwrap() {
+                let path = entry.unwrap().path();
+                let stem = path.file_stem().unwrap().to_str().unwrap().to_string();
+                if KIND_MODULES.contains(&stem.as_str()) {
+                    kinds += 1;
+                } else {
+                    assert!(
+                        shared.contains(&stem.as_str()),
+                        "{dir}/{stem}.rs is neither a registered kind nor shared support"
+                    );
+                }
+            }
+            assert_eq!(kinds, KIND_MODULES.len(), "{dir}");
+        }
+    }
 }
 
 #[cfg(test)]

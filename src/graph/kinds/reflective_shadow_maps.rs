@@ -4,8 +4,9 @@
 //! in one render pass. Writes the four textures and the view table the `VplSpawn` pass
 //! reads (`src/indirect/rsm_views.rs` allocates the tiles).
 
-use super::{Access, KindCtx, SlotSpec, SlotType, Usage};
+use super::{Access, BufferLayout, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
+use crate::graph::plan::FrameSize;
 use crate::graph::model::{ResourceDesc, TextureFormat, TextureSize};
 use serde::{Deserialize, Serialize};
 
@@ -146,6 +147,20 @@ pub fn check(p: &ReflectiveShadowMaps, ctx: &KindCtx, errors: &mut Vec<GraphErro
                 }
             }
         }
+    }
+}
+
+impl KindRules for ReflectiveShadowMaps {
+    fn slots(&self) -> &'static [SlotSpec] {
+        SLOTS
+    }
+    fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+        check(self, ctx, errors)
+    }
+    fn buffer_layout(&self, slot: &str, _frame: FrameSize) -> Option<BufferLayout> {
+        (slot == RSM_VIEWS).then(|| BufferLayout::RsmViews {
+            max_views: self.max_views(),
+        })
     }
 }
 

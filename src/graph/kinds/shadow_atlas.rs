@@ -4,8 +4,9 @@
 //! atlas and the view table that shading passes sample it through
 //! (`shaders/common/shadows.wgsl`, `SHADOW_ATLAS`).
 
-use super::{Access, KindCtx, SlotSpec, SlotType, Usage};
+use super::{Access, BufferLayout, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
+use crate::graph::plan::FrameSize;
 use crate::graph::model::{ResourceDesc, TextureSize};
 use serde::{Deserialize, Serialize};
 
@@ -166,6 +167,22 @@ pub fn check(p: &ShadowAtlas, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
             )),
             Some(_) => {}
         }
+    }
+}
+
+impl KindRules for ShadowAtlas {
+    fn slots(&self) -> &'static [SlotSpec] {
+        SLOTS
+    }
+    fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+        check(self, ctx, errors)
+    }
+    fn buffer_layout(&self, slot: &str, frame: FrameSize) -> Option<BufferLayout> {
+        (slot == SHADOW_VIEWS).then(|| BufferLayout::ShadowViews {
+            lights: frame.lights,
+            max_views: self.max_views(),
+            filter: self.filter,
+        })
     }
 }
 

@@ -7,7 +7,7 @@
 use super::g_buffer::{G_NORMAL, G_POSITION, G_POSITION_READ};
 use super::shadow_atlas::{SHADOW_ATLAS, SHADOW_VIEWS};
 use super::shadow_ray_jobs::SHADOW_MASK;
-use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
+use super::{slot, Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 
 pub const SHADOW_ERRORS: &str = "shadow_errors";
@@ -30,15 +30,18 @@ pub const SLOTS: &[SlotSpec] = &[
         SlotType::Buffer,
         Access::Read,
         Usage::Bound,
-    ),
-    SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound),
+    )
+    .needs(&[Contents::LightLists]),
+    SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound)
+        .needs(&[Contents::ShadowMask]),
     SlotSpec::new(
         SHADOW_ATLAS,
         SlotType::DepthTexture,
         Access::Read,
         Usage::Sampled,
     ),
-    SlotSpec::new(SHADOW_VIEWS, SlotType::Buffer, Access::Read, Usage::Bound),
+    SlotSpec::new(SHADOW_VIEWS, SlotType::Buffer, Access::Read, Usage::Bound)
+        .needs(&[Contents::ShadowViews]),
     SlotSpec::new(SHADOW_ERRORS, SlotType::Buffer, Access::Write, Usage::Bound),
 ];
 
@@ -49,6 +52,18 @@ pub fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         errors,
     );
     super::check_shadow_atlas_texture(ctx, errors);
+}
+
+/// `ShadowCompare` has no parameters: this names it for its rules.
+pub struct ShadowCompare;
+
+impl KindRules for ShadowCompare {
+    fn slots(&self) -> &'static [SlotSpec] {
+        SLOTS
+    }
+    fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+        check(ctx, errors)
+    }
 }
 
 #[cfg(test)]

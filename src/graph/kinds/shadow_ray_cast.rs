@@ -5,7 +5,7 @@
 
 use super::g_buffer::{G_GEOMETRIC_READ, G_POSITION_READ};
 use super::shadow_ray_jobs::{SHADOW_JOBS, SHADOW_MASK};
-use super::{Access, KindCtx, SlotSpec, SlotType, Usage};
+use super::{Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 use crate::graph::model::SceneResource;
 use serde::{Deserialize, Serialize};
@@ -31,7 +31,8 @@ pub const BVH_NODES: &str = "bvh_nodes";
 pub const BVH_TRIANGLES: &str = "bvh_triangles";
 
 pub const SLOTS: &[SlotSpec] = &[
-    SlotSpec::new(SHADOW_JOBS, SlotType::Buffer, Access::Read, Usage::Bound),
+    SlotSpec::new(SHADOW_JOBS, SlotType::Buffer, Access::Read, Usage::Bound)
+        .needs(&[Contents::ShadowJobs]),
     G_POSITION_READ,
     G_GEOMETRIC_READ,
     super::LIGHT_GEOMETRY_READ,
@@ -56,6 +57,15 @@ pub fn check(p: &ShadowRayCast, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
             "normal_offset {} must be in [0, 0.1]",
             p.normal_offset
         )));
+    }
+}
+
+impl KindRules for ShadowRayCast {
+    fn slots(&self) -> &'static [SlotSpec] {
+        SLOTS
+    }
+    fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+        check(self, ctx, errors)
     }
 }
 

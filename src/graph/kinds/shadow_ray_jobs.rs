@@ -4,8 +4,9 @@
 //! `shaders/shadow/shadow_ray_jobs.wgsl`.
 
 use super::g_buffer::{G_GEOMETRIC, G_GEOMETRIC_READ, G_POSITION, G_POSITION_READ};
-use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
+use super::{slot, Access, BufferLayout, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
+use crate::graph::plan::FrameSize;
 use serde::{Deserialize, Serialize};
 
 /// `ShadowRayJobs(jobs_per_pixel: 16.0)`.
@@ -55,7 +56,8 @@ pub const SLOTS: &[SlotSpec] = &[
         SlotType::Buffer,
         Access::Read,
         Usage::Bound,
-    ),
+    )
+    .needs(&[Contents::LightLists]),
     SlotSpec::new(SHADOW_JOBS, SlotType::Buffer, Access::Write, Usage::Bound),
     SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Write, Usage::Bound),
 ];
@@ -72,6 +74,26 @@ pub fn check(p: &ShadowRayJobs, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         "ray-cast shadows read world positions and geometric normals from single-sample Rgba32Float G-buffer textures (not the packed G-buffer)",
         errors,
     );
+}
+
+impl KindRules for ShadowRayJobs {
+    fn slots(&self) -> &'static [SlotSpec] {
+        SLOTS
+    }
+    fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+        check(self, ctx, errors)
+    }
+    fn buffer_layout(&self, slot: &str, frame: FrameSize) -> Option<BufferLayout> {
+        match slot {
+            SHADOW_JOBS => Some(BufferLayout::ShadowJobs {
+                capacity: self.capacity(frame.width, frame.height),
+            }),
+            SHADOW_MASK => Some(BufferLayout::ShadowMask {
+                pixels: frame.width as u64 * frame.height as u64,
+            }),
+            _ => None,
+        }
+    }
 }
 
 #[cfg(test)]

@@ -3,8 +3,8 @@
 //! transparent culling range (AMD's TiledLighting11 sample). Runs `shaders/forward/forward.wgsl` with
 //! `DEPTH_ONLY`.
 
-use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
-use crate::graph::error::GraphError;
+use super::{slot, Access, KindRules, SlotSpec, SlotType, Usage};
+use crate::graph::roles::PassRoles;
 
 pub const SLOTS: &[SlotSpec] = &[
     super::GEOMETRY_READ,
@@ -16,7 +16,17 @@ pub const SLOTS: &[SlotSpec] = &[
     ),
 ];
 
-pub fn check(_ctx: &KindCtx, _errors: &mut [GraphError]) {}
+/// `TransparentDepth` has no parameters: this names it for its rules.
+pub struct TransparentDepth;
+
+impl KindRules for TransparentDepth {
+    fn slots(&self) -> &'static [SlotSpec] {
+        SLOTS
+    }
+    fn writes_transparency(&self, _roles: &PassRoles) -> bool {
+        true
+    }
+}
 
 #[cfg(test)]
 mod tests {

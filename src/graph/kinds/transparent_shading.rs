@@ -3,7 +3,7 @@
 //! shading wrote, tested against (never writing) the opaque depth. Runs
 //! `shaders/forward/forward.wgsl` with `SHADE`.
 
-use super::{check_light_source, slot, Access, KindCtx, SlotSpec, SlotType, Usage};
+use super::{check_light_source, slot, Access, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 use crate::graph::model::LightSource;
 use serde::{Deserialize, Serialize};
@@ -53,6 +53,15 @@ pub fn check(p: &TransparentShading, ctx: &KindCtx, errors: &mut Vec<GraphError>
                 "transparent surfaces blend into the colour target: list it in writes too",
             ));
         }
+    }
+}
+
+impl KindRules for TransparentShading {
+    fn slots(&self) -> &'static [SlotSpec] {
+        SLOTS
+    }
+    fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+        check(self, ctx, errors)
     }
 }
 

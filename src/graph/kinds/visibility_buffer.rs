@@ -3,7 +3,7 @@
 //! where nothing is). Alpha-masked geometry discards. Runs `shaders/forward/forward.wgsl`
 //! with `VISIBILITY`.
 
-use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
+use super::{slot, Access, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 use crate::graph::model::{ResourceDesc, TextureFormat};
 
@@ -56,6 +56,18 @@ pub fn check_ids(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
             ids,
             "triangle ids are a single-sample R32Uint texture (MSAA is not supported)",
         ));
+    }
+}
+
+/// `VisibilityBuffer` has no parameters: this names it for its rules.
+pub struct VisibilityBuffer;
+
+impl KindRules for VisibilityBuffer {
+    fn slots(&self) -> &'static [SlotSpec] {
+        SLOTS
+    }
+    fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+        check(ctx, errors)
     }
 }
 

@@ -9,7 +9,7 @@
 use super::deferred_shading::HDR;
 use super::shadow_ray_jobs::SHADOW_MASK;
 use super::visibility_buffer::VISIBILITY;
-use super::{check_light_source, Access, KindCtx, SlotSpec, SlotType, Usage};
+use super::{check_light_source, Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 use crate::graph::model::{LightSource, SceneResource};
 use serde::{Deserialize, Serialize};
@@ -109,7 +109,9 @@ pub const SLOTS: &[SlotSpec] = &[
     super::LIGHT_LISTS_READ,
     SlotSpec::new(HDR, SlotType::ColorTexture, Access::Write, Usage::Storage),
     // Taken only to refuse them by name (see `check`).
-    SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound).optional(),
+    SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound)
+        .optional()
+        .needs(&[Contents::ShadowMask]),
     super::SHADOW_ATLAS_READ,
     super::SHADOW_VIEWS_READ,
 ];
@@ -142,6 +144,15 @@ pub fn check(p: &VisibilityShading, ctx: &KindCtx, errors: &mut Vec<GraphError>)
             name,
             "visibility shading does not shadow its lights yet: use a G-buffer or forward graph for shadows",
         ));
+    }
+}
+
+impl KindRules for VisibilityShading {
+    fn slots(&self) -> &'static [SlotSpec] {
+        SLOTS
+    }
+    fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+        check(self, ctx, errors)
     }
 }
 

@@ -7,8 +7,9 @@
 //! Runs `shaders/indirect/vpl_spawn.wgsl`.
 
 use super::reflective_shadow_maps::{RSM_FLUX, RSM_NORMAL, RSM_POSITION, RSM_VIEWS};
-use super::{slot, Access, KindCtx, SlotSpec, SlotType, Usage};
+use super::{slot, Access, BufferLayout, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
+use crate::graph::plan::FrameSize;
 use crate::graph::model::SceneResource;
 use serde::{Deserialize, Serialize};
 
@@ -47,7 +48,8 @@ pub const SLOTS: &[SlotSpec] = &[
     sampled(RSM_NORMAL),
     sampled(RSM_FLUX),
     sampled(RSM_POSITION),
-    SlotSpec::new(RSM_VIEWS, SlotType::Buffer, Access::Read, Usage::Bound),
+    SlotSpec::new(RSM_VIEWS, SlotType::Buffer, Access::Read, Usage::Bound)
+        .needs(&[Contents::RsmViews]),
     SlotSpec::new(
         SCENE_LIGHT_GEOMETRY,
         SlotType::Import(SceneResource::LightGeometry),
@@ -87,6 +89,23 @@ pub fn check(p: &VplSpawn, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
                 ));
             }
         }
+    }
+}
+
+impl KindRules for VplSpawn {
+    fn slots(&self) -> &'static [SlotSpec] {
+        SLOTS
+    }
+    fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+        check(self, ctx, errors)
+    }
+    fn buffer_layout(&self, slot: &str, frame: FrameSize) -> Option<BufferLayout> {
+        (slot == slot::LIGHT_GEOMETRY || slot == slot::LIGHT_PROPERTIES).then(|| {
+            BufferLayout::Lights {
+                lights: frame.lights as u64 + self.max_vpls as u64,
+                stride: 32,
+            }
+        })
     }
 }
 

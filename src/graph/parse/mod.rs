@@ -1,11 +1,4 @@
-//! Step 1: text to [`GraphDesc`], with file:line:col on every syntax error.
-//!
-//! Two paths to the same value: [`fast`], a small deserializer for the RON subset graph
-//! files use, and `ron` itself. The fast path answers only "this value" or "not mine";
-//! on the second, and so on every error, `ron` parses the text again, so every value
-//! and every error message and position is `ron`'s.
-
-mod fast;
+//! Step 1: text to [`GraphDesc`] with `ron`, with file:line:col on every syntax error.
 
 use super::error::GraphError;
 use super::location::SourceText;
@@ -26,23 +19,6 @@ pub fn load(path: &Path) -> Result<(GraphDesc, SourceText), GraphError> {
 
 /// Parses graph text; `source.file` is only used in messages.
 pub fn parse(source: &SourceText) -> Result<GraphDesc, GraphError> {
-    match parse_fast(&source.text) {
-        Some(desc) => Ok(desc),
-        None => parse_ron_only(source),
-    }
-}
-
-/// The fast path alone: `None` where the text is outside its subset or wrong.
-fn parse_fast(text: &str) -> Option<GraphDesc> {
-    let mut desc: GraphDesc = fast::from_str(text)?;
-    for pass in &mut desc.passes {
-        pass.split_named_slots();
-    }
-    Some(desc)
-}
-
-/// `ron` alone, with the graph's error messages.
-fn parse_ron_only(source: &SourceText) -> Result<GraphDesc, GraphError> {
     // Kinds wrap their parameter struct: `LightCulling(tile: 16)`, not `LightCulling((tile: 16))`.
     let options = ron::Options::default()
         .with_default_extension(ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES);
@@ -73,20 +49,4 @@ fn parse_ron_only(source: &SourceText) -> Result<GraphDesc, GraphError> {
         pass.split_named_slots();
     }
     Ok(desc)
-}
-
-/// Both parse paths, for tests that compare them (`graph::parse` is what to call).
-impl GraphDesc {
-    /// The fast RON-subset path alone: `None` where it does not apply or the text is
-    /// wrong. When it returns a value, `ron` returns the same one.
-    #[doc(hidden)]
-    pub fn parse_fast(text: &str) -> Option<GraphDesc> {
-        parse_fast(text)
-    }
-
-    /// `ron` alone, with the same errors as [`parse`].
-    #[doc(hidden)]
-    pub fn parse_ron_only(source: &SourceText) -> Result<GraphDesc, GraphError> {
-        parse_ron_only(source)
-    }
 }

@@ -510,6 +510,18 @@ impl PreparedPass for ComputeRasterPass {
     }
 }
 
+impl super::PrepareKind for crate::graph::kinds::compute_raster::ComputeRaster {
+    /// The compute rasterizer, or its hardware fallback on an adapter without its
+    /// 64-bit atomics.
+    fn prepare(
+        &self,
+        cx: &mut PrepareCtx<'_>,
+        sp: &ScheduledPass,
+    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
+        super::compute_raster_fallback::prepare(cx, sp)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -83,3 +83,13 @@ impl PreparedPass for GBuffer {
         self.draws.record(&mut pass);
     }
 }
+
+impl super::PrepareKind for crate::graph::kinds::g_buffer::GBuffer {
+    fn prepare(
+        &self,
+        cx: &mut PrepareCtx<'_>,
+        sp: &ScheduledPass,
+    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
+        Ok(Box::new(prepare(cx, sp)?))
+    }
+}

@@ -51,22 +51,7 @@ pub(super) fn prepare(
                 format!("'{lists}' is not the tile lists of a LightCulling pass: the linked list reads its candidates from them"),
             )
         })?;
-        // A list pixel reads the one list of the one tile it lies in.
-        if tiles.lists_per_tile != 1 {
-            return Err(pass_error(
-                &sp.name,
-                format!("'{lists}' has {} lists a tile ({:?}); the linked list reads one list a tile (Frustum or DepthMask)", tiles.lists_per_tile, tiles.variant),
-            ));
-        }
-        if tiles.tile % layout.scale != 0 {
-            return Err(pass_error(
-                &sp.name,
-                format!(
-                    "scale {} does not divide the culling tile of {} pixels of '{lists}'",
-                    layout.scale, tiles.tile
-                ),
-            ));
-        }
+        // One list a tile, its tile a multiple of the scale: checked by validation.
         offered.buffer(
             "list_params",
             &crate::gpu::structs::GpuListParams::new(&tiles).buffer(&cx.device()),
@@ -121,5 +106,15 @@ impl PreparedPass for LightLinkedListPass {
             overflow_pixels: w[2] as u64,
             longest_list: w[3],
         })))
+    }
+}
+
+impl super::PrepareKind for crate::graph::kinds::light_linked_list::LightLinkedList {
+    fn prepare(
+        &self,
+        cx: &mut PrepareCtx<'_>,
+        sp: &ScheduledPass,
+    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
+        Ok(Box::new(prepare(cx, sp, self)?))
     }
 }

@@ -1,28 +1,12 @@
 //! Built-in and generic passes, one file per kind (named as in `graph/kinds/`): each
 //! prepares its pipelines and bind groups from a scheduled pass and records itself.
-//! This file holds the one match from a compiled pass to its prepared form.
+//! This file holds the prepare dispatch, generated from the registry of kinds
+//! (`graph::kinds::built_in_kinds!`), and what preparing any pass needs.
 
 mod compute;
-mod compute_raster;
 mod compute_raster_fallback;
 mod compute_raster_resolve;
-mod deferred_shading;
-mod depth_prepass;
-mod forward_shading;
 mod fullscreen;
-mod g_buffer;
-pub(super) mod light_culling;
-mod light_linked_list;
-mod reflective_shadow_maps;
-mod shadow_atlas;
-mod shadow_compare;
-mod shadow_ray_cast;
-mod shadow_ray_jobs;
-mod transparent_depth;
-mod transparent_shading;
-mod visibility_buffer;
-mod visibility_shading;
-pub mod vpl_spawn;
 
 use super::bind::{BindingSet, Bound};
 use super::pipelines::{Pipeline, PipelineKey};
@@ -31,6 +15,7 @@ use super::resources::FrameResources;
 use super::scene_gpu::SceneGpu;
 use super::{RenderError, Renderer};
 use crate::gpu::structs::{GpuLinkParams, GpuListParams};
+use crate::graph::kinds::{built_in_kinds, kind_value};
 use crate::graph::{
     CompiledGraph, FrameSize, PassKind, ResourceDesc, SceneResource, ScheduledPass,
 };
@@ -49,41 +34,46 @@ pub(super) trait PreparedPass {
     fn set_view(&self, _r: &Renderer, _camera: &crate::scene::Camera) {}
 }
 
-/// Prepares one scheduled pass.
-pub(super) fn prepare(
-    cx: &mut PrepareCtx<'_>,
-    sp: &ScheduledPass,
-) -> Result<Box<dyn PreparedPass>, RenderError> {
-    Ok(match &sp.kind {
-        PassKind::DepthPrepass => Box::new(depth_prepass::prepare(cx, sp)?),
-        PassKind::LightCulling(p) => Box::new(light_culling::prepare(cx, sp, p)?),
-        PassKind::LightLinkedList(p) => Box::new(light_linked_list::prepare(cx, sp, p)?),
-        PassKind::ForwardShading(p) => Box::new(forward_shading::prepare(cx, sp, p)?),
-        PassKind::GBuffer => Box::new(g_buffer::prepare(cx, sp)?),
-        PassKind::DeferredShading(p) => Box::new(deferred_shading::prepare(cx, sp, p)?),
-        PassKind::ShadowRayJobs(p) => Box::new(shadow_ray_jobs::prepare(cx, sp, p)?),
-        PassKind::ShadowRayCast(p) => Box::new(shadow_ray_cast::prepare(cx, sp, p)?),
-        PassKind::ShadowAtlas(p) => Box::new(shadow_atlas::prepare(cx, sp, p)?),
-        PassKind::ShadowCompare => Box::new(shadow_compare::prepare(cx, sp)?),
-        PassKind::TransparentDepth => Box::new(transparent_depth::prepare(cx, sp)?),
-        PassKind::TransparentShading(p) => Box::new(transparent_shading::prepare(cx, sp, p)?),
-        PassKind::ReflectiveShadowMaps(p) => Box::new(reflective_shadow_maps::prepare(cx, sp, p)?),
-        PassKind::VplSpawn(p) => Box::new(vpl_spawn::prepare(cx, sp, p)?),
-        PassKind::VisibilityBuffer => Box::new(visibility_buffer::prepare(cx, sp)?),
-        PassKind::VisibilityShading(p) => Box::new(visibility_shading::prepare(cx, sp, p)?),
-        // The compute rasterizer, or its hardware fallback on an adapter without its
-        // 64-bit atomics.
-        PassKind::ComputeRaster => compute_raster_fallback::prepare(cx, sp)?,
-        PassKind::Compute {
-            shader,
-            entry,
-            dispatch,
-        } => Box::new(compute::prepare(cx, sp, shader, entry, *dispatch)?),
-        PassKind::Fullscreen { shader, entry } => {
-            Box::new(fullscreen::prepare(cx, sp, shader, entry)?)
-        }
-    })
+/// How a built-in kind prepares its pass; implemented in `render/passes/<kind>.rs` by the
+/// type `graph/kinds/<kind>.rs` implements `KindRules` on.
+pub(super) trait PrepareKind {
+    fn prepare(
+        &self,
+        cx: &mut PrepareCtx<'_>,
+        sp: &ScheduledPass,
+    ) -> Result<Box<dyn PreparedPass>, RenderError>;
 }
+
+/// The render side of the registry (`graph::kinds::built_in_kinds`): the kinds' modules
+/// and the prepare dispatch, with the two generic kinds after the built-in ones.
+macro_rules! render_side {
+    ($( $(#[$doc:meta])* $kind:ident $( ($params:ident : $ty:ident) )? => $module:ident, )*) => {
+        $( mod $module; )*
+
+        /// Prepares one scheduled pass.
+        pub(super) fn prepare(
+            cx: &mut PrepareCtx<'_>,
+            sp: &ScheduledPass,
+        ) -> Result<Box<dyn PreparedPass>, RenderError> {
+            let built_in: &dyn PrepareKind = match &sp.kind {
+                $( PassKind::$kind $( ($params) )? => {
+                    kind_value!($($params)? ; crate::graph::kinds::$module::$kind)
+                } )*
+                PassKind::Compute {
+                    shader,
+                    entry,
+                    dispatch,
+                } => return Ok(Box::new(compute::prepare(cx, sp, shader, entry, *dispatch)?)),
+                PassKind::Fullscreen { shader, entry } => {
+                    return Ok(Box::new(fullscreen::prepare(cx, sp, shader, entry)?))
+                }
+            };
+            built_in.prepare(cx, sp)
+        }
+    };
+}
+
+built_in_kinds!(render_side);
 
 /// Which lights a shading pass visits at a pixel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -327,8 +317,8 @@ impl PrepareCtx<'_> {
         }
         if let Some(layout) = self.graph.plan.list_layout(lists) {
             let per_list = match layout.storage {
-                crate::graph::plan::ListStorage::Fixed { capacity } => capacity as u64,
-                crate::graph::plan::ListStorage::Compact { max_indices, .. } => max_indices as u64,
+                crate::graph::ListStorage::Fixed { capacity } => capacity as u64,
+                crate::graph::ListStorage::Compact { max_indices, .. } => max_indices as u64,
             };
             loop_check(
                 per_list.min(lights_bound),

@@ -320,3 +320,13 @@ impl PreparedPass for ShadowAtlasPass {
         self.allocate(r, camera);
     }
 }
+
+impl super::PrepareKind for crate::graph::kinds::shadow_atlas::ShadowAtlas {
+    fn prepare(
+        &self,
+        cx: &mut PrepareCtx<'_>,
+        sp: &ScheduledPass,
+    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
+        Ok(Box::new(prepare(cx, sp, self)?))
+    }
+}

@@ -42,11 +42,12 @@ pub(super) fn prepare(
         .graph
         .passes
         .iter()
-        .find_map(|q| match &q.kind {
-            PassKind::ReflectiveShadowMaps(r) if q.roles.slot(RSM_VIEWS) == Some(views_name) => {
-                Some((*r, q.required(RSM_FLUX).to_string()))
-            }
-            _ => None,
+        .filter(|q| q.roles.slot(RSM_VIEWS) == Some(views_name))
+        .find_map(|q| {
+            let PassKind::ReflectiveShadowMaps(r) = &q.kind else {
+                return None;
+            };
+            Some((*r, q.required(RSM_FLUX).to_string()))
         })
         .ok_or_else(|| {
             pass_error(
@@ -176,5 +177,15 @@ impl PreparedPass for VplSpawnPass {
         report.dropped = w[1];
         report.with_flux = w[5];
         Ok(Some(PassReport::Vpl(report)))
+    }
+}
+
+impl super::PrepareKind for crate::graph::kinds::vpl_spawn::VplSpawn {
+    fn prepare(
+        &self,
+        cx: &mut PrepareCtx<'_>,
+        sp: &ScheduledPass,
+    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
+        Ok(Box::new(prepare(cx, sp, self)?))
     }
 }
