@@ -32,6 +32,7 @@ pub struct GraphDesc {
 
 /// A named resource. Sizes are plain data relative to the output.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
 pub enum ResourceDesc {
     Texture {
         name: Name,
@@ -114,6 +115,7 @@ pub enum TextureSize {
 }
 
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
 pub enum BufferSize {
     /// Sized by the built-in pass that writes it (e.g. per-tile light lists from the
     /// culling pass's tile size and capacity).
@@ -224,6 +226,7 @@ impl PassDesc {
 
 /// How a culling pass bounds a tile in depth.
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash, Default)]
+#[serde(deny_unknown_fields)]
 pub enum CullVariant {
     /// One list per tile between the tile's min and max depth.
     #[default]
@@ -259,6 +262,7 @@ pub enum LightSource {
 }
 
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
+#[serde(deny_unknown_fields)]
 pub enum Dispatch {
     /// One invocation per output pixel, in workgroups of the given size.
     PerPixel {

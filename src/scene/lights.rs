@@ -68,6 +68,7 @@ impl Pcg32 {
 
 /// Where a random light set is placed.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Placement {
     /// Uniformly in this box.
     Box { min: Vec3, max: Vec3 },

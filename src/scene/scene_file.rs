@@ -137,6 +137,7 @@ impl Transform {
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum CameraSpec {
     LookAt {
         eye: Vec3,

@@ -53,6 +53,7 @@ pub struct LightCulling {
 
 /// How a culling pass stores its lists.
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
+#[serde(deny_unknown_fields)]
 pub enum ListMode {
     /// Room for `capacity` lights in every list: one pass, lists cut at the capacity.
     #[default]

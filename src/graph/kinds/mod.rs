@@ -82,6 +82,7 @@ macro_rules! graph_side {
         /// A pass's kind and its parameters, as graph files write it (`kind: DepthPrepass`,
         /// `kind: LightCulling(tile: 16)`).
         #[derive(Clone, Debug, serde::Deserialize, serde::Serialize, PartialEq)]
+        #[serde(deny_unknown_fields)]
         pub enum PassKind {
             $( $(#[$doc])* $kind $( ($module::$ty) )?, )*
             /// A compute shader the graph file names; bindings are matched by name.
