@@ -2,7 +2,8 @@
 # The benchmarks the docs quote, on the GPU machine (see docs/benchmarks.md). Stages
 # (STAGES, default all, in this order):
 #   frames    every frame kind on harada, AMD's atrium and the Cornell box glTF
-#             (frame_kinds_*.ron), and Forward+'s tile tests (forward_plus_culling.ron);
+#             (frame_kinds_*.ron), Forward+'s tile tests (forward_plus_culling.ron), and
+#             visibility shading's material classification (material_classification.ron);
 #   features  ray-cast shadows, the shadow atlas, transparency, MSAA, VPL indirect light
 #             and the light linked list (their sweeps);
 #   extras    the VPL bounce against its path-traced reference (vpl-error) and hot-reload
@@ -22,6 +23,7 @@ if [[ $stages == *" frames "* ]]; then
     run_sweep frame_kinds_atrium frame_kinds_atrium 120
     run_sweep frame_kinds_cornell frame_kinds_cornell 120
     run_sweep forward_plus_culling forward_plus_culling 150
+    run_sweep material_classification material_classification 200
 fi
 if [[ $stages == *" features "* ]]; then
     for s in raycast_shadows shadow_atlas transparency msaa indirect_vpl light_linked_list; do
