@@ -438,3 +438,29 @@ fn big_generated_grid_glb() {
     assert!(l.warnings.iter().all(|w| !w.contains("error")));
     let _ = encode_png; // re-exported helper used by other tests
 }
+
+/// Khronos's 2CylinderEngine gives its camera znear 0.05 and zfar 1e6, a range f32 depth
+/// cannot resolve (over 2^24): the far plane is pulled in to the scene's farthest point,
+/// with a warning, instead of refusing a real model.
+#[test]
+fn a_far_plane_past_depth_precision_is_pulled_in_to_the_scene() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/assets/khronos/2CylinderEngine/2CylinderEngine.gltf");
+    let loaded = scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let cam = loaded.scene.camera;
+    assert!(
+        cam.far / cam.near <= lightgraph::scene::MAX_FAR_OVER_NEAR,
+        "near {} far {}",
+        cam.near,
+        cam.far
+    );
+    assert!(cam.far < 1e6 && cam.far > 1000.0, "far {}", cam.far);
+    assert!(
+        loaded
+            .warnings
+            .iter()
+            .any(|w| w.contains("zfar 1000000") && w.contains("pulled in")),
+        "{:?}",
+        loaded.warnings
+    );
+}

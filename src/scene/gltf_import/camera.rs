@@ -2,7 +2,7 @@
 
 use super::Importer;
 use crate::scene::error::SceneError;
-use crate::scene::types::Camera;
+use crate::scene::types::{Camera, MAX_FAR_OVER_NEAR};
 use glam::{Mat4, Vec3};
 
 /// (element name, world matrix, (yfov, znear, zfar)).
@@ -29,7 +29,26 @@ impl Importer {
         if !(znear.is_finite() && znear > 0.0) {
             return Err(self.err(element, format!("znear {znear} must be > 0")));
         }
+        // Past the farthest corner of the scene nothing is drawn.
+        let scene_far = bounds.map(|(lo, hi)| {
+            let c = (lo + hi) * 0.5;
+            ((eye - c).length() + (hi - lo).length()).max(znear * 10.0)
+        });
         let far = match zfar {
+            // A far plane past the scene that f32 depth cannot resolve from this near
+            // plane (CAD exports write 1e6) is pulled in to the scene: the image is the
+            // same and depth keeps its precision. One that cuts the scene is kept.
+            Some(f) if f.is_finite() && f > znear && f / znear > MAX_FAR_OVER_NEAR => {
+                match scene_far {
+                    Some(s) if s < f => {
+                        self.warnings.push(format!(
+                            "{element}: zfar {f} is over 2^24 × znear {znear}, past what f32 depth resolves; the far plane is pulled in to the scene's farthest point ({s})"
+                        ));
+                        s
+                    }
+                    _ => f,
+                }
+            }
             Some(f) if f.is_finite() && f > znear => f,
             Some(f) => {
                 return Err(self.err(
@@ -37,16 +56,8 @@ impl Importer {
                     format!("zfar {f} must be finite and > znear {znear}"),
                 ))
             }
-            None => {
-                // Infinite projection: reach past the farthest corner of the scene.
-                let far = bounds
-                    .map(|(lo, hi)| {
-                        let c = (lo + hi) * 0.5;
-                        (eye - c).length() + (hi - lo).length()
-                    })
-                    .unwrap_or(1000.0);
-                far.max(znear * 10.0)
-            }
+            // Infinite projection: reach past the farthest corner of the scene.
+            None => scene_far.unwrap_or(1000.0_f32.max(znear * 10.0)),
         };
         if let Some(m) = Camera::lens_error(yfov.to_degrees(), znear, far) {
             return Err(self.err(element, format!("camera lens: {m}")));
