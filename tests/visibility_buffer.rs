@@ -568,16 +568,16 @@ fn staged_and_range_first_loops_match_brute_force_on_harada() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// `graph_text` with its VisibilityShading pass's materials dispatched per material over
-/// the whole frame instead of over their classified tiles.
-fn per_material(graph_text: &str) -> String {
+/// `graph_text` with its VisibilityShading pass's materials dispatched as `how`
+/// (`Classified` or `PerMaterial`).
+fn with_materials(graph_text: &str, how: &str) -> String {
     assert!(
         graph_text.contains("VisibilityShading("),
         "a VisibilityShading pass"
     );
     graph_text.replace(
         "VisibilityShading(",
-        "VisibilityShading(materials: PerMaterial, ",
+        &format!("VisibilityShading(materials: {how}, "),
     )
 }
 
@@ -621,8 +621,8 @@ fn classified_shading_equals_per_material_dispatches_to_the_bit() {
         for graph in graphs.iter() {
             for kind in loops.iter() {
                 let text = with_loop(&file(graph), kind);
-                let classified = render_text(&mut r, &text, s, W, H);
-                let whole = render_text(&mut r, &per_material(&text), s, W, H);
+                let classified = render_text(&mut r, &with_materials(&text, "Classified"), s, W, H);
+                let whole = render_text(&mut r, &with_materials(&text, "PerMaterial"), s, W, H);
                 let lit = whole
                     .image
                     .iter()

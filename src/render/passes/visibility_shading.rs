@@ -1,8 +1,8 @@
 //! `VisibilityShading`: one compute dispatch per material with triangles, rebuilding each
 //! pixel's surface from its triangle id (shaders/visibility/visibility_shading.wgsl).
 //! Textured materials sample with explicit derivatives (`MaterialProgram::compute_wgsl`)
-//! and bind their textures in group 2. With more than one material (and `materials:
-//! Classified`) a classification dispatch first lists every tile under the materials it
+//! and bind their textures in group 2. With `materials: Classified` and more than one
+//! material a classification dispatch first lists every tile under the materials it
 //! holds (shaders/visibility/classify_materials.wgsl) and each material's dispatch is
 //! indirect, over its own tiles; otherwise each covers the whole frame.
 
