@@ -11,8 +11,10 @@
 //! The hard places are cancellations: n·l and n·v at grazing angles, |n × h| at the GGX peak
 //! and at h ≈ n for sheen, v·h where l ≈ −v, and 1 − F at grazing. The lobe library
 //! (`shaders/material/lobes.wgsl`) therefore
-//! - computes dot and cross products of unit vectors with a split into a 2^-11 grid part,
-//!   whose products are done exactly in i32, and a small remainder (`lg_dot`, `lg_cross`):
+//! - computes dot and cross products of unit vectors as plain f32 where the result is at
+//!   least 1/16 (accurate there), and below that with a split into a 2^-11 grid part,
+//!   whose products are done exactly in i32, and a small remainder (`lg_dot`, `lg_cross`;
+//!   sheen always takes the split |n × h|²):
 //!   FMA-based error-free transformations are not portable (lavapipe does not fuse `fma`,
 //!   and Mesa's NIR algebraic passes fold TwoSum away and factor `a·b + a·c`);
 //! - takes |n × h|² from the accurate cross product with l + v scaled by a power of two

@@ -155,7 +155,8 @@ pub enum Lobe {
         #[serde(default)]
         ior: Option<f32>,
     },
-    /// Charlie sheen (Estevez & Kulla D, Neubelt visibility).
+    /// Charlie sheen (Estevez & Kulla's D and fitted Λ visibility with their terminator
+    /// softening; see `shaders/material/lobes.wgsl`).
     Sheen {
         #[serde(default = "one_f32")]
         weight: f32,
