@@ -10,7 +10,9 @@ use super::{defines, PrepareCtx, PreparedPass, ShadeLists, Timestamps};
 use crate::graph::kinds::visibility_shading::{LightLoop, MaterialDispatch};
 use crate::graph::Name;
 use crate::graph::{ListLayout, ScheduledPass, VisibilityShading};
+use crate::render::device_limits::create_internal_buffer;
 use crate::render::pipelines::PipelineKey;
+use crate::render::scene_gpu::storage_buffer;
 use crate::render::RenderError;
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -141,46 +143,44 @@ fn classification(
 ) -> Result<Classification, RenderError> {
     let device = cx.device();
     let slots = shaded.len() as u32;
-    let list_bytes = u64::from(slots) * u64::from(tiles) * 4;
-    let limit = device.limits().max_storage_buffer_binding_size;
-    if list_bytes > limit {
-        return Err(super::pass_error(
-            &sp.name,
-            format!(
-                "classifying {slots} materials over {tiles} tiles takes {list_bytes} bytes of tile lists; this device binds at most {limit} bytes (use materials: PerMaterial, or a larger workgroup)"
-            ),
-        ));
-    }
     // Ascending by first triangle: draws are sorted by material, so shaded[] is too.
     let slot_triangles: Vec<u32> = shaded.iter().flat_map(|&m| ranges[m]).collect();
     let storage = wgpu::BufferUsages::STORAGE;
+    // Checked against the device's limits, naming the pass: the tile lists grow with the
+    // materials times the tiles.
     let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
-        device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size: size.max(4),
-            usage,
-            mapped_at_creation: false,
-        })
+        create_internal_buffer(
+            &device,
+            &sp.name,
+            &wgpu::BufferDescriptor {
+                label: Some(label),
+                size: size.max(4),
+                usage,
+                mapped_at_creation: false,
+            },
+        )
     };
-    let slot_buffer = wgpu::util::DeviceExt::create_buffer_init(
+    let slot_buffer = storage_buffer(
         &device,
-        &wgpu::util::BufferInitDescriptor {
-            label: Some("material slot triangles"),
-            contents: bytemuck::cast_slice(&slot_triangles),
-            usage: storage,
-        },
+        "material slot triangles",
+        bytemuck::cast_slice(&slot_triangles),
+        wgpu::BufferUsages::empty(),
     );
-    let material_tiles = buffer("material tiles", list_bytes, storage);
+    let material_tiles = buffer(
+        "material tiles",
+        u64::from(slots) * u64::from(tiles) * 4,
+        storage,
+    )?;
     let counts = buffer(
         "material tile counts",
         u64::from(slots) * 4,
         storage | wgpu::BufferUsages::COPY_DST,
-    );
+    )?;
     let dispatch = buffer(
         "material dispatch arguments",
         u64::from(slots) * 12,
         storage | wgpu::BufferUsages::INDIRECT,
-    );
+    )?;
     offered.buffer("slot_triangles", &slot_buffer);
     offered.buffer("material_tiles", &material_tiles);
     offered.buffer("material_tile_counts", &counts);
