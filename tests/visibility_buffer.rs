@@ -455,6 +455,35 @@ fn bit_differences(a: &[[f32; 4]], b: &[[f32; 4]]) -> (usize, Option<usize>) {
     (n, a.iter().zip(b).position(differs))
 }
 
+/// An image and what it is called in a failure.
+type NamedImage<'a> = (&'a str, &'a [[f32; 4]]);
+
+/// Compares an image with its reference to the bit (the reference lit at over 1,000
+/// pixels, so the comparison means something): prints the count of differing pixels and
+/// adds a failure naming `what`, the first such pixel and both values.
+fn compare_bits(
+    what: &str,
+    ((test_name, test), (reference_name, reference)): (NamedImage, NamedImage),
+    failures: &mut Vec<String>,
+) {
+    let lit = reference
+        .iter()
+        .filter(|p| p[0] + p[1] + p[2] > 0.0)
+        .count();
+    assert!(lit > 1000, "{what}: only {lit} lit pixels");
+    let (n, first) = bit_differences(test, reference);
+    println!("{what:64} {n} pixels differ");
+    if let Some(i) = first {
+        failures.push(format!(
+            "{what}: {n} pixels differ, first ({}, {}): {test_name} {:?}, {reference_name} {:?}",
+            i as u32 % W,
+            i as u32 / W,
+            test[i],
+            reference[i]
+        ));
+    }
+}
+
 /// Renders `scene` through every staging graph with each light loop (Staged, RangeFirst,
 /// GroupList; the last with workgroups of 16 and 8) against forward shading's loop
 /// (Forward); the failures where the images differ in any bit. Staging only reorders loads
@@ -482,24 +511,11 @@ fn check_staging_is_exact(r: &mut lightgraph::render::Renderer, scene: &Scene) -
                 staged.links.iter().all(|l| l.links_dropped == 0),
                 "{name}: link pool overflowed"
             );
-            let lit = plain
-                .image
-                .iter()
-                .filter(|p| p[0] + p[1] + p[2] > 0.0)
-                .count();
-            assert!(lit > 1000, "{} {name}: only {lit} lit pixels", scene.name);
-            let (n, first) = bit_differences(&staged.image, &plain.image);
-            println!("{:16} {name:36} {n} pixels differ", scene.name);
-            if let Some(i) = first {
-                failures.push(format!(
-                    "{} {name}: {n} pixels differ, first ({}, {}): staged {:?}, per pixel {:?}",
-                    scene.name,
-                    i as u32 % W,
-                    i as u32 / W,
-                    staged.image[i],
-                    plain.image[i]
-                ));
-            }
+            let pair = (
+                ("staged", &staged.image[..]),
+                ("per pixel", &plain.image[..]),
+            );
+            compare_bits(&format!("{} {name}", scene.name), pair, &mut failures);
         }
     }
     failures
@@ -623,28 +639,11 @@ fn classified_shading_equals_per_material_dispatches_to_the_bit() {
                 let text = with_loop(&file(graph), kind);
                 let classified = render_text(&mut r, &with_materials(&text, "Classified"), s, W, H);
                 let whole = render_text(&mut r, &with_materials(&text, "PerMaterial"), s, W, H);
-                let lit = whole
-                    .image
-                    .iter()
-                    .filter(|p| p[0] + p[1] + p[2] > 0.0)
-                    .count();
-                assert!(
-                    lit > 1000,
-                    "{} {graph} {kind}: only {lit} lit pixels",
-                    s.name
+                let pair = (
+                    ("classified", &classified.image[..]),
+                    ("per material", &whole.image[..]),
                 );
-                let (n, first) = bit_differences(&classified.image, &whole.image);
-                println!("{:28} {graph:32} {kind:24} {n} pixels differ", s.name);
-                if let Some(i) = first {
-                    failures.push(format!(
-                        "{} {graph} {kind}: {n} pixels differ, first ({}, {}): classified {:?}, per material {:?}",
-                        s.name,
-                        i as u32 % W,
-                        i as u32 / W,
-                        classified.image[i],
-                        whole.image[i]
-                    ));
-                }
+                compare_bits(&format!("{} {graph} {kind}", s.name), pair, &mut failures);
             }
         }
     }
