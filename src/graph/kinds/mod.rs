@@ -142,7 +142,12 @@ macro_rules! graph_side {
 built_in_kinds!(graph_side);
 
 pub(crate) mod contracts;
+mod layout;
 mod matching;
+mod slots;
+
+pub use layout::{BufferLayout, Contents};
+pub use slots::*;
 
 /// What a built-in kind tells validation and planning, implemented by its parameters
 /// (or the unit struct its module names after a kind without any).
@@ -166,272 +171,11 @@ pub trait KindRules {
 }
 
 use super::error::GraphError;
-use super::model::{PassDesc, ResourceDesc, SceneResource};
+use super::model::{PassDesc, ResourceDesc};
 use super::plan::FrameSize;
 use super::roles::{PassRoles, RoleCtx};
-use light_culling::ListLayout;
 
 pub(crate) use matching::resolve;
-
-/// Slot names shared by several kinds; each is also the WGSL binding name the kind's
-/// shader uses for it (attachments are not bindings).
-pub mod slot {
-    pub const GEOMETRY: &str = "geometry";
-    pub const DEPTH: &str = "depth";
-    pub const COLOR: &str = "color";
-    pub const LIGHT_GEOMETRY: &str = "light_geometry";
-    pub const LIGHT_PROPERTIES: &str = "light_properties";
-    pub const LIGHT_LISTS: &str = "light_lists";
-    /// The nearest transparent depth a culling pass bounds its tiles with.
-    pub const TRANSPARENT_DEPTH: &str = "transparent_depth";
-}
-
-/// What a slot takes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SlotType {
-    DepthTexture,
-    /// A depth texture, or a single-sample R32Float texture of depth values (what a
-    /// compute-only frame writes: compute cannot store depth formats). Only kinds whose
-    /// shaders read either take it (`FLOAT_DEPTH` selects `texture_2d<f32>`).
-    DepthValues,
-    /// Any texture that is not depth (the kind's checks narrow the format).
-    ColorTexture,
-    Buffer,
-    Import(SceneResource),
-    /// A light array: the scene's import, or (by name only) a buffer a `VplSpawn` pass
-    /// wrote with the scene's lights and its virtual lights after them.
-    Lights(SceneResource),
-}
-
-impl SlotType {
-    fn describe(self) -> String {
-        match self {
-            SlotType::DepthTexture => "a depth texture".into(),
-            SlotType::DepthValues => "a depth texture (or an R32Float texture of depths)".into(),
-            SlotType::ColorTexture => "a colour texture".into(),
-            SlotType::Buffer => "a buffer".into(),
-            SlotType::Import(from) => format!("an Import of {from:?}"),
-            SlotType::Lights(from) => {
-                format!("an Import of {from:?} (or a VplSpawn pass's buffer, by name)")
-            }
-        }
-    }
-    /// Whether a resource of type `ty` fills a slot of this type; `by_name`: the
-    /// resource is named after the slot (or names it); `float_depth`: it is an R32Float
-    /// texture (a colour texture that may hold depths; the kind checks its samples).
-    fn takes(self, ty: SlotType, by_name: bool, float_depth: bool) -> bool {
-        match self {
-            SlotType::Lights(from) => {
-                ty == SlotType::Import(from) || (by_name && ty == SlotType::Buffer)
-            }
-            SlotType::DepthValues => ty == SlotType::DepthTexture || float_depth,
-            _ => self == ty,
-        }
-    }
-}
-
-/// Which of the pass's lists a slot's resource belongs in.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Access {
-    Read,
-    Write,
-    /// Reads or writes: a depth attachment that is tested against, or written first.
-    ReadOrWrite,
-}
-
-impl Access {
-    fn allows(self, write: bool) -> bool {
-        match self {
-            Access::Read => !write,
-            Access::Write => write,
-            Access::ReadOrWrite => true,
-        }
-    }
-    fn describe(self) -> &'static str {
-        match self {
-            Access::Read => "in reads",
-            Access::Write => "in writes",
-            Access::ReadOrWrite => "in reads or writes",
-        }
-    }
-}
-
-/// How the pass's GPU work uses a texture slot (for the plan's texture usages).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Usage {
-    /// A render-pass attachment.
-    Attachment,
-    /// Sampled or loaded in a shader.
-    Sampled,
-    /// A storage texture.
-    Storage,
-    /// Drawn into or stored from compute, whichever the pass picks on this device (the
-    /// compute rasterizer and its hardware fallback): a depth format is an attachment,
-    /// R32Float a storage texture, any other format both.
-    AttachmentOrStorage,
-    /// Buffers and imports: bound as storage or uniform.
-    Bound,
-}
-
-/// One row of a kind's slot table.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct SlotSpec {
-    pub name: &'static str,
-    pub ty: SlotType,
-    pub access: Access,
-    pub optional: bool,
-    pub usage: Usage,
-    /// A read buffer's contract: what its writer must publish on it (one of these);
-    /// empty: anything. Checked by validation (`contracts.rs`).
-    pub needs: &'static [Contents],
-}
-
-impl SlotSpec {
-    pub const fn new(name: &'static str, ty: SlotType, access: Access, usage: Usage) -> Self {
-        Self {
-            name,
-            ty,
-            access,
-            optional: false,
-            usage,
-            needs: &[],
-        }
-    }
-    pub const fn optional(self) -> Self {
-        Self {
-            optional: true,
-            ..self
-        }
-    }
-    /// A read buffer that one of its writers must have laid out as one of `contents`.
-    pub const fn needs(self, contents: &'static [Contents]) -> Self {
-        Self {
-            needs: contents,
-            ..self
-        }
-    }
-}
-
-/// What a buffer slot's writer says about its contents, published on the planned
-/// buffer so readers never search for the producer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BufferLayout {
-    LightLists(ListLayout),
-    /// Per-pixel light linked lists: heads and the link pool.
-    LightLinks(light_linked_list::LinkLayout),
-    /// Ray-cast shadow jobs: a header and room for `capacity` jobs.
-    ShadowJobs {
-        capacity: u64,
-    },
-    /// A 128-bit hit mask per pixel.
-    ShadowMask {
-        pixels: u64,
-    },
-    /// A light array with room for `lights` entries of `stride` bytes (scene lights and
-    /// virtual lights after them).
-    Lights {
-        lights: u64,
-        stride: u64,
-    },
-    /// A reflective shadow map's view table.
-    RsmViews {
-        max_views: u64,
-    },
-    /// A shadow atlas's view table, and how shading filters the atlas.
-    ShadowViews {
-        lights: u32,
-        max_views: u64,
-        filter: shadow_atlas::ShadowFilter,
-    },
-}
-
-/// What a laid-out buffer holds: a [`BufferLayout`] without its sizes, for contracts
-/// between a buffer's writer and its readers.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Contents {
-    LightLists,
-    LightLinks,
-    ShadowJobs,
-    ShadowMask,
-    Lights,
-    RsmViews,
-    ShadowViews,
-}
-
-impl Contents {
-    /// The kind whose pass lays such a buffer out, for messages.
-    pub fn producer(self) -> &'static str {
-        match self {
-            Contents::LightLists => "LightCulling",
-            Contents::LightLinks => "LightLinkedList",
-            Contents::ShadowJobs | Contents::ShadowMask => "ShadowRayJobs",
-            Contents::Lights => "VplSpawn",
-            Contents::RsmViews => "ReflectiveShadowMaps",
-            Contents::ShadowViews => "ShadowAtlas",
-        }
-    }
-}
-
-impl BufferLayout {
-    pub fn contents(&self) -> Contents {
-        match self {
-            BufferLayout::LightLists(_) => Contents::LightLists,
-            BufferLayout::LightLinks(_) => Contents::LightLinks,
-            BufferLayout::ShadowJobs { .. } => Contents::ShadowJobs,
-            BufferLayout::ShadowMask { .. } => Contents::ShadowMask,
-            BufferLayout::Lights { .. } => Contents::Lights,
-            BufferLayout::RsmViews { .. } => Contents::RsmViews,
-            BufferLayout::ShadowViews { .. } => Contents::ShadowViews,
-        }
-    }
-    pub fn bytes(&self) -> u64 {
-        match self {
-            BufferLayout::LightLists(l) => l.bytes(),
-            BufferLayout::LightLinks(l) => l.bytes(),
-            BufferLayout::ShadowJobs { capacity } => shadow_ray_jobs::job_buffer_bytes(*capacity),
-            BufferLayout::ShadowMask { pixels } => 4 * shadow_ray_jobs::MASK_WORDS * pixels,
-            BufferLayout::Lights { lights, stride } => (*lights).max(1) * stride,
-            BufferLayout::RsmViews { max_views } => {
-                reflective_shadow_maps::view_table_bytes(*max_views)
-            }
-            BufferLayout::ShadowViews {
-                lights, max_views, ..
-            } => shadow_atlas::view_table_bytes(*lights, *max_views),
-        }
-    }
-}
-
-/// Rows several kinds share: the scene's geometry (optional; drawn, never bound) and the
-/// two light arrays, read.
-pub const GEOMETRY_READ: SlotSpec = SlotSpec::new(
-    slot::GEOMETRY,
-    SlotType::Import(SceneResource::Geometry),
-    Access::Read,
-    Usage::Bound,
-)
-.optional();
-pub const LIGHT_GEOMETRY_READ: SlotSpec = SlotSpec::new(
-    slot::LIGHT_GEOMETRY,
-    SlotType::Lights(SceneResource::LightGeometry),
-    Access::Read,
-    Usage::Bound,
-);
-pub const LIGHT_PROPERTIES_READ: SlotSpec = SlotSpec::new(
-    slot::LIGHT_PROPERTIES,
-    SlotType::Lights(SceneResource::LightProperties),
-    Access::Read,
-    Usage::Bound,
-);
-/// The tile lists of a `LightCulling` pass (or a `LightLinkedList`'s links), read by the
-/// passes that walk them; optional: without them a pass visits every light.
-pub const LIGHT_LISTS_READ: SlotSpec = SlotSpec::new(
-    slot::LIGHT_LISTS,
-    SlotType::Buffer,
-    Access::Read,
-    Usage::Bound,
-)
-.optional()
-.needs(&[Contents::LightLists, Contents::LightLinks]);
 
 /// The slot table of a built-in kind; `None` for generic kinds.
 pub fn slots(kind: &PassKind) -> Option<&'static [SlotSpec]> {
@@ -561,23 +305,6 @@ pub fn check_shadow_mask(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     }
 }
 
-/// Rows every shading pass shares: a ShadowAtlas pass's atlas and view table, read.
-pub const SHADOW_ATLAS_READ: SlotSpec = SlotSpec::new(
-    shadow_atlas::SHADOW_ATLAS,
-    SlotType::DepthTexture,
-    Access::Read,
-    Usage::Sampled,
-)
-.optional();
-pub const SHADOW_VIEWS_READ: SlotSpec = SlotSpec::new(
-    shadow_atlas::SHADOW_VIEWS,
-    SlotType::Buffer,
-    Access::Read,
-    Usage::Bound,
-)
-.optional()
-.needs(&[Contents::ShadowViews]);
-
 /// A shading pass samples an atlas through its view table, and shadows one way only.
 pub fn check_shadow_atlas(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     use shadow_atlas::{SHADOW_ATLAS, SHADOW_VIEWS};
@@ -656,7 +383,10 @@ mod registry_tests {
     fn every_kind_file_is_registered() {
         let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
         let support: [(&str, &[&str]); 2] = [
-            ("graph/kinds", &["mod", "matching", "contracts"]),
+            (
+                "graph/kinds",
+                &["mod", "matching", "contracts", "slots", "layout"],
+            ),
             (
                 "render/passes",
                 &[
