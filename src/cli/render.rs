@@ -211,8 +211,9 @@ pub fn render(args: RenderArgs) -> Result<()> {
     if size.width == 0 || size.height == 0 {
         bail!("output size {}x{} is empty", size.width, size.height);
     }
-    let compiled = graph::compile(checked, &scene.features(), size);
-    for w in graph::coverage::undrawn(&compiled, &scene.features()) {
+    let features = scene.features();
+    let compiled = graph::compile(checked, &features, size);
+    for w in graph::coverage::undrawn(&compiled, &features) {
         eprintln!("warning: {w}");
     }
     if args.heatmap.is_some() && !compiled.has_light_culling() {

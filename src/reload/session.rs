@@ -459,8 +459,9 @@ impl ReloadSession {
     fn compile_graph(&self, scene: &Scene) -> Result<CompiledGraph, String> {
         let checked = assets::check_graph(&self.graph_path, &self.renderer.shaders)
             .map_err(|e| e.to_string())?;
-        let compiled = graph::compile(checked, &scene.features(), self.frame_size(scene));
-        for w in graph::coverage::undrawn(&compiled, &scene.features()) {
+        let features = scene.features();
+        let compiled = graph::compile(checked, &features, self.frame_size(scene));
+        for w in graph::coverage::undrawn(&compiled, &features) {
             log::warn!("{w}");
         }
         Ok(compiled)
