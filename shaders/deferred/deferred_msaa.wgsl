@@ -5,9 +5,9 @@
 //
 // Distinct: the G-buffer draw runs once per pixel and triangle at the centroid of the
 // covered samples (as MSAA forward shading does), so the samples one triangle covers hold
-// the same texels, and a sample whose position and normal equal an earlier sample's, bit
-// for bit, takes that sample's colour: shading is a function of those texels (the
-// material index is the position's w) and the pixel alone. A pixel whose samples are all
+// the same texels, and a sample whose position, normal and surface texels equal an
+// earlier sample's, bit for bit, takes that sample's colour: shading is a function of
+// those texels (the material index is the position's w) and the pixel alone. A pixel whose samples are all
 // alike (Lauritzen's edge test) is shaded once, an edge pixel once per surface in it.
 // The samples a workgroup must shade are pooled and shared out over its invocations
 // (Lauritzen's repacking), so an edge pixel does not keep its neighbours waiting.
@@ -39,7 +39,15 @@ fn same_surface(p: vec2<u32>, a: u32, b: u32) -> bool {
     let pb = bitcast<vec4<u32>>(textureLoad(g_position, p, b));
     let na = bitcast<vec4<u32>>(textureLoad(g_normal, p, a));
     let nb = bitcast<vec4<u32>>(textureLoad(g_normal, p, b));
+#if G_SURFACE
+    let sa = bitcast<vec4<u32>>(textureLoad(g_surface, p, a));
+    let sb = bitcast<vec4<u32>>(textureLoad(g_surface, p, b));
+    let da = bitcast<vec4<u32>>(textureLoad(g_uv_grad, p, a));
+    let db = bitcast<vec4<u32>>(textureLoad(g_uv_grad, p, b));
+    return all(pa == pb) && all(na == nb) && all(sa == sb) && all(da == db);
+#else
     return all(pa == pb) && all(na == nb);
+#endif
 }
 
 // The colour and alpha of sample `s` of pixel `p` (the single-sample main's arithmetic).
@@ -49,8 +57,7 @@ fn shade_sample(p: vec2<u32>, s: u32) -> vec4<f32> {
     q.position = g.xyz;
     q.normal = textureLoad(g_normal, p, s).xyz;
     q.view = normalize(frame.camera_pos.xyz - q.position);
-    q.tangent = vec4<f32>(0.0);
-    q.uv = vec2<f32>(0.0);
+    load_surface(&q, p, s);
     let m = material_setup(q);
     let view_z = -(frame.view * vec4<f32>(q.position, 1.0)).z;
     let pixel = vec2<f32>(p) + 0.5;

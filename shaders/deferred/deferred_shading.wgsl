@@ -4,6 +4,9 @@
 // fragment work (GH100) this is where the lighting throughput is.
 // With G_PACKED the G-buffer is one texture: view depth, octahedral normal, material;
 // the position is rebuilt on the pixel's view ray.
+// With G_SURFACE the G-buffer also holds the material's surface (deferred/g_surface.wgsl:
+// uv and tangent) and the uv's screen derivatives, which textured materials
+// (MATERIAL_TEXTURED, code generated with explicit derivatives) sample with.
 // Defines: MATERIAL_INDEX, LIGHT_LISTS (tile lists) or LINKED_LISTS (a light linked
 // list), G_PACKED, G_SAMPLES (a multisampled G-buffer of that many samples: the main of
 // deferred/deferred_msaa.wgsl), SHADOWS with SHADOW_MASK (ray-cast shadows from
@@ -29,6 +32,10 @@
 @group(0) @binding(5) var g_position: texture_multisampled_2d<f32>;
 @group(0) @binding(6) var g_normal: texture_multisampled_2d<f32>;
 @group(0) @binding(7) var hdr: texture_storage_2d<rgba32float, read_write>;
+#if G_SURFACE
+@group(0) @binding(12) var g_surface: texture_multisampled_2d<f32>;
+@group(0) @binding(13) var g_uv_grad: texture_multisampled_2d<f32>;
+#endif
 #else
 @group(0) @binding(5) var g_position: texture_2d<f32>;
 #if G_PACKED
@@ -37,6 +44,10 @@
 @group(0) @binding(6) var g_normal: texture_2d<f32>;
 #endif
 @group(0) @binding(7) var hdr: texture_storage_2d<rgba32float, write>;
+#if G_SURFACE
+@group(0) @binding(12) var g_surface: texture_2d<f32>;
+@group(0) @binding(13) var g_uv_grad: texture_2d<f32>;
+#endif
 #endif
 
 #include "common/light_lists.wgsl"
@@ -62,6 +73,28 @@ struct ShadingPoint {
 
 #include <material>
 #include "common/light_loop.wgsl"
+#if G_SURFACE
+#include "deferred/g_surface.wgsl"
+#endif
+
+// The material's inputs at sample `s` of pixel `p` besides position and normal: the
+// surface's uv and tangent (zero without G_SURFACE), and for textured materials the uv
+// derivatives their samples take.
+fn load_surface(q: ptr<function, ShadingPoint>, p: vec2<u32>, s: u32) {
+#if G_SURFACE
+    let t = textureLoad(g_surface, p, s);
+    (*q).uv = t.xy;
+    (*q).tangent = surface_tangent((*q).normal, t);
+#if MATERIAL_TEXTURED
+    let d = textureLoad(g_uv_grad, p, s);
+    material_uv_ddx = d.xy;
+    material_uv_ddy = d.zw;
+#endif
+#else
+    (*q).tangent = vec4<f32>(0.0);
+    (*q).uv = vec2<f32>(0.0);
+#endif
+}
 
 #if G_SAMPLES
 #include "deferred/deferred_msaa.wgsl"
@@ -107,8 +140,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     p.normal = textureLoad(g_normal, id.xy, 0).xyz;
 #endif
     p.view = normalize(frame.camera_pos.xyz - p.position);
-    p.tangent = vec4<f32>(0.0);
-    p.uv = vec2<f32>(0.0);
+    load_surface(&p, id.xy, 0u);
     let m = material_setup(p);
     let view_z = -(frame.view * vec4<f32>(p.position, 1.0)).z;
     let pixel = vec2<f32>(id.xy) + 0.5;

@@ -155,12 +155,21 @@ fn shading_point(in: VertexOut, front: bool) -> ShadingPoint {
 
 #if GBUFFER
 // Deferred shading's G-buffer: world position with the material index in w (-1 where
-// nothing was drawn), and the shading normal (already facing the viewer).
+// nothing was drawn), and the shading normal (already facing the viewer). With
+// GBUFFER_SURFACE two more targets, last: the surface the material samples
+// (deferred/g_surface.wgsl) and the uv's screen derivatives.
+#if GBUFFER_SURFACE
+#include "deferred/g_surface.wgsl"
+#endif
 #if GBUFFER_PACKED
 // Packed: one texture of view depth, octahedral normal and the material index (or -1).
 #include "common/octahedral.wgsl"
 struct GBufferOut {
     @location(0) packed: vec4<f32>,
+#if GBUFFER_SURFACE
+    @location(1) surface: vec4<f32>,
+    @location(2) uv_grad: vec4<f32>,
+#endif
 };
 #else
 #if GBUFFER_NORMALS
@@ -170,6 +179,15 @@ struct GBufferOut {
 #if GBUFFER_GEOMETRIC
     // Ray-cast shadows: the triangle's normal, facing the eye.
     @location(2) geometric: vec4<f32>,
+#if GBUFFER_SURFACE
+    @location(3) surface: vec4<f32>,
+    @location(4) uv_grad: vec4<f32>,
+#endif
+#else
+#if GBUFFER_SURFACE
+    @location(2) surface: vec4<f32>,
+    @location(3) uv_grad: vec4<f32>,
+#endif
 #endif
 };
 #else
@@ -186,6 +204,11 @@ fn fs_gbuffer(in: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
 #if GBUFFER_GEOMETRIC
     let ng = face_normal(in.world);
 #endif
+#if GBUFFER_SURFACE
+    // The derivatives forward shading's textureSample takes implicitly (uniform control
+    // flow: before any discard).
+    let uv_grad = vec4<f32>(dpdx(in.uv), dpdy(in.uv));
+#endif
     let p = shading_point(in, front);
 #if ALPHA_MASK
     let m = material_setup(p);
@@ -193,23 +216,32 @@ fn fs_gbuffer(in: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
         discard;
     }
 #endif
+    var out: GBufferOut;
 #if GBUFFER_PACKED
     // Deferred shading rebuilds the position from the pixel's view ray and this depth.
     let view_z = -(frame.view * vec4<f32>(in.world, 1.0)).z;
     let n = oct_encode(p.normal);
-    return GBufferOut(vec4<f32>(view_z, n.x, n.y, f32(MATERIAL_INDEX)));
+    out.packed = vec4<f32>(view_z, n.x, n.y, f32(MATERIAL_INDEX));
+#if GBUFFER_SURFACE
+    // The tangent about the normal deferred shading decodes, so both build one frame.
+    out.surface = encode_surface(oct_decode(n), p.tangent, p.uv);
+#endif
 #else
-    let position = vec4<f32>(in.world, f32(MATERIAL_INDEX));
+    out.position = vec4<f32>(in.world, f32(MATERIAL_INDEX));
 #if GBUFFER_NORMALS
+    out.normal = vec4<f32>(p.normal, 0.0);
+#if GBUFFER_SURFACE
+    out.surface = encode_surface(p.normal, p.tangent, p.uv);
+#endif
+#endif
 #if GBUFFER_GEOMETRIC
-    return GBufferOut(position, vec4<f32>(p.normal, 0.0), vec4<f32>(ng, 0.0));
-#else
-    return GBufferOut(position, vec4<f32>(p.normal, 0.0));
-#endif
-#else
-    return GBufferOut(position, vec4<f32>(ng, 0.0));
+    out.geometric = vec4<f32>(ng, 0.0);
 #endif
 #endif
+#if GBUFFER_SURFACE
+    out.uv_grad = uv_grad;
+#endif
+    return out;
 }
 #endif
 

@@ -24,8 +24,10 @@ pub(super) enum DrawMode {
         packed: bool,
         /// Unpacked: a target of shading normals after the positions.
         normals: bool,
-        /// Unpacked: a target of geometric normals last (ray-cast shadows).
+        /// Unpacked: a target of geometric normals next (ray-cast shadows).
         geometric: bool,
+        /// Two targets last: the surface the material samples and the uv derivatives.
+        surface: bool,
     },
     Shade {
         lists: super::passes::ShadeLists,
@@ -186,6 +188,7 @@ impl Renderer {
                     packed,
                     normals,
                     geometric,
+                    surface,
                     ..
                 } => {
                     d.push(("GBUFFER", "1".into()));
@@ -198,6 +201,9 @@ impl Renderer {
                     }
                     if geometric {
                         d.push(("GBUFFER_GEOMETRIC", "1".into()));
+                    }
+                    if surface {
+                        d.push(("GBUFFER_SURFACE", "1".into()));
                     }
                 }
                 DrawMode::Shade { lists, shadows, .. } => {
@@ -355,10 +361,13 @@ fn build_pipeline(
     let (entry, colour_targets) = match mode {
         DrawMode::DepthOnly => ("fs_depth", 0),
         DrawMode::GBuffer {
-            normals, geometric, ..
+            normals,
+            geometric,
+            surface,
+            ..
         } => (
             "fs_gbuffer",
-            1 + usize::from(normals) + usize::from(geometric),
+            1 + usize::from(normals) + usize::from(geometric) + 2 * usize::from(surface),
         ),
         DrawMode::Shade { .. } => ("fs_main", 1),
         DrawMode::AtlasDepth { .. } => ("fs_depth", 0),

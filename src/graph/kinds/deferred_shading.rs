@@ -1,7 +1,7 @@
 //! `DeferredShading`: lighting in a compute shader from the G-buffer (tiled deferred
 //! with `lights: Culled`), one dispatch per material. Runs `shaders/deferred/deferred_shading.wgsl`.
 
-use super::g_buffer::{G_NORMAL, G_POSITION};
+use super::g_buffer::{G_NORMAL, G_POSITION, G_SURFACE, G_UV_GRAD};
 use super::shadow_ray_jobs::SHADOW_MASK;
 use super::{check_light_source, Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
@@ -44,6 +44,9 @@ pub const SLOTS: &[SlotSpec] = &[
     // Shadow maps: a ShadowAtlas pass's atlas and view table.
     super::SHADOW_ATLAS_READ,
     super::SHADOW_VIEWS_READ,
+    // Textured and anisotropic materials: the surface the material samples.
+    super::g_buffer::G_SURFACE_READ,
+    super::g_buffer::G_UV_GRAD_READ,
 ];
 
 pub fn check(p: &DeferredShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
@@ -55,6 +58,7 @@ pub fn check(p: &DeferredShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         "deferred shading stores into a single-sample Rgba32Float texture",
         errors,
     );
+    super::g_buffer::check_surface_pair(ctx, errors);
     check_msaa(ctx, errors);
 }
 
@@ -66,12 +70,15 @@ fn check_msaa(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         return;
     };
     let ps = ctx.samples(position);
-    if let Some(normal) = ctx.slot(G_NORMAL) {
+    for normal in [G_NORMAL, G_SURFACE, G_UV_GRAD]
+        .iter()
+        .filter_map(|s| ctx.slot(s))
+    {
         let ns = ctx.samples(normal);
         if ns != ps {
             errors.push(ctx.mismatch(
                 normal,
-                format!("G-buffer texture has {ns} sample(s) but '{position}' has {ps}: both are read sample by sample"),
+                format!("G-buffer texture has {ns} sample(s) but '{position}' has {ps}: all are read sample by sample"),
             ));
         }
     }

@@ -1,7 +1,9 @@
 //! `GBuffer`: the scene's geometry into one packed Rgba32Float texture (view depth,
 //! octahedral normal, material) or two (world position with the material in w, shading
-//! normal). After a depth prepass it only tests depth. Runs `shaders/forward/forward.wgsl`
-//! with `GBUFFER`.
+//! normal), plus optionally the surface the material samples (`g_surface`: uv, tangent;
+//! `g_uv_grad`: the uv's screen derivatives) for textured and anisotropic materials.
+//! After a depth prepass it only tests depth. Runs `shaders/forward/forward.wgsl` with
+//! `GBUFFER`.
 
 use super::{slot, Access, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
@@ -10,6 +12,10 @@ pub const G_POSITION: &str = "g_position";
 pub const G_NORMAL: &str = "g_normal";
 /// Geometric (face) normals facing the viewer, for ray-cast shadows' origin offset.
 pub const G_GEOMETRIC: &str = "g_geometric";
+/// The material's surface inputs: uv, the tangent's angle about the normal, handedness.
+pub const G_SURFACE: &str = "g_surface";
+/// The uv's screen derivatives (d/dx, d/dy), the mip footprint textures are sampled with.
+pub const G_UV_GRAD: &str = "g_uv_grad";
 
 pub const SLOTS: &[SlotSpec] = &[
     super::GEOMETRY_READ,
@@ -40,10 +46,25 @@ pub const SLOTS: &[SlotSpec] = &[
         Usage::Attachment,
     )
     .optional(),
+    // Last, so graphs that fill the slots above by order keep their meaning.
+    SlotSpec::new(
+        G_SURFACE,
+        SlotType::ColorTexture,
+        Access::Write,
+        Usage::Attachment,
+    )
+    .optional(),
+    SlotSpec::new(
+        G_UV_GRAD,
+        SlotType::ColorTexture,
+        Access::Write,
+        Usage::Attachment,
+    )
+    .optional(),
 ];
 
 pub fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
-    let targets = [G_POSITION, G_NORMAL, G_GEOMETRIC];
+    let targets = [G_POSITION, G_NORMAL, G_GEOMETRIC, G_SURFACE, G_UV_GRAD];
     for s in targets {
         if let Some(name) = ctx.slot(s) {
             if !ctx.is_rgba32f(name) {
@@ -51,6 +72,7 @@ pub fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
             }
         }
     }
+    check_surface_pair(ctx, errors);
     let Some(depth) = ctx.slot(slot::DEPTH) else {
         return;
     };
@@ -68,6 +90,18 @@ pub fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     }
     if ds > 1 {
         check_msaa_layout(ctx, depth, errors);
+    }
+}
+
+/// `g_surface` and `g_uv_grad` come together: textures are sampled at the stored uv
+/// with the stored derivatives.
+pub fn check_surface_pair(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+    match (ctx.slot(G_SURFACE), ctx.slot(G_UV_GRAD)) {
+        (Some(one), None) | (None, Some(one)) => errors.push(ctx.mismatch(
+            one,
+            format!("the G-buffer's surface is two textures, {G_SURFACE} (uv, tangent) and {G_UV_GRAD} (uv derivatives): give both or neither"),
+        )),
+        _ => {}
     }
 }
 
@@ -103,6 +137,22 @@ pub const G_GEOMETRIC_READ: SlotSpec = SlotSpec::new(
     Access::Read,
     Usage::Sampled,
 );
+
+/// Deferred shading's reads of the surface targets.
+pub const G_SURFACE_READ: SlotSpec = SlotSpec::new(
+    G_SURFACE,
+    SlotType::ColorTexture,
+    Access::Read,
+    Usage::Sampled,
+)
+.optional();
+pub const G_UV_GRAD_READ: SlotSpec = SlotSpec::new(
+    G_UV_GRAD,
+    SlotType::ColorTexture,
+    Access::Read,
+    Usage::Sampled,
+)
+.optional();
 
 /// Whether the pass writes the packed layout (one texture: no normals of either kind).
 pub fn packed(roles: &crate::graph::PassRoles) -> bool {

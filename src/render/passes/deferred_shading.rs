@@ -1,10 +1,12 @@
 //! `DeferredShading`: one compute dispatch per material over the frame, reading the
 //! G-buffer and storing lit colour; from a multisampled G-buffer, the mean of every
-//! sample's colour (shaders/deferred/deferred_msaa.wgsl).
+//! sample's colour (shaders/deferred/deferred_msaa.wgsl). Textured materials sample
+//! their textures at the G-buffer's uv with its uv derivatives (group 2, as visibility
+//! shading binds them).
 
 use super::{defines, pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::deferred_shading::HDR;
-use crate::graph::kinds::g_buffer::G_NORMAL;
+use crate::graph::kinds::g_buffer::{G_NORMAL, G_SURFACE};
 use crate::graph::Name;
 use crate::graph::{DeferredShading, ScheduledPass};
 use crate::render::pipelines::PipelineKey;
@@ -14,9 +16,15 @@ use std::sync::Arc;
 
 pub(super) struct DeferredShadingPass {
     name: Name,
-    pipelines: Vec<Arc<wgpu::ComputePipeline>>,
-    bind: Option<wgpu::BindGroup>,
+    dispatches: Vec<ShadeDispatch>,
     groups: [u32; 3],
+}
+
+/// One material's dispatch: its pipeline, group 0, and its textures (group 2), if any.
+struct ShadeDispatch {
+    pipeline: Arc<wgpu::ComputePipeline>,
+    bind: wgpu::BindGroup,
+    textures: Option<wgpu::BindGroup>,
 }
 
 pub(super) fn prepare(
@@ -26,6 +34,7 @@ pub(super) fn prepare(
 ) -> Result<DeferredShadingPass, RenderError> {
     // Without a normals texture the G-buffer is the packed one.
     let packed = sp.roles.slot(G_NORMAL).is_none();
+    let surface = sp.roles.slot(G_SURFACE).is_some();
     let mut offered = cx.declared(sp)?;
     let lists = cx.shading_lists(sp, p.lights, &mut offered)?;
     let shadows = cx.shading_shadows(sp, &mut offered);
@@ -55,13 +64,13 @@ pub(super) fn prepare(
             ));
         }
     }
-    let mut pipelines = Vec::new();
-    let mut bind = None;
+    let mut dispatches = Vec::new();
     for (index, m) in cx.gpu.materials.iter().enumerate() {
-        if m.textures.is_some() {
+        let textured = m.textures.is_some();
+        if textured && !surface {
             return Err(pass_error(
                 &sp.name,
-                format!("material '{}' has textures; deferred shading supports untextured materials only (the G-buffer holds no UVs or tangents yet)", m.name),
+                format!("material '{}' has textures: its G-buffer needs the surface targets '{G_SURFACE}' and 'g_uv_grad' (uv, tangent and uv derivatives), which this pass does not read", m.name),
             ));
         }
         let mut d = vec![("MATERIAL_INDEX", index.to_string())];
@@ -71,24 +80,40 @@ pub(super) fn prepare(
         if msaa {
             d.push(("G_SAMPLES", sp.samples.to_string()));
         }
+        if surface {
+            d.push(("G_SURFACE", "1".into()));
+        }
+        if textured {
+            d.push(("MATERIAL_TEXTURED", "1".into()));
+        }
         d.extend(lists.define());
         d.extend(crate::render::draws::shadow_defines(shadows));
         let key = PipelineKey {
             shader: "deferred/deferred_shading.wgsl".into(),
             defines: defines(&d),
-            virtual_code: BTreeMap::from([("material".to_string(), m.wgsl.clone())]),
+            virtual_code: BTreeMap::from([(
+                "material".to_string(),
+                m.wgsl_for_compute().to_string(),
+            )]),
             state: String::new(),
         };
         let label = format!("{} (material '{}')", sp.name, m.name);
-        let (pipeline, b) = cx.compute_pipeline(&label, key, "main", &offered)?;
-        pipelines.push(pipeline);
-        // Every material's shader declares the same bindings: one group serves all.
-        bind.get_or_insert(b);
+        let (pipeline, bind, textures) = cx.compute_pipeline_with_material(
+            &label,
+            key,
+            "main",
+            &offered,
+            m.textures.as_ref(),
+        )?;
+        dispatches.push(ShadeDispatch {
+            pipeline,
+            bind,
+            textures,
+        });
     }
     Ok(DeferredShadingPass {
         name: sp.name.clone(),
-        pipelines,
-        bind,
+        dispatches,
         groups: [cx.size.width.div_ceil(8), cx.size.height.div_ceil(8), 1],
     })
 }
@@ -99,12 +124,13 @@ impl PreparedPass for DeferredShadingPass {
             label: Some(&self.name),
             timestamp_writes: ts.compute(),
         });
-        if let Some(bind) = &self.bind {
-            pass.set_bind_group(0, bind, &[]);
-        }
         let [x, y, z] = self.groups;
-        for p in &self.pipelines {
-            pass.set_pipeline(p);
+        for d in &self.dispatches {
+            pass.set_pipeline(&d.pipeline);
+            pass.set_bind_group(0, &d.bind, &[]);
+            if let Some(t) = &d.textures {
+                pass.set_bind_group(2, t, &[]);
+            }
             pass.dispatch_workgroups(x, y, z);
         }
     }

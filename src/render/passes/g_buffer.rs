@@ -1,10 +1,13 @@
-//! `GBuffer`: every opaque mesh into one packed or two Rgba32Float textures. After a
+//! `GBuffer`: every opaque mesh into one packed or two Rgba32Float textures (and the
+//! material's surface into two more when the graph gives them). After a
 //! depth prepass it loads that depth and only tests against it, so each pixel is
 //! written once instead of once per overlapping surface. Multisampled, it draws at the
 //! targets' sample count with centroid inputs, as MSAA forward shading does.
 
 use super::{PrepareCtx, PreparedPass, Timestamps};
-use crate::graph::kinds::g_buffer::{self as kind, G_GEOMETRIC, G_NORMAL, G_POSITION};
+use crate::graph::kinds::g_buffer::{
+    self as kind, G_GEOMETRIC, G_NORMAL, G_POSITION, G_SURFACE, G_UV_GRAD,
+};
 use crate::graph::Name;
 use crate::graph::{slot, ScheduledPass};
 use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws, MeshSet};
@@ -15,7 +18,8 @@ pub(super) struct GBuffer {
     depth: wgpu::TextureView,
     /// False after a depth prepass.
     clear_depth: bool,
-    /// Positions, or the packed texture; then normals and geometric normals, if any.
+    /// Positions, or the packed texture; then normals, geometric normals, the surface
+    /// and the uv derivatives, those that are given.
     targets: Vec<wgpu::TextureView>,
     draws: MeshDraws,
 }
@@ -34,6 +38,7 @@ pub(super) fn prepare(cx: &mut PrepareCtx, sp: &ScheduledPass) -> Result<GBuffer
         packed,
         normals: sp.roles.slot(G_NORMAL).is_some(),
         geometric,
+        surface: sp.roles.slot(G_SURFACE).is_some(),
     };
     let draws = cx.renderer.mesh_draws(
         cx.gpu,
@@ -44,7 +49,7 @@ pub(super) fn prepare(cx: &mut PrepareCtx, sp: &ScheduledPass) -> Result<GBuffer
         &offered,
     )?;
     let mut targets = vec![cx.view(&sp.name, sp.required(G_POSITION))?];
-    for slot in [G_NORMAL, G_GEOMETRIC] {
+    for slot in [G_NORMAL, G_GEOMETRIC, G_SURFACE, G_UV_GRAD] {
         if let Some(name) = sp.roles.slot(slot) {
             targets.push(cx.view(&sp.name, name)?);
         }
