@@ -5,6 +5,7 @@
 //! (the same lights, lists and shadows), by FLIP mean (bench/metrics.rs).
 
 mod common;
+use common::msaa::offered;
 use common::textured::*;
 use common::*;
 use lightgraph::bench::metrics::{compare, CompareOptions};
@@ -18,7 +19,10 @@ const PAIRS: &[(&str, &str)] = &[
     ("tiled_deferred.ron", "forward_plus.ron"),
     ("tiled_deferred_prepass.ron", "forward_plus.ron"),
     ("tiled_deferred_packed.ron", "forward_plus.ron"),
-    ("tiled_deferred_depth_mask.ron", "forward_plus_depth_mask.ron"),
+    (
+        "tiled_deferred_depth_mask.ron",
+        "forward_plus_depth_mask.ron",
+    ),
     ("deferred_brute_force.ron", "brute_force.ron"),
     ("light_linked_list_deferred.ron", "light_linked_list.ron"),
     ("tiled_deferred_msaa.ron", "msaa.ron"),
@@ -29,16 +33,24 @@ const PAIRS: &[(&str, &str)] = &[
 ];
 
 /// FLIP mean of a deferred image against forward's. Measured on lavapipe at 160×96
-/// (see the report this test prints): TODO. Where deferred and forward differ at all it
-/// is in the last bits of a uv or a tangent (stored and rebuilt: the tangent as an angle),
-/// which moves a bilinear tap by at most one 1/256 step of the 8-bit filter weights.
-const FLIP_BOUND: f64 = 1.0;
+/// (2026-12-06): BoxTextured 3.6e-5, the textured scene 1.25e-4 (1.26e-4 packed), no
+/// pixel over 1.1e-3 relative; forward samples with textureSample, deferred with
+/// textureSampleGrad at the stored uv and derivatives, and the tangent comes back from
+/// an angle, so filter weights (8-bit on lavapipe) and normal-mapped shading move in
+/// their last steps. For comparison, ignoring the uv (every texel at uv 0) scores
+/// FLIP 0.1-0.3. The bound is about 2.4× the worst.
+const FLIP_BOUND: f64 = 3e-4;
+/// At 4× MSAA: BoxTextured 2.96e-4, the textured scene 5.24e-4. Higher: edge pixels
+/// average samples whose uv derivatives lavapipe's implicit sampling takes across the
+/// quad at centroid-moved positions, while the G-buffer stores dpdx of the centroid uv.
+const FLIP_BOUND_MSAA: f64 = 1.2e-3;
 
 fn scenes() -> Vec<(String, Scene)> {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut box_textured = scene::load(&root.join("tests/assets/khronos/BoxTextured/BoxTextured.gltf"))
-        .unwrap()
-        .scene;
+    let mut box_textured =
+        scene::load(&root.join("tests/assets/khronos/BoxTextured/BoxTextured.gltf"))
+            .unwrap()
+            .scene;
     box_textured.add_headlight_if_unlit();
     vec![
         ("BoxTextured".into(), box_textured),
@@ -49,6 +61,8 @@ fn scenes() -> Vec<(String, Scene)> {
 #[test]
 fn every_deferred_graph_matches_forward_on_textured_scenes() {
     let mut r = renderer();
+    // lavapipe offers 4× but not 8×: graphs at a count the adapter lacks are skipped.
+    let eight = !offered(&r, &[8]).is_empty();
     let mut bad = Vec::new();
     for (name, s) in scenes() {
         assert!(
@@ -56,22 +70,73 @@ fn every_deferred_graph_matches_forward_on_textured_scenes() {
             "{name}: not textured"
         );
         for (deferred, forward) in PAIRS {
+            if deferred.contains("8x") && !eight {
+                println!("{name:14} {deferred:36} skipped: no 8× MSAA here");
+                continue;
+            }
             let reference = render_file(&mut r, forward, &s, W, H);
             let out = render_file(&mut r, deferred, &s, W, H);
             assert_eq!(out.image.len(), (W * H) as usize, "{deferred}");
             assert_eq!(reference.image.len(), out.image.len(), "{forward}");
-            let m = compare(&reference.image, &out.image, W, H, &CompareOptions::default())
-                .unwrap();
+            let m = compare(
+                &reference.image,
+                &out.image,
+                W,
+                H,
+                &CompareOptions::default(),
+            )
+            .unwrap();
             let flip = m.flip_mean.unwrap();
             let (d, _) = max_rel_diff(&out.image, &reference.image);
             println!(
                 "{name:14} {deferred:36} FLIP mean {flip:.3e}, max rel {d:.3e}, bad pixels {}",
                 m.bad_pixels
             );
-            if !(flip <= FLIP_BOUND) {
+            let bound = if deferred.contains("msaa") {
+                FLIP_BOUND_MSAA
+            } else {
+                FLIP_BOUND
+            };
+            if !(flip <= bound) {
                 bad.push(format!("{name} {deferred} against {forward}: {m}"));
             }
         }
     }
     assert!(bad.is_empty(), "{}", bad.join("\n"));
+}
+
+/// A G-buffer without the surface targets cannot shade a textured material: refused at
+/// prepare, naming the pass and the material (untextured scenes still render with it).
+#[test]
+fn a_textured_material_needs_the_surface_targets() {
+    let text = std::fs::read_to_string(graph_path("tiled_deferred.ron"))
+        .unwrap()
+        .replace(", \"g_surface\", \"g_uv_grad\"", "");
+    assert!(!text.contains("\"g_surface\", "), "{text}");
+    let (_, s) = scenes().remove(0);
+    let checked = lightgraph::graph::check_text(
+        std::path::Path::new("<test>"),
+        &text,
+        &lightgraph::shader::ShaderLibrary::builtin(),
+    )
+    .unwrap();
+    let size = lightgraph::graph::FrameSize {
+        width: W,
+        height: H,
+        lights: s.lights.len() as u32,
+    };
+    let compiled = lightgraph::graph::compile(checked, &s.features(), size);
+    let mut r = renderer();
+    let gpu = lightgraph::render::SceneGpu::upload(&r.ctx.device, &r.ctx.queue, &s).unwrap();
+    let e = match r.prepare(compiled, &s, &gpu, size, false) {
+        Ok(_) => panic!("a textured material through a G-buffer without surface targets"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        e.contains("deferred_shading")
+            && e.contains(
+                "has textures: its G-buffer needs the surface targets 'g_surface' and 'g_uv_grad'"
+            ),
+        "{e}"
+    );
 }

@@ -205,9 +205,9 @@ fn fs_gbuffer(in: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
     let ng = face_normal(in.world);
 #endif
 #if GBUFFER_SURFACE
-    // The derivatives forward shading's textureSample takes implicitly (uniform control
-    // flow: before any discard).
-    let uv_grad = vec4<f32>(dpdx(in.uv), dpdy(in.uv));
+    // The derivatives forward shading's textureSample takes implicitly, across the 2×2
+    // quad as the rasterizer takes them (uniform control flow: before any discard).
+    let uv_grad = vec4<f32>(dpdxCoarse(in.uv), dpdyCoarse(in.uv));
 #endif
     let p = shading_point(in, front);
 #if ALPHA_MASK

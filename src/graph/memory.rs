@@ -203,7 +203,7 @@ mod tests {
 
     #[test]
     fn deferred_msaa_counts_its_multisampled_g_buffer() {
-        // The depth and both G-buffer textures at 4×; the output stays single-sample and
+        // The depth and the four G-buffer textures at 4×; the output stays single-sample and
         // there is no multisampled colour texture (the shading pass resolves).
         let t = by_technique(&compiled("tiled_deferred_msaa.ron", false));
         assert_eq!(t.len(), 1, "{t:?}");
@@ -221,10 +221,12 @@ mod tests {
                 ("depth_msaa", 4 * px * 4, 4 * px * 3),
                 ("g_normal", 16 * px * 4, 16 * px * 3),
                 ("g_position", 16 * px * 4, 16 * px * 3),
+                ("g_surface", 16 * px * 4, 16 * px * 3),
+                ("g_uv_grad", 16 * px * 4, 16 * px * 3),
             ]
         );
         let t = by_technique(&compiled("tiled_deferred_msaa_8x.ron", false));
         assert_eq!(t[0].technique, "MSAA 8×");
-        assert_eq!(t[0].added(), (4 + 16 + 16) * px * 7);
+        assert_eq!(t[0].added(), (4 + 4 * 16) * px * 7);
     }
 }

@@ -203,6 +203,31 @@ mod tests {
     }
 
     #[test]
+    fn surface_targets_come_in_pairs_at_the_depths_samples() {
+        let pass = |writes: &str| {
+            format!(r#"Pass(name: "g", kind: GBuffer, reads: ["geometry"], writes: [{writes}])"#)
+        };
+        validate(
+            &pass(r#""depth", "pos", "nrm", "g_surface=geo", "g_uv_grad=hdr""#),
+            "pos",
+        )
+        .unwrap();
+        let e = errors(&pass(r#""depth", "pos", "nrm", "g_surface=geo""#), "pos");
+        assert!(
+            e.contains("resource 'geo': the G-buffer's surface is two textures"),
+            "{e}"
+        );
+        let e = errors(
+            &pass(r#""depth4", "pos4", "nrm4", "g_surface=geo", "g_uv_grad=hdr4""#),
+            "pos4",
+        );
+        assert!(
+            e.contains("resource 'geo': G-buffer texture has 1 sample(s) but depth 'depth4' has 4"),
+            "{e}"
+        );
+    }
+
+    #[test]
     fn msaa_targets_take_the_depths_samples_and_two_textures() {
         // The G-buffer pass writes `targets`; a deferred pass reads its colour textures.
         let graph = |targets: &str, reads: &str| {
