@@ -219,7 +219,7 @@ mod tests {
         );
         let e = errors(
             &pass(r#""depth4", "pos4", "nrm4", "g_surface=geo", "g_uv_grad=hdr4""#),
-            "pos4",
+            "geo",
         );
         assert!(
             e.contains("resource 'geo': G-buffer texture has 1 sample(s) but depth 'depth4' has 4"),
