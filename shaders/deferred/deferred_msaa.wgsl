@@ -7,8 +7,9 @@
 // covered samples (as MSAA forward shading does), so the samples one triangle covers hold
 // the same texels, and a sample whose position, normal and surface texels equal an
 // earlier sample's, bit for bit, takes that sample's colour: shading is a function of
-// those texels (the material index is the position's w) and the pixel alone. A pixel whose samples are all
-// alike (Lauritzen's edge test) is shaded once, an edge pixel once per surface in it.
+// those texels (the material index is the position's w) and the pixel alone. A pixel
+// whose samples are all alike (Lauritzen's edge test) is shaded once, an edge pixel once
+// per surface in it.
 // The samples a workgroup must shade are pooled and shared out over its invocations
 // (Lauritzen's repacking), so an edge pixel does not keep its neighbours waiting.
 //

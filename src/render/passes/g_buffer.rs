@@ -40,6 +40,13 @@ pub(super) fn prepare(cx: &mut PrepareCtx, sp: &ScheduledPass) -> Result<GBuffer
         geometric,
         surface: sp.roles.slot(G_SURFACE).is_some(),
     };
+    let count = 1 + [G_NORMAL, G_GEOMETRIC, G_SURFACE, G_UV_GRAD]
+        .iter()
+        .filter(|s| sp.roles.slot(s).is_some())
+        .count() as u32;
+    if let Some(problem) = attachment_problem(count, &cx.device().limits()) {
+        return Err(super::pass_error(&sp.name, problem));
+    }
     let draws = cx.renderer.mesh_draws(
         cx.gpu,
         mode,
@@ -60,6 +67,19 @@ pub(super) fn prepare(cx: &mut PrepareCtx, sp: &ScheduledPass) -> Result<GBuffer
         clear_depth: sp.clears(depth),
         targets,
         draws,
+    })
+}
+
+/// Why `targets` Rgba32Float colour targets (16 bytes a sample each) exceed the device's
+/// colour attachment limits, if they do (wgpu would say so in its own words).
+fn attachment_problem(targets: u32, limits: &wgpu::Limits) -> Option<String> {
+    let bytes = 16 * targets;
+    let (max_targets, max_bytes) = (
+        limits.max_color_attachments,
+        limits.max_color_attachment_bytes_per_sample,
+    );
+    (targets > max_targets || bytes > max_bytes).then(|| {
+        format!("its {targets} Rgba32Float targets take {bytes} bytes a sample; the device allows {max_targets} colour targets and {max_bytes} bytes a sample (leave out g_geometric or the surface pair g_surface, g_uv_grad)")
     })
 }
 
@@ -96,5 +116,27 @@ impl super::PrepareKind for crate::graph::kinds::g_buffer::GBuffer {
         sp: &ScheduledPass,
     ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
         Ok(Box::new(prepare(cx, sp)?))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::attachment_problem;
+
+    #[test]
+    fn targets_past_the_colour_attachment_limits_are_named() {
+        // WebGPU's defaults: 8 targets, 32 bytes a sample.
+        let limits = wgpu::Limits::default();
+        assert_eq!(attachment_problem(2, &limits), None);
+        let e = attachment_problem(4, &limits).unwrap();
+        assert!(
+            e.contains("its 4 Rgba32Float targets take 64 bytes a sample; the device allows 8 colour targets and 32 bytes"),
+            "{e}"
+        );
+        let wide = wgpu::Limits {
+            max_color_attachment_bytes_per_sample: 128,
+            ..limits
+        };
+        assert_eq!(attachment_problem(5, &wide), None);
     }
 }
