@@ -325,8 +325,10 @@ pub fn runtime_dir_fallback() {
     }
     let user = std::env::var("USER").unwrap_or_else(|_| "user".into());
     let dir = std::env::temp_dir().join(format!("lightgraph-runtime-{user}"));
-    use std::os::unix::fs::DirBuilderExt;
-    let made = std::fs::DirBuilder::new().mode(0o700).create(&dir);
+    let mut builder = std::fs::DirBuilder::new();
+    #[cfg(unix)]
+    std::os::unix::fs::DirBuilderExt::mode(&mut builder, 0o700);
+    let made = builder.create(&dir);
     if made.is_ok() || dir.is_dir() {
         std::env::set_var("XDG_RUNTIME_DIR", &dir);
     }
