@@ -2,12 +2,12 @@
 
 use super::camera::{CameraController, CameraMode, Movement};
 use super::overlay::{FrameInfo, Overlay, OverlayAction};
-use super::present::Presenter;
 use super::{ViewError, ViewOptions};
 use crate::bench::image_io::write_png_rgb8;
 use crate::gpu::readback::read_texture;
 use crate::gpu::GpuContext;
 use crate::reload::ReloadSession;
+use crate::render::Presenter;
 use crate::render::Renderer;
 use crate::shader::ShaderLibrary;
 use std::collections::HashSet;

@@ -6,7 +6,6 @@
 mod app;
 pub mod camera;
 pub mod overlay;
-pub mod present;
 
 pub use app::run;
 pub use camera::{CameraController, CameraMode, Movement};

@@ -284,9 +284,18 @@ impl PreparedFrame {
     }
 
     fn encode(&self, r: &Renderer) -> wgpu::CommandBuffer {
-        let device = &r.ctx.device;
+        let mut encoder = r.ctx.device.create_command_encoder(&Default::default());
+        self.record(&mut encoder);
+        encoder.finish()
+    }
+
+    /// Records one frame into the caller's encoder (an engine's frame with its own passes
+    /// before and after): the caller submits. The graph's output is then
+    /// [`output_texture`](Self::output_texture), or draw it into any colour target with a
+    /// [`Presenter`](crate::render::Presenter) on the same encoder. Per-pass timestamps are
+    /// recorded but only [`execute`](Self::execute) reads them back.
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder) {
         let plan = &self.graph.plan;
-        let mut encoder = device.create_command_encoder(&Default::default());
         // Resources whose writers were culled read as zero.
         for name in &self.absent {
             if let Some(b) = self.resources.buffer(plan, name) {
@@ -320,15 +329,14 @@ impl PreparedFrame {
         }
         for (i, (_, pass)) in self.passes.iter().enumerate() {
             let ts = Timestamps(self.queries.as_ref().map(|(q, _)| (q, i as u32)));
-            pass.record(&mut encoder, ts);
+            pass.record(encoder, ts);
             if let Some(stats) = self.stats.as_ref().filter(|s| s.after == i) {
-                stats.record(&mut encoder);
+                stats.record(encoder);
             }
         }
         if let Some((q, buf)) = &self.queries {
             encoder.resolve_query_set(q, 0..2 * self.passes.len() as u32, buf, 0);
         }
-        encoder.finish()
     }
 
     fn execute_unscoped(&self, r: &Renderer) -> Result<(PassTimes, RenderTimings), RenderError> {
