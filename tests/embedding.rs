@@ -127,7 +127,7 @@ fn a_device_without_the_wanted_features_falls_back_and_says_so() {
     let mut r = Renderer::from_device(adapter, device, queue);
     assert_eq!(
         r.ctx.disabled_features,
-        offered & GpuContext::wanted_features() - wgpu::Features::PRIMITIVE_INDEX,
+        offered & (GpuContext::wanted_features() - wgpu::Features::PRIMITIVE_INDEX),
         "every other wanted feature the adapter offers counts as disabled on this device"
     );
     let scene = common::random_scene(16, 3);
