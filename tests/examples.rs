@@ -57,3 +57,40 @@ fn the_headless_example_writes_its_png() {
         share * 100.0
     );
 }
+
+/// Pixels of exactly the outline's colour (4, 3, 0.5) after the PNG's tonemap.
+fn outline_pixels(png: &image::RgbImage) -> usize {
+    let outline = lightgraph::bench::tonemap::Tonemap::default().to_srgb8([4.0, 3.0, 0.5]);
+    png.pixels().filter(|p| p.0 == outline).count()
+}
+
+#[test]
+fn the_custom_pass_example_outlines_the_silhouettes() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("outlined.png");
+    let run = Command::new(example("custom_pass"))
+        .arg(root.join("scenes/harada.ron"))
+        .arg(&out)
+        .output()
+        .expect("the example runs");
+    assert!(
+        run.status.success(),
+        "custom_pass failed: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let png = image::open(&out).expect("a PNG was written").to_rgb8();
+    assert_eq!(
+        png.dimensions(),
+        (640, 360),
+        "the example's documented size"
+    );
+    // Harada's boxes against the floor and the black sky: thousands of silhouette pixels
+    // (about 3% of the frame); lit surfaces never reach the outline's exact colour.
+    let share = outline_pixels(&png) as f64 / (640.0 * 360.0);
+    assert!(
+        (0.01..0.2).contains(&share),
+        "{:.2}% of the frame is outline",
+        share * 100.0
+    );
+}
