@@ -310,3 +310,59 @@ fn without_blended_meshes_the_transparency_passes_are_skipped() {
         "a dark frame tests nothing"
     );
 }
+
+/// The default graph (graphs/default.ron) on a scene without blended meshes: its
+/// transparency passes are skipped and what runs is the plain compute-first frame
+/// (graphs/visibility_compute_raster.ron), pass for pass, with the same image bit for bit
+/// (its Depth32Float depth holds the bits the R32Float one holds: the draw resolve and the
+/// compute resolve agree exactly, tests/compute_raster.rs).
+#[test]
+fn without_blended_meshes_the_default_graph_is_the_compute_first_frame() {
+    let scene = random_scene(24, 15);
+    assert!(!scene.features().has_transparent);
+    let size = FrameSize {
+        width: W,
+        height: H,
+        lights: scene.lights.len() as u32,
+    };
+    let compile = |name: &str| {
+        let checked =
+            graph::check_text(Path::new(name), &graph_file(name), &ShaderLibrary::builtin())
+                .unwrap();
+        graph::compile(checked, &scene.features(), size)
+    };
+    let default = compile("default.ron");
+    let plain = compile("visibility_compute_raster.ron");
+    let passes = |g: &graph::CompiledGraph| {
+        g.passes
+            .iter()
+            .map(|p| (p.name.to_string(), p.kind.clone()))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(passes(&default), passes(&plain));
+    assert_eq!(default.passes.len(), 3);
+    let mut skipped: Vec<&str> = default
+        .culled
+        .iter()
+        .filter(|c| matches!(&c.reason, CullReason::WhenFalse(f) if f == "Transparent"))
+        .map(|c| c.name.as_str())
+        .collect();
+    skipped.sort();
+    assert_eq!(
+        skipped,
+        [
+            "transparent_culling",
+            "transparent_prepass",
+            "transparent_shading"
+        ]
+    );
+    let mut r = renderer();
+    let a = render_file(&mut r, "visibility_compute_raster.ron", &scene, W, H);
+    let b = render_file(&mut r, "default.ron", &scene, W, H);
+    assert_eq!(a.image.len(), (W * H) as usize);
+    assert_eq!(differing(&a.image, &b.image), 0);
+    assert!(
+        a.image.iter().any(|p| p[0] > 0.0),
+        "a dark frame tests nothing"
+    );
+}
