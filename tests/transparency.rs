@@ -255,7 +255,11 @@ fn blended_back_to_front_whatever_the_scene_order() {
     };
     let mut r = renderer();
     // default.ron: no opaque triangle at all for its compute rasterizer.
-    for graph in ["transparent_brute_force.ron", "transparent.ron", "default.ron"] {
+    for graph in [
+        "transparent_brute_force.ron",
+        "transparent.ron",
+        "default.ron",
+    ] {
         let f = render_file(&mut r, graph, &scene, 64, 64);
         // The frame's centre sees both quads (near x in [-1.5, 0.5], far in [-0.5, 1.5]).
         let p = f.image[(32 * 64 + 32) as usize];
@@ -326,9 +330,12 @@ fn without_blended_meshes_the_default_graph_is_the_compute_first_frame() {
         lights: scene.lights.len() as u32,
     };
     let compile = |name: &str| {
-        let checked =
-            graph::check_text(Path::new(name), &graph_file(name), &ShaderLibrary::builtin())
-                .unwrap();
+        let checked = graph::check_text(
+            Path::new(name),
+            &graph_file(name),
+            &ShaderLibrary::builtin(),
+        )
+        .unwrap();
         graph::compile(checked, &scene.features(), size)
     };
     let default = compile("default.ron");

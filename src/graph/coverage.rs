@@ -37,7 +37,11 @@ impl Reported {
     /// The warnings for `graph` and `features` not given by the last compile.
     pub fn new_warnings(&mut self, graph: &CompiledGraph, features: &SceneFeatures) -> Vec<String> {
         let now = undrawn(graph, features);
-        let new = now.iter().filter(|w| !self.last.contains(w)).cloned().collect();
+        let new = now
+            .iter()
+            .filter(|w| !self.last.contains(w))
+            .cloned()
+            .collect();
         self.last = now;
         new
     }

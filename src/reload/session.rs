@@ -465,7 +465,11 @@ impl ReloadSession {
             .map_err(|e| e.to_string())?;
         let features = scene.features();
         let compiled = graph::compile(checked, &features, self.frame_size(scene));
-        for w in self.reported.borrow_mut().new_warnings(&compiled, &features) {
+        for w in self
+            .reported
+            .borrow_mut()
+            .new_warnings(&compiled, &features)
+        {
             log::warn!("{w}");
         }
         Ok(compiled)
