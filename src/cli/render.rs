@@ -9,6 +9,14 @@ use lightgraph::scene::{self, Scene};
 use lightgraph::shader::{assets, ShaderLibrary};
 use std::path::{Path, PathBuf};
 
+/// The scene `lightgraph` renders without arguments: `scenes/gallery.ron` of the project
+/// root (a checkout: glTF models, many coloured lights, glass), if there is one; `None`
+/// (the built-in atrium, which needs no files) for an installed binary run elsewhere.
+pub fn default_scene_path() -> Option<PathBuf> {
+    let root = assets::project().root?;
+    Some(root.join("scenes/gallery.ron")).filter(|p| p.is_file())
+}
+
 pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
     match path {
         None => Ok(scene::builtin::atrium()),
@@ -188,7 +196,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
     let graph_path = args
         .graph
         .clone()
-        .unwrap_or_else(|| project_path("graphs/forward_plus.ron"));
+        .unwrap_or_else(|| project_path("graphs/default.ron"));
     let options = lightgraph::gpu::ContextOptions {
         disabled_features: match &args.disable_features {
             Some(list) => lightgraph::gpu::ContextOptions::parse_features(list)
