@@ -12,8 +12,14 @@ use lightgraph::scene::gltf_writer::{GltfWriter, ImageStorage, MaterialDesc, Pri
 use lightgraph::scene::{self, Camera, Light, Loaded, Mesh, Scene};
 use std::path::PathBuf;
 
+/// A fresh folder per call: tests run in parallel and write models of the same name.
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("lg_gltf_materials_{name}"));
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let d = std::env::temp_dir().join(format!(
+        "lg_gltf_materials_{}_{name}_{n}",
+        std::process::id()
+    ));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
@@ -403,8 +409,9 @@ fn asymmetry(img: &[[f32; 4]]) -> (f32, u32, u32) {
 }
 
 /// Mirror symmetry of the left and right quads: the same light on mirrored geometry,
-/// differing only in f32 rounding of mirrored positions (measured below 1e-5).
-const SYMMETRY_TOL: f32 = 1e-3;
+/// differing only in f32 rounding (measured 5.5e-7 of the peak on lavapipe in both paths;
+/// with the tangent's w ignored, 0.54).
+const SYMMETRY_TOL: f32 = 1e-5;
 
 #[test]
 fn mirrored_uvs_shade_as_the_mirror_image_with_given_and_generated_tangents() {
