@@ -212,7 +212,7 @@ fn worst_abs(img: &[[f32; 4]], expected: impl Fn(u32, u32) -> [f32; 3]) -> (f32,
             let p = img[(y * W + x) as usize];
             for c in 0..3 {
                 let d = (p[c] - e[c]).abs();
-                if !(d <= worst.0) {
+                if d > worst.0 || d.is_nan() {
                     worst = (d, x, y);
                 }
             }
@@ -399,7 +399,7 @@ fn asymmetry(img: &[[f32; 4]]) -> (f32, u32, u32) {
             let (a, b) = (img[(y * W + x) as usize], img[(y * W + W - 1 - x) as usize]);
             for c in 0..3 {
                 let d = (a[c] - b[c]).abs() / peak;
-                if !(d <= worst.0) {
+                if d > worst.0 || d.is_nan() {
                     worst = (d, x, y);
                 }
             }

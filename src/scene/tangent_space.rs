@@ -53,7 +53,7 @@ impl Geometry for Corners<'_> {
 /// mesh without them is left as is and `false` returned.
 pub fn mikktspace_tangents(mesh: &mut Mesh) -> bool {
     let n = mesh.positions.len();
-    if mesh.uvs.len() != n || mesh.normals.len() != n || mesh.indices.len() % 3 != 0 {
+    if mesh.uvs.len() != n || mesh.normals.len() != n || !mesh.indices.len().is_multiple_of(3) {
         return false;
     }
     let mut corners = Corners {
