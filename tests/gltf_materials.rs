@@ -724,3 +724,43 @@ fn a_bad_texture_transform_is_an_error_naming_the_texture() {
         }
     }
 }
+
+/// A RON material sets a texture's sampler and transform as glTF does; slots sharing a
+/// sampler share its binding.
+#[test]
+fn ron_material_textures_take_a_sampler_and_a_transform() {
+    let d = tmp("ron_sampler");
+    texels().save(d.join("t.png")).unwrap();
+    let src = r#"(
+        name: "tiles",
+        textures: {
+            "a": (file: "t.png", srgb: true, sampler: (wrap_u: MirroredRepeat, mag_filter: Nearest, mipmap_filter: None)),
+            "b": (file: "t.png", transform: Some((offset: (0.5, 0), rotation: 0.25, scale: (2, 2)))),
+            "c": (file: "t.png", sampler: (wrap_u: MirroredRepeat, mag_filter: Nearest, mipmap_filter: None)),
+        },
+        layers: [(lobes: [Lambert(color: Tex(texture: "a", scale: (1, 1, 1)))])],
+    )"#;
+    let m = lightgraph::material::Material::parse(src, d.join("tiles.ron")).unwrap();
+    let slots = m.texture_slots();
+    assert_eq!(slots[0].sampler.wrap_u, Wrap::MirroredRepeat);
+    assert_eq!(slots[0].sampler.mipmap_filter, MipmapFilter::None);
+    assert_eq!(slots[1].sampler, SamplerDesc::default());
+    assert_eq!(slots[1].transform.unwrap().scale, (2.0, 2.0));
+    let (samplers, of_slot) = m.samplers();
+    assert_eq!(samplers.len(), 2);
+    assert_eq!(of_slot, vec![0, 1, 0]);
+    let code = m.wgsl().unwrap();
+    // Textures at 1..=3, the second sampler after them.
+    assert!(
+        code.contains("@group(2) @binding(4) var material_sampler1: sampler;"),
+        "{code}"
+    );
+    assert!(
+        code.contains("textureSample(material_tex2, material_sampler, p.uv)"),
+        "{code}"
+    );
+    assert!(
+        code.contains("textureSample(material_tex1, material_sampler1, uv1)"),
+        "{code}"
+    );
+}
