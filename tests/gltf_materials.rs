@@ -712,7 +712,10 @@ fn a_bad_texture_transform_is_an_error_naming_the_texture() {
             &lightgraph::scene::gltf_writer::BufferStorage::Embedded,
         )
         .unwrap();
-        let e = scene::load(&path).err().expect("an error").to_string();
+        let Err(e) = scene::load(&path) else {
+            panic!("{transform}: loaded without an error");
+        };
+        let e = e.to_string();
         for part in [
             "bad.gltf",
             "material 0",
