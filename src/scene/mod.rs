@@ -15,6 +15,7 @@ mod locate;
 mod model_budget;
 pub mod ranges;
 pub mod scene_file;
+pub mod tangent_space;
 mod types;
 pub mod vpl;
 

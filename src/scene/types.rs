@@ -1,3 +1,4 @@
+use crate::material::model::TextureSampling;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use serde::{Deserialize, Serialize};
 
@@ -58,6 +59,20 @@ pub struct SurfaceMaterial {
     pub emissive_texture: Option<std::sync::Arc<TextureImage>>,
     pub occlusion_texture: Option<std::sync::Arc<TextureImage>>,
     pub occlusion_strength: f32,
+    /// glTF `KHR_materials_unlit`: the base colour (× texture) shows as is, unlit.
+    pub unlit: bool,
+    /// Each texture slot's sampler and uv transform.
+    pub sampling: SlotSampling,
+}
+
+/// The sampler and uv transform of each texture slot of a [`SurfaceMaterial`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SlotSampling {
+    pub base_color: TextureSampling,
+    pub metallic_roughness: TextureSampling,
+    pub normal: TextureSampling,
+    pub emissive: TextureSampling,
+    pub occlusion: TextureSampling,
 }
 
 impl Default for SurfaceMaterial {
@@ -78,6 +93,8 @@ impl Default for SurfaceMaterial {
             emissive_texture: None,
             occlusion_texture: None,
             occlusion_strength: 1.0,
+            unlit: false,
+            sampling: SlotSampling::default(),
         }
     }
 }
