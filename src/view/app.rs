@@ -388,12 +388,7 @@ impl Viewer {
         let session = &self.session;
         let prepared = session.prepared()?;
         let scene = session.scene();
-        prepared.set_view(
-            &session.renderer,
-            &camera,
-            scene.ambient,
-            scene.lights.len() as u32,
-        );
+        prepared.set_view(&session.renderer, &camera, scene.ambient);
         let result = prepared.execute(&session.renderer);
         if self.frames.is_multiple_of(REPORT_EVERY) {
             if let Ok((culling, stats)) = prepared.read_reports(&session.renderer) {
