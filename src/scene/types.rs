@@ -312,6 +312,17 @@ impl Scene {
         super::motion::animate_into(&self.lights, &self.light_motion, t, out);
     }
 
+    /// Moves the lights to where they are at `t` seconds, for good: the motion is dropped
+    /// (a still frame of a moving scene).
+    pub fn place_lights_at(&mut self, t: f64) {
+        if self.has_motion() {
+            let mut lights = Vec::with_capacity(self.lights.len());
+            self.lights_at(t, &mut lights);
+            self.lights = lights;
+            self.light_motion.clear();
+        }
+    }
+
     /// Number of triangles over all meshes.
     pub fn triangle_count(&self) -> usize {
         self.meshes.iter().map(|m| m.indices.len() / 3).sum()
