@@ -320,3 +320,26 @@ fn bad_motion_is_named_with_its_light() {
         .to_string();
     assert!(e.contains("light_sets[0]") && e.contains("flicker amplitude"), "{e}");
 }
+
+#[test]
+fn the_shadow_atlas_follows_moved_casters() {
+    let mut r = renderer();
+    let scene = random_scene(0, 4);
+    let caster = |p: Vec3| {
+        let mut l = Light::point(p, 10.0, Vec3::ONE, 20.0);
+        l.flags = lightgraph::scene::light_flags::CASTS_SHADOW;
+        l
+    };
+    let a = [caster(Vec3::new(-4.0, 2.0, -8.0)), caster(Vec3::new(3.0, 5.0, -20.0))];
+    let b = [caster(Vec3::new(4.0, 1.5, -12.0)), caster(Vec3::new(-3.0, 3.0, -16.0))];
+    let mut start = scene.clone();
+    start.lights = a.to_vec();
+    let (prepared, gpu) = prepare(&mut r, "shadow_atlas.ron", &start, 0);
+    prepared.render(&r).unwrap();
+    prepared.update_lights(&r, &gpu, &b).unwrap();
+    let moved = prepared.render(&r).unwrap().image;
+    // The same graph prepared with the casters at B from the start: the same atlas
+    // allocation and views, so the same image.
+    assert_same(&moved, &still(&mut r, "shadow_atlas.ron", &scene, &b), "atlas at B");
+    assert_differs(&moved, &still(&mut r, "shadow_atlas.ron", &scene, &a), "vs A");
+}
