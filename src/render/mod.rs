@@ -61,6 +61,8 @@ pub enum RenderError {
     /// The scene upload has room for more lights than the graph's plan was sized for.
     #[error("the graph was compiled for {compiled} lights but the scene upload has room for {capacity}: compile it with FrameSize::lights = {capacity}")]
     LightCapacity { compiled: u32, capacity: u32 },
+    #[error(transparent)]
+    LightUpdate(#[from] LightUpdateError),
 }
 
 /// A device, the shader library and the pipeline cache.
