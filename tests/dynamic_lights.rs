@@ -376,5 +376,5 @@ fn an_animated_sweep_moves_the_lights_and_compares_them_where_they_started() {
     let e = Sweep::parse(&bad, Path::new("animated.ron"))
         .unwrap_err()
         .to_string();
-    assert!(e.contains("12: animate 0 must be"), "{e}");
+    assert!(e.contains("11: animate 0 must be"), "{e}");
 }
