@@ -66,7 +66,10 @@ fn still(r: &mut Renderer, graph_file: &str, scene: &Scene, lights: &[Light]) ->
 
 fn assert_same(a: &[[f32; 4]], b: &[[f32; 4]], what: &str) {
     let (d, at) = max_rel_diff(a, b);
-    assert!(d <= SAME_LIGHTS, "{what}: relative error {d:e} at pixel {at}");
+    assert!(
+        d <= SAME_LIGHTS,
+        "{what}: relative error {d:e} at pixel {at}"
+    );
 }
 
 fn assert_differs(a: &[[f32; 4]], b: &[[f32; 4]], what: &str) {
@@ -113,8 +116,16 @@ fn moved_lights_light_their_new_places_and_the_lists_follow() {
 
     let brute_0 = still(&mut r, "brute_force.ron", &scene, &at_0);
     let brute_2 = still(&mut r, "brute_force.ron", &scene, &at_2);
-    assert_same(&before, &brute_0, "culled frame before the move vs brute force at t=0");
-    assert_same(&after, &brute_2, "culled frame after the move vs brute force at t=2");
+    assert_same(
+        &before,
+        &brute_0,
+        "culled frame before the move vs brute force at t=0",
+    );
+    assert_same(
+        &after,
+        &brute_2,
+        "culled frame after the move vs brute force at t=2",
+    );
     assert_differs(&after, &brute_0, "after the move vs the old places");
 }
 
@@ -130,7 +141,11 @@ fn one_moved_light_lights_the_new_place_not_the_old() {
     prepared.update_lights(&r, &gpu, &[b]).unwrap();
     let moved = prepared.render(&r).unwrap().image;
     let at_a = still(&mut r, "brute_force.ron", &scene, &[a]);
-    assert_same(&moved, &still(&mut r, "brute_force.ron", &scene, &[b]), "at B");
+    assert_same(
+        &moved,
+        &still(&mut r, "brute_force.ron", &scene, &[b]),
+        "at B",
+    );
     assert_differs(&moved, &at_a, "vs A");
     // The left quarter of the frame: A lights it, B (6 m range, 12 m to the right) not.
     let left_lit = |image: &[[f32; 4]]| {
@@ -157,12 +172,11 @@ fn the_light_count_changes_up_to_the_capacity_and_no_further() {
         *scene.lights.iter().find(spot).unwrap(),
     ];
     let (prepared, gpu) = prepare(&mut r, "forward_plus.ron", &start, 12);
-    assert_eq!(
-        (prepared.light_count(), prepared.light_capacity()),
-        (2, 12)
-    );
+    assert_eq!((prepared.light_count(), prepared.light_capacity()), (2, 12));
     for n in [12, 5, 1] {
-        prepared.update_lights(&r, &gpu, &scene.lights[..n]).unwrap();
+        prepared
+            .update_lights(&r, &gpu, &scene.lights[..n])
+            .unwrap();
         assert_eq!(prepared.light_count(), n as u32);
         let image = prepared.render(&r).unwrap().image;
         let brute = still(&mut r, "brute_force.ron", &scene, &scene.lights[..n]);
@@ -171,12 +185,21 @@ fn the_light_count_changes_up_to_the_capacity_and_no_further() {
     prepared.update_lights(&r, &gpu, &[]).unwrap();
     let dark = prepared.render(&r).unwrap().image;
     assert_eq!(dark.len(), (W * H) as usize);
-    assert!(dark.iter().all(|p| p[..3] == [0.0; 3]), "no lights, no light");
+    assert!(
+        dark.iter().all(|p| p[..3] == [0.0; 3]),
+        "no lights, no light"
+    );
     let mut more = scene.lights.clone();
     more.push(scene.lights[0]);
     let e = prepared.update_lights(&r, &gpu, &more).unwrap_err();
     assert!(
-        matches!(e, LightUpdateError::OverCapacity { count: 13, capacity: 12 }),
+        matches!(
+            e,
+            LightUpdateError::OverCapacity {
+                count: 13,
+                capacity: 12
+            }
+        ),
         "{e}"
     );
     assert!(e.to_string().contains("over the capacity of 12"), "{e}");
@@ -199,7 +222,9 @@ fn updates_that_the_prepared_graph_cannot_show_are_refused() {
         inner_angle: 0.2,
         outer_angle: 0.4,
     };
-    let e = prepared.update_lights(&r, &gpu, &[point, spot]).unwrap_err();
+    let e = prepared
+        .update_lights(&r, &gpu, &[point, spot])
+        .unwrap_err();
     assert!(e.to_string().contains("light 1 adds a spot light"), "{e}");
     let mut bad = point;
     bad.range = f32::NAN;
@@ -208,17 +233,25 @@ fn updates_that_the_prepared_graph_cannot_show_are_refused() {
 
     // A plan sized for fewer lights than the upload holds is refused at prepare.
     let text = std::fs::read_to_string(graph_path("forward_plus.ron")).unwrap();
-    let checked =
-        graph::check_text(Path::new("fp"), &text, &ShaderLibrary::builtin()).unwrap();
+    let checked = graph::check_text(Path::new("fp"), &text, &ShaderLibrary::builtin()).unwrap();
     let size = FrameSize {
         width: W,
         height: H,
         lights: 1,
     };
     let compiled = graph::compile(checked, &start.features(), size);
-    let err = r.prepare(compiled, &start, &gpu, size, false).err().unwrap();
+    let err = r
+        .prepare(compiled, &start, &gpu, size, false)
+        .err()
+        .unwrap();
     assert!(
-        matches!(err, RenderError::LightCapacity { compiled: 1, capacity: 4 }),
+        matches!(
+            err,
+            RenderError::LightCapacity {
+                compiled: 1,
+                capacity: 4
+            }
+        ),
         "{err}"
     );
 }
@@ -243,16 +276,14 @@ fn render_at(dir: &Path, scene: &Path, time: &str, out: &str) -> Vec<u8> {
     let o = Command::new(env!("CARGO_BIN_EXE_lightgraph"))
         .current_dir(dir)
         .args(["render", "--scene", scene.to_str().unwrap()])
-        .args(["--width", "64", "--height", "36", "--time", time, "--out", out])
+        .args([
+            "--width", "64", "--height", "36", "--time", time, "--out", out,
+        ])
         .env_remove("LIGHTGRAPH_ROOT")
         .env_remove("XDG_RUNTIME_DIR")
         .output()
         .expect("the binary runs");
-    assert!(
-        o.status.success(),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     std::fs::read(dir.join(out)).unwrap()
 }
 
@@ -272,8 +303,7 @@ fn render_time_is_reproducible_and_moves_the_lights() {
 #[test]
 fn scene_file_motion_is_a_pure_function_of_time() {
     let loaded = lightgraph::scene::scene_file::build_scene(
-        &lightgraph::scene::scene_file::parse_scene_file(MOVING_SCENE, Path::new("m.ron"))
-            .unwrap(),
+        &lightgraph::scene::scene_file::parse_scene_file(MOVING_SCENE, Path::new("m.ron")).unwrap(),
         Path::new("m.ron"),
     )
     .unwrap();
@@ -304,21 +334,25 @@ fn scene_file_motion_is_a_pure_function_of_time() {
 #[test]
 fn bad_motion_is_named_with_its_light() {
     let text = MOVING_SCENE.replace("period: 3", "period: 0");
-    let spec =
-        lightgraph::scene::scene_file::parse_scene_file(&text, Path::new("m.ron")).unwrap();
+    let spec = lightgraph::scene::scene_file::parse_scene_file(&text, Path::new("m.ron")).unwrap();
     let e = lightgraph::scene::scene_file::build_scene(&spec, Path::new("m.ron"))
         .err()
         .unwrap()
         .to_string();
-    assert!(e.contains("lights[0]") && e.contains("path period 0"), "{e}");
+    assert!(
+        e.contains("lights[0]") && e.contains("path period 0"),
+        "{e}"
+    );
     let text = MOVING_SCENE.replace("amplitude: 0.8", "amplitude: 1.5");
-    let spec =
-        lightgraph::scene::scene_file::parse_scene_file(&text, Path::new("m.ron")).unwrap();
+    let spec = lightgraph::scene::scene_file::parse_scene_file(&text, Path::new("m.ron")).unwrap();
     let e = lightgraph::scene::scene_file::build_scene(&spec, Path::new("m.ron"))
         .err()
         .unwrap()
         .to_string();
-    assert!(e.contains("light_sets[0]") && e.contains("flicker amplitude"), "{e}");
+    assert!(
+        e.contains("light_sets[0]") && e.contains("flicker amplitude"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -330,8 +364,14 @@ fn the_shadow_atlas_follows_moved_casters() {
         l.flags = lightgraph::scene::light_flags::CASTS_SHADOW;
         l
     };
-    let a = [caster(Vec3::new(-4.0, 2.0, -8.0)), caster(Vec3::new(3.0, 5.0, -20.0))];
-    let b = [caster(Vec3::new(4.0, 1.5, -12.0)), caster(Vec3::new(-3.0, 3.0, -16.0))];
+    let a = [
+        caster(Vec3::new(-4.0, 2.0, -8.0)),
+        caster(Vec3::new(3.0, 5.0, -20.0)),
+    ];
+    let b = [
+        caster(Vec3::new(4.0, 1.5, -12.0)),
+        caster(Vec3::new(-3.0, 3.0, -16.0)),
+    ];
     let mut start = scene.clone();
     start.lights = a.to_vec();
     let (prepared, gpu) = prepare(&mut r, "shadow_atlas.ron", &start, 0);
@@ -340,8 +380,16 @@ fn the_shadow_atlas_follows_moved_casters() {
     let moved = prepared.render(&r).unwrap().image;
     // The same graph prepared with the casters at B from the start: the same atlas
     // allocation and views, so the same image.
-    assert_same(&moved, &still(&mut r, "shadow_atlas.ron", &scene, &b), "atlas at B");
-    assert_differs(&moved, &still(&mut r, "shadow_atlas.ron", &scene, &a), "vs A");
+    assert_same(
+        &moved,
+        &still(&mut r, "shadow_atlas.ron", &scene, &b),
+        "atlas at B",
+    );
+    assert_differs(
+        &moved,
+        &still(&mut r, "shadow_atlas.ron", &scene, &a),
+        "vs A",
+    );
 }
 
 const ANIMATED_SWEEP: &str = r#"Sweep(

@@ -367,7 +367,7 @@ pub fn run(
                         None => timing::time_point(&frames, renderer, &sweep.method())?,
                         Some(step) => super::animate::time_moving(
                             &frames,
-                            &point.scene,
+                            point.scene,
                             &gpu,
                             renderer,
                             &sweep.method(),

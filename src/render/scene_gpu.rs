@@ -121,7 +121,9 @@ impl SceneGpu {
         capacity: u32,
     ) -> Result<Self, crate::material::MaterialError> {
         let materials = MaterialProgram::for_scene(device, queue, scene)?;
-        Ok(Self::upload_with_capacity(device, scene, materials, capacity))
+        Ok(Self::upload_with_capacity(
+            device, scene, materials, capacity,
+        ))
     }
 
     /// Writes `lights` over the light buffers: one queue write per buffer, no allocation.

@@ -240,7 +240,10 @@ mod tests {
             ..Default::default()
         };
         let quarter = m.apply(&point(), 0, 1.0).position;
-        assert!((quarter - Vec3::new(0.0, 1.0, -2.0)).length() < 1e-5, "{quarter}");
+        assert!(
+            (quarter - Vec3::new(0.0, 1.0, -2.0)).length() < 1e-5,
+            "{quarter}"
+        );
         let turn = m.apply(&point(), 0, 4.0).position;
         assert!((turn - point().position).length() < 1e-5, "{turn}");
     }
@@ -254,7 +257,10 @@ mod tests {
                 interpolation,
             };
             for (t, want) in [(0.0, Vec3::ZERO), (1.0, Vec3::X), (5.0, p.points[2])] {
-                assert!((p.offset(t) - want).length() < 1e-5, "{interpolation:?} t={t}");
+                assert!(
+                    (p.offset(t) - want).length() < 1e-5,
+                    "{interpolation:?} t={t}"
+                );
             }
         }
         let linear = KeyframePath {

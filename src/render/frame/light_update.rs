@@ -55,9 +55,11 @@ impl PreparedFrame {
         gpu.write_lights(&r.ctx.queue, lights)?;
         let count = lights.len() as u32;
         self.light_count.store(count, Ordering::Relaxed);
-        r.ctx
-            .queue
-            .write_buffer(&self.frame_uniform, LIGHT_COUNT_OFFSET, &count.to_ne_bytes());
+        r.ctx.queue.write_buffer(
+            &self.frame_uniform,
+            LIGHT_COUNT_OFFSET,
+            &count.to_ne_bytes(),
+        );
         for (_, pass) in &self.passes {
             pass.follow_lights(r, lights);
         }

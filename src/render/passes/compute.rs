@@ -64,9 +64,11 @@ pub(super) fn prepare(
             size.height.div_ceil(tile.max(1)),
             1,
         ],
-        Dispatch::PerLight { workgroup } => {
-            [cx.gpu.light_capacity.div_ceil(workgroup.max(1)).max(1), 1, 1]
-        }
+        Dispatch::PerLight { workgroup } => [
+            cx.gpu.light_capacity.div_ceil(workgroup.max(1)).max(1),
+            1,
+            1,
+        ],
         Dispatch::Fixed(x, y, z) => [x, y, z],
     };
     crate::render::device_limits::check_dispatch(cx.graph, &sp.name, groups, &device.limits())?;
