@@ -414,6 +414,7 @@ fn an_animated_sweep_moves_the_lights_and_compares_them_where_they_started() {
         sweep::run(&plan, Path::new("."), &mut r, |_| {}).expect("sweep")
     };
     assert_eq!(rows.len(), 1);
+    assert_eq!(rows[0].params, "animate=0.25s");
     // The error columns render after the sweep gives every frame the scene's lights
     // back: the same lights as the reference, so only summation order differs (lights
     // left where the last timed frame moved them are off by the whole signal).

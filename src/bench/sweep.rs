@@ -380,6 +380,11 @@ pub fn run(
                         let mut row = BenchRow {
                             scene: scene.name.clone(),
                             technique: g.trim_end_matches(".ron").to_string(),
+                            // Moving-light timings are told apart from still ones.
+                            params: sweep
+                                .animate
+                                .map(|s| format!("animate={s}s"))
+                                .unwrap_or_default(),
                             light_count: size.lights,
                             width,
                             height,
