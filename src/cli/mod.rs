@@ -210,6 +210,9 @@ pub struct RenderArgs {
     /// runs its hardware fallback and says so).
     #[arg(long, value_name = "FEATURES")]
     pub disable_features: Option<String>,
+    /// Time in seconds at which moving lights are placed (scene `motion:`; default 0).
+    #[arg(long, value_name = "SECONDS")]
+    pub time: Option<f64>,
 }
 
 #[derive(clap::Args)]

@@ -187,12 +187,16 @@ fn check_outputs(args: &RenderArgs) -> Result<()> {
     if args.width == Some(0) || args.height == Some(0) {
         bail!("--width and --height must be at least 1");
     }
+    if args.time.is_some_and(|t| !t.is_finite()) {
+        bail!("--time must be a finite number of seconds");
+    }
     Ok(())
 }
 
 pub fn render(args: RenderArgs) -> Result<()> {
     check_outputs(&args)?;
-    let scene = load_scene(args.scene.as_deref())?;
+    let mut scene = load_scene(args.scene.as_deref())?;
+    scene.place_lights_at(args.time.unwrap_or(0.0));
     let graph_path = args
         .graph
         .clone()

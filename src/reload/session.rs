@@ -267,6 +267,11 @@ impl ReloadSession {
         &self.scene
     }
 
+    /// The live frame's scene upload (what `PreparedFrame::update_lights` writes).
+    pub fn gpu(&self) -> &SceneGpu {
+        &self.gpu
+    }
+
     /// The graph file the session renders (normalised).
     pub fn graph_path(&self) -> &Path {
         &self.graph_path

@@ -20,7 +20,7 @@ pub mod visibility_geometry;
 
 pub use bind::LayoutCache;
 pub use device_limits::supported_sample_counts;
-pub use frame::{PreparedFrame, RenderTimings};
+pub use frame::{LightUpdateError, PreparedFrame, RenderTimings};
 pub use materials::MaterialProgram;
 pub use pipelines::{
     CacheCounters, GpuStateAtBuild, Pipeline, PipelineBuild, PipelineCache, PipelineKey,
@@ -60,6 +60,11 @@ pub enum RenderError {
     Wgpu(String),
     #[error(transparent)]
     Material(#[from] crate::material::MaterialError),
+    /// The scene upload has room for more lights than the graph's plan was sized for.
+    #[error("the graph was compiled for {compiled} lights but the scene upload has room for {capacity}: compile it with FrameSize::lights = {capacity}")]
+    LightCapacity { compiled: u32, capacity: u32 },
+    #[error(transparent)]
+    LightUpdate(#[from] LightUpdateError),
 }
 
 /// A device, the shader library and the pipeline cache.

@@ -272,6 +272,9 @@ pub struct Scene {
     /// Art controls of indirect lights, by light index (lights marked indirect without
     /// an entry use [`super::VplControls::default`]).
     pub vpl_controls: std::collections::BTreeMap<u32, super::VplControls>,
+    /// How lights move over time (scene files: `motion:` on a light or a light set);
+    /// `lights` holds them as placed, before any motion.
+    pub light_motion: Vec<super::motion::LightMotion>,
 }
 
 impl Scene {
@@ -312,6 +315,28 @@ impl Scene {
             has_double_sided: uses(&|m| m.double_sided),
             has_emissive: uses(&|m| m.emissive != Vec3::ZERO || m.emissive_texture.is_some()),
             has_material_masks: self.lights.iter().any(|l| l.material_mask != u32::MAX),
+        }
+    }
+
+    /// Whether any light moves or flickers.
+    pub fn has_motion(&self) -> bool {
+        !self.light_motion.is_empty()
+    }
+
+    /// The lights at `t` seconds into `out` (cleared first; no allocation once it has
+    /// room): a pure function of the scene and `t`.
+    pub fn lights_at(&self, t: f64, out: &mut Vec<Light>) {
+        super::motion::animate_into(&self.lights, &self.light_motion, t, out);
+    }
+
+    /// Moves the lights to where they are at `t` seconds, for good: the motion is dropped
+    /// (a still frame of a moving scene).
+    pub fn place_lights_at(&mut self, t: f64) {
+        if self.has_motion() {
+            let mut lights = Vec::with_capacity(self.lights.len());
+            self.lights_at(t, &mut lights);
+            self.lights = lights;
+            self.light_motion.clear();
         }
     }
 
