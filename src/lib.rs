@@ -3,6 +3,7 @@
 //! Pass graphs and materials are RON files; they are parsed, validated and compiled
 //! without a GPU (see [`graph`]), then executed headless on wgpu (see [`render`]).
 
+#[cfg(feature = "bench")]
 pub mod bench;
 pub mod cull;
 pub mod file_kind;
@@ -16,6 +17,7 @@ pub mod render;
 pub mod scene;
 pub mod shader;
 pub mod shadow;
+#[cfg(feature = "viewer")]
 pub mod view;
 
 /// The folder the user's shaders/, graphs/ and materials/ are looked for in first (see

@@ -11,6 +11,7 @@ fn main() -> anyhow::Result<()> {
     // for other command-line tools, instead of Rust's ignored SIGPIPE turning the next
     // print into a panic ("failed printing to stdout: Broken pipe").
     // SAFETY: called before any thread starts; SIG_DFL is a valid handler for SIGPIPE.
+    #[cfg(unix)]
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }

@@ -6,6 +6,8 @@
 //! by its make_hostile.py), and the large or special ones generated here into a temporary
 //! folder: a 20,000-term WGSL expression, a 10,000-file include chain, a 20,000-layer
 //! material, and /dev/zero, /dev/urandom and FIFOs in every place a file is read.
+// Resource limits and special files (FIFOs, symlinks) through libc: Unix only.
+#![cfg(unix)]
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};

@@ -49,6 +49,29 @@ fn no_arguments_writes_lightgraph_png_sized_for_the_adapter() {
     assert!(lit * 2 > image.pixels().len(), "{lit} lit pixels");
 }
 
+/// In a checkout (the root has scenes/gallery.ron) no arguments render the gallery, its
+/// glTF models, 1,024 lights and glass, through the default graph, and say where the
+/// picture went.
+#[test]
+fn no_arguments_in_a_checkout_render_the_gallery() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let o = lightgraph(dir.path(), &["--root", root.to_str().unwrap()]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{out}\n{err}");
+    assert!(err.contains("rendering gallery (1024 lights) at "), "{err}");
+    assert!(out.contains("graphs/default.ron, "), "{out}");
+    assert!(out.contains("transparent_shading"), "{out}");
+    assert!(!err.contains("TransparentShading"), "{err}");
+    let png = dir.path().join("lightgraph.png");
+    let shown = std::path::absolute(&png).unwrap();
+    assert!(out.contains(&format!("wrote {}", shown.display())), "{out}");
+    let image = image::open(&png).expect("a PNG").to_rgb8();
+    if err.contains("software adapter: small size") {
+        assert_eq!(image.dimensions(), (640, 360));
+    }
+}
+
 #[test]
 fn validate_without_files_is_a_usage_error() {
     let dir = tempfile::tempdir().unwrap();
@@ -374,7 +397,7 @@ fn render_reports_compact_lists_and_their_bound() {
 }
 
 /// Glass through a graph without transparency passes is rendered without it, and `render`
-/// says so; a graph with them says nothing.
+/// says so once; a graph with them (the default one too) says nothing.
 #[test]
 fn render_warns_when_the_graph_draws_no_blended_meshes() {
     let dir = tempfile::tempdir().unwrap();
@@ -405,11 +428,16 @@ fn render_warns_when_the_graph_draws_no_blended_meshes() {
     };
     for graph in ["forward_plus.ron", "visibility_compute_raster.ron"] {
         let err = run(graph);
-        assert!(
-            err.contains("has no TransparentShading pass: the scene's blended"),
+        // Once for the render, though it draws a warm-up frame and the reported one.
+        assert_eq!(
+            err.matches("has no TransparentShading pass: the scene's blended")
+                .count(),
+            1,
             "{graph}: {err}"
         );
     }
-    let err = run("transparent.ron");
-    assert!(!err.contains("TransparentShading"), "{err}");
+    for graph in ["transparent.ron", "default.ron"] {
+        let err = run(graph);
+        assert!(!err.contains("TransparentShading"), "{graph}: {err}");
+    }
 }

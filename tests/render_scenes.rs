@@ -1,5 +1,7 @@
-//! Whole-scene renders checked by pixel values: the analytic sphere (exact radiance) and
-//! the Cornell box glTF in scenes/cornell_box (copied from the shared assets) (red and green walls, lit interior).
+//! Whole-scene renders checked by pixel values: the analytic sphere (exact radiance), the
+//! Cornell box glTF in scenes/cornell_box (copied from the shared assets) (red and green
+//! walls, lit interior), and the default scene (scenes/gallery.ron: textured models, many
+//! lights, glass) through the default graph.
 
 mod common;
 use common::*;
@@ -198,4 +200,58 @@ fn alpha_masked_geometry_is_cut_out_in_prepass_and_shading() {
     let solid = render_file(&mut r, "forward_plus.ron", &scene, 96, 64);
     let (d, _) = max_rel_diff(&solid.image, &reference.image);
     assert!(d > 0.1, "an opaque-enough panel must show: {d}");
+}
+
+/// The default scene (`cargo run --release` in a checkout) shows what lightgraph is for:
+/// textured glTF models and many materials, many coloured lights and blended glass, drawn
+/// by the default graph (graphs/default.ron) with its transparency passes, lit across the
+/// frame.
+#[test]
+fn the_default_scene_has_textures_many_lights_and_glass_through_the_default_graph() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/gallery.ron");
+    let s = scene::load(&path).expect("the gallery loads").scene;
+    let textured = s
+        .materials
+        .iter()
+        .filter(|m| m.base_color_texture.is_some())
+        .count();
+    assert!(textured >= 2, "{textured} textured materials");
+    assert!(
+        s.materials.iter().any(|m| m.normal_texture.is_some()),
+        "no normal-mapped material"
+    );
+    assert!(s.materials.len() >= 30, "{} materials", s.materials.len());
+    assert!(s.lights.len() >= 1024, "{} lights", s.lights.len());
+    let features = s.features();
+    assert!(features.has_transparent, "no blended meshes");
+    let (w, h) = (160, 90);
+    let mut r = renderer();
+    let frame = render_file(&mut r, "default.ron", &s, w, h);
+    let opaque = render_file(&mut r, "visibility_compute_raster.ron", &s, w, h);
+    assert_eq!(frame.image.len(), (w * h) as usize);
+    assert_eq!(opaque.image.len(), frame.image.len());
+    let lit = frame
+        .image
+        .iter()
+        .filter(|p| p[0] + p[1] + p[2] > 1e-3)
+        .count();
+    assert!(lit * 2 > frame.image.len(), "{lit} lit pixels");
+    // The glass shows: the transparency passes change part of the frame.
+    let glass = frame
+        .image
+        .iter()
+        .zip(&opaque.image)
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(
+        glass > frame.image.len() / 100,
+        "only {glass} pixels show glass"
+    );
+    // Many lights are culled into the tiles, not a handful.
+    let listed: u32 = frame.culling[0].per_tile().iter().sum();
+    let tiles = frame.culling[0].per_tile().len() as u32;
+    assert!(
+        listed > 10 * tiles,
+        "{listed} lights listed over {tiles} tiles"
+    );
 }

@@ -2,8 +2,9 @@
 //! equal the brute-force graph with the same blending order (graphs/
 //! transparent_brute_force.ron) on the built-in glass scene (quads in front of, between
 //! and behind opaque boxes, one against the sky, lights among them), for every culling
-//! variant; blended meshes are drawn back to front; without blended meshes the
-//! transparency passes are skipped and the image is exactly Forward+'s.
+//! variant; so must glass over the compute-first frame (graphs/default.ron); blended
+//! meshes are drawn back to front; without blended meshes the transparency passes are
+//! skipped and the image is exactly Forward+'s (or the plain compute-first frame's).
 //!
 //! Tolerance: 2e-6 relative (as tests/culling_exact.rs). A culled light contributes
 //! exactly zero and lists keep ascending light order, so both graphs sum the same
@@ -122,6 +123,85 @@ fn opaque_lists_for_glass_differ_from_brute_force() {
     );
 }
 
+/// The largest absolute difference of two images of one size, over colour channels.
+fn max_abs_diff(a: &[[f32; 4]], b: &[[f32; 4]]) -> (f32, usize) {
+    assert_eq!(a.len(), b.len(), "images of different sizes");
+    let mut worst = (0.0f32, 0);
+    for (i, (x, y)) in a.iter().zip(b).enumerate() {
+        for c in 0..3 {
+            let d = (x[c] - y[c]).abs();
+            if d > worst.0 || d.is_nan() {
+                worst = (d, i);
+            }
+        }
+    }
+    worst
+}
+
+/// Glass over the compute-first frame (graphs/default.ron: compute rasterizer, compute
+/// shading, then the transparency passes on its depth) against forward brute force with
+/// the same blending order.
+///
+/// Tolerance: the opaque layer is shaded from the visibility buffer (the point rebuilt
+/// from the triangle, not interpolated by the rasterizer), so it differs from forward
+/// shading by a few f32 ulps of position turned into radiance; that difference is
+/// measured here on the same scene with the glass left out (brute_force.ron against
+/// visibility_compute_raster.ron: 5.5e-5 absolute, 5e-5 of the peak, on lavapipe at
+/// 160x90) and must stay within twice that. Glass blends over it with weight 1 − α ≤ 1, and the glass itself is shaded by
+/// the same code from lists that hold every light reaching it (culled lights add exactly
+/// 0), so the composite may differ by at most the opaque difference plus TOL of the peak
+/// for the contraction slack of the glass terms.
+#[test]
+fn glass_over_the_compute_first_frame_equals_brute_force() {
+    let scene = glass();
+    let mut r = renderer();
+    let reference = render_file(&mut r, "transparent_brute_force.ron", &scene, W, H);
+    let frame = render_file(&mut r, "default.ron", &scene, W, H);
+    assert_eq!(frame.image.len(), (W * H) as usize);
+    // The opaque layers alone: these graphs have no transparency pass and skip the glass.
+    let opaque_reference = render_file(&mut r, "brute_force.ron", &scene, W, H);
+    let opaque = render_file(&mut r, "visibility_compute_raster.ron", &scene, W, H);
+    let (opaque_err, _) = max_abs_diff(&opaque.image, &opaque_reference.image);
+    let peak = reference
+        .image
+        .iter()
+        .flat_map(|p| p[..3].iter().copied())
+        .fold(0.0f32, f32::max);
+    assert!(peak > 0.0, "a dark frame tests nothing");
+    assert!(
+        opaque_err <= 1e-4 * peak,
+        "the opaque compute-first frame differs from brute force by {opaque_err:e} (peak {peak})"
+    );
+    // The glass shows: it changes a large share of the compute-first frame's pixels.
+    let changed = differing(&frame.image, &opaque.image);
+    assert!(
+        changed > (W * H / 10) as usize,
+        "only {changed} pixels show glass over the compute-first frame"
+    );
+    let (err, at) = max_abs_diff(&frame.image, &reference.image);
+    eprintln!("opaque {opaque_err:e}, with glass {err:e}, peak {peak}");
+    assert!(
+        err <= opaque_err + TOL * peak,
+        "error {err:e} (opaque layer alone {opaque_err:e}) at pixel ({}, {}): {:?} vs {:?}",
+        at as u32 % W,
+        at as u32 / W,
+        frame.image[at],
+        reference.image[at]
+    );
+    // The glass was culled into its own lists, on the compute rasterizer's depth.
+    let t = frame
+        .culling
+        .iter()
+        .find(|c| c.pass == "transparent_culling")
+        .expect("a report of the transparent culling pass");
+    let listed: u32 = t.per_tile().iter().sum();
+    assert!(listed > 0, "transparent lists are empty");
+    assert!(
+        (listed as usize) < t.per_tile().len() * scene.lights.len() / 4,
+        "transparent lists hold {listed} lights"
+    );
+}
+
 fn emissive_quad(name: &str, material: usize, z: f32, x0: f32) -> Mesh {
     let mut m = Mesh {
         name: name.into(),
@@ -174,7 +254,12 @@ fn blended_back_to_front_whatever_the_scene_order() {
         ..Default::default()
     };
     let mut r = renderer();
-    for graph in ["transparent_brute_force.ron", "transparent.ron"] {
+    // default.ron: no opaque triangle at all for its compute rasterizer.
+    for graph in [
+        "transparent_brute_force.ron",
+        "transparent.ron",
+        "default.ron",
+    ] {
         let f = render_file(&mut r, graph, &scene, 64, 64);
         // The frame's centre sees both quads (near x in [-1.5, 0.5], far in [-0.5, 1.5]).
         let p = f.image[(32 * 64 + 32) as usize];
@@ -226,6 +311,65 @@ fn without_blended_meshes_the_transparency_passes_are_skipped() {
     assert_eq!(differing(&plain.image, &with.image), 0);
     assert!(
         plain.image.iter().any(|p| p[0] > 0.0),
+        "a dark frame tests nothing"
+    );
+}
+
+/// The default graph (graphs/default.ron) on a scene without blended meshes: its
+/// transparency passes are skipped and what runs is the plain compute-first frame
+/// (graphs/visibility_compute_raster.ron), pass for pass, with the same image bit for bit
+/// (its Depth32Float depth holds the bits the R32Float one holds: the draw resolve and the
+/// compute resolve agree exactly, tests/compute_raster.rs).
+#[test]
+fn without_blended_meshes_the_default_graph_is_the_compute_first_frame() {
+    let scene = random_scene(24, 15);
+    assert!(!scene.features().has_transparent);
+    let size = FrameSize {
+        width: W,
+        height: H,
+        lights: scene.lights.len() as u32,
+    };
+    let compile = |name: &str| {
+        let checked = graph::check_text(
+            Path::new(name),
+            &graph_file(name),
+            &ShaderLibrary::builtin(),
+        )
+        .unwrap();
+        graph::compile(checked, &scene.features(), size)
+    };
+    let default = compile("default.ron");
+    let plain = compile("visibility_compute_raster.ron");
+    let passes = |g: &graph::CompiledGraph| {
+        g.passes
+            .iter()
+            .map(|p| (p.name.to_string(), p.kind.clone()))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(passes(&default), passes(&plain));
+    assert_eq!(default.passes.len(), 3);
+    let mut skipped: Vec<&str> = default
+        .culled
+        .iter()
+        .filter(|c| matches!(&c.reason, CullReason::WhenFalse(f) if f == "Transparent"))
+        .map(|c| c.name.as_str())
+        .collect();
+    skipped.sort();
+    assert_eq!(
+        skipped,
+        [
+            "transparent_culling",
+            "transparent_prepass",
+            "transparent_shading"
+        ]
+    );
+    let mut r = renderer();
+    let a = render_file(&mut r, "visibility_compute_raster.ron", &scene, W, H);
+    let b = render_file(&mut r, "default.ron", &scene, W, H);
+    assert_eq!(a.image.len(), (W * H) as usize);
+    assert_eq!(differing(&a.image, &b.image), 0);
+    assert!(
+        a.image.iter().any(|p| p[0] > 0.0),
         "a dark frame tests nothing"
     );
 }

@@ -167,7 +167,7 @@ fn watch_in_a_copy_reports_the_copys_file_line_then_recovers() {
     });
     assert_eq!(image::image_dimensions(&out).unwrap(), (48, 32));
 
-    // Break the copy's lighting (included by the default graph's forward shader) on line 9.
+    // Break the copy's lighting (included by the default graph's shading) on line 9.
     let shader = work.join("shaders/common/lighting.wgsl");
     let original = std::fs::read_to_string(&shader).unwrap();
     let mut lines: Vec<&str> = original.lines().collect();
@@ -207,7 +207,7 @@ fn renders_the_default_scene_in_an_empty_folder_from_built_in_files() {
     let (ok, printed) = run_to_end(command, Duration::from_secs(300));
     assert!(ok, "render failed:\n{printed}");
     assert!(
-        printed.contains("graph: <built-in>/graphs/forward_plus.ron"),
+        printed.contains("graph: <built-in>/graphs/default.ron"),
         "not the built-in graph:\n{printed}"
     );
     assert_eq!(image::image_dimensions(&out).unwrap(), (40, 24));

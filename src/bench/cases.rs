@@ -101,6 +101,9 @@ impl SceneCase {
             }
             lights.extend(self.lights.iter().flatten().map(LightSpec::to_light));
             s.lights = lights;
+            // Replaced lights do not move as the scene file said (sweeps' `animate`
+            // orbits them instead).
+            s.light_motion.clear();
         }
         for l in &mut s.lights {
             l.range = self.range.unwrap_or(l.range);

@@ -2,6 +2,7 @@
 //! project's one tonemapper, HDR image I/O (EXR, tonemapped PNG), and reports (CSV, Markdown,
 //! PNG plots). Only the sweeps and the hot-reload latency benchmark need a GPU.
 
+pub mod animate;
 pub mod cases;
 pub mod gpu_clock;
 pub mod heatmap;

@@ -64,6 +64,10 @@ pub struct Sweep {
     /// it costs as much as a brute-force frame.
     #[serde(default = "yes")]
     pub light_stats: bool,
+    /// Seconds of light motion between frames: every warm-up and timed frame first moves
+    /// the lights there (`PreparedFrame::update_lights`). See [`crate::bench::animate`].
+    #[serde(default)]
+    pub animate: Option<f64>,
 }
 
 fn yes() -> bool {
@@ -185,6 +189,12 @@ impl Sweep {
                 crate::scene::scene_file::MAX_SCENE_LIGHTS
             )));
         }
+        if let Some(step) = sweep.animate.filter(|s| !(s.is_finite() && *s > 0.0)) {
+            let line = line_of("animate");
+            return Err(error(format!(
+                "{line}animate {step} must be a finite number of seconds > 0"
+            )));
+        }
         if !(0.0..=3600.0).contains(&sweep.warmup_seconds) {
             let line = line_of("warmup_seconds");
             return Err(error(format!(
@@ -253,6 +263,7 @@ pub fn with_light_count(scene: &Scene, count: u32) -> Scene {
         set.range = (r, r);
         set.intensity = (r * r * 0.5, r * r * 2.0);
         s.lights = set.generate(Some((lo, hi)));
+        s.light_motion.clear();
     }
     s
 }
@@ -352,13 +363,28 @@ pub fn run(
                         .map(|g| prepare(g, &point, renderer))
                         .collect::<Result<Vec<_>, _>>()?;
                     let frames: Vec<&PreparedFrame> = prepared.iter().collect();
-                    let times = timing::time_point(&frames, renderer, &sweep.method())?;
+                    let times = match sweep.animate {
+                        None => timing::time_point(&frames, renderer, &sweep.method())?,
+                        Some(step) => super::animate::time_moving(
+                            &frames,
+                            point.scene,
+                            &gpu,
+                            renderer,
+                            &sweep.method(),
+                            step,
+                        )?,
+                    };
                     for ((g, frame), graph_times) in
                         sweep.graphs.iter().zip(&prepared).zip(&times.graphs)
                     {
                         let mut row = BenchRow {
                             scene: scene.name.clone(),
                             technique: g.trim_end_matches(".ron").to_string(),
+                            // Moving-light timings are told apart from still ones.
+                            params: sweep
+                                .animate
+                                .map(|s| format!("animate={s}s"))
+                                .unwrap_or_default(),
                             light_count: size.lights,
                             width,
                             height,

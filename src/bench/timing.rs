@@ -64,12 +64,24 @@ pub fn time_point(
     renderer: &Renderer,
     method: &Method,
 ) -> Result<PointTimes, RenderError> {
+    time_point_with(frames, renderer, method, &mut |_| Ok(()))
+}
+
+/// [`time_point`] calling `before(graph)` ahead of every frame it runs (warm-up and
+/// timed), e.g. to move the lights.
+pub fn time_point_with(
+    frames: &[&PreparedFrame],
+    renderer: &Renderer,
+    method: &Method,
+    before: &mut dyn FnMut(usize) -> Result<(), RenderError>,
+) -> Result<PointTimes, RenderError> {
     let clock_start = gpu_clock::read();
     let started = Instant::now();
     let warmup_time = Duration::from_secs_f64(method.warmup_seconds.clamp(0.0, 3600.0));
     let mut warmed = 0;
     while !frames.is_empty() && (warmed < method.warmup_frames || started.elapsed() < warmup_time) {
-        for f in frames {
+        for (g, f) in frames.iter().enumerate() {
+            before(g)?;
             f.execute(renderer)?;
         }
         warmed += 1;
@@ -82,6 +94,7 @@ pub fn time_point(
             let g = (k + round) % frames.len();
             let mut this_round = Vec::with_capacity(per_round as usize);
             for _ in 0..per_round {
+                before(g)?;
                 if let Some(times) = frames[g].execute(renderer)? {
                     let total = times.iter().map(|t| t.1).sum::<f64>();
                     this_round.push(total);

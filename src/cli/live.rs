@@ -26,7 +26,7 @@ pub fn watch(
         );
     }
     println!("{}", watched_root(&project));
-    let graph = graph.unwrap_or_else(|| project_path("graphs/forward_plus.ron"));
+    let graph = graph.unwrap_or_else(|| project_path("graphs/default.ron"));
     let source = match scene {
         Some(p) => SceneSource::File(p),
         None => SceneSource::Fixed(Box::new(load_scene(None)?)),
@@ -81,7 +81,7 @@ pub fn view(args: ViewArgs) -> Result<()> {
     let (graph, variants) = match args.graph {
         // The project's graphs: the root's own and the built-in ones.
         None => (
-            project_path("graphs/forward_plus.ron"),
+            project_path("graphs/default.ron"),
             project.list("graphs", "ron"),
         ),
         Some(graph) => {

@@ -59,7 +59,7 @@ pub enum Command {
         /// it reads.
         #[arg(long)]
         scene: Option<PathBuf>,
-        /// Graph file (default: graphs/forward_plus.ron of the root, else built in). Watched.
+        /// Graph file (default: graphs/default.ron of the root, else built in). Watched.
         #[arg(long)]
         graph: Option<PathBuf>,
         /// Frame width in pixels.
@@ -189,7 +189,7 @@ pub struct RenderArgs {
     /// Scene: .ron, .gltf or .glb (default: the built-in atrium).
     #[arg(long)]
     pub scene: Option<PathBuf>,
-    /// Graph file (default: graphs/forward_plus.ron).
+    /// Graph file (default: graphs/default.ron).
     #[arg(long)]
     pub graph: Option<PathBuf>,
     /// Frame width in pixels (default: the scene's; on a software adapter, without
@@ -210,6 +210,9 @@ pub struct RenderArgs {
     /// runs its hardware fallback and says so).
     #[arg(long, value_name = "FEATURES")]
     pub disable_features: Option<String>,
+    /// Time in seconds at which moving lights are placed (scene `motion:`; default 0).
+    #[arg(long, value_name = "SECONDS")]
+    pub time: Option<f64>,
 }
 
 #[derive(clap::Args)]
@@ -217,7 +220,7 @@ pub struct ViewArgs {
     /// Scene: .ron, .gltf or .glb (default: the built-in atrium). Watched and reloaded.
     #[arg(long)]
     pub scene: Option<PathBuf>,
-    /// Graph file (default: graphs/forward_plus.ron of the root, else built in); the other
+    /// Graph file (default: graphs/default.ron of the root, else built in); the other
     /// graphs in its folder are offered as variants.
     #[arg(long)]
     pub graph: Option<PathBuf>,
@@ -247,7 +250,8 @@ fn where_files_are(project: &Project) -> String {
         "Where files are found:\n  \
          shaders/, graphs/ and materials/ are read, and watched by `watch` and `view`, in a root\n  \
          folder; a file the root lacks comes from the copy built into this binary (so the\n  \
-         default scene renders from any folder). The root is the first of:\n    \
+         built-in scenes render from any folder; without arguments lightgraph renders the\n  \
+         root's scenes/gallery.ron, else the built-in atrium). The root is the first of:\n    \
          1. --root DIR\n    \
          2. the {env} environment variable\n    \
          3. the current directory, if it has shaders/, graphs/ or materials/\n    \
@@ -289,8 +293,10 @@ pub fn run() -> Result<()> {
     }
     assets::set_project(project);
     match cli.command {
-        // The README's first command: the default scene, sized for the adapter, to a file.
+        // The README's first command: the default scene (the root's gallery, else the
+        // built-in atrium), sized for the adapter, to a file.
         None => render::render(RenderArgs {
+            scene: render::default_scene_path(),
             out: Some(PathBuf::from("lightgraph.png")),
             ..RenderArgs::default()
         }),
@@ -325,8 +331,10 @@ pub fn runtime_dir_fallback() {
     }
     let user = std::env::var("USER").unwrap_or_else(|_| "user".into());
     let dir = std::env::temp_dir().join(format!("lightgraph-runtime-{user}"));
-    use std::os::unix::fs::DirBuilderExt;
-    let made = std::fs::DirBuilder::new().mode(0o700).create(&dir);
+    let mut builder = std::fs::DirBuilder::new();
+    #[cfg(unix)]
+    std::os::unix::fs::DirBuilderExt::mode(&mut builder, 0o700);
+    let made = builder.create(&dir);
     if made.is_ok() || dir.is_dir() {
         std::env::set_var("XDG_RUNTIME_DIR", &dir);
     }

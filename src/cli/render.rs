@@ -9,6 +9,14 @@ use lightgraph::scene::{self, Scene};
 use lightgraph::shader::{assets, ShaderLibrary};
 use std::path::{Path, PathBuf};
 
+/// The scene `lightgraph` renders without arguments: `scenes/gallery.ron` of the project
+/// root (a checkout: glTF models, many coloured lights, glass), if there is one; `None`
+/// (the built-in atrium, which needs no files) for an installed binary run elsewhere.
+pub fn default_scene_path() -> Option<PathBuf> {
+    let root = assets::project().root?;
+    Some(root.join("scenes/gallery.ron")).filter(|p| p.is_file())
+}
+
 pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
     match path {
         None => Ok(scene::builtin::atrium()),
@@ -179,16 +187,20 @@ fn check_outputs(args: &RenderArgs) -> Result<()> {
     if args.width == Some(0) || args.height == Some(0) {
         bail!("--width and --height must be at least 1");
     }
+    if args.time.is_some_and(|t| !t.is_finite()) {
+        bail!("--time must be a finite number of seconds");
+    }
     Ok(())
 }
 
 pub fn render(args: RenderArgs) -> Result<()> {
     check_outputs(&args)?;
-    let scene = load_scene(args.scene.as_deref())?;
+    let mut scene = load_scene(args.scene.as_deref())?;
+    scene.place_lights_at(args.time.unwrap_or(0.0));
     let graph_path = args
         .graph
         .clone()
-        .unwrap_or_else(|| project_path("graphs/forward_plus.ron"));
+        .unwrap_or_else(|| project_path("graphs/default.ron"));
     let options = lightgraph::gpu::ContextOptions {
         disabled_features: match &args.disable_features {
             Some(list) => lightgraph::gpu::ContextOptions::parse_features(list)

@@ -15,6 +15,10 @@ pub enum GpuError {
     Readback(String),
 }
 
+/// Per-pass GPU timestamps, inside and between passes.
+const TIMESTAMPS: wgpu::Features =
+    wgpu::Features::TIMESTAMP_QUERY.union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
+
 /// How to open the device. The default takes every feature the project uses that the
 /// adapter offers.
 #[derive(Clone, Debug, Default)]
@@ -56,7 +60,8 @@ pub struct GpuContext {
     /// the last handle goes and after hot reloads that built pipelines.
     pub pipeline_cache: Option<Arc<DiskPipelineCache>>,
     /// Features the adapter offers that the device was opened without, on request
-    /// ([`ContextOptions::disabled_features`]): passes that fall back say so.
+    /// ([`ContextOptions::disabled_features`]) or by the caller who made the device
+    /// ([`Self::from_device`]): passes that fall back say so.
     pub disabled_features: wgpu::Features,
 }
 
@@ -85,6 +90,63 @@ impl GpuContext {
         ))
     }
 
+    /// A context on the caller's device (see [`crate::render::Renderer::from_device`]):
+    /// the features lightgraph would use that the adapter offers but `device` was opened
+    /// without count as disabled, so the passes that need them fall back and say so.
+    /// The driver's pipeline cache stays off (it belongs to whoever made the device).
+    pub fn from_device(adapter: wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Self {
+        let disabled_features = (adapter.features() & Self::wanted_features()) - device.features();
+        Self {
+            has_timestamps: device.features().contains(TIMESTAMPS),
+            adapter,
+            device,
+            queue,
+            pipeline_cache: None,
+            disabled_features,
+        }
+    }
+
+    /// The features lightgraph takes where the adapter offers them; each has a fallback.
+    pub fn wanted_features() -> wgpu::Features {
+        // MSAA of Rgba32Float targets and sample counts past 4 are the adapter's to
+        // grant (not guaranteed by WebGPU); blending transparent surfaces into them
+        // needs FLOAT32_BLENDABLE. Taken where offered; passes that need them say so.
+        // The visibility buffer's prepass writes triangle ids (PRIMITIVE_INDEX); the
+        // compute rasterizer resolves depth with 64-bit atomic min (SHADER_INT64 and
+        // SHADER_INT64_ATOMIC_MIN_MAX). Where missing, those passes say so.
+        TIMESTAMPS
+            | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
+            | wgpu::Features::FLOAT32_BLENDABLE
+            | wgpu::Features::PRIMITIVE_INDEX
+            | wgpu::Features::SHADER_INT64
+            | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX
+            // Light culling finds a tile's depth range by subgroup reductions where offered.
+            | wgpu::Features::SUBGROUP
+            // Compiled pipelines kept on disk between runs (see `pipeline_cache`).
+            | wgpu::Features::PIPELINE_CACHE
+    }
+
+    /// The limits lightgraph asks of `adapter`: WebGPU's defaults, raised to the
+    /// adapter's own where a pass can use more.
+    pub fn wanted_limits(adapter: &wgpu::Adapter) -> wgpu::Limits {
+        let adapter_limits = adapter.limits();
+        wgpu::Limits {
+            max_storage_buffer_binding_size: adapter_limits.max_storage_buffer_binding_size,
+            max_buffer_size: adapter_limits.max_buffer_size,
+            max_storage_buffers_per_shader_stage: adapter_limits
+                .max_storage_buffers_per_shader_stage
+                .min(16),
+            max_compute_workgroup_storage_size: adapter_limits.max_compute_workgroup_storage_size,
+            // A G-buffer with geometric normals for ray-cast shadows has three Rgba32Float
+            // targets (48 bytes a sample; the default allows 32).
+            max_color_attachment_bytes_per_sample: adapter_limits
+                .max_color_attachment_bytes_per_sample,
+            // Shadow atlases up to 16384² (the default allows 8192).
+            max_texture_dimension_2d: adapter_limits.max_texture_dimension_2d,
+            ..wgpu::Limits::default()
+        }
+    }
+
     async fn open(
         instance: &wgpu::Instance,
         compatible_surface: Option<&wgpu::Surface<'_>>,
@@ -99,43 +161,11 @@ impl GpuContext {
             })
             .await
             .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
-        let timestamps =
-            wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
-        // MSAA of Rgba32Float targets and sample counts past 4 are the adapter's to
-        // grant (not guaranteed by WebGPU); blending transparent surfaces into them
-        // needs FLOAT32_BLENDABLE. Taken where offered; passes that need them say so.
-        // The visibility buffer's prepass writes triangle ids (PRIMITIVE_INDEX); the
-        // compute rasterizer resolves depth with 64-bit atomic min (SHADER_INT64 and
-        // SHADER_INT64_ATOMIC_MIN_MAX). Where missing, those passes say so.
-        let wanted = timestamps
-            | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
-            | wgpu::Features::FLOAT32_BLENDABLE
-            | wgpu::Features::PRIMITIVE_INDEX
-            | wgpu::Features::SHADER_INT64
-            | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX
-            // Light culling finds a tile's depth range by subgroup reductions where offered.
-            | wgpu::Features::SUBGROUP
-            // Compiled pipelines kept on disk between runs (see `pipeline_cache`).
-            | wgpu::Features::PIPELINE_CACHE;
+        let wanted = Self::wanted_features();
         let disabled_features = adapter.features() & wanted & options.disabled_features;
         let features = (adapter.features() & wanted) - disabled_features;
-        let has_timestamps = features.contains(timestamps);
-        let adapter_limits = adapter.limits();
-        let limits = wgpu::Limits {
-            max_storage_buffer_binding_size: adapter_limits.max_storage_buffer_binding_size,
-            max_buffer_size: adapter_limits.max_buffer_size,
-            max_storage_buffers_per_shader_stage: adapter_limits
-                .max_storage_buffers_per_shader_stage
-                .min(16),
-            max_compute_workgroup_storage_size: adapter_limits.max_compute_workgroup_storage_size,
-            // A G-buffer with geometric normals for ray-cast shadows has three Rgba32Float
-            // targets (48 bytes a sample; the default allows 32).
-            max_color_attachment_bytes_per_sample: adapter_limits
-                .max_color_attachment_bytes_per_sample,
-            // Shadow atlases up to 16384² (the default allows 8192).
-            max_texture_dimension_2d: adapter_limits.max_texture_dimension_2d,
-            ..wgpu::Limits::default()
-        };
+        let has_timestamps = features.contains(TIMESTAMPS);
+        let limits = Self::wanted_limits(&adapter);
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("lightgraph"),

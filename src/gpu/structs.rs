@@ -160,38 +160,38 @@ impl GpuLinkParams {
 
 /// Splits lights into the two GPU arrays.
 pub fn light_buffers(lights: &[Light]) -> (Vec<GpuLightGeometry>, Vec<GpuLightProperties>) {
-    lights
-        .iter()
-        .map(|l| {
-            let (direction, cos_outer, cos_inner) = match l.shape {
-                LightShape::Point => (Vec3::ZERO, -1.0, -1.0),
-                LightShape::Spot {
-                    direction,
-                    inner_angle,
-                    outer_angle,
-                } => (
-                    direction.normalize_or_zero(),
-                    outer_angle.cos(),
-                    inner_angle.min(outer_angle).cos(),
-                ),
-            };
-            (
-                GpuLightGeometry {
-                    position: l.position.into(),
-                    range: l.range,
-                    direction: direction.into(),
-                    cos_outer,
-                },
-                GpuLightProperties {
-                    color: (l.color * l.intensity).into(),
-                    cos_inner,
-                    flags: l.flags,
-                    material_mask: l.material_mask,
-                    _pad: [0; 2],
-                },
-            )
-        })
-        .unzip()
+    lights.iter().map(gpu_light).unzip()
+}
+
+/// One light as culling and shading read it (what [`light_buffers`] writes per light).
+pub fn gpu_light(l: &Light) -> (GpuLightGeometry, GpuLightProperties) {
+    let (direction, cos_outer, cos_inner) = match l.shape {
+        LightShape::Point => (Vec3::ZERO, -1.0, -1.0),
+        LightShape::Spot {
+            direction,
+            inner_angle,
+            outer_angle,
+        } => (
+            direction.normalize_or_zero(),
+            outer_angle.cos(),
+            inner_angle.min(outer_angle).cos(),
+        ),
+    };
+    (
+        GpuLightGeometry {
+            position: l.position.into(),
+            range: l.range,
+            direction: direction.into(),
+            cos_outer,
+        },
+        GpuLightProperties {
+            color: (l.color * l.intensity).into(),
+            cos_inner,
+            flags: l.flags,
+            material_mask: l.material_mask,
+            _pad: [0; 2],
+        },
+    )
 }
 
 /// Vertex layout of every mesh: position, normal, uv, tangent.

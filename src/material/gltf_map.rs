@@ -23,15 +23,24 @@ const OCCLUSION: &str = "occlusion";
 
 pub(super) fn map(s: &SurfaceMaterial) -> (MaterialDesc, Vec<TextureSlot>) {
     let mut textures = BTreeMap::new();
-    for (name, img) in [
-        (BASE, &s.base_color_texture),
-        (MR, &s.metallic_roughness_texture),
-        (NORMAL, &s.normal_texture),
-        (EMISSIVE, &s.emissive_texture),
-        (OCCLUSION, &s.occlusion_texture),
+    let sampling = &s.sampling;
+    for (name, img, how) in [
+        (BASE, &s.base_color_texture, sampling.base_color),
+        (
+            MR,
+            &s.metallic_roughness_texture,
+            sampling.metallic_roughness,
+        ),
+        (NORMAL, &s.normal_texture, sampling.normal),
+        (EMISSIVE, &s.emissive_texture, sampling.emissive),
+        (OCCLUSION, &s.occlusion_texture, sampling.occlusion),
     ] {
+        // Unlit: the base colour alone (KHR_materials_unlit ignores every other input).
+        if s.unlit && name != BASE {
+            continue;
+        }
         if let Some(img) = img {
-            textures.insert(name.to_string(), img.clone());
+            textures.insert(name.to_string(), (img.clone(), how));
         }
     }
     let has = |n: &str| textures.contains_key(n);
@@ -44,6 +53,7 @@ pub(super) fn map(s: &SurfaceMaterial) -> (MaterialDesc, Vec<TextureSlot>) {
     } else {
         Color::Rgb(bc.x, bc.y, bc.z)
     };
+    let base_unlit = base.clone();
     let channel = |factor: f32, ch: Channel| {
         if has(MR) {
             Scalar::Expr(ScalarExpr::Tex {
@@ -111,6 +121,13 @@ pub(super) fn map(s: &SurfaceMaterial) -> (MaterialDesc, Vec<TextureSlot>) {
             }),
         }],
     };
+    // Unlit: no lobes, and the base colour emitted, so every shading path that takes
+    // the layered model shows it as is (ambient and lights add nothing).
+    let (emissive, layers) = if s.unlit {
+        (base_unlit, Vec::new())
+    } else {
+        (emissive, vec![spec, diffuse])
+    };
     let desc = MaterialDesc {
         name: s.name.clone(),
         type_bit: s.type_bit,
@@ -118,12 +135,14 @@ pub(super) fn map(s: &SurfaceMaterial) -> (MaterialDesc, Vec<TextureSlot>) {
         double_sided: s.double_sided,
         textures: textures
             .iter()
-            .map(|(k, img)| {
+            .map(|(k, (img, how))| {
                 (
                     k.clone(),
                     TextureDesc {
                         file: img.name.clone(),
                         srgb: img.srgb,
+                        sampler: how.sampler,
+                        transform: how.transform,
                     },
                 )
             })
@@ -139,15 +158,17 @@ pub(super) fn map(s: &SurfaceMaterial) -> (MaterialDesc, Vec<TextureSlot>) {
             channel: Channel::R,
             strength: s.occlusion_strength,
         }),
-        layers: vec![spec, diffuse],
+        layers,
     };
     let slots = textures
         .into_iter()
         .enumerate()
-        .map(|(i, (name, img))| TextureSlot {
+        .map(|(i, (name, (img, how)))| TextureSlot {
             binding: i as u32 + 1,
             name,
             source: TextureSource::Image(img),
+            sampler: how.sampler,
+            transform: how.transform,
         })
         .collect();
     (desc, slots)

@@ -92,12 +92,25 @@ impl TextureSource {
 }
 
 /// One `texture_2d<f32>` of the material's bind group (`@group(2)`; binding 0 is the
-/// filtering sampler `material_sampler`).
+/// first sampler `material_sampler`, further distinct samplers follow the textures), with
+/// how it is sampled.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TextureSlot {
     pub binding: u32,
     pub name: String,
     pub source: TextureSource,
+    pub sampler: model::SamplerDesc,
+    pub transform: Option<model::UvTransform>,
+}
+
+/// The WGSL name of the material's `k`-th distinct sampler: `material_sampler` (binding
+/// 0) for the first, then `material_sampler{k}` at bindings after the textures.
+pub fn sampler_wgsl_name(k: usize) -> String {
+    if k == 0 {
+        "material_sampler".into()
+    } else {
+        format!("material_sampler{k}")
+    }
 }
 
 /// A validated, sanitised material.
@@ -169,10 +182,27 @@ impl Material {
     pub fn type_bit(&self) -> u32 {
         self.desc.type_bit
     }
-    /// Texture slots in binding order (bindings 1..; 0 is the sampler). Empty: the
+    /// Texture slots in binding order (bindings 1..; 0 is the first sampler). Empty: the
     /// generated WGSL declares nothing in `@group(2)`.
     pub fn texture_slots(&self) -> &[TextureSlot] {
         &self.slots
+    }
+    /// The distinct samplers of the texture slots in first-use order, and for each slot
+    /// the index of its sampler (see [`sampler_wgsl_name`]).
+    pub fn samplers(&self) -> (Vec<model::SamplerDesc>, Vec<usize>) {
+        let mut distinct: Vec<model::SamplerDesc> = Vec::new();
+        let of_slot = self
+            .slots
+            .iter()
+            .map(|s| match distinct.iter().position(|d| *d == s.sampler) {
+                Some(k) => k,
+                None => {
+                    distinct.push(s.sampler);
+                    distinct.len() - 1
+                }
+            })
+            .collect();
+        (distinct, of_slot)
     }
     /// Values past physical ranges (allowed, or clamped where they would produce NaN/Inf);
     /// logged once when the material was created.

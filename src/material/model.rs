@@ -45,6 +45,116 @@ pub struct TextureDesc {
     /// sRGB-encoded colour data (base colour, emissive) rather than linear data.
     #[serde(default)]
     pub srgb: bool,
+    /// Wrap and filter modes (a glTF sampler). Default: repeat, trilinear.
+    #[serde(default)]
+    pub sampler: SamplerDesc,
+    /// A transform of the uv before sampling (glTF `KHR_texture_transform`).
+    #[serde(default)]
+    pub transform: Option<UvTransform>,
+}
+
+/// How a texture is sampled: glTF's sampler (wrapS/wrapT, magFilter, minFilter).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SamplerDesc {
+    /// Along u (glTF `wrapS`).
+    #[serde(default)]
+    pub wrap_u: Wrap,
+    /// Along v (glTF `wrapT`).
+    #[serde(default)]
+    pub wrap_v: Wrap,
+    #[serde(default)]
+    pub mag_filter: Filter,
+    #[serde(default)]
+    pub min_filter: Filter,
+    /// Between mip levels; `None` samples level 0 only (glTF minFilter NEAREST or LINEAR).
+    #[serde(default)]
+    pub mipmap_filter: MipmapFilter,
+}
+
+/// What a uv outside [0, 1] reads.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Wrap {
+    /// The texture tiles (glTF REPEAT, the default).
+    #[default]
+    Repeat,
+    /// The edge texel (glTF CLAMP_TO_EDGE).
+    ClampToEdge,
+    /// The texture tiles, every other copy mirrored (glTF MIRRORED_REPEAT).
+    MirroredRepeat,
+}
+
+/// Within one mip level.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Filter {
+    /// The nearest texel.
+    Nearest,
+    /// Bilinear between the four nearest texels.
+    #[default]
+    Linear,
+}
+
+/// Between mip levels.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum MipmapFilter {
+    /// Level 0 only, however small the footprint.
+    None,
+    /// The nearest level.
+    Nearest,
+    /// Blends the two nearest levels (trilinear with linear `min_filter`).
+    #[default]
+    Linear,
+}
+
+/// glTF `KHR_texture_transform`: uv' = T(offset) R(rotation) S(scale) uv.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UvTransform {
+    #[serde(default)]
+    pub offset: (f32, f32),
+    /// Radians, counter-clockwise in uv space (clockwise as the image shows it).
+    #[serde(default)]
+    pub rotation: f32,
+    #[serde(default = "ones2")]
+    pub scale: (f32, f32),
+}
+
+impl Default for UvTransform {
+    fn default() -> Self {
+        UvTransform {
+            offset: (0.0, 0.0),
+            rotation: 0.0,
+            scale: (1.0, 1.0),
+        }
+    }
+}
+
+impl UvTransform {
+    /// The rows of the 2×3 matrix T R S of the glTF extension.
+    pub fn matrix(&self) -> [[f32; 3]; 2] {
+        let (s, c) = self.rotation.sin_cos();
+        let (sx, sy) = self.scale;
+        [
+            [c * sx, s * sy, self.offset.0],
+            [-s * sx, c * sy, self.offset.1],
+        ]
+    }
+
+    /// The transformed uv.
+    pub fn apply(&self, uv: [f32; 2]) -> [f32; 2] {
+        let m = self.matrix();
+        [
+            m[0][0] * uv[0] + m[0][1] * uv[1] + m[0][2],
+            m[1][0] * uv[0] + m[1][1] * uv[1] + m[1][2],
+        ]
+    }
+}
+
+/// How one texture slot of a glTF material is sampled (its sampler and transform).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TextureSampling {
+    pub sampler: SamplerDesc,
+    pub transform: Option<UvTransform>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -263,6 +373,9 @@ fn one_u32() -> u32 {
 }
 fn one_f32() -> f32 {
     1.0
+}
+fn ones2() -> (f32, f32) {
+    (1.0, 1.0)
 }
 fn ones3() -> (f32, f32, f32) {
     (1.0, 1.0, 1.0)

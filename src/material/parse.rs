@@ -259,6 +259,8 @@ pub fn file_slots(
                 path: resolved,
                 srgb: tex.srgb,
             },
+            sampler: tex.sampler,
+            transform: tex.transform,
         });
     }
     Ok(slots)

@@ -138,13 +138,29 @@ pub fn generate(m: &Material, opts: &WgslOptions) -> String {
         o.push_str(LOBE_LIBRARY);
     }
     o.push_str("\n// ---- material ----\n\n");
+    let (samplers, sampler_of) = m.samplers();
     if !slots.is_empty() {
-        o.push_str("@group(2) @binding(0) var material_sampler: sampler;\n");
+        // The first sampler at binding 0, the textures after it, further samplers after
+        // them: a material of one sampler keeps the layout it always had.
+        let _ = writeln!(
+            o,
+            "@group(2) @binding(0) var {}: sampler;",
+            super::sampler_wgsl_name(0)
+        );
         for (i, s) in slots.iter().enumerate() {
             let _ = writeln!(
                 o,
                 "@group(2) @binding({}) var material_tex{i}: texture_2d<f32>; // {}",
                 s.binding, s.name
+            );
+        }
+        let after = slots.iter().map(|s| s.binding).max().unwrap_or(0);
+        for (k, d) in samplers.iter().enumerate().skip(1) {
+            let _ = writeln!(
+                o,
+                "@group(2) @binding({}) var {}: sampler; // {d:?}",
+                after as usize + k,
+                super::sampler_wgsl_name(k)
             );
         }
         if opts.sample_grad {
@@ -186,13 +202,40 @@ pub fn generate(m: &Material, opts: &WgslOptions) -> String {
     o.push_str(
         "fn material_setup(p: ShadingPoint) -> MaterialSample {\n    var m: MaterialSample;\n",
     );
-    for (i, _) in slots.iter().enumerate() {
+    for (i, slot) in slots.iter().enumerate() {
+        let smp = super::sampler_wgsl_name(sampler_of[i]);
+        // KHR_texture_transform: uv' = M (uv, 1); the derivatives take M's linear part.
+        let (uv, ddx, ddy) = match &slot.transform {
+            Some(t) => {
+                let [r0, r1] = t.matrix().map(|r| r.map(lit));
+                let _ = writeln!(
+                    o,
+                    "    let uv{i} = vec2<f32>({} * p.uv.x + {} * p.uv.y + {}, {} * p.uv.x + {} * p.uv.y + {});",
+                    r0[0], r0[1], r0[2], r1[0], r1[1], r1[2]
+                );
+                if opts.sample_grad {
+                    for d in ["ddx", "ddy"] {
+                        let _ = writeln!(
+                            o,
+                            "    let {d}{i} = vec2<f32>({} * material_uv_{d}.x + {} * material_uv_{d}.y, {} * material_uv_{d}.x + {} * material_uv_{d}.y);",
+                            r0[0], r0[1], r1[0], r1[1]
+                        );
+                    }
+                }
+                (format!("uv{i}"), format!("ddx{i}"), format!("ddy{i}"))
+            }
+            None => (
+                "p.uv".to_string(),
+                "material_uv_ddx".to_string(),
+                "material_uv_ddy".to_string(),
+            ),
+        };
         let sample = if opts.sample_grad {
-            format!("textureSampleGrad(material_tex{i}, material_sampler, p.uv, material_uv_ddx, material_uv_ddy)")
+            format!("textureSampleGrad(material_tex{i}, {smp}, {uv}, {ddx}, {ddy})")
         } else if opts.sample_level_zero {
-            format!("textureSampleLevel(material_tex{i}, material_sampler, p.uv, 0.0)")
+            format!("textureSampleLevel(material_tex{i}, {smp}, {uv}, 0.0)")
         } else {
-            format!("textureSample(material_tex{i}, material_sampler, p.uv)")
+            format!("textureSample(material_tex{i}, {smp}, {uv})")
         };
         let _ = writeln!(o, "    let tx{i} = {sample};");
     }

@@ -118,6 +118,9 @@ pub struct ReloadSession {
     pub frame: Option<FrameResult>,
     /// The current error, if the last reload failed.
     pub error: Option<String>,
+    /// The undrawn-content warnings already logged: a resize or a reload that recompiles
+    /// the graph does not repeat them.
+    reported: std::cell::RefCell<graph::coverage::Reported>,
 }
 
 /// [`normalize_path`], except for built-in files' names (`<built-in>/...`).
@@ -231,6 +234,7 @@ impl ReloadSession {
             read_back: true,
             frame: None,
             error: None,
+            reported: Default::default(),
         };
         session.watch_dependency(GRAPH, vec![session.graph_path.clone()])?;
         if !scene_files.is_empty() {
@@ -261,6 +265,11 @@ impl ReloadSession {
     /// The scene the live frame shows.
     pub fn scene(&self) -> &Scene {
         &self.scene
+    }
+
+    /// The live frame's scene upload (what `PreparedFrame::update_lights` writes).
+    pub fn gpu(&self) -> &SceneGpu {
+        &self.gpu
     }
 
     /// The graph file the session renders (normalised).
@@ -461,7 +470,11 @@ impl ReloadSession {
             .map_err(|e| e.to_string())?;
         let features = scene.features();
         let compiled = graph::compile(checked, &features, self.frame_size(scene));
-        for w in graph::coverage::undrawn(&compiled, &features) {
+        for w in self
+            .reported
+            .borrow_mut()
+            .new_warnings(&compiled, &features)
+        {
             log::warn!("{w}");
         }
         Ok(compiled)

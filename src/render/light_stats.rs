@@ -42,7 +42,7 @@ impl LightStatsPass {
         super::device_limits::check_light_loop(
             &r.ctx.adapter.get_info(),
             PASS,
-            gpu.light_count as u64,
+            gpu.light_capacity as u64,
             "its exact count walks every light",
         )?;
         let after = graph

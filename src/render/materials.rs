@@ -3,6 +3,7 @@
 //! bind group 2, and what the pipelines need to know.
 
 use super::bind::{BindingSet, Bound};
+use crate::material::model::{Filter, MipmapFilter, SamplerDesc, Wrap};
 use crate::material::{Material, MaterialError, TextureSource};
 use crate::scene::{AlphaMode, Scene, SurfaceMaterial};
 use std::path::PathBuf;
@@ -54,19 +55,16 @@ impl MaterialProgram {
             None
         } else {
             let mut set = BindingSet::default();
-            set.offer(
-                "material_sampler",
-                Bound::Sampler(device.create_sampler(&wgpu::SamplerDescriptor {
-                    label: Some("material_sampler"),
-                    address_mode_u: wgpu::AddressMode::Repeat,
-                    address_mode_v: wgpu::AddressMode::Repeat,
-                    mag_filter: wgpu::FilterMode::Linear,
-                    min_filter: wgpu::FilterMode::Linear,
-                    // Trilinear: textures carry full mip chains (texture_mips.rs).
-                    mipmap_filter: wgpu::MipmapFilterMode::Linear,
-                    ..Default::default()
-                })),
-            );
+            // One sampler per distinct sampler of the slots (glTF samplers), by the names
+            // the generated WGSL declares.
+            let (samplers, _) = material.samplers();
+            for (k, desc) in samplers.iter().enumerate() {
+                let name = crate::material::sampler_wgsl_name(k);
+                set.offer(
+                    &name,
+                    Bound::Sampler(device.create_sampler(&sampler_descriptor(&name, desc))),
+                );
+            }
             for (i, slot) in slots.iter().enumerate() {
                 let image = slot.source.load()?;
                 let max = device.limits().max_texture_dimension_2d;
@@ -195,6 +193,37 @@ impl MaterialProgram {
             surface.double_sided,
         )?;
         Ok((program, files))
+    }
+}
+
+/// The wgpu sampler of a material sampler. Textures carry full mip chains
+/// (texture_mips.rs); `MipmapFilter::None` clamps the level of detail to 0.25 with the
+/// nearest level: level 0 only, while min_filter still applies where minified (a clamp
+/// of 0 would make every sample magnified, as the Vulkan spec notes).
+fn sampler_descriptor<'a>(label: &'a str, d: &SamplerDesc) -> wgpu::SamplerDescriptor<'a> {
+    let wrap = |w: Wrap| match w {
+        Wrap::Repeat => wgpu::AddressMode::Repeat,
+        Wrap::ClampToEdge => wgpu::AddressMode::ClampToEdge,
+        Wrap::MirroredRepeat => wgpu::AddressMode::MirrorRepeat,
+    };
+    let filter = |f: Filter| match f {
+        Filter::Nearest => wgpu::FilterMode::Nearest,
+        Filter::Linear => wgpu::FilterMode::Linear,
+    };
+    let (mipmap_filter, lod_max_clamp) = match d.mipmap_filter {
+        MipmapFilter::None => (wgpu::MipmapFilterMode::Nearest, 0.25),
+        MipmapFilter::Nearest => (wgpu::MipmapFilterMode::Nearest, 32.0),
+        MipmapFilter::Linear => (wgpu::MipmapFilterMode::Linear, 32.0),
+    };
+    wgpu::SamplerDescriptor {
+        label: Some(label),
+        address_mode_u: wrap(d.wrap_u),
+        address_mode_v: wrap(d.wrap_v),
+        mag_filter: filter(d.mag_filter),
+        min_filter: filter(d.min_filter),
+        mipmap_filter,
+        lod_max_clamp,
+        ..Default::default()
     }
 }
 

@@ -10,6 +10,7 @@ pub mod materials;
 mod passes;
 mod pipelines;
 mod prepare_stats;
+mod present;
 mod report;
 mod resources;
 mod scene_gpu;
@@ -19,12 +20,13 @@ pub mod visibility_geometry;
 
 pub use bind::LayoutCache;
 pub use device_limits::supported_sample_counts;
-pub use frame::{PreparedFrame, RenderTimings};
+pub use frame::{LightUpdateError, PreparedFrame, RenderTimings};
 pub use materials::MaterialProgram;
 pub use pipelines::{
     CacheCounters, GpuStateAtBuild, Pipeline, PipelineBuild, PipelineCache, PipelineKey,
 };
 pub use prepare_stats::PrepareStats;
+pub use present::Presenter;
 pub use report::FallbackReport;
 pub use report::{
     AtlasReport, CullingReport, FrameResult, LightStats, LinkReport, PassReport, RasterReport,
@@ -58,6 +60,11 @@ pub enum RenderError {
     Wgpu(String),
     #[error(transparent)]
     Material(#[from] crate::material::MaterialError),
+    /// The scene upload has room for more lights than the graph's plan was sized for.
+    #[error("the graph was compiled for {compiled} lights but the scene upload has room for {capacity}: compile it with FrameSize::lights = {capacity}")]
+    LightCapacity { compiled: u32, capacity: u32 },
+    #[error(transparent)]
+    LightUpdate(#[from] LightUpdateError),
 }
 
 /// A device, the shader library and the pipeline cache.
@@ -77,6 +84,20 @@ impl Renderer {
             shaders,
             layouts: Default::default(),
         }
+    }
+
+    /// A renderer on the caller's device and queue (an engine embedding lightgraph), with
+    /// the built-in shaders. `adapter` is the one `device` was requested from. Features
+    /// the device was opened without are fallbacks, not errors: a pass that has another
+    /// way to run says so in every frame's report ([`FallbackReport`]), one that has none
+    /// (blending glass needs `FLOAT32_BLENDABLE`) is refused at prepare with its name.
+    /// Request [`GpuContext::wanted_features`] and [`GpuContext::wanted_limits`] to get
+    /// the fast paths.
+    pub fn from_device(adapter: wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Self {
+        Self::new(
+            GpuContext::from_device(adapter, device, queue),
+            ShaderLibrary::builtin(),
+        )
     }
 
     /// Opens the first adapter and uses the project's shaders/.

@@ -3,9 +3,16 @@
 
 use super::materials::MaterialProgram;
 use super::visibility_geometry::VisibilityGeometry;
-use crate::gpu::structs::{light_buffers, GpuVertex};
-use crate::scene::{AlphaMode, Scene};
+use crate::gpu::structs::{
+    gpu_light, light_buffers, GpuLightGeometry, GpuLightProperties, GpuVertex,
+};
+use crate::scene::{AlphaMode, Light, Scene};
 use wgpu::util::DeviceExt;
+
+/// Bytes of one light in either light buffer.
+const LIGHT_BYTES: usize = 32;
+const _: () = assert!(std::mem::size_of::<GpuLightGeometry>() == LIGHT_BYTES);
+const _: () = assert!(std::mem::size_of::<GpuLightProperties>() == LIGHT_BYTES);
 
 #[derive(Clone)]
 pub struct GpuMesh {
@@ -34,7 +41,12 @@ pub struct SceneGpu {
     pub materials: Vec<MaterialProgram>,
     pub light_geometry: wgpu::Buffer,
     pub light_properties: wgpu::Buffer,
+    /// Lights at upload. After [`SceneGpu::write_lights`] a prepared frame's count is the
+    /// one passes read (`PreparedFrame::update_lights`).
     pub light_count: u32,
+    /// Lights the two light buffers hold room for (at least `light_count`): the most a
+    /// light update may write.
+    pub light_capacity: u32,
     /// The shadow BVH, built the first time a pass binds it (see [`SceneGpu::bvh`]);
     /// shared by clones of this upload.
     bvh: std::sync::Arc<std::sync::OnceLock<Result<GpuBvh, String>>>,
@@ -96,8 +108,56 @@ impl SceneGpu {
         queue: &wgpu::Queue,
         scene: &Scene,
     ) -> Result<Self, crate::material::MaterialError> {
+        Self::upload_with_light_capacity(device, queue, scene, 0)
+    }
+
+    /// Like [`upload`](Self::upload) with light buffers holding room for `capacity` lights
+    /// (or the scene's, if more), so that [`write_lights`](Self::write_lights) may later
+    /// write up to that many. Compile the graph with `FrameSize::lights` = the capacity.
+    pub fn upload_with_light_capacity(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        capacity: u32,
+    ) -> Result<Self, crate::material::MaterialError> {
         let materials = MaterialProgram::for_scene(device, queue, scene)?;
-        Ok(Self::upload_with(device, scene, materials))
+        Ok(Self::upload_with_capacity(
+            device, scene, materials, capacity,
+        ))
+    }
+
+    /// Writes `lights` over the light buffers: one queue write per buffer, no allocation.
+    /// The frames that render them need their count and light-dependent state updated too:
+    /// call `PreparedFrame::update_lights`, which calls this.
+    pub fn write_lights(
+        &self,
+        queue: &wgpu::Queue,
+        lights: &[Light],
+    ) -> Result<(), super::LightUpdateError> {
+        if lights.len() > self.light_capacity as usize {
+            return Err(super::LightUpdateError::OverCapacity {
+                count: lights.len(),
+                capacity: self.light_capacity,
+            });
+        }
+        for (index, l) in lights.iter().enumerate() {
+            crate::scene::lights::check_light(l)
+                .map_err(|problem| super::LightUpdateError::BadLight { index, problem })?;
+        }
+        let Some(bytes) = std::num::NonZeroU64::new(lights.len() as u64 * LIGHT_BYTES as u64)
+        else {
+            return Ok(());
+        };
+        // The staging views are write-only: each light goes in as its 32 bytes.
+        if let Some(mut g) = queue.write_buffer_with(&self.light_geometry, 0, bytes) {
+            let (slots, _) = g.slice(..).into_chunks::<LIGHT_BYTES>();
+            slots.write_iter(lights.iter().map(|l| bytemuck::cast(gpu_light(l).0)));
+        }
+        if let Some(mut p) = queue.write_buffer_with(&self.light_properties, 0, bytes) {
+            let (slots, _) = p.slice(..).into_chunks::<LIGHT_BYTES>();
+            slots.write_iter(lights.iter().map(|l| bytemuck::cast(gpu_light(l).1)));
+        }
+        Ok(())
     }
 
     /// The scene's BVH buffers, or why there are none: built on first use, so graphs
@@ -141,6 +201,17 @@ impl SceneGpu {
         scene: &Scene,
         materials: Vec<MaterialProgram>,
     ) -> Self {
+        Self::upload_with_capacity(device, scene, materials, 0)
+    }
+
+    /// [`upload_with`](Self::upload_with) with room for `capacity` lights (at least the
+    /// scene's).
+    pub fn upload_with_capacity(
+        device: &wgpu::Device,
+        scene: &Scene,
+        materials: Vec<MaterialProgram>,
+        capacity: u32,
+    ) -> Self {
         let meshes: Vec<GpuMesh> = scene
             .meshes
             .iter()
@@ -183,7 +254,12 @@ impl SceneGpu {
                 }
             })
             .collect();
-        let (geometry, properties) = light_buffers(&scene.lights);
+        let (mut geometry, mut properties) = light_buffers(&scene.lights);
+        let light_capacity = capacity.max(scene.lights.len() as u32);
+        // Room for the lights an update may add: zeroed entries past the count are never
+        // read (every pass loops to the frame's light count).
+        geometry.resize(light_capacity as usize, bytemuck::Zeroable::zeroed());
+        properties.resize(light_capacity as usize, bytemuck::Zeroable::zeroed());
         // A scene without lights binds one unused entry.
         let storage = |label: &str, bytes: &[u8]| {
             storage_buffer(device, label, bytes, wgpu::BufferUsages::COPY_DST)
@@ -194,6 +270,7 @@ impl SceneGpu {
             light_geometry: storage("light geometry", bytemuck::cast_slice(&geometry)),
             light_properties: storage("light properties", bytemuck::cast_slice(&properties)),
             light_count: scene.lights.len() as u32,
+            light_capacity,
             // A new upload (hot reload of geometry) builds its own when first bound.
             bvh: Default::default(),
             visibility: Default::default(),

@@ -188,6 +188,7 @@ pub fn atrium() -> Scene {
         casts_shadow: false,
         indirect: false,
         material_mask: u32::MAX,
+        motion: None,
     }
     .generate(None);
 
@@ -260,6 +261,7 @@ pub fn harada() -> Scene {
         casts_shadow: false,
         indirect: false,
         material_mask: u32::MAX,
+        motion: None,
     }
     .generate(None);
     Scene {
@@ -327,6 +329,7 @@ pub fn depth_discontinuity() -> Scene {
         casts_shadow: false,
         indirect: false,
         material_mask: u32::MAX,
+        motion: None,
     }
     .generate(None);
     Scene {

@@ -165,6 +165,7 @@ pub fn chairs() -> Scene {
         casts_shadow: true,
         indirect: false,
         material_mask: u32::MAX,
+        motion: None,
     }
     .generate(None);
 

@@ -131,6 +131,7 @@ pub fn glass_scene() -> Scene {
         casts_shadow: false,
         indirect: false,
         material_mask: u32::MAX,
+        motion: None,
     }
     .generate(None);
     Scene {

@@ -59,6 +59,12 @@ pub struct MaterialDesc {
     pub normal_texture: Option<usize>,
     pub emissive_texture: Option<usize>,
     pub occlusion_texture: Option<usize>,
+    /// Members of the material's `extensions` object, as JSON text
+    /// (`"KHR_materials_unlit":{}`).
+    pub extensions: Option<String>,
+    /// A `KHR_texture_transform` object (JSON text) per textureInfo key
+    /// (`"baseColorTexture"`, `"normalTexture"`, ...).
+    pub texture_transforms: Vec<(&'static str, String)>,
 }
 
 impl Default for MaterialDesc {
@@ -77,6 +83,8 @@ impl Default for MaterialDesc {
             normal_texture: None,
             emissive_texture: None,
             occlusion_texture: None,
+            extensions: None,
+            texture_transforms: Vec::new(),
         }
     }
 }
@@ -103,6 +111,7 @@ pub struct GltfWriter {
     meshes: Vec<String>,
     materials: Vec<String>,
     textures: Vec<String>,
+    samplers: Vec<String>,
     images: Vec<(String, ImageStorage, Vec<u8>)>,
     nodes: Vec<String>,
     cameras: Vec<String>,
@@ -266,17 +275,26 @@ impl GltfWriter {
     }
 
     pub fn add_material(&mut self, m: &MaterialDesc) -> usize {
-        let tex = |i: Option<usize>| i.map(|i| format!("{{\"index\":{i}}}"));
+        let tex = |key: &str, i: Option<usize>| {
+            i.map(
+                |i| match m.texture_transforms.iter().find(|(k, _)| *k == key) {
+                    Some((_, t)) => format!(
+                        "{{\"index\":{i},\"extensions\":{{\"KHR_texture_transform\":{t}}}}}"
+                    ),
+                    None => format!("{{\"index\":{i}}}"),
+                },
+            )
+        };
         let mut pbr = format!(
             "\"baseColorFactor\":{},\"metallicFactor\":{:?},\"roughnessFactor\":{:?}",
             arr(&m.base_color.to_array()),
             m.metallic,
             m.roughness
         );
-        if let Some(t) = tex(m.base_color_texture) {
+        if let Some(t) = tex("baseColorTexture", m.base_color_texture) {
             let _ = write!(pbr, ",\"baseColorTexture\":{t}");
         }
-        if let Some(t) = tex(m.metallic_roughness_texture) {
+        if let Some(t) = tex("metallicRoughnessTexture", m.metallic_roughness_texture) {
             let _ = write!(pbr, ",\"metallicRoughnessTexture\":{t}");
         }
         let mut s = format!(
@@ -294,9 +312,12 @@ impl GltfWriter {
             ("emissiveTexture", m.emissive_texture),
             ("occlusionTexture", m.occlusion_texture),
         ] {
-            if let Some(t) = tex(t) {
+            if let Some(t) = tex(k, t) {
                 let _ = write!(s, ",\"{k}\":{t}");
             }
+        }
+        if let Some(e) = &m.extensions {
+            let _ = write!(s, ",\"extensions\":{{{e}}}");
         }
         s.push('}');
         self.materials.push(s);
@@ -334,6 +355,19 @@ impl GltfWriter {
         self.textures
             .push(format!("{{\"source\":{}}}", self.images.len() - 1));
         self.textures.len() - 1
+    }
+
+    /// Adds a sampler from its JSON text (`{"wrapS":33071}`); returns its index.
+    pub fn add_sampler(&mut self, json: &str) -> usize {
+        self.samplers.push(json.to_string());
+        self.samplers.len() - 1
+    }
+
+    /// Makes `texture` sample through `sampler` (from [`GltfWriter::add_sampler`]).
+    pub fn set_texture_sampler(&mut self, texture: usize, sampler: usize) {
+        let t = &mut self.textures[texture];
+        t.pop();
+        let _ = write!(t, ",\"sampler\":{sampler}}}");
     }
 
     /// Adds an RGBA8 image encoded as PNG; returns the texture index.
@@ -454,6 +488,7 @@ impl GltfWriter {
             ("meshes", &self.meshes),
             ("materials", &self.materials),
             ("textures", &self.textures),
+            ("samplers", &self.samplers),
             ("accessors", &self.accessors),
             ("bufferViews", &self.views),
             ("cameras", &self.cameras),

@@ -112,6 +112,9 @@ pub struct RandomLights {
     pub indirect: bool,
     #[serde(default = "all_bits")]
     pub material_mask: u32,
+    /// How every light of the set moves (each from its own position).
+    #[serde(default)]
+    pub motion: Option<super::motion::Motion>,
 }
 
 fn all_bits() -> u32 {
@@ -133,6 +136,7 @@ impl RandomLights {
             casts_shadow: false,
             indirect: false,
             material_mask: u32::MAX,
+            motion: None,
         }
     }
 
@@ -253,6 +257,9 @@ pub struct AmdLights {
     pub shadow_casters: u32,
     #[serde(default = "amd_seed")]
     pub seed: u64,
+    /// How every light of the set moves (each from its own position).
+    #[serde(default)]
+    pub motion: Option<super::motion::Motion>,
 }
 
 fn amd_count() -> u32 {
@@ -276,6 +283,7 @@ impl Default for AmdLights {
             spot_count: 2048,
             shadow_casters: 0,
             seed: AMD_SEED,
+            motion: None,
         }
     }
 }

@@ -13,8 +13,10 @@ pub mod gltf_writer;
 pub mod lights;
 mod locate;
 mod model_budget;
+pub mod motion;
 pub mod ranges;
 pub mod scene_file;
+pub mod tangent_space;
 mod types;
 pub mod vpl;
 

@@ -192,6 +192,9 @@ pub struct LightSpec {
     pub vpl: Option<super::VplControls>,
     #[serde(default = "all")]
     pub material_mask: u32,
+    /// How the light moves and flickers over time.
+    #[serde(default)]
+    pub motion: Option<super::motion::Motion>,
 }
 
 fn all() -> u32 {
@@ -301,6 +304,28 @@ fn transform_scene(scene: &mut Scene, m: Mat4) {
     c.eye = m.transform_point3(c.eye);
     c.target = m.transform_point3(c.target);
     c.up = (m3 * c.up).normalize_or(Vec3::Y);
+}
+
+/// Records `motion` for the `count` lights about to be appended to `scene`.
+fn add_motion(
+    scene: &mut Scene,
+    motion: Option<&super::motion::Motion>,
+    count: u32,
+    file: &Path,
+    element: &str,
+) -> Result<(), SceneError> {
+    let Some(motion) = motion else {
+        return Ok(());
+    };
+    motion
+        .check()
+        .map_err(|m| SceneError::invalid(file, element, format!("motion: {m}")))?;
+    scene.light_motion.push(super::motion::LightMotion {
+        first: scene.lights.len() as u32,
+        count,
+        motion: motion.clone(),
+    });
+    Ok(())
 }
 
 /// Builds a scene from a parsed scene file; `file` is the RON file (relative paths resolve
@@ -429,6 +454,7 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
                 .map_err(|m| SceneError::invalid(file, &element, m))?;
             scene.vpl_controls.insert(scene.lights.len() as u32, *vpl);
         }
+        add_motion(&mut scene, l.motion.as_ref(), 1, file, &element)?;
         scene.lights.push(light);
     }
 
@@ -452,6 +478,11 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
             });
         }
         let bounds = scene.bounds();
+        let motion = match set {
+            LightSetSpec::Random(r) => r.motion.as_ref(),
+            LightSetSpec::Amd(a) => a.motion.as_ref(),
+        };
+        add_motion(&mut scene, motion, count as u32, file, &element)?;
         match set {
             LightSetSpec::Random(r) => {
                 r.check()

@@ -1,3 +1,4 @@
+use crate::material::model::TextureSampling;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use serde::{Deserialize, Serialize};
 
@@ -58,6 +59,20 @@ pub struct SurfaceMaterial {
     pub emissive_texture: Option<std::sync::Arc<TextureImage>>,
     pub occlusion_texture: Option<std::sync::Arc<TextureImage>>,
     pub occlusion_strength: f32,
+    /// glTF `KHR_materials_unlit`: the base colour (× texture) shows as is, unlit.
+    pub unlit: bool,
+    /// Each texture slot's sampler and uv transform.
+    pub sampling: SlotSampling,
+}
+
+/// The sampler and uv transform of each texture slot of a [`SurfaceMaterial`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SlotSampling {
+    pub base_color: TextureSampling,
+    pub metallic_roughness: TextureSampling,
+    pub normal: TextureSampling,
+    pub emissive: TextureSampling,
+    pub occlusion: TextureSampling,
 }
 
 impl Default for SurfaceMaterial {
@@ -78,6 +93,8 @@ impl Default for SurfaceMaterial {
             emissive_texture: None,
             occlusion_texture: None,
             occlusion_strength: 1.0,
+            unlit: false,
+            sampling: SlotSampling::default(),
         }
     }
 }
@@ -255,6 +272,9 @@ pub struct Scene {
     /// Art controls of indirect lights, by light index (lights marked indirect without
     /// an entry use [`super::VplControls::default`]).
     pub vpl_controls: std::collections::BTreeMap<u32, super::VplControls>,
+    /// How lights move over time (scene files: `motion:` on a light or a light set);
+    /// `lights` holds them as placed, before any motion.
+    pub light_motion: Vec<super::motion::LightMotion>,
 }
 
 impl Scene {
@@ -295,6 +315,28 @@ impl Scene {
             has_double_sided: uses(&|m| m.double_sided),
             has_emissive: uses(&|m| m.emissive != Vec3::ZERO || m.emissive_texture.is_some()),
             has_material_masks: self.lights.iter().any(|l| l.material_mask != u32::MAX),
+        }
+    }
+
+    /// Whether any light moves or flickers.
+    pub fn has_motion(&self) -> bool {
+        !self.light_motion.is_empty()
+    }
+
+    /// The lights at `t` seconds into `out` (cleared first; no allocation once it has
+    /// room): a pure function of the scene and `t`.
+    pub fn lights_at(&self, t: f64, out: &mut Vec<Light>) {
+        super::motion::animate_into(&self.lights, &self.light_motion, t, out);
+    }
+
+    /// Moves the lights to where they are at `t` seconds, for good: the motion is dropped
+    /// (a still frame of a moving scene).
+    pub fn place_lights_at(&mut self, t: f64) {
+        if self.has_motion() {
+            let mut lights = Vec::with_capacity(self.lights.len());
+            self.lights_at(t, &mut lights);
+            self.lights = lights;
+            self.light_motion.clear();
         }
     }
 

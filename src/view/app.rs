@@ -2,12 +2,12 @@
 
 use super::camera::{CameraController, CameraMode, Movement};
 use super::overlay::{FrameInfo, Overlay, OverlayAction};
-use super::present::Presenter;
 use super::{ViewError, ViewOptions};
 use crate::bench::image_io::write_png_rgb8;
 use crate::gpu::readback::read_texture;
 use crate::gpu::GpuContext;
 use crate::reload::ReloadSession;
+use crate::render::Presenter;
 use crate::render::Renderer;
 use crate::shader::ShaderLibrary;
 use std::collections::HashSet;
@@ -114,6 +114,7 @@ struct Viewer {
     screenshot: Option<(std::path::PathBuf, u32)>,
     frames: u32,
     last_frame: Instant,
+    light_clock: super::animation::LightClock,
 }
 
 /// Weight of the newest sample in the overlay's running averages (about 20 frames).
@@ -214,6 +215,7 @@ impl Viewer {
             screenshot: options.screenshot,
             frames: 0,
             last_frame: Instant::now(),
+            light_clock: Default::default(),
         })
     }
 
@@ -283,6 +285,7 @@ impl Viewer {
                 self.set_camera_mode(mode);
             }
             KeyCode::F1 => self.overlay.visible = !self.overlay.visible,
+            KeyCode::Space => self.light_clock.paused = !self.light_clock.paused,
             _ => {}
         }
         None
@@ -308,6 +311,12 @@ impl Viewer {
 
         self.reload_if_changed();
         self.follow_window_size();
+        if let Err(e) = self.light_clock.advance(&self.session, dt as f64) {
+            // Said once: the lights stay where they are until Space is pressed again.
+            eprintln!("moving lights stopped: {e}");
+            self.info.error = Some(e);
+            self.light_clock.paused = true;
+        }
         let pass_ms = self.render_graph();
         if let Some(ms) = pass_ms {
             smooth_pass_times(&mut self.info.pass_ms, ms);
@@ -388,12 +397,7 @@ impl Viewer {
         let session = &self.session;
         let prepared = session.prepared()?;
         let scene = session.scene();
-        prepared.set_view(
-            &session.renderer,
-            &camera,
-            scene.ambient,
-            scene.lights.len() as u32,
-        );
+        prepared.set_view(&session.renderer, &camera, scene.ambient);
         let result = prepared.execute(&session.renderer);
         if self.frames.is_multiple_of(REPORT_EVERY) {
             if let Ok((culling, stats)) = prepared.read_reports(&session.renderer) {

@@ -3,10 +3,10 @@
 //! overlay shows per-pass GPU times, light statistics and the current reload error.
 //! Edits to shaders, materials, the graph or the scene show in the next frame.
 
+mod animation;
 mod app;
 pub mod camera;
 pub mod overlay;
-pub mod present;
 
 pub use app::run;
 pub use camera::{CameraController, CameraMode, Movement};

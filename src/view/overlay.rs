@@ -92,7 +92,7 @@ impl Overlay {
                     .default_open(true)
                     .show(ui, |ui| self.controls(ui, &mut actions));
                 ui.small(
-                    "drag: rotate · wheel: zoom/speed · WASD QE: move · Tab: mode · F1: overlay",
+                    "drag: rotate · wheel: zoom/speed · WASD QE: move · Tab: mode · Space: pause lights · F1: overlay",
                 );
             });
         actions

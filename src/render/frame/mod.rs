@@ -3,8 +3,11 @@
 //! The loops live here: prepare every pass, record every pass between timestamps, read
 //! back. What each pass does lives in `passes/<kind>.rs`.
 
+mod light_update;
 mod parallel_builds;
 mod readback;
+
+pub use light_update::LightUpdateError;
 
 use parallel_builds::prebuild_in_parallel;
 
@@ -85,6 +88,13 @@ pub struct PreparedFrame {
     queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
     stats: Option<LightStatsPass>,
     prepare_stats: PrepareStats,
+    /// The light count every pass reads (the frame uniform's): the upload's, then what
+    /// the last [`update_lights`](Self::update_lights) wrote.
+    light_count: std::sync::atomic::AtomicU32,
+    /// Room in the scene's light buffers.
+    light_capacity: u32,
+    /// The light features the graph was compiled and its pipelines specialised for.
+    light_features: crate::scene::SceneFeatures,
 }
 
 impl Renderer {
@@ -169,6 +179,12 @@ impl Renderer {
     ) -> Result<PreparedFrame, RenderError> {
         let device = self.ctx.device.clone();
         check_output_written(&graph)?;
+        if size.lights < gpu.light_capacity {
+            return Err(RenderError::LightCapacity {
+                compiled: size.lights,
+                capacity: gpu.light_capacity,
+            });
+        }
         super::device_limits::check_plan(&graph, &device.limits())?;
         super::device_limits::check_samples(&graph, &self.ctx.adapter, &device)?;
         let resources = FrameResources::create_reusing(&device, &graph.plan, pool);
@@ -247,6 +263,9 @@ impl Renderer {
             queries,
             stats,
             prepare_stats: PrepareStats::default(),
+            light_count: gpu.light_count.into(),
+            light_capacity: gpu.light_capacity,
+            light_features: scene.features(),
         })
     }
 }
@@ -284,9 +303,18 @@ impl PreparedFrame {
     }
 
     fn encode(&self, r: &Renderer) -> wgpu::CommandBuffer {
-        let device = &r.ctx.device;
+        let mut encoder = r.ctx.device.create_command_encoder(&Default::default());
+        self.record(&mut encoder);
+        encoder.finish()
+    }
+
+    /// Records one frame into the caller's encoder (an engine's frame with its own passes
+    /// before and after): the caller submits. The graph's output is then
+    /// [`output_texture`](Self::output_texture), or draw it into any colour target with a
+    /// [`Presenter`](crate::render::Presenter) on the same encoder. Per-pass timestamps are
+    /// recorded but only [`execute`](Self::execute) reads them back.
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder) {
         let plan = &self.graph.plan;
-        let mut encoder = device.create_command_encoder(&Default::default());
         // Resources whose writers were culled read as zero.
         for name in &self.absent {
             if let Some(b) = self.resources.buffer(plan, name) {
@@ -320,15 +348,14 @@ impl PreparedFrame {
         }
         for (i, (_, pass)) in self.passes.iter().enumerate() {
             let ts = Timestamps(self.queries.as_ref().map(|(q, _)| (q, i as u32)));
-            pass.record(&mut encoder, ts);
+            pass.record(encoder, ts);
             if let Some(stats) = self.stats.as_ref().filter(|s| s.after == i) {
-                stats.record(&mut encoder);
+                stats.record(encoder);
             }
         }
         if let Some((q, buf)) = &self.queries {
             encoder.resolve_query_set(q, 0..2 * self.passes.len() as u32, buf, 0);
         }
-        encoder.finish()
     }
 
     fn execute_unscoped(&self, r: &Renderer) -> Result<(PassTimes, RenderTimings), RenderError> {
@@ -424,18 +451,19 @@ impl PreparedFrame {
     }
 
     /// Moves the camera without re-preparing (benchmarks, the viewer).
-    pub fn set_camera(&self, r: &Renderer, scene: &Scene, light_count: u32) {
-        self.set_view(r, &scene.camera, scene.ambient, light_count);
+    pub fn set_camera(&self, r: &Renderer, scene: &Scene) {
+        self.set_view(r, &scene.camera, scene.ambient);
     }
 
-    /// Writes the frame uniform for `camera`: the next `execute` renders from there.
-    pub fn set_view(&self, r: &Renderer, camera: &Camera, ambient: Vec3, light_count: u32) {
+    /// Writes the frame uniform for `camera`: the next `execute` renders from there. The
+    /// light count stays the frame's own (see [`update_lights`](Self::update_lights)).
+    pub fn set_view(&self, r: &Renderer, camera: &Camera, ambient: Vec3) {
         let f = GpuFrame::new(
             camera,
             ambient,
             self.size.width,
             self.size.height,
-            light_count,
+            self.light_count(),
         );
         r.ctx
             .queue

@@ -8,6 +8,7 @@ use crate::render::bind::Bound;
 use crate::render::pipelines::{Pipeline, PipelineKey};
 use crate::render::RenderError;
 use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::Arc;
 
 pub(super) struct ComputePass {
@@ -15,6 +16,9 @@ pub(super) struct ComputePass {
     pipeline: Arc<wgpu::ComputePipeline>,
     bind: wgpu::BindGroup,
     groups: [u32; 3],
+    /// For `PerLight` dispatches: the workgroup size and the light count it is run for
+    /// now (light updates change it; the dispatch limit was checked at the capacity).
+    per_light: Option<(u32, AtomicU32)>,
 }
 
 pub(super) fn prepare(
@@ -60,17 +64,26 @@ pub(super) fn prepare(
             size.height.div_ceil(tile.max(1)),
             1,
         ],
-        Dispatch::PerLight { workgroup } => {
-            [cx.gpu.light_count.div_ceil(workgroup.max(1)).max(1), 1, 1]
-        }
+        Dispatch::PerLight { workgroup } => [
+            cx.gpu.light_capacity.div_ceil(workgroup.max(1)).max(1),
+            1,
+            1,
+        ],
         Dispatch::Fixed(x, y, z) => [x, y, z],
     };
     crate::render::device_limits::check_dispatch(cx.graph, &sp.name, groups, &device.limits())?;
+    let per_light = match d {
+        Dispatch::PerLight { workgroup } => {
+            Some((workgroup.max(1), AtomicU32::new(cx.gpu.light_count)))
+        }
+        _ => None,
+    };
     Ok(ComputePass {
         name: sp.name.clone(),
         pipeline,
         bind,
         groups,
+        per_light,
     })
 }
 
@@ -109,7 +122,16 @@ impl PreparedPass for ComputePass {
             ts,
             &self.pipeline,
             &self.bind,
-            self.groups,
+            match &self.per_light {
+                Some((w, lights)) => [lights.load(Ordering::Relaxed).div_ceil(*w).max(1), 1, 1],
+                None => self.groups,
+            },
         );
+    }
+
+    fn follow_lights(&self, _r: &crate::render::Renderer, lights: &[crate::scene::Light]) {
+        if let Some((_, count)) = &self.per_light {
+            count.store(lights.len() as u32, Ordering::Relaxed);
+        }
     }
 }

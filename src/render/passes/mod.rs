@@ -32,6 +32,15 @@ pub(super) trait PreparedPass {
     /// The camera moved without re-preparing: passes that depend on the view (the
     /// shadow atlas's allocation) update for the next frame.
     fn set_view(&self, _r: &Renderer, _camera: &crate::scene::Camera) {}
+    /// Why this pass cannot follow light updates, if it cannot (state laid out from the
+    /// lights at prepare that is too costly to redo per frame).
+    fn can_follow_lights(&self) -> Result<(), String> {
+        Ok(())
+    }
+    /// The scene's lights changed without re-preparing (`PreparedFrame::update_lights`):
+    /// passes that keep per-light state on the CPU (atlas allocation, per-light
+    /// dispatches) update it for the next frame.
+    fn follow_lights(&self, _r: &Renderer, _lights: &[crate::scene::Light]) {}
 }
 
 /// How a built-in kind prepares its pass; implemented in `render/passes/<kind>.rs` by the

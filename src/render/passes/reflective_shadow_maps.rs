@@ -103,6 +103,10 @@ pub(super) fn prepare(
 }
 
 impl PreparedPass for RsmPass {
+    fn can_follow_lights(&self) -> Result<(), String> {
+        Err("its views are laid out from the indirect lights at prepare: prepare the frame again to move or change lights".into())
+    }
+
     fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
         encoder.copy_buffer_to_buffer(&self.staging, 0, &self.views, 0, self.table_bytes);
         // The maps are small (a few MiB at most): clearing them whole costs nothing and

@@ -25,7 +25,9 @@ pub(super) struct ShadowAtlasPass {
     max_views: u64,
     normal_offset: f32,
     size: FrameSize,
-    lights: Vec<Light>,
+    /// The lights and camera allocated for, kept to reallocate when either changes.
+    lights: Mutex<Vec<Light>>,
+    camera: Mutex<Camera>,
     /// Each draw's mesh: its bounds and triangle chunks, in draw order.
     meshes: Vec<(
         [glam::Vec3; 2],
@@ -70,7 +72,8 @@ pub(super) fn prepare(
     // Its side against the device's limit was checked with every planned texture
     // (render/device_limits.rs) before any was created.
     let views = cx.buffer(&sp.name, sp.required(SHADOW_VIEWS))?;
-    let table_bytes = view_table_bytes(cx.gpu.light_count, p.max_views());
+    // Room for every light an update may write.
+    let table_bytes = view_table_bytes(cx.gpu.light_capacity, p.max_views());
     if views.size() < table_bytes {
         return Err(pass_error(
             &sp.name,
@@ -78,7 +81,7 @@ pub(super) fn prepare(
                 "buffer '{}' holds {} bytes; the view table for {} lights and {} views needs {table_bytes} (size: Auto)",
                 sp.required(SHADOW_VIEWS),
                 views.size(),
-                cx.gpu.light_count,
+                cx.gpu.light_capacity,
                 p.max_views()
             ),
         ));
@@ -121,7 +124,8 @@ pub(super) fn prepare(
         max_views: p.max_views(),
         normal_offset: p.normal_offset,
         size: cx.size,
-        lights: cx.scene.lights.clone(),
+        lights: Mutex::new(cx.scene.lights.clone()),
+        camera: Mutex::new(cx.scene.camera),
         meshes,
         atlas: cx.view(&sp.name, atlas_name)?,
         atlas_bytes: side as u64 * side as u64 * bytes_per_texel as u64,
@@ -201,8 +205,10 @@ fn tile_clear_pipeline(
 impl ShadowAtlasPass {
     /// Allocates for `camera`, uploads the table and culls each view's casters.
     fn allocate(&self, r: &Renderer, camera: &Camera) {
+        *self.camera.lock().unwrap_or_else(|e| e.into_inner()) = *camera;
+        let lights = self.lights.lock().unwrap_or_else(|e| e.into_inner());
         let a = allocate(
-            &self.lights,
+            &lights,
             camera,
             self.size.width,
             self.size.height,
@@ -213,7 +219,7 @@ impl ShadowAtlasPass {
         table[0] = [
             a.views.len() as u32,
             self.config.size,
-            self.lights.len() as u32,
+            lights.len() as u32,
             max_views as u32,
         ];
         let n = self.config.size as f32;
@@ -314,6 +320,16 @@ impl PreparedPass for ShadowAtlasPass {
                 .flat_map(|d| d.ranges.iter().map(|r| r.2 as u64 / 3))
                 .sum(),
         })))
+    }
+
+    fn follow_lights(&self, r: &Renderer, lights: &[Light]) {
+        {
+            let mut kept = self.lights.lock().unwrap_or_else(|e| e.into_inner());
+            kept.clear();
+            kept.extend_from_slice(lights);
+        }
+        let camera = *self.camera.lock().unwrap_or_else(|e| e.into_inner());
+        self.allocate(r, &camera);
     }
 
     fn set_view(&self, r: &Renderer, camera: &Camera) {

@@ -151,6 +151,10 @@ const LIGHT_COUNT_OFFSET: u64 =
     std::mem::offset_of!(crate::gpu::structs::GpuFrame, light_count) as u64;
 
 impl PreparedPass for VplSpawnPass {
+    fn can_follow_lights(&self) -> Result<(), String> {
+        Err("it appends VPLs after the scene's light count fixed at prepare: prepare the frame again to move or change lights".into())
+    }
+
     fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {

@@ -186,6 +186,13 @@ impl Importer {
                 Some(v) => self.world_normals(&pel, v, normal_m, &positions, &indices),
                 None => compute_normals(&positions, &indices),
             };
+            let material = self.material(prim.material())?;
+            // glTF: a normal-mapped primitive without tangents gets MikkTSpace's (below).
+            // (The file's tangents count only with the file's normals, as glTF says.)
+            let file_tangents = tangents_local.is_some() && normals_local.is_some();
+            let mikktspace = !file_tangents
+                && uvs.len() == n
+                && self.scene.materials[material].normal_texture.is_some();
             let tangents = match &tangents_local {
                 Some(v) if normals_local.is_some() => v
                     .iter()
@@ -198,16 +205,16 @@ impl Importer {
                         t3.extend(w)
                     })
                     .collect::<Vec<Vec4>>(),
+                _ if mikktspace => Vec::new(),
                 _ => compute_tangents(&positions, &normals, &uvs, &indices),
             };
-            let material = self.material(prim.material())?;
             let name = match (mesh.name(), prim_count) {
                 (Some(nm), 1) => nm.to_string(),
                 (Some(nm), _) => format!("{nm}/{}", prim.index()),
                 (None, 1) => format!("mesh{}", mesh.index()),
                 (None, _) => format!("mesh{}/{}", mesh.index(), prim.index()),
             };
-            self.scene.meshes.push(Mesh {
+            let mut mesh = Mesh {
                 name,
                 positions,
                 normals,
@@ -215,7 +222,11 @@ impl Importer {
                 tangents,
                 indices,
                 material,
-            });
+            };
+            if mikktspace {
+                crate::scene::tangent_space::mikktspace_tangents(&mut mesh);
+            }
+            self.scene.meshes.push(mesh);
         }
         Ok(())
     }

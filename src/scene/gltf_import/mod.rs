@@ -38,8 +38,12 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// Extensions this importer understands; any other in `extensionsRequired` is refused.
-pub const SUPPORTED_EXTENSIONS: &[&str] =
-    &["KHR_lights_punctual", "KHR_materials_emissive_strength"];
+pub const SUPPORTED_EXTENSIONS: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_unlit",
+    "KHR_texture_transform",
+];
 
 /// Safety limits: inputs past them are refused with a [`SceneError::Limit`].
 #[derive(Clone, Copy, Debug)]

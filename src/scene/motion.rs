@@ -1,0 +1,307 @@
+//! Light motion in scene files: orbits, keyframed paths and intensity flicker. Every
+//! value is a pure function of (light, time), so a frame at time t is the same on every
+//! run; evaluating it allocates nothing (see [`animate_into`]).
+
+use super::types::{Light, LightShape};
+use glam::{Quat, Vec3};
+use serde::{Deserialize, Serialize};
+
+/// How a light, or every light of a light set, moves over time (`motion:` in a scene
+/// file). The parts combine: the path offset is added to the light's position, the orbit
+/// then turns the result about its axis, and flicker scales the intensity.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Motion {
+    #[serde(default)]
+    pub orbit: Option<Orbit>,
+    #[serde(default)]
+    pub path: Option<KeyframePath>,
+    #[serde(default)]
+    pub flicker: Option<Flicker>,
+}
+
+/// A circle about an axis through `centre`; the radius is the light's distance from the
+/// axis at time 0. Spot directions turn with it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Orbit {
+    pub centre: Vec3,
+    #[serde(default = "up")]
+    pub axis: Vec3,
+    /// Degrees per second (counter-clockwise looking down the axis).
+    pub speed_deg: f32,
+}
+
+fn up() -> Vec3 {
+    Vec3::Y
+}
+
+/// Offsets from the light's position, reached at evenly spaced times over `period`
+/// seconds, looping back to the first.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KeyframePath {
+    pub points: Vec<Vec3>,
+    pub period: f32,
+    #[serde(default)]
+    pub interpolation: Interpolation,
+}
+
+/// How a path moves between its points.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Interpolation {
+    /// Straight segments.
+    #[default]
+    Linear,
+    /// A uniform Catmull–Rom spline through the points (smooth at every point).
+    CatmullRom,
+}
+
+/// Seeded 1D value noise on the intensity: `intensity × (1 + amplitude × n(t))` with
+/// n in [−1, 1], a new random value `frequency` times a second, smoothly blended.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Flicker {
+    pub amplitude: f32,
+    pub frequency: f32,
+    #[serde(default)]
+    pub seed: u64,
+}
+
+/// A motion applied to `count` consecutive lights of a scene from `first`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightMotion {
+    pub first: u32,
+    pub count: u32,
+    pub motion: Motion,
+}
+
+/// Most keyframes a path may have (a scene file is read whole; this bounds one path).
+pub const MAX_PATH_POINTS: usize = 1 << 16;
+
+impl Motion {
+    /// Checks the parameters; the message names the bad field.
+    pub fn check(&self) -> Result<(), String> {
+        if let Some(o) = &self.orbit {
+            if !o.centre.is_finite() {
+                return Err(format!("orbit centre {} is not finite", o.centre));
+            }
+            if !o.axis.is_finite() || o.axis.length_squared() < 1e-12 {
+                return Err(format!(
+                    "orbit axis {} is not a finite non-zero vector",
+                    o.axis
+                ));
+            }
+            if !o.speed_deg.is_finite() {
+                return Err(format!("orbit speed_deg {} is not finite", o.speed_deg));
+            }
+        }
+        if let Some(p) = &self.path {
+            if p.points.is_empty() || p.points.len() > MAX_PATH_POINTS {
+                return Err(format!(
+                    "path has {} points; it needs 1..={MAX_PATH_POINTS}",
+                    p.points.len()
+                ));
+            }
+            if let Some(bad) = p.points.iter().position(|v| !v.is_finite()) {
+                return Err(format!("path point {bad} is not finite"));
+            }
+            if !p.period.is_finite() || p.period <= 0.0 {
+                return Err(format!(
+                    "path period {} must be finite and > 0 seconds",
+                    p.period
+                ));
+            }
+        }
+        if let Some(f) = &self.flicker {
+            if !(0.0..=1.0).contains(&f.amplitude) {
+                return Err(format!(
+                    "flicker amplitude {} must lie in 0..=1",
+                    f.amplitude
+                ));
+            }
+            if !f.frequency.is_finite() || f.frequency < 0.0 {
+                return Err(format!(
+                    "flicker frequency {} must be finite and >= 0",
+                    f.frequency
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// `base` at time `t` seconds; `index` is the light's place in its set (it seeds the
+    /// flicker, so lights of one set flicker apart).
+    pub fn apply(&self, base: &Light, index: u32, t: f64) -> Light {
+        let mut l = *base;
+        if let Some(p) = &self.path {
+            l.position += p.offset(t);
+        }
+        if let Some(o) = &self.orbit {
+            // The angle is reduced in f64 so that long runs keep their precision.
+            let angle = (o.speed_deg as f64).to_radians() * t;
+            let q = Quat::from_axis_angle(
+                o.axis.normalize(),
+                angle.rem_euclid(std::f64::consts::TAU) as f32,
+            );
+            l.position = o.centre + q * (l.position - o.centre);
+            if let LightShape::Spot { direction, .. } = &mut l.shape {
+                *direction = q * *direction;
+            }
+        }
+        if let Some(f) = &self.flicker {
+            l.intensity *= (1.0 + f.amplitude * f.noise(index, t)).max(0.0);
+        }
+        l
+    }
+}
+
+impl KeyframePath {
+    /// The offset at time `t`: the path loops every `period` seconds.
+    pub fn offset(&self, t: f64) -> Vec3 {
+        let n = self.points.len();
+        if n < 2 {
+            return self.points.first().copied().unwrap_or(Vec3::ZERO);
+        }
+        let u = (t / self.period as f64).rem_euclid(1.0) * n as f64;
+        let i = (u.floor() as usize).min(n - 1);
+        let s = (u - i as f64) as f32;
+        let at = |k: usize| self.points[k % n];
+        match self.interpolation {
+            Interpolation::Linear => at(i).lerp(at(i + 1), s),
+            Interpolation::CatmullRom => {
+                let (p0, p1, p2, p3) = (at(i + n - 1), at(i), at(i + 1), at(i + 2));
+                let (s2, s3) = (s * s, s * s * s);
+                0.5 * (2.0 * p1
+                    + (p2 - p0) * s
+                    + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * s2
+                    + (3.0 * p1 - p0 - 3.0 * p2 + p3) * s3)
+            }
+        }
+    }
+}
+
+impl Flicker {
+    /// Value noise in [−1, 1]: hashed lattice values at integer `t × frequency`,
+    /// blended with smoothstep.
+    pub fn noise(&self, index: u32, t: f64) -> f32 {
+        let x = t * self.frequency as f64;
+        let k = x.floor();
+        let f = (x - k) as f32;
+        let s = f * f * (3.0 - 2.0 * f);
+        let lattice = |k: i64| {
+            let h = mix64(self.seed ^ mix64(((index as u64) << 32) ^ k as u64));
+            (h >> 40) as f32 * (2.0 / 16_777_216.0) - 1.0
+        };
+        let k = k as i64;
+        lattice(k) + (lattice(k.wrapping_add(1)) - lattice(k)) * s
+    }
+}
+
+/// SplitMix64's finaliser: a fixed, platform-independent 64-bit hash.
+fn mix64(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Writes `base` moved to time `t` into `out` (cleared first). No allocation once `out`
+/// has room for `base.len()` lights. Motions past the end of `base` (a light count
+/// changed after loading) are ignored.
+pub fn animate_into(base: &[Light], motions: &[LightMotion], t: f64, out: &mut Vec<Light>) {
+    out.clear();
+    out.extend_from_slice(base);
+    for m in motions {
+        let first = (m.first as usize).min(out.len());
+        let end = first.saturating_add(m.count as usize).min(out.len());
+        for (i, l) in out[first..end].iter_mut().enumerate() {
+            *l = m.motion.apply(l, i as u32, t);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point() -> Light {
+        Light::point(Vec3::new(2.0, 1.0, 0.0), 3.0, Vec3::ONE, 1.0)
+    }
+
+    #[test]
+    fn orbit_keeps_radius_and_returns_after_a_turn() {
+        let m = Motion {
+            orbit: Some(Orbit {
+                centre: Vec3::ZERO,
+                axis: Vec3::Y,
+                speed_deg: 90.0,
+            }),
+            ..Default::default()
+        };
+        let quarter = m.apply(&point(), 0, 1.0).position;
+        assert!(
+            (quarter - Vec3::new(0.0, 1.0, -2.0)).length() < 1e-5,
+            "{quarter}"
+        );
+        let turn = m.apply(&point(), 0, 4.0).position;
+        assert!((turn - point().position).length() < 1e-5, "{turn}");
+    }
+
+    #[test]
+    fn paths_pass_through_their_points_and_loop() {
+        for interpolation in [Interpolation::Linear, Interpolation::CatmullRom] {
+            let p = KeyframePath {
+                points: vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 0.0, 1.0)],
+                period: 3.0,
+                interpolation,
+            };
+            for (t, want) in [(0.0, Vec3::ZERO), (1.0, Vec3::X), (5.0, p.points[2])] {
+                assert!(
+                    (p.offset(t) - want).length() < 1e-5,
+                    "{interpolation:?} t={t}"
+                );
+            }
+        }
+        let linear = KeyframePath {
+            points: vec![Vec3::ZERO, Vec3::X],
+            period: 2.0,
+            interpolation: Interpolation::Linear,
+        };
+        assert!((linear.offset(0.5) - Vec3::X * 0.5).length() < 1e-6);
+    }
+
+    #[test]
+    fn flicker_is_seeded_bounded_and_varies() {
+        let f = Flicker {
+            amplitude: 1.0,
+            frequency: 10.0,
+            seed: 7,
+        };
+        let values: Vec<f32> = (0..200).map(|i| f.noise(3, i as f64 * 0.013)).collect();
+        assert!(values.iter().all(|v| (-1.0..=1.0).contains(v)));
+        assert!(values.iter().any(|&v| (v - values[0]).abs() > 0.1));
+        assert_eq!(f.noise(3, 1.234), f.noise(3, 1.234));
+        assert_ne!(f.noise(3, 1.234), f.noise(4, 1.234));
+    }
+
+    #[test]
+    fn animate_into_ignores_motions_past_the_lights() {
+        let m = LightMotion {
+            first: 1,
+            count: 5,
+            motion: Motion {
+                path: Some(KeyframePath {
+                    points: vec![Vec3::Y],
+                    period: 1.0,
+                    interpolation: Interpolation::Linear,
+                }),
+                ..Default::default()
+            },
+        };
+        let mut out = Vec::new();
+        animate_into(&[point(), point()], &[m], 0.0, &mut out);
+        assert_eq!(out[0].position, point().position);
+        assert_eq!(out[1].position, point().position + Vec3::Y);
+    }
+}

@@ -1,0 +1,429 @@
+//! Moving lights: scene-file motion is a pure function of time (`render --time` twice
+//! gives the same image, another time a different one), and `PreparedFrame::update_lights`
+//! moves lights between frames of one prepared graph: the culled image after a move
+//! equals brute force with the lights placed there statically, the light count changes
+//! up to the capacity set at upload, and past it the update is refused by name.
+
+mod common;
+use common::*;
+
+use glam::Vec3;
+use lightgraph::graph::{self, FrameSize};
+use lightgraph::render::{LightUpdateError, PreparedFrame, RenderError, Renderer, SceneGpu};
+use lightgraph::scene::motion::{Flicker, LightMotion, Motion, Orbit};
+use lightgraph::scene::{Light, Scene};
+use lightgraph::shader::ShaderLibrary;
+use std::path::Path;
+use std::process::Command;
+
+const W: u32 = 96;
+const H: u32 = 54;
+
+/// Same lights, same shading code: forward+ and brute force differ only in the order
+/// lights are summed (the bound of tests/forward_plus.rs, relative to the peak here).
+const SAME_LIGHTS: f32 = 2e-6;
+
+/// `graph` prepared for `scene` with light buffers holding room for `capacity` lights.
+fn prepare(
+    r: &mut Renderer,
+    graph_file: &str,
+    scene: &Scene,
+    capacity: u32,
+) -> (PreparedFrame, SceneGpu) {
+    let text = std::fs::read_to_string(graph_path(graph_file)).unwrap();
+    let checked = graph::check_text(Path::new(graph_file), &text, &ShaderLibrary::builtin())
+        .expect("valid graph");
+    let gpu = SceneGpu::upload_with_light_capacity(&r.ctx.device, &r.ctx.queue, scene, capacity)
+        .expect("materials");
+    let size = FrameSize {
+        width: W,
+        height: H,
+        lights: gpu.light_capacity,
+    };
+    let compiled = graph::compile(checked, &scene.features(), size);
+    let prepared = r
+        .prepare(compiled, scene, &gpu, size, false)
+        .expect("prepare");
+    (prepared, gpu)
+}
+
+/// A still render of `scene` with `lights` placed in it from the start.
+fn still(r: &mut Renderer, graph_file: &str, scene: &Scene, lights: &[Light]) -> Vec<[f32; 4]> {
+    let mut s = scene.clone();
+    s.lights = lights.to_vec();
+    let image = render_text_with(
+        r,
+        &std::fs::read_to_string(graph_path(graph_file)).unwrap(),
+        &s,
+        W,
+        H,
+        false,
+    )
+    .image;
+    assert_eq!(image.len(), (W * H) as usize);
+    image
+}
+
+fn assert_same(a: &[[f32; 4]], b: &[[f32; 4]], what: &str) {
+    let (d, at) = max_rel_diff(a, b);
+    assert!(
+        d <= SAME_LIGHTS,
+        "{what}: relative error {d:e} at pixel {at}"
+    );
+}
+
+fn assert_differs(a: &[[f32; 4]], b: &[[f32; 4]], what: &str) {
+    let (d, at) = max_rel_diff(a, b);
+    // Lights moved by metres: some pixel changes by a good part of the peak.
+    assert!(d > 0.05, "{what}: only {d:e} apart (pixel {at})");
+}
+
+/// Every light of `scene` orbiting the room's centre, flickering.
+fn orbiting(mut scene: Scene) -> Scene {
+    scene.light_motion = vec![LightMotion {
+        first: 0,
+        count: scene.lights.len() as u32,
+        motion: Motion {
+            orbit: Some(Orbit {
+                centre: Vec3::new(0.0, 0.0, -17.0),
+                axis: Vec3::Y,
+                speed_deg: 30.0,
+            }),
+            flicker: Some(Flicker {
+                amplitude: 0.5,
+                frequency: 3.0,
+                seed: 9,
+            }),
+            path: None,
+        },
+    }];
+    scene
+}
+
+#[test]
+fn moved_lights_light_their_new_places_and_the_lists_follow() {
+    let mut r = renderer();
+    let scene = orbiting(random_scene(256, 5));
+    let (mut at_0, mut at_2) = (Vec::new(), Vec::new());
+    scene.lights_at(0.0, &mut at_0);
+    scene.lights_at(2.0, &mut at_2);
+    let mut start = scene.clone();
+    start.lights = at_0.clone();
+    let (prepared, gpu) = prepare(&mut r, "forward_plus.ron", &start, 0);
+    let before = prepared.render(&r).unwrap().image;
+    prepared.update_lights(&r, &gpu, &at_2).unwrap();
+    let after = prepared.render(&r).unwrap().image;
+
+    let brute_0 = still(&mut r, "brute_force.ron", &scene, &at_0);
+    let brute_2 = still(&mut r, "brute_force.ron", &scene, &at_2);
+    assert_same(
+        &before,
+        &brute_0,
+        "culled frame before the move vs brute force at t=0",
+    );
+    assert_same(
+        &after,
+        &brute_2,
+        "culled frame after the move vs brute force at t=2",
+    );
+    assert_differs(&after, &brute_0, "after the move vs the old places");
+}
+
+#[test]
+fn one_moved_light_lights_the_new_place_not_the_old() {
+    let mut r = renderer();
+    let scene = random_scene(0, 2);
+    let a = Light::point(Vec3::new(-6.0, 1.0, -10.0), 6.0, Vec3::ONE, 8.0);
+    let b = Light::point(Vec3::new(6.0, 1.0, -10.0), 6.0, Vec3::ONE, 8.0);
+    let mut start = scene.clone();
+    start.lights = vec![a];
+    let (prepared, gpu) = prepare(&mut r, "forward_plus.ron", &start, 0);
+    prepared.update_lights(&r, &gpu, &[b]).unwrap();
+    let moved = prepared.render(&r).unwrap().image;
+    let at_a = still(&mut r, "brute_force.ron", &scene, &[a]);
+    assert_same(
+        &moved,
+        &still(&mut r, "brute_force.ron", &scene, &[b]),
+        "at B",
+    );
+    assert_differs(&moved, &at_a, "vs A");
+    // The left quarter of the frame: A lights it, B (6 m range, 12 m to the right) not.
+    let left_lit = |image: &[[f32; 4]]| {
+        image
+            .iter()
+            .enumerate()
+            .filter(|(i, p)| (*i as u32 % W) < W / 4 && p[0] > 0.0)
+            .count()
+    };
+    assert!(left_lit(&at_a) > 50, "A lights the left quarter");
+    assert_eq!(left_lit(&moved), 0, "the old place is still lit");
+}
+
+#[test]
+fn the_light_count_changes_up_to_the_capacity_and_no_further() {
+    let mut r = renderer();
+    let scene = random_scene(12, 8);
+    // Starts with one point and one spot light (what the graph is compiled for), room
+    // for twelve.
+    let spot = |l: &&Light| matches!(l.shape, lightgraph::scene::LightShape::Spot { .. });
+    let mut start = scene.clone();
+    start.lights = vec![
+        *scene.lights.iter().find(|l| !spot(l)).unwrap(),
+        *scene.lights.iter().find(spot).unwrap(),
+    ];
+    let (prepared, gpu) = prepare(&mut r, "forward_plus.ron", &start, 12);
+    assert_eq!((prepared.light_count(), prepared.light_capacity()), (2, 12));
+    for n in [12, 5, 1] {
+        prepared
+            .update_lights(&r, &gpu, &scene.lights[..n])
+            .unwrap();
+        assert_eq!(prepared.light_count(), n as u32);
+        let image = prepared.render(&r).unwrap().image;
+        let brute = still(&mut r, "brute_force.ron", &scene, &scene.lights[..n]);
+        assert_same(&image, &brute, &format!("{n} lights"));
+    }
+    prepared.update_lights(&r, &gpu, &[]).unwrap();
+    let dark = prepared.render(&r).unwrap().image;
+    assert_eq!(dark.len(), (W * H) as usize);
+    assert!(
+        dark.iter().all(|p| p[..3] == [0.0; 3]),
+        "no lights, no light"
+    );
+    let mut more = scene.lights.clone();
+    more.push(scene.lights[0]);
+    let e = prepared.update_lights(&r, &gpu, &more).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            LightUpdateError::OverCapacity {
+                count: 13,
+                capacity: 12
+            }
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("over the capacity of 12"), "{e}");
+    // Refused means untouched: the last update's count stays.
+    assert_eq!(prepared.light_count(), 0);
+}
+
+#[test]
+fn updates_that_the_prepared_graph_cannot_show_are_refused() {
+    let mut r = renderer();
+    let scene = random_scene(0, 3);
+    let point = Light::point(Vec3::new(0.0, 1.0, -5.0), 4.0, Vec3::ONE, 2.0);
+    let mut start = scene.clone();
+    start.lights = vec![point];
+    let (prepared, gpu) = prepare(&mut r, "forward_plus.ron", &start, 4);
+    // Spots were compiled away: the scene had none.
+    let mut spot = point;
+    spot.shape = lightgraph::scene::LightShape::Spot {
+        direction: Vec3::NEG_Y,
+        inner_angle: 0.2,
+        outer_angle: 0.4,
+    };
+    let e = prepared
+        .update_lights(&r, &gpu, &[point, spot])
+        .unwrap_err();
+    assert!(e.to_string().contains("light 1 adds a spot light"), "{e}");
+    let mut bad = point;
+    bad.range = f32::NAN;
+    let e = prepared.update_lights(&r, &gpu, &[bad]).unwrap_err();
+    assert!(e.to_string().contains("light 0: range NaN"), "{e}");
+
+    // A plan sized for fewer lights than the upload holds is refused at prepare.
+    let text = std::fs::read_to_string(graph_path("forward_plus.ron")).unwrap();
+    let checked = graph::check_text(Path::new("fp"), &text, &ShaderLibrary::builtin()).unwrap();
+    let size = FrameSize {
+        width: W,
+        height: H,
+        lights: 1,
+    };
+    let compiled = graph::compile(checked, &start.features(), size);
+    let err = r
+        .prepare(compiled, &start, &gpu, size, false)
+        .err()
+        .unwrap();
+    assert!(
+        matches!(
+            err,
+            RenderError::LightCapacity {
+                compiled: 1,
+                capacity: 4
+            }
+        ),
+        "{err}"
+    );
+}
+
+/// A scene file whose lights move: an explicit light on a path and a random set orbiting.
+const MOVING_SCENE: &str = r#"Scene(
+    builtin: "harada",
+    keep_model_lights: false,
+    lights: [
+        (position: (0, 1, 0), range: 8, intensity: 20,
+         motion: (path: (points: [(-8, 0, 0), (8, 0, 0), (0, 0, 8)], period: 3,
+                         interpolation: CatmullRom))),
+    ],
+    light_sets: [
+        Random(count: 48, placement: SceneBounds(margin: 0), range: (2, 5), intensity: (1, 4),
+               seed: 3, motion: (orbit: (centre: (0, 0, 0), speed_deg: 40),
+                                 flicker: (amplitude: 0.8, frequency: 4, seed: 1))),
+    ],
+)"#;
+
+fn render_at(dir: &Path, scene: &Path, time: &str, out: &str) -> Vec<u8> {
+    let o = Command::new(env!("CARGO_BIN_EXE_lightgraph"))
+        .current_dir(dir)
+        .args(["render", "--scene", scene.to_str().unwrap()])
+        .args([
+            "--width", "64", "--height", "36", "--time", time, "--out", out,
+        ])
+        .env_remove("LIGHTGRAPH_ROOT")
+        .env_remove("XDG_RUNTIME_DIR")
+        .output()
+        .expect("the binary runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::read(dir.join(out)).unwrap()
+}
+
+#[test]
+fn render_time_is_reproducible_and_moves_the_lights() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("moving.ron");
+    std::fs::write(&scene, MOVING_SCENE).unwrap();
+    let first = render_at(dir.path(), &scene, "1.25", "a.exr");
+    let again = render_at(dir.path(), &scene, "1.25", "b.exr");
+    let later = render_at(dir.path(), &scene, "2.5", "c.exr");
+    assert!(first.len() > 64 * 36 * 4, "an EXR of 64x36 pixels");
+    assert!(first == again, "the same --time gave different images");
+    assert!(first != later, "another --time gave the same image");
+}
+
+#[test]
+fn scene_file_motion_is_a_pure_function_of_time() {
+    let loaded = lightgraph::scene::scene_file::build_scene(
+        &lightgraph::scene::scene_file::parse_scene_file(MOVING_SCENE, Path::new("m.ron")).unwrap(),
+        Path::new("m.ron"),
+    )
+    .unwrap();
+    let scene = loaded.scene;
+    assert_eq!(scene.lights.len(), 49);
+    assert_eq!(scene.light_motion.len(), 2);
+    let (mut a, mut b, mut c) = (Vec::new(), Vec::new(), Vec::new());
+    scene.lights_at(1.25, &mut a);
+    scene.lights_at(1.25, &mut b);
+    scene.lights_at(2.5, &mut c);
+    assert_eq!(a, b);
+    // The path light is at its second point a third of the way round (t = 1 of 3 s).
+    scene.lights_at(1.0, &mut c);
+    assert!((c[0].position - Vec3::new(8.0, 1.0, 0.0)).length() < 1e-4);
+    // Orbits keep each light's distance from the axis and its height.
+    for (l0, l1) in scene.lights[1..].iter().zip(&a[1..]) {
+        let radius = |p: Vec3| Vec3::new(p.x, 0.0, p.z).length();
+        assert!((radius(l0.position) - radius(l1.position)).abs() < 1e-3);
+        assert!((l0.position.y - l1.position.y).abs() < 1e-4);
+        assert!(l1.intensity <= l0.intensity * 1.8 + 1e-4);
+    }
+    assert!(scene.lights[1..]
+        .iter()
+        .zip(&a[1..])
+        .all(|(l0, l1)| (l0.position - l1.position).length() > 1e-3));
+}
+
+#[test]
+fn bad_motion_is_named_with_its_light() {
+    let text = MOVING_SCENE.replace("period: 3", "period: 0");
+    let spec = lightgraph::scene::scene_file::parse_scene_file(&text, Path::new("m.ron")).unwrap();
+    let e = lightgraph::scene::scene_file::build_scene(&spec, Path::new("m.ron"))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("lights[0]") && e.contains("path period 0"),
+        "{e}"
+    );
+    let text = MOVING_SCENE.replace("amplitude: 0.8", "amplitude: 1.5");
+    let spec = lightgraph::scene::scene_file::parse_scene_file(&text, Path::new("m.ron")).unwrap();
+    let e = lightgraph::scene::scene_file::build_scene(&spec, Path::new("m.ron"))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("light_sets[0]") && e.contains("flicker amplitude"),
+        "{e}"
+    );
+}
+
+#[test]
+fn the_shadow_atlas_follows_moved_casters() {
+    let mut r = renderer();
+    let scene = random_scene(0, 4);
+    let caster = |p: Vec3| {
+        let mut l = Light::point(p, 10.0, Vec3::ONE, 20.0);
+        l.flags = lightgraph::scene::light_flags::CASTS_SHADOW;
+        l
+    };
+    let a = [
+        caster(Vec3::new(-4.0, 2.0, -8.0)),
+        caster(Vec3::new(3.0, 5.0, -20.0)),
+    ];
+    let b = [
+        caster(Vec3::new(4.0, 1.5, -12.0)),
+        caster(Vec3::new(-3.0, 3.0, -16.0)),
+    ];
+    let mut start = scene.clone();
+    start.lights = a.to_vec();
+    let (prepared, gpu) = prepare(&mut r, "shadow_atlas.ron", &start, 0);
+    prepared.render(&r).unwrap();
+    prepared.update_lights(&r, &gpu, &b).unwrap();
+    let moved = prepared.render(&r).unwrap().image;
+    // The same graph prepared with the casters at B from the start: the same atlas
+    // allocation and views, so the same image.
+    assert_same(
+        &moved,
+        &still(&mut r, "shadow_atlas.ron", &scene, &b),
+        "atlas at B",
+    );
+    assert_differs(
+        &moved,
+        &still(&mut r, "shadow_atlas.ron", &scene, &a),
+        "vs A",
+    );
+}
+
+const ANIMATED_SWEEP: &str = r#"Sweep(
+    scenes: ["builtin:glass"],
+    graphs: ["forward_plus.ron"],
+    lights: [64],
+    resolutions: [(48, 27)],
+    warmup: 2,
+    warmup_seconds: 0,
+    frames: 3,
+    rounds: 1,
+    light_stats: false,
+    animate: 0.25,
+)"#;
+
+#[test]
+fn an_animated_sweep_moves_the_lights_and_compares_them_where_they_started() {
+    use lightgraph::bench::sweep::{self, Sweep};
+    let plan = Sweep::parse(ANIMATED_SWEEP, Path::new("animated.ron")).unwrap();
+    let rows = {
+        let mut r = renderer();
+        sweep::run(&plan, Path::new("."), &mut r, |_| {}).expect("sweep")
+    };
+    assert_eq!(rows.len(), 1);
+    assert_eq!(rows[0].params, "animate=0.25s");
+    // The error columns render after the sweep gives every frame the scene's lights
+    // back: the same lights as the reference, so only summation order differs (lights
+    // left where the last timed frame moved them are off by the whole signal).
+    let max_rel = rows[0].max_rel.expect("an error column");
+    assert!(max_rel <= 1e-3, "max_rel {max_rel}");
+
+    let bad = ANIMATED_SWEEP.replace("animate: 0.25", "animate: 0");
+    let e = Sweep::parse(&bad, Path::new("animated.ron"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("11: animate 0 must be"), "{e}");
+}
