@@ -348,6 +348,36 @@ fn without_blended_meshes_the_default_graph_is_the_compute_first_frame() {
     };
     assert_eq!(passes(&default), passes(&plain));
     assert_eq!(default.passes.len(), 3);
+    // ComputeRaster resolves in compute, as in the plain frame: its depth is an R32Float
+    // storage texture, never an attachment (a Depth32Float depth is resolved by a
+    // full-screen draw, several times slower on GPUs that run graphics on few SMs).
+    let depth = |g: &graph::CompiledGraph| {
+        let planned = g.plan.get("depth").expect("a planned depth");
+        g.plan.physical[planned.physical].clone()
+    };
+    let (d, p) = (depth(&default), depth(&plain));
+    assert!(
+        matches!(
+            d.desc,
+            graph::plan::PhysicalDesc::Texture {
+                format: graph::TextureFormat::R32Float,
+                samples: 1,
+                ..
+            }
+        ),
+        "{:?}",
+        d.desc
+    );
+    assert_eq!(d.desc, p.desc);
+    assert!(
+        d.texture_usage
+            .contains(wgpu::TextureUsages::STORAGE_BINDING)
+            && !d
+                .texture_usage
+                .contains(wgpu::TextureUsages::RENDER_ATTACHMENT),
+        "{:?}",
+        d.texture_usage
+    );
     let mut skipped: Vec<&str> = default
         .culled
         .iter()

@@ -10,7 +10,8 @@
 // so the tiles' lists are exactly those without it.
 // MSAA: the depth is multisampled and every one of its SAMPLES samples bounds the tile.
 // FLOAT_DEPTH: the depth is single-sample R32Float (a compute resolve's; the same values
-// a depth texture holds), read as texture_2d<f32>. Not with MSAA or TRANSPARENT.
+// a depth texture holds), read as texture_2d<f32>. Not with MSAA; with TRANSPARENT the
+// transparent depth stays a depth texture.
 // TRANSPARENT: lists for transparent surfaces (AMD's TiledLighting11 sample). A sample where a transparent
 // surface lies in front of the opaque one contributes the range from the nearest
 // transparent depth to the opaque depth (the far plane over the background): every

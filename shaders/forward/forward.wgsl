@@ -6,6 +6,9 @@
 // sample. The material's generated code is included as <material>; ALPHA_MASK
 // discards below the cutoff. Only SHADE binds lights: a pass binds what it declares.
 // VISIBILITY writes each fragment's triangle id (the visibility buffer).
+// FLOAT_DEPTH (SHADE, single-sample): the depth to test against is an R32Float texture (a
+// compute resolve's) instead of a depth attachment; each fragment loads it at its pixel
+// and is discarded where the attachment's LessEqual test would fail.
 
 #if VISIBILITY
 enable primitive_index;
@@ -42,6 +45,9 @@ enable primitive_index;
 #endif
 #if SHADOWS
 #include "common/shadows.wgsl"
+#endif
+#if FLOAT_DEPTH
+@group(0) @binding(12) var depth: texture_2d<f32>;
 #endif
 #endif
 #if ATLAS_DEPTH
@@ -330,6 +336,14 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> @location(0) ve
     // The prepass discarded these fragments; shading must too, or a masked surface
     // nearer than the depth buffer would pass the LessEqual test.
     if (material_alpha(m) < ALPHA_CUTOFF) {
+        discard;
+    }
+#endif
+#if FLOAT_DEPTH
+    // The depth attachment's test (LessEqual, depths cleared to 1.0), on the fragment's
+    // own depth: the position's z is the value that test compares. After the material
+    // setup: its texture samples take derivatives, which must not follow a discard.
+    if (in.clip.z > textureLoad(depth, vec2<u32>(in.clip.xy), 0).x) {
         discard;
     }
 #endif

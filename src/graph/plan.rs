@@ -288,6 +288,8 @@ fn describe(
                             T::STORAGE_BINDING
                         }
                         Usage::AttachmentOrStorage => T::RENDER_ATTACHMENT | T::STORAGE_BINDING,
+                        Usage::AttachmentOrSampled if format.is_depth() => T::RENDER_ATTACHMENT,
+                        Usage::AttachmentOrSampled => T::TEXTURE_BINDING,
                         Usage::Bound => T::empty(),
                     };
                 }

@@ -33,6 +33,10 @@ pub(super) enum DrawMode {
         lists: super::passes::ShadeLists,
         blend: bool,
         shadows: Shadows,
+        /// The depth tested against is an R32Float texture (`FLOAT_DEPTH`), not an
+        /// attachment: the fragment shader loads it and discards what the attachment's
+        /// LessEqual test would have failed; the pipeline has no depth state.
+        float_depth: bool,
     },
     /// A shadow atlas's views: depth only, the view from the instance index, both faces,
     /// biased.
@@ -206,10 +210,18 @@ impl Renderer {
                         d.push(("GBUFFER_SURFACE", "1".into()));
                     }
                 }
-                DrawMode::Shade { lists, shadows, .. } => {
+                DrawMode::Shade {
+                    lists,
+                    shadows,
+                    float_depth,
+                    ..
+                } => {
                     d.push(("SHADE", "1".into()));
                     d.extend(lists.define());
                     d.extend(shadow_defines(shadows));
+                    if float_depth {
+                        d.push(("FLOAT_DEPTH", "1".into()));
+                    }
                 }
             }
             if let AlphaMode::Mask(cutoff) = m.alpha_mode {
@@ -394,8 +406,8 @@ fn build_pipeline(
         compilation_options: Default::default(),
         targets: &targets,
     });
-    Pipeline::Render(Arc::new(device.create_render_pipeline(
-        &wgpu::RenderPipelineDescriptor {
+    Pipeline::Render(Arc::new(
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(pass),
             layout: Some(layout),
             vertex: wgpu::VertexState {
@@ -408,7 +420,14 @@ fn build_pipeline(
                 cull_mode,
                 ..Default::default()
             },
-            depth_stencil: Some(wgpu::DepthStencilState {
+            depth_stencil: (!matches!(
+                mode,
+                DrawMode::Shade {
+                    float_depth: true,
+                    ..
+                }
+            ))
+            .then(|| wgpu::DepthStencilState {
                 format: match mode {
                     DrawMode::AtlasDepth { format, .. } => format,
                     _ => wgpu::TextureFormat::Depth32Float,
@@ -440,8 +459,8 @@ fn build_pipeline(
             fragment,
             multiview_mask: None,
             cache: crate::render::pipelines::driver_cache().as_ref(),
-        },
-    )))
+        }),
+    ))
 }
 
 /// Material code for pipelines that include the material but never call it (`None`

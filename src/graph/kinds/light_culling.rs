@@ -2,10 +2,10 @@
 //! DepthMask, Clustered), with an optional coarse stage. Runs `shaders/cull/light_culling.wgsl`.
 //! A multisampled depth is read sample by sample. The depth may also be a single-sample
 //! R32Float texture (ComputeRaster's compute resolve), read as `texture_2d<f32>`
-//! (`FLOAT_DEPTH`); not with transparent lists. With a `transparent_depth` (a
-//! TransparentDepth pass's) the lists are for transparent surfaces: a tile spans, over
-//! its pixels that hold one, from the nearest transparent depth to the opaque depth
-//! behind it (AMD's TiledLighting11 sample).
+//! (`FLOAT_DEPTH`). With a `transparent_depth` (a TransparentDepth pass's, always a
+//! depth format) the lists are for transparent surfaces: a tile spans, over its pixels
+//! that hold one, from the nearest transparent depth to the opaque depth behind it (AMD's
+//! TiledLighting11 sample); the opaque depth may be either format there too.
 //!
 //! Two list layouts (`lists:`), read alike through `shaders/common/light_lists.wgsl`:
 //! `Fixed` gives every list room for `capacity` lights (a longer list is cut, counted
@@ -252,14 +252,6 @@ pub const SLOTS: &[SlotSpec] = &[
 pub fn check(p: &LightCulling, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     super::check_float_depth_samples(ctx, errors);
     if let (Some(depth), Some(t)) = (ctx.slot(slot::DEPTH), ctx.slot(slot::TRANSPARENT_DEPTH)) {
-        if ctx.is_float_depth(depth) {
-            errors.push(ctx.mismatch(
-                t,
-                format!("transparent lists compare the transparent depth with the opaque one as depth textures; '{depth}' is R32Float: give the graph a Depth32Float opaque depth"),
-            ));
-        }
-    }
-    if let (Some(depth), Some(t)) = (ctx.slot(slot::DEPTH), ctx.slot(slot::TRANSPARENT_DEPTH)) {
         let (ds, ts) = (ctx.samples(depth), ctx.samples(t));
         if ds != ts {
             errors.push(ctx.mismatch(
@@ -446,6 +438,23 @@ mod tests {
             e.contains("transparent depth has 1 sample(s) but depth 'depth4' has 4"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn transparent_lists_read_an_r32float_opaque_depth() {
+        // A compute resolve's R32Float depth beside a TransparentDepth pass's depth.
+        const FLOAT_FRAME: &str = r#"Pass(name: "cr", kind: ComputeRaster, reads: ["vertices", "triangles", "material_triangles"], writes: ["fdepth", "visibility"]),
+            Pass(name: "tp", kind: TransparentDepth, reads: ["geometry"], writes: ["depth"]),
+            Pass(name: "c", kind: LightCulling(tile: 16), reads: ["fdepth", "transparent_depth=depth", "lg"], writes: ["lists"]),
+            Pass(name: "s", kind: VisibilityShading(lights: Culled), reads: ["visibility", "vertices", "triangles", "material_triangles", "lg", "lp", "lists"], writes: ["hdr"])"#;
+        crate::graph::kinds::test_support::validate(FLOAT_FRAME, "hdr")
+            .expect("an R32Float opaque depth with a Depth32Float transparent depth is valid");
+        // The transparent depth itself stays a depth texture.
+        let e = errors(
+            &FLOAT_FRAME.replace(r#""transparent_depth=depth""#, r#""transparent_depth=fdepth4""#),
+            "hdr",
+        );
+        assert!(e.contains("pass 'c', resource 'fdepth4'"), "{e}");
     }
 
     #[test]

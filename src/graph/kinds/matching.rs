@@ -48,7 +48,7 @@ pub(crate) fn resolve(
     let depth_hint = |name: &str| {
         let has_depth_slot = specs.iter().any(|s| s.ty == SlotType::DepthTexture);
         if float_depth(name) && has_depth_slot {
-            format!(" ({kind} reads depth from a depth texture only; an R32Float depth is read by LightCulling and LightLinkedList)")
+            format!(" ({kind} reads depth from a depth texture only; an R32Float depth is read by LightCulling, LightLinkedList and TransparentShading)")
         } else {
             String::new()
         }

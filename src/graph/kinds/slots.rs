@@ -101,6 +101,9 @@ pub enum Usage {
     /// compute rasterizer and its hardware fallback): a depth format is an attachment,
     /// R32Float a storage texture, any other format both.
     AttachmentOrStorage,
+    /// Tested against as a depth attachment, or (an R32Float texture of depths) loaded
+    /// in the shader, which then tests itself.
+    AttachmentOrSampled,
     /// Buffers and imports: bound as storage or uniform.
     Bound,
 }

@@ -1,7 +1,10 @@
 //! `TransparentShading`: the scene's blended meshes through the light loop, back to
 //! front by view depth (per mesh), both faces lit, blended over the colour the opaque
 //! shading wrote, tested against (never writing) the opaque depth. Runs
-//! `shaders/forward/forward.wgsl` with `SHADE`.
+//! `shaders/forward/forward.wgsl` with `SHADE`. The opaque depth is a depth attachment,
+//! or a single-sample R32Float texture (a compute resolve's): then the pass has no depth
+//! attachment and each fragment loads the depth at its pixel and is discarded where the
+//! attachment's LessEqual test would have failed (`FLOAT_DEPTH`).
 
 use super::{check_light_source, slot, Access, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
@@ -21,12 +24,14 @@ pub const SLOTS: &[SlotSpec] = &[
     super::LIGHT_GEOMETRY_READ,
     super::LIGHT_PROPERTIES_READ,
     super::LIGHT_LISTS_READ,
-    // The opaque depth: transparent fragments behind it are not drawn.
+    // The opaque depth: transparent fragments behind it are not drawn. A depth format
+    // is the attachment they are tested against; R32Float is loaded and tested in the
+    // fragment shader.
     SlotSpec::new(
         slot::DEPTH,
-        SlotType::DepthTexture,
+        SlotType::DepthValues,
         Access::Read,
-        Usage::Attachment,
+        Usage::AttachmentOrSampled,
     ),
     // Blended over what the opaque pass wrote: in reads (for the order) and writes.
     SlotSpec::new(
@@ -39,9 +44,15 @@ pub const SLOTS: &[SlotSpec] = &[
 
 pub fn check(p: &TransparentShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     check_light_source(ctx, p.lights, errors);
+    super::check_float_depth_samples(ctx, errors);
     if let (Some(c), Some(d)) = (ctx.slot(slot::COLOR), ctx.slot(slot::DEPTH)) {
         let (cs, ds) = (ctx.samples(c), ctx.samples(d));
-        if cs != ds {
+        if cs != ds && ctx.is_float_depth(d) {
+            errors.push(ctx.mismatch(
+                c,
+                format!("colour target has {cs} sample(s) but the opaque depth '{d}' is R32Float, which is single-sample: MSAA glass needs a multisampled Depth32Float depth"),
+            ));
+        } else if cs != ds {
             errors.push(ctx.mismatch(
                 c,
                 format!("colour target has {cs} sample(s) but depth '{d}' has {ds}: MSAA needs both multisampled"),
@@ -71,6 +82,42 @@ mod tests {
 
     const OPAQUE: &str = r#"Pass(name: "pre", kind: DepthPrepass, reads: ["geometry"], writes: ["depth"]),
         Pass(name: "s", kind: ForwardShading(), reads: ["depth", "lg", "lp"], writes: ["hdr"]),"#;
+
+    /// The compute-first frame: ComputeRaster's R32Float depth ("fdepth"), culled and
+    /// shaded in compute, then glass culled into its own lists.
+    const FLOAT_FRAME: &str = r#"Pass(name: "cr", kind: ComputeRaster, reads: ["vertices", "triangles", "material_triangles"], writes: ["fdepth", "visibility"]),
+        Pass(name: "s", kind: VisibilityShading(), reads: ["visibility", "vertices", "triangles", "material_triangles", "lg", "lp"], writes: ["HDR"]),
+        Pass(name: "tp", kind: TransparentDepth, reads: ["geometry"], writes: ["depth"]),
+        Pass(name: "c", kind: LightCulling(tile: 16), reads: ["fdepth", "transparent_depth=depth", "lg"], writes: ["lists"]),"#;
+
+    #[test]
+    fn tests_glass_against_an_r32float_opaque_depth() {
+        let frame = |hdr: &str, depth: &str| {
+            format!(
+                r#"{} Pass(name: "t", kind: TransparentShading(lights: Culled), reads: ["geometry", "{depth}", "lg", "lp", "lists", "{hdr}"], writes: ["{hdr}"])"#,
+                FLOAT_FRAME.replace("HDR", hdr)
+            )
+        };
+        validate(&frame("hdr", "fdepth"), "hdr")
+            .expect("glass over a compute resolve's R32Float depth is valid");
+        // MSAA glass needs a multisampled depth attachment: R32Float is single-sample.
+        let e = errors(&frame("hdr4", "fdepth"), "hdr");
+        assert!(
+            e.contains("pass 't', resource 'hdr4': colour target has 4 sample(s) but the opaque depth 'fdepth' is R32Float, which is single-sample: MSAA glass needs a multisampled Depth32Float depth"),
+            "{e}"
+        );
+        let e = errors(&frame("hdr4", "fdepth4"), "hdr");
+        assert!(
+            e.contains("pass 't', resource 'fdepth4': an R32Float depth is single-sample"),
+            "{e}"
+        );
+        // Other colour formats are no depth: the slot stays empty.
+        let e = errors(&frame("hdr", "small"), "hdr");
+        assert!(
+            e.contains("TransparentShading needs a depth texture (or an R32Float texture of depths) in reads (slot 'depth')"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn blends_over_the_opaque_colour() {

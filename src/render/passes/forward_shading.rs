@@ -29,6 +29,7 @@ pub(super) fn prepare(
         lists,
         blend: false,
         shadows,
+        float_depth: false,
     };
     let draws = cx.renderer.mesh_draws(
         cx.gpu,

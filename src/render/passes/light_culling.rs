@@ -126,7 +126,7 @@ pub(super) fn prepare(
     if device.features().contains(wgpu::Features::SUBGROUP) {
         d.push(("SUBGROUPS", "1".into()));
     }
-    // A compute resolve's R32Float depth (validation keeps it single-sample and opaque).
+    // A compute resolve's R32Float depth (validation keeps it single-sample).
     if cx.float_depth(sp.required(slot::DEPTH)) {
         d.push(("FLOAT_DEPTH", "1".into()));
     }

@@ -1,7 +1,8 @@
 //! `TransparentShading`: every blended mesh through its material and the light loop,
 //! back to front by the view depth of its bounds' centre, alpha-blended over the colour
-//! target, tested against the opaque depth (not written). The order follows the camera
-//! (`set_view`).
+//! target, tested against the opaque depth (not written): as a read-only depth
+//! attachment, or (an R32Float depth, a compute resolve's) in the fragment shader, with
+//! no depth attachment. The order follows the camera (`set_view`).
 
 use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::Name;
@@ -15,7 +16,8 @@ use std::sync::Mutex;
 pub(super) struct TransparentShadingPass {
     name: Name,
     color: wgpu::TextureView,
-    depth: wgpu::TextureView,
+    /// The depth attachment; None where the shader tests an R32Float depth itself.
+    depth: Option<wgpu::TextureView>,
     clear: bool,
     draws: MeshDraws,
     gpu: SceneGpu,
@@ -42,10 +44,13 @@ pub(super) fn prepare(
     }
     let mut offered = cx.declared(sp)?;
     let lists = cx.shading_lists(sp, p.lights, &mut offered)?;
+    // Validation keeps an R32Float depth single-sample, as the colour target.
+    let float_depth = cx.float_depth(depth);
     let mode = DrawMode::Shade {
         lists,
         blend: true,
         shadows: crate::graph::kinds::forward_shading::Shadows::None,
+        float_depth,
     };
     let draws = cx.renderer.mesh_draws(
         cx.gpu,
@@ -59,7 +64,11 @@ pub(super) fn prepare(
     Ok(TransparentShadingPass {
         name: sp.name.clone(),
         color: cx.view(&sp.name, color)?,
-        depth: cx.view(&sp.name, depth)?,
+        depth: if float_depth {
+            None
+        } else {
+            Some(cx.view(&sp.name, depth)?)
+        },
         clear: sp.clears(color),
         draws,
         gpu: cx.gpu.clone(),
@@ -73,7 +82,7 @@ impl PreparedPass for TransparentShadingPass {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(&self.name),
             color_attachments: &[Some(color_attachment(&self.color, clear, None))],
-            depth_stencil_attachment: Some(depth_attachment(&self.depth, false)),
+            depth_stencil_attachment: self.depth.as_ref().map(|d| depth_attachment(d, false)),
             timestamp_writes: ts.render(),
             occlusion_query_set: None,
             multiview_mask: None,
