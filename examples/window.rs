@@ -105,8 +105,7 @@ impl App {
             &gpu,
             (config.width, config.height),
         );
-        let presenter = Presenter::new(&device, &renderer.shaders, config.format)
-            .unwrap_or_else(|e| panic!("{e}"));
+        let presenter = Presenter::new(&renderer, config.format).unwrap_or_else(|e| panic!("{e}"));
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("bar"),
             source: wgpu::ShaderSource::Wgsl(BAR_WGSL.into()),

@@ -81,7 +81,7 @@ fn a_frame_recorded_into_the_callers_encoder_lands_in_the_callers_texture() {
         view_formats: &[],
     });
     let view = target.create_view(&Default::default());
-    let presenter = Presenter::new(&device, &r.shaders, format).expect("present pipeline");
+    let presenter = Presenter::new(&r, format).expect("present pipeline");
     let mut encoder = device.create_command_encoder(&Default::default());
     frame.record(&mut encoder);
     presenter.draw(

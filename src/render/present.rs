@@ -1,7 +1,9 @@
-//! Draws a graph's HDR output into the window: scaled to the window size and tonemapped
-//! exactly like the CLI's PNG output (`shaders/view/present.wgsl`).
+//! Draws a graph's HDR output into a colour target (the viewer's window, or an embedding
+//! application's texture): scaled to the target's size and tonemapped exactly like the
+//! CLI's PNG output (`shaders/view/present.wgsl`).
 
-use crate::shader::{ShaderError, ShaderLibrary};
+use super::Renderer;
+use crate::shader::ShaderError;
 use std::collections::BTreeMap;
 
 #[repr(C)]
@@ -19,12 +21,10 @@ pub struct Presenter {
 }
 
 impl Presenter {
-    /// Builds the present pipeline for a window of `format`.
-    pub fn new(
-        device: &wgpu::Device,
-        shaders: &ShaderLibrary,
-        format: wgpu::TextureFormat,
-    ) -> Result<Self, ShaderError> {
+    /// Builds the present pipeline for a target of `format` (a window's, or any colour
+    /// texture of the caller's), with the renderer's shaders and driver pipeline cache.
+    pub fn new(renderer: &Renderer, format: wgpu::TextureFormat) -> Result<Self, ShaderError> {
+        let (device, shaders) = (&renderer.ctx.device, &renderer.shaders);
         let defines =
             BTreeMap::from([("SRGB_ENCODE".to_string(), (!format.is_srgb()).to_string())]);
         let composed = shaders.compose("view/present.wgsl", &defines, &BTreeMap::new())?;
@@ -83,7 +83,7 @@ impl Presenter {
                 targets: &[Some(format.into())],
             }),
             multiview_mask: None,
-            cache: None,
+            cache: renderer.ctx.pipeline_cache.as_ref().map(|c| c.cache()),
         });
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("present params"),

@@ -155,7 +155,7 @@ impl Viewer {
         }
 
         let renderer = Renderer::new(ctx, ShaderLibrary::builtin());
-        let presenter = Presenter::new(&renderer.ctx.device, &renderer.shaders, config.format)?;
+        let presenter = Presenter::new(&renderer, config.format)?;
         let egui_renderer =
             egui_wgpu::Renderer::new(&renderer.ctx.device, config.format, Default::default());
         let adapter = renderer.ctx.adapter_name();
