@@ -178,6 +178,18 @@ impl Material {
     pub fn path(&self) -> &Path {
         &self.path
     }
+    /// Whether shading it reads more of the surface than a position and a normal: the
+    /// uv (its textures) or the tangent (an anisotropic lobe). A deferred G-buffer keeps
+    /// those for such materials only.
+    pub fn reads_uv_or_tangent(&self) -> bool {
+        !self.slots.is_empty()
+            || self
+                .desc
+                .layers
+                .iter()
+                .flat_map(|l| &l.lobes)
+                .any(|l| matches!(l, model::Lobe::AnisoGgx { .. }))
+    }
     /// The bit this material answers to in a light's material mask.
     pub fn type_bit(&self) -> u32 {
         self.desc.type_bit

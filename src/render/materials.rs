@@ -23,6 +23,8 @@ pub struct MaterialProgram {
     pub(super) textures: Option<BindingSet>,
     /// GPU bytes of the material's textures, every mip level included (4/3 of level 0).
     pub texture_bytes: u64,
+    /// Whether shading reads the uv or the tangent ([`Material::reads_uv_or_tangent`]).
+    pub reads_uv_or_tangent: bool,
 }
 
 impl MaterialProgram {
@@ -137,6 +139,7 @@ impl MaterialProgram {
             double_sided,
             textures,
             texture_bytes,
+            reads_uv_or_tangent: material.reads_uv_or_tangent(),
         })
     }
 

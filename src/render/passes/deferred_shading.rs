@@ -27,6 +27,14 @@ struct ShadeDispatch {
     textures: Option<wgpu::BindGroup>,
 }
 
+/// Whether the G-buffer's surface pair (`g_surface`, `g_uv_grad`) is written and read:
+/// where the graph gives it (the G-buffer pass and deferred shading name it alike) and a
+/// material of the scene reads the uv or the tangent. Without such a material the pair
+/// would be bandwidth for nothing, so neither pass touches it.
+pub(super) fn writes_surface(cx: &PrepareCtx, sp: &ScheduledPass) -> bool {
+    sp.roles.slot(G_SURFACE).is_some() && cx.gpu.materials.iter().any(|m| m.reads_uv_or_tangent)
+}
+
 pub(super) fn prepare(
     cx: &mut PrepareCtx,
     sp: &ScheduledPass,
@@ -34,7 +42,7 @@ pub(super) fn prepare(
 ) -> Result<DeferredShadingPass, RenderError> {
     // Without a normals texture the G-buffer is the packed one.
     let packed = sp.roles.slot(G_NORMAL).is_none();
-    let surface = sp.roles.slot(G_SURFACE).is_some();
+    let surface = writes_surface(cx, sp);
     let mut offered = cx.declared(sp)?;
     let lists = cx.shading_lists(sp, p.lights, &mut offered)?;
     let shadows = cx.shading_shadows(sp, &mut offered);
@@ -67,7 +75,7 @@ pub(super) fn prepare(
     let mut dispatches = Vec::new();
     for (index, m) in cx.gpu.materials.iter().enumerate() {
         let textured = m.textures.is_some();
-        if textured && !surface {
+        if m.reads_uv_or_tangent && !surface {
             return Err(pass_error(
                 &sp.name,
                 format!("material '{}' has textures: its G-buffer needs the surface targets '{G_SURFACE}' and 'g_uv_grad' (uv, tangent and uv derivatives), which this pass does not read", m.name),
