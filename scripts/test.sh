@@ -57,6 +57,8 @@ fi
 # Headless tests need no display server; the runtime dir quiets winit and Mesa.
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp}"
 cargo test --release --all-targets
+# The crate documentation's example renders a frame; --all-targets leaves doctests out.
+cargo test --release --doc
 # The renderer alone, as a library user without the CLI, bench or viewer builds it. A check
 # (no code generation) finds every compile error of a library at a fraction of a build's
 # time.
