@@ -4,7 +4,7 @@
 //! ([`parse`]), its out-of-range values are clamped or flagged ([`sanitize`]), and it
 //! compiles to WGSL ([`wgsl`]) that plugs into the forward light loop through
 //! `material_setup` / `material_eval` / `material_emission` / `material_alpha`.
-//! [`reference`] is the f64 CPU implementation the tests compare the GPU against.
+//! [`reference`](mod@reference) is the f64 CPU implementation the tests compare the GPU against.
 //!
 //! # Accuracy (f32 WGSL against the f64 reference)
 //!

@@ -320,7 +320,7 @@ impl PipelineCache {
         self.keys_last_generation.get(pass).copied().unwrap_or(0)
     }
 
-    /// Whether this [`ForkMode::Only`] fork's build raised no validation error.
+    /// Whether this `ForkMode::Only` fork's build raised no validation error.
     pub fn fork_build_clean(&self) -> bool {
         self.fork_build_clean
     }

@@ -53,7 +53,7 @@ pub struct MaterialDesc {
     pub alpha_mode: &'static str,
     pub alpha_cutoff: Option<f32>,
     pub double_sided: bool,
-    /// Texture indices from [`GltfWriter::add_texture`].
+    /// Texture indices from [`GltfWriter::add_texture_bytes`].
     pub base_color_texture: Option<usize>,
     pub metallic_roughness_texture: Option<usize>,
     pub normal_texture: Option<usize>,

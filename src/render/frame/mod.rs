@@ -443,7 +443,7 @@ impl PreparedFrame {
     }
 
     /// The graph's output texture (Rgba32Float; sampled by the viewer). Planned for every
-    /// prepared frame: [`check_output_written`].
+    /// prepared frame: `check_output_written`.
     pub fn output_texture(&self) -> &wgpu::Texture {
         self.resources
             .texture(&self.graph.plan, self.graph.output())
