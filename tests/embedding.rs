@@ -162,3 +162,32 @@ fn a_device_that_cannot_run_a_pass_is_refused_with_the_pass_and_the_features() {
         assert!(e.contains(needed), "'{needed}' missing from: {e}");
     }
 }
+
+/// A project's own present shader that binds something the present pass does not offer
+/// is refused when the presenter is built, naming its file and line, instead of failing
+/// inside wgpu when the pipeline or bind group is made.
+#[test]
+fn a_present_shader_binding_an_unoffered_name_is_refused_with_its_line() {
+    let (adapter, device, queue) = callers_device(GpuContext::wanted_features());
+    let mut r = Renderer::from_device(adapter, device, queue);
+    let dir = tempfile::tempdir().unwrap();
+    let builtin = lightgraph::shader::assets::builtin("shaders/view/present.wgsl").unwrap();
+    let own = builtin.replace(
+        "@group(0) @binding(1) var<uniform> params: PresentParams;",
+        "@group(0) @binding(1) var<uniform> params: PresentParams;\n@group(0) @binding(2) var<uniform> extra: vec4<f32>;",
+    );
+    assert_ne!(own, builtin, "the test edits the shipped shader");
+    let own = own.replace(
+        "return vec4<f32>(rgb, 1.0);",
+        "return vec4<f32>(rgb, 1.0) + extra * 0.0;",
+    );
+    std::fs::create_dir_all(dir.path().join("view")).unwrap();
+    std::fs::write(dir.path().join("view/present.wgsl"), own).unwrap();
+    r.shaders = lightgraph::shader::ShaderLibrary::with_builtin(dir.path());
+    let e = Presenter::new(&r, wgpu::TextureFormat::Rgba8UnormSrgb)
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(e.contains("present.wgsl:14"), "{e}");
+    assert!(e.contains("'extra'"), "{e}");
+}

@@ -2,8 +2,9 @@
 //! application's texture): scaled to the target's size and tonemapped exactly like the
 //! CLI's PNG output (`shaders/view/present.wgsl`).
 
+use super::bind::{layout_entries, BindingSet, Bound};
 use super::Renderer;
-use crate::shader::ShaderError;
+use crate::shader::{reflect_bindings, ReflectedBinding, ShaderError};
 use std::collections::BTreeMap;
 
 #[repr(C)]
@@ -14,9 +15,13 @@ struct PresentParams {
     target_size: [f32; 2],
 }
 
+/// What the present pass offers its shader, by binding name.
+const OFFERED: [&str; 2] = ["hdr", "params"];
+
 pub struct Presenter {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
+    bindings: Vec<ReflectedBinding>,
     params: wgpu::Buffer,
 }
 
@@ -28,36 +33,36 @@ impl Presenter {
         let defines =
             BTreeMap::from([("SRGB_ENCODE".to_string(), (!format.is_srgb()).to_string())]);
         let composed = shaders.compose("view/present.wgsl", &defines, &BTreeMap::new())?;
-        composed.validate()?;
+        // Bound by the reflected binding names, as every pass's shader is.
+        let bindings = reflect_bindings(&composed.validate()?);
+        if let Some(b) = bindings
+            .iter()
+            .find(|b| !OFFERED.contains(&b.name.as_str()))
+        {
+            // A project's own present.wgsl may declare anything: name the line.
+            let declared = |l: &&str| l.contains("var") && l.contains(&format!(" {}:", b.name));
+            let at = composed
+                .text
+                .lines()
+                .position(|l| declared(&l))
+                .unwrap_or(0);
+            let (file, line) = composed.origin.get(at).cloned().unwrap_or_default();
+            return Err(ShaderError::Directive {
+                file,
+                line,
+                message: format!(
+                    "the present pass binds '{}'; it offers only {OFFERED:?}",
+                    b.name
+                ),
+            });
+        }
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("present"),
             source: wgpu::ShaderSource::Wgsl(composed.text.into()),
         });
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("present"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        // Rgba32Float is not filterable everywhere: the shader loads texels.
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-            ],
+            entries: &layout_entries(&bindings, 0, wgpu::ShaderStages::FRAGMENT),
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("present"),
@@ -94,6 +99,7 @@ impl Presenter {
         Ok(Self {
             pipeline,
             layout,
+            bindings,
             params,
         })
     }
@@ -116,21 +122,12 @@ impl Presenter {
             target_size: [target_size[0] as f32, target_size[1] as f32],
         };
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
-        let hdr_view = hdr.create_view(&Default::default());
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("present"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&hdr_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: self.params.as_entire_binding(),
-                },
-            ],
-        });
+        let mut offered = BindingSet::default();
+        offered.offer("hdr", Bound::View(hdr.create_view(&Default::default())));
+        offered.buffer("params", &self.params);
+        let bind = offered
+            .bind(device, "present", &self.layout, &self.bindings, 0)
+            .expect("new() refused shaders binding anything but OFFERED");
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("present"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
