@@ -123,21 +123,8 @@ fn a_textured_material_needs_the_surface_targets() {
         "{text}"
     );
     let (_, s) = scenes().remove(0);
-    let checked = lightgraph::graph::check_text(
-        std::path::Path::new("<test>"),
-        &text,
-        &lightgraph::shader::ShaderLibrary::builtin(),
-    )
-    .unwrap();
-    let size = lightgraph::graph::FrameSize {
-        width: W,
-        height: H,
-        lights: s.lights.len() as u32,
-    };
-    let compiled = lightgraph::graph::compile(checked, &s.features(), size);
     let mut r = renderer();
-    let gpu = lightgraph::render::SceneGpu::upload(&r.ctx.device, &r.ctx.queue, &s).unwrap();
-    let e = match r.prepare(compiled, &s, &gpu, size, false) {
+    let e = match prepare_text(&mut r, &text, &s, W, H, false) {
         Ok(_) => panic!("a textured material through a G-buffer without surface targets"),
         Err(e) => e.to_string(),
     };
@@ -181,20 +168,7 @@ fn the_surface_pair_is_written_only_for_materials_that_read_it() {
     let mut r = renderer();
     let written = |r: &mut lightgraph::render::Renderer, s: &Scene| {
         let text = std::fs::read_to_string(graph_path("tiled_deferred.ron")).unwrap();
-        let checked = lightgraph::graph::check_text(
-            std::path::Path::new("tiled_deferred.ron"),
-            &text,
-            &lightgraph::shader::ShaderLibrary::builtin(),
-        )
-        .unwrap();
-        let size = lightgraph::graph::FrameSize {
-            width: W,
-            height: H,
-            lights: s.lights.len() as u32,
-        };
-        let compiled = lightgraph::graph::compile(checked, &s.features(), size);
-        let gpu = lightgraph::render::SceneGpu::upload(&r.ctx.device, &r.ctx.queue, s).unwrap();
-        let frame = r.prepare(compiled, s, &gpu, size, false).unwrap();
+        let frame = prepare_text(r, &text, s, W, H, false).unwrap();
         frame.execute(r).unwrap();
         let surface = frame.read_texture(r, "g_surface").unwrap();
         assert_eq!(surface.len(), (W * H) as usize, "g_surface's size");

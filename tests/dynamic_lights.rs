@@ -333,22 +333,20 @@ fn scene_file_motion_is_a_pure_function_of_time() {
 
 #[test]
 fn bad_motion_is_named_with_its_light() {
-    let text = MOVING_SCENE.replace("period: 3", "period: 0");
-    let spec = lightgraph::scene::scene_file::parse_scene_file(&text, Path::new("m.ron")).unwrap();
-    let e = lightgraph::scene::scene_file::build_scene(&spec, Path::new("m.ron"))
-        .err()
-        .unwrap()
-        .to_string();
+    let refusal = |text: &str| {
+        let spec =
+            lightgraph::scene::scene_file::parse_scene_file(text, Path::new("m.ron")).unwrap();
+        lightgraph::scene::scene_file::build_scene(&spec, Path::new("m.ron"))
+            .err()
+            .unwrap()
+            .to_string()
+    };
+    let e = refusal(&MOVING_SCENE.replace("period: 3", "period: 0"));
     assert!(
         e.contains("lights[0]") && e.contains("path period 0"),
         "{e}"
     );
-    let text = MOVING_SCENE.replace("amplitude: 0.8", "amplitude: 1.5");
-    let spec = lightgraph::scene::scene_file::parse_scene_file(&text, Path::new("m.ron")).unwrap();
-    let e = lightgraph::scene::scene_file::build_scene(&spec, Path::new("m.ron"))
-        .err()
-        .unwrap()
-        .to_string();
+    let e = refusal(&MOVING_SCENE.replace("amplitude: 0.8", "amplitude: 1.5"));
     assert!(
         e.contains("light_sets[0]") && e.contains("flicker amplitude"),
         "{e}"

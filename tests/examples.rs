@@ -25,20 +25,20 @@ fn example(name: &str) -> PathBuf {
     path
 }
 
-#[test]
-fn the_headless_example_writes_its_png() {
+/// Runs example `name` with `inputs` (paths under the project) and an output PNG in a
+/// fresh folder, and returns the PNG it wrote, checked to be the documented 640×360.
+fn run_for_png(name: &str, inputs: &[&str]) -> image::RgbImage {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("frame.png");
-    let run = Command::new(example("headless_png"))
-        .arg(root.join("scenes/harada.ron"))
-        .arg(root.join("graphs/visibility_compute_raster.ron"))
+    let run = Command::new(example(name))
+        .args(inputs.iter().map(|i| root.join(i)))
         .arg(&out)
         .output()
         .expect("the example runs");
     assert!(
         run.status.success(),
-        "headless_png failed: {}",
+        "{name} failed: {}",
         String::from_utf8_lossy(&run.stderr)
     );
     let png = image::open(&out).expect("a PNG was written").to_rgb8();
@@ -46,6 +46,15 @@ fn the_headless_example_writes_its_png() {
         png.dimensions(),
         (640, 360),
         "the example's documented size"
+    );
+    png
+}
+
+#[test]
+fn the_headless_example_writes_its_png() {
+    let png = run_for_png(
+        "headless_png",
+        &["scenes/harada.ron", "graphs/visibility_compute_raster.ron"],
     );
     // Harada's floor and boxes fill most of the lower half under 3,072 lights; an
     // unlit, black or blank frame would light almost nothing (the sky above is black).
@@ -66,25 +75,7 @@ fn outline_pixels(png: &image::RgbImage) -> usize {
 
 #[test]
 fn the_custom_pass_example_outlines_the_silhouettes() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("outlined.png");
-    let run = Command::new(example("custom_pass"))
-        .arg(root.join("scenes/harada.ron"))
-        .arg(&out)
-        .output()
-        .expect("the example runs");
-    assert!(
-        run.status.success(),
-        "custom_pass failed: {}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-    let png = image::open(&out).expect("a PNG was written").to_rgb8();
-    assert_eq!(
-        png.dimensions(),
-        (640, 360),
-        "the example's documented size"
-    );
+    let png = run_for_png("custom_pass", &["scenes/harada.ron"]);
     // Harada's boxes against the floor and the black sky: thousands of silhouette pixels
     // (about 3% of the frame); lit surfaces never reach the outline's exact colour.
     let share = outline_pixels(&png) as f64 / (640.0 * 360.0);

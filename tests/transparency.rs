@@ -273,6 +273,18 @@ fn blended_back_to_front_whatever_the_scene_order() {
     }
 }
 
+/// The passes `when: Transparent` dropped from `compiled`, sorted.
+fn skipped_without_glass(compiled: &graph::CompiledGraph) -> Vec<&str> {
+    let mut skipped: Vec<&str> = compiled
+        .culled
+        .iter()
+        .filter(|c| matches!(&c.reason, CullReason::WhenFalse(f) if f == "Transparent"))
+        .map(|c| c.name.as_str())
+        .collect();
+    skipped.sort();
+    skipped
+}
+
 #[test]
 fn without_blended_meshes_the_transparency_passes_are_skipped() {
     let scene = random_scene(24, 15);
@@ -289,15 +301,8 @@ fn without_blended_meshes_the_transparency_passes_are_skipped() {
         lights: scene.lights.len() as u32,
     };
     let compiled = graph::compile(checked, &scene.features(), size);
-    let mut skipped: Vec<&str> = compiled
-        .culled
-        .iter()
-        .filter(|c| matches!(&c.reason, CullReason::WhenFalse(f) if f == "Transparent"))
-        .map(|c| c.name.as_str())
-        .collect();
-    skipped.sort();
     assert_eq!(
-        skipped,
+        skipped_without_glass(&compiled),
         [
             "transparent_culling",
             "transparent_prepass",
@@ -378,15 +383,8 @@ fn without_blended_meshes_the_default_graph_is_the_compute_first_frame() {
         "{:?}",
         d.texture_usage
     );
-    let mut skipped: Vec<&str> = default
-        .culled
-        .iter()
-        .filter(|c| matches!(&c.reason, CullReason::WhenFalse(f) if f == "Transparent"))
-        .map(|c| c.name.as_str())
-        .collect();
-    skipped.sort();
     assert_eq!(
-        skipped,
+        skipped_without_glass(&default),
         [
             "transparent_culling",
             "transparent_prepass",

@@ -7,7 +7,7 @@ pub mod textured;
 
 use glam::{Vec2, Vec3, Vec4};
 use lightgraph::graph::{self, FrameSize};
-use lightgraph::render::{FrameResult, Renderer, SceneGpu};
+use lightgraph::render::{FrameResult, PreparedFrame, RenderError, Renderer, SceneGpu};
 use lightgraph::scene::{Camera, Light, LightShape, Mesh, Scene, SurfaceMaterial};
 use lightgraph::shader::ShaderLibrary;
 use std::path::Path;
@@ -254,6 +254,21 @@ pub fn render_text_with(
     height: u32,
     light_stats: bool,
 ) -> FrameResult {
+    let prepared = prepare_text(r, graph_text, scene, width, height, light_stats).expect("prepare");
+    prepared.render(r).expect("render")
+}
+
+/// A valid graph's text compiled for `scene` and prepared at `width`×`height` (light
+/// statistics where asked and the graph has forward shading): what `render_text_with`
+/// runs, for tests that read the frame's resources or expect prepare to refuse.
+pub fn prepare_text(
+    r: &mut Renderer,
+    graph_text: &str,
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    light_stats: bool,
+) -> Result<PreparedFrame, RenderError> {
     let checked = graph::check_text(Path::new("<test>"), graph_text, &ShaderLibrary::builtin())
         .expect("valid graph");
     let size = FrameSize {
@@ -264,10 +279,7 @@ pub fn render_text_with(
     let compiled = graph::compile(checked, &scene.features(), size);
     let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, scene).expect("materials");
     let stats = light_stats && compiled.has_forward_shading();
-    let prepared = r
-        .prepare(compiled, scene, &gpu, size, stats)
-        .expect("prepare");
-    prepared.render(r).expect("render")
+    r.prepare(compiled, scene, &gpu, size, stats)
 }
 
 pub fn render_file(
