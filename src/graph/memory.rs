@@ -32,7 +32,7 @@ impl TechniqueMemory {
     }
 }
 
-pub fn bytes_per_texel(format: TextureFormat) -> u64 {
+pub(crate) fn bytes_per_texel(format: TextureFormat) -> u64 {
     match format {
         TextureFormat::Rgba8Unorm
         | TextureFormat::R32Float
@@ -44,7 +44,7 @@ pub fn bytes_per_texel(format: TextureFormat) -> u64 {
     }
 }
 
-pub fn physical_bytes(desc: &PhysicalDesc) -> u64 {
+pub(crate) fn physical_bytes(desc: &PhysicalDesc) -> u64 {
     match *desc {
         PhysicalDesc::Texture {
             format,

@@ -15,7 +15,7 @@ mod order;
 mod parse;
 pub mod plan;
 mod roles;
-pub mod sizes;
+pub(crate) mod sizes;
 mod specialise;
 mod validate;
 

@@ -83,13 +83,13 @@ pub enum TextureFormat {
 }
 
 impl TextureFormat {
-    pub fn is_depth(self) -> bool {
+    pub(crate) fn is_depth(self) -> bool {
         matches!(
             self,
             TextureFormat::Depth32Float | TextureFormat::Depth16Unorm
         )
     }
-    pub fn to_wgpu(self) -> wgpu::TextureFormat {
+    pub(crate) fn to_wgpu(self) -> wgpu::TextureFormat {
         use wgpu::TextureFormat as W;
         match self {
             TextureFormat::Rgba8Unorm => W::Rgba8Unorm,

@@ -29,7 +29,7 @@ pub enum PhysicalDesc {
 pub struct PhysicalResource {
     pub desc: PhysicalDesc,
     pub texture_usage: wgpu::TextureUsages,
-    pub buffer_usage: wgpu::BufferUsages,
+    pub(crate) buffer_usage: wgpu::BufferUsages,
     /// Graph resources this one serves, in order of use.
     pub serves: Vec<Name>,
     /// Last schedule position of any resource it serves.

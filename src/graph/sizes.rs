@@ -20,16 +20,16 @@ pub const MAX_TEXTURE_SIDE: u32 = 16384;
 pub const MAX_SCALE: f32 = 4.0;
 /// Largest `Bytes` buffer, and largest per-pixel, per-tile or per-light unit.
 pub const MAX_BUFFER_BYTES: u64 = 1 << 40;
-pub const MAX_BUFFER_UNIT: u64 = 1 << 32;
+pub(crate) const MAX_BUFFER_UNIT: u64 = 1 << 32;
 /// WebGPU's default limits, which every wgpu device offers.
 pub const MAX_WORKGROUPS_PER_DIMENSION: u32 = 65535;
-pub const MAX_INVOCATIONS_PER_WORKGROUP: u32 = 256;
-pub const MAX_WORKGROUP_SIZE: [u32; 3] = [256, 256, 64];
+pub(crate) const MAX_INVOCATIONS_PER_WORKGROUP: u32 = 256;
+pub(crate) const MAX_WORKGROUP_SIZE: [u32; 3] = [256, 256, 64];
 /// Sample counts wgpu knows; which of them a format has on the adapter is checked at
 /// prepare (`render/device_limits.rs`).
 pub const SAMPLE_COUNTS: [u32; 5] = [1, 2, 4, 8, 16];
 
-pub fn check_resources(desc: &GraphDesc, source: &SourceText, errors: &mut Vec<GraphError>) {
+pub(crate) fn check_resources(desc: &GraphDesc, source: &SourceText, errors: &mut Vec<GraphError>) {
     for r in &desc.resources {
         let problem = match r {
             ResourceDesc::Texture { size, samples, .. } => texture_problem(*size).or_else(|| {

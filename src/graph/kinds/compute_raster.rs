@@ -10,13 +10,13 @@ use super::{slot, Access, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 use crate::graph::model::{ResourceDesc, SceneResource, TextureFormat};
 
-pub const VERTICES: &str = "vertices";
-pub const TRIANGLES: &str = "triangles";
-pub const MATERIAL_TRIANGLES: &str = "material_triangles";
+pub(crate) const VERTICES: &str = "vertices";
+pub(crate) const TRIANGLES: &str = "triangles";
+pub(crate) const MATERIAL_TRIANGLES: &str = "material_triangles";
 /// Per pixel, the id of the nearest triangle (what visibility-buffer shading reads).
 pub const VISIBILITY: &str = "visibility";
 
-pub const SLOTS: &[SlotSpec] = &[
+pub(crate) const SLOTS: &[SlotSpec] = &[
     SlotSpec::new(
         VERTICES,
         SlotType::Import(SceneResource::Vertices),

@@ -19,7 +19,7 @@ pub struct DeferredShading {
 /// The texture it stores into (the shader's binding name).
 pub const HDR: &str = "hdr";
 
-pub const SLOTS: &[SlotSpec] = &[
+pub(crate) const SLOTS: &[SlotSpec] = &[
     SlotSpec::new(
         G_POSITION,
         SlotType::ColorTexture,

@@ -3,7 +3,7 @@
 
 use super::{slot, Access, KindRules, SlotSpec, SlotType, Usage};
 
-pub const SLOTS: &[SlotSpec] = &[
+pub(crate) const SLOTS: &[SlotSpec] = &[
     super::GEOMETRY_READ,
     SlotSpec::new(
         slot::DEPTH,

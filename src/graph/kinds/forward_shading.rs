@@ -16,7 +16,7 @@ pub struct ForwardShading {
     pub lights: LightSource,
 }
 
-pub const SLOTS: &[SlotSpec] = &[
+pub(crate) const SLOTS: &[SlotSpec] = &[
     super::GEOMETRY_READ,
     super::LIGHT_GEOMETRY_READ,
     super::LIGHT_PROPERTIES_READ,

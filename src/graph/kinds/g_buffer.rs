@@ -8,8 +8,8 @@
 use super::{slot, Access, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 
-pub const G_POSITION: &str = "g_position";
-pub const G_NORMAL: &str = "g_normal";
+pub(crate) const G_POSITION: &str = "g_position";
+pub(crate) const G_NORMAL: &str = "g_normal";
 /// Geometric (face) normals facing the viewer, for ray-cast shadows' origin offset.
 pub const G_GEOMETRIC: &str = "g_geometric";
 /// The material's surface inputs: uv, the tangent's angle about the normal, handedness.
@@ -17,7 +17,7 @@ pub const G_SURFACE: &str = "g_surface";
 /// The uv's screen derivatives (d/dx, d/dy), the mip footprint textures are sampled with.
 pub const G_UV_GRAD: &str = "g_uv_grad";
 
-pub const SLOTS: &[SlotSpec] = &[
+pub(crate) const SLOTS: &[SlotSpec] = &[
     super::GEOMETRY_READ,
     SlotSpec::new(
         slot::DEPTH,
@@ -131,7 +131,7 @@ pub const G_POSITION_READ: SlotSpec = SlotSpec::new(
     Access::Read,
     Usage::Sampled,
 );
-pub const G_GEOMETRIC_READ: SlotSpec = SlotSpec::new(
+pub(crate) const G_GEOMETRIC_READ: SlotSpec = SlotSpec::new(
     G_GEOMETRIC,
     SlotType::ColorTexture,
     Access::Read,
@@ -146,7 +146,7 @@ pub const G_SURFACE_READ: SlotSpec = SlotSpec::new(
     Usage::Sampled,
 )
 .optional();
-pub const G_UV_GRAD_READ: SlotSpec = SlotSpec::new(
+pub(crate) const G_UV_GRAD_READ: SlotSpec = SlotSpec::new(
     G_UV_GRAD,
     SlotType::ColorTexture,
     Access::Read,

@@ -74,7 +74,7 @@ pub enum ListMode {
     },
 }
 
-pub const DEFAULT_CAPACITY: u32 = 256;
+pub(crate) const DEFAULT_CAPACITY: u32 = 256;
 /// Scratch slot of compact lists, in light indices: at 1920×1080 with 16-pixel tiles
 /// fixed lists of 256 held every tile of harada's 3,072 lights, so none is filled twice
 /// there; 8 MiB of the shipped 64 MiB bound.
@@ -113,7 +113,7 @@ impl LightCulling {
             },
         }
     }
-    pub fn list_layout(&self, width: u32, height: u32) -> ListLayout {
+    pub(crate) fn list_layout(&self, width: u32, height: u32) -> ListLayout {
         ListLayout::new(self.tile, self.variant, self.storage(), width, height)
     }
 }
@@ -153,7 +153,7 @@ pub enum ListStorage {
 }
 
 impl ListLayout {
-    pub const HEADER_WORDS: u32 = 4;
+    pub(crate) const HEADER_WORDS: u32 = 4;
     /// Words per list entry: offset, count, and the view-depth range it covers (f32 bits).
     pub const ENTRY_WORDS: u32 = 4;
     /// Lists per workgroup of the compact layout's scan (256 invocations × 4 lists).
@@ -225,7 +225,7 @@ impl ListLayout {
     }
 }
 
-pub const SLOTS: &[SlotSpec] = &[
+pub(crate) const SLOTS: &[SlotSpec] = &[
     // A depth format, or R32Float depths (a compute-only frame's ComputeRaster).
     SlotSpec::new(
         slot::DEPTH,

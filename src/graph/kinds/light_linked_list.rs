@@ -30,7 +30,7 @@ fn default_links_per_pixel() -> u32 {
 pub const LIGHT_LINKS: &str = "light_links";
 
 impl LightLinkedList {
-    pub fn link_layout(&self, width: u32, height: u32) -> LinkLayout {
+    pub(crate) fn link_layout(&self, width: u32, height: u32) -> LinkLayout {
         let scale = self.scale.max(1);
         let (w, h) = (width.div_ceil(scale), height.div_ceil(scale));
         LinkLayout {
@@ -57,8 +57,8 @@ pub struct LinkLayout {
 }
 
 impl LinkLayout {
-    pub const HEADER_WORDS: u64 = 4;
-    pub const LINK_WORDS: u64 = 3;
+    pub(crate) const HEADER_WORDS: u64 = 4;
+    pub(crate) const LINK_WORDS: u64 = 3;
     pub fn pixels(&self) -> u64 {
         self.width as u64 * self.height as u64
     }
@@ -76,7 +76,7 @@ impl LinkLayout {
     }
 }
 
-pub const SLOTS: &[SlotSpec] = &[
+pub(crate) const SLOTS: &[SlotSpec] = &[
     // A depth format, or R32Float depths (a compute-only frame's ComputeRaster).
     SlotSpec::new(
         slot::DEPTH,

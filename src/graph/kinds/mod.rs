@@ -205,7 +205,7 @@ impl KindCtx<'_> {
     pub fn slot(&self, name: &str) -> Option<&str> {
         self.roles.slot(name)
     }
-    pub fn mismatch(&self, resource: &str, problem: impl Into<String>) -> GraphError {
+    pub(crate) fn mismatch(&self, resource: &str, problem: impl Into<String>) -> GraphError {
         self.graph.mismatch(self.pass, resource, problem)
     }
     pub fn bad(&self, problem: impl Into<String>) -> GraphError {
@@ -249,7 +249,7 @@ impl KindCtx<'_> {
     pub fn is_float_depth(&self, name: &str) -> bool {
         is_float_depth(self.graph.resources.get(name).copied())
     }
-    pub fn is_single_rgba32f(&self, name: &str) -> bool {
+    pub(crate) fn is_single_rgba32f(&self, name: &str) -> bool {
         matches!(
             self.graph.resources.get(name),
             Some(ResourceDesc::Texture {

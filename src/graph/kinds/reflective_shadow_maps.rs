@@ -44,11 +44,11 @@ impl ReflectiveShadowMaps {
     }
 }
 
-pub const RSM_DEPTH: &str = "rsm_depth";
-pub const RSM_NORMAL: &str = "rsm_normal";
-pub const RSM_FLUX: &str = "rsm_flux";
-pub const RSM_POSITION: &str = "rsm_position";
-pub const RSM_VIEWS: &str = "rsm_views";
+pub(crate) const RSM_DEPTH: &str = "rsm_depth";
+pub(crate) const RSM_NORMAL: &str = "rsm_normal";
+pub(crate) const RSM_FLUX: &str = "rsm_flux";
+pub(crate) const RSM_POSITION: &str = "rsm_position";
+pub(crate) const RSM_VIEWS: &str = "rsm_views";
 
 /// vec4 words of a view in the table: view-projection (4); (tile x, tile y, light, n)
 /// as u32; (texel solid angle on the axis, intensity scale, VPL range, distance clamp);
@@ -60,7 +60,7 @@ pub fn view_table_bytes(max_views: u64) -> u64 {
     16 * (1 + VIEW_VEC4S * max_views)
 }
 
-pub const SLOTS: &[SlotSpec] = &[
+pub(crate) const SLOTS: &[SlotSpec] = &[
     super::GEOMETRY_READ,
     super::LIGHT_GEOMETRY_READ,
     super::LIGHT_PROPERTIES_READ,

@@ -88,7 +88,7 @@ impl Default for ShadowAtlas {
 }
 
 pub const SHADOW_ATLAS: &str = "shadow_atlas";
-pub const SHADOW_VIEWS: &str = "shadow_views";
+pub(crate) const SHADOW_VIEWS: &str = "shadow_views";
 
 /// vec4 words a view takes in the view table: its view-projection (4), its tile in
 /// atlas UV (min, max), then (texel scale, normal offset, 0, 0).
@@ -107,7 +107,7 @@ impl ShadowAtlas {
     }
 }
 
-pub const SLOTS: &[SlotSpec] = &[
+pub(crate) const SLOTS: &[SlotSpec] = &[
     super::GEOMETRY_READ,
     SlotSpec::new(
         SHADOW_ATLAS,

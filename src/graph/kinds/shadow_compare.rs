@@ -10,12 +10,12 @@ use super::shadow_ray_jobs::SHADOW_MASK;
 use super::{slot, Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 
-pub const SHADOW_ERRORS: &str = "shadow_errors";
+pub(crate) const SHADOW_ERRORS: &str = "shadow_errors";
 /// Counters: pairs, disagreeing pairs with 5×5 PCF, with the 2×2 tap, pairs in a 5×5
 /// penumbra (0 < visibility < 1).
 pub const ERROR_WORDS: u64 = 4;
 
-pub const SLOTS: &[SlotSpec] = &[
+pub(crate) const SLOTS: &[SlotSpec] = &[
     G_POSITION_READ,
     SlotSpec::new(
         G_NORMAL,

@@ -27,10 +27,10 @@ fn default_normal_offset() -> f32 {
     DEFAULT_NORMAL_OFFSET
 }
 
-pub const BVH_NODES: &str = "bvh_nodes";
-pub const BVH_TRIANGLES: &str = "bvh_triangles";
+pub(crate) const BVH_NODES: &str = "bvh_nodes";
+pub(crate) const BVH_TRIANGLES: &str = "bvh_triangles";
 
-pub const SLOTS: &[SlotSpec] = &[
+pub(crate) const SLOTS: &[SlotSpec] = &[
     SlotSpec::new(SHADOW_JOBS, SlotType::Buffer, Access::Read, Usage::Bound)
         .needs(&[Contents::ShadowJobs]),
     G_POSITION_READ,

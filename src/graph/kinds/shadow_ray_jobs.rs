@@ -23,8 +23,8 @@ fn default_jobs_per_pixel() -> f32 {
     16.0
 }
 
-pub const SHADOW_JOBS: &str = "shadow_jobs";
-pub const SHADOW_MASK: &str = "shadow_mask";
+pub(crate) const SHADOW_JOBS: &str = "shadow_jobs";
+pub(crate) const SHADOW_MASK: &str = "shadow_mask";
 
 /// Words before the jobs: wanted, dropped, pixels over 128 casters, unused, then the
 /// indirect dispatch (x, y, z, unused).
@@ -46,7 +46,7 @@ pub fn job_buffer_bytes(capacity: u64) -> u64 {
     4 * (JOB_HEADER_WORDS + JOB_WORDS * capacity)
 }
 
-pub const SLOTS: &[SlotSpec] = &[
+pub(crate) const SLOTS: &[SlotSpec] = &[
     G_POSITION_READ,
     G_GEOMETRIC_READ,
     super::LIGHT_GEOMETRY_READ,

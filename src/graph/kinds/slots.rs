@@ -8,11 +8,11 @@ use crate::graph::model::SceneResource;
 /// Slot names shared by several kinds; each is also the WGSL binding name the kind's
 /// shader uses for it (attachments are not bindings).
 pub mod slot {
-    pub const GEOMETRY: &str = "geometry";
-    pub const DEPTH: &str = "depth";
-    pub const COLOR: &str = "color";
-    pub const LIGHT_GEOMETRY: &str = "light_geometry";
-    pub const LIGHT_PROPERTIES: &str = "light_properties";
+    pub(crate) const GEOMETRY: &str = "geometry";
+    pub(crate) const DEPTH: &str = "depth";
+    pub(crate) const COLOR: &str = "color";
+    pub(crate) const LIGHT_GEOMETRY: &str = "light_geometry";
+    pub(crate) const LIGHT_PROPERTIES: &str = "light_properties";
     pub const LIGHT_LISTS: &str = "light_lists";
     /// The nearest transparent depth a culling pass bounds its tiles with.
     pub const TRANSPARENT_DEPTH: &str = "transparent_depth";
@@ -113,7 +113,7 @@ pub enum Usage {
 pub struct SlotSpec {
     pub name: &'static str,
     pub ty: SlotType,
-    pub access: Access,
+    pub(crate) access: Access,
     pub optional: bool,
     pub usage: Usage,
     /// A read buffer's contract: what its writer must publish on it (one of these);
@@ -156,13 +156,13 @@ pub const GEOMETRY_READ: SlotSpec = SlotSpec::new(
     Usage::Bound,
 )
 .optional();
-pub const LIGHT_GEOMETRY_READ: SlotSpec = SlotSpec::new(
+pub(crate) const LIGHT_GEOMETRY_READ: SlotSpec = SlotSpec::new(
     slot::LIGHT_GEOMETRY,
     SlotType::Lights(SceneResource::LightGeometry),
     Access::Read,
     Usage::Bound,
 );
-pub const LIGHT_PROPERTIES_READ: SlotSpec = SlotSpec::new(
+pub(crate) const LIGHT_PROPERTIES_READ: SlotSpec = SlotSpec::new(
     slot::LIGHT_PROPERTIES,
     SlotType::Lights(SceneResource::LightProperties),
     Access::Read,
@@ -187,7 +187,7 @@ pub const SHADOW_ATLAS_READ: SlotSpec = SlotSpec::new(
     Usage::Sampled,
 )
 .optional();
-pub const SHADOW_VIEWS_READ: SlotSpec = SlotSpec::new(
+pub(crate) const SHADOW_VIEWS_READ: SlotSpec = SlotSpec::new(
     shadow_atlas::SHADOW_VIEWS,
     SlotType::Buffer,
     Access::Read,

@@ -6,7 +6,7 @@
 use super::{slot, Access, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::roles::PassRoles;
 
-pub const SLOTS: &[SlotSpec] = &[
+pub(crate) const SLOTS: &[SlotSpec] = &[
     super::GEOMETRY_READ,
     SlotSpec::new(
         slot::DEPTH,

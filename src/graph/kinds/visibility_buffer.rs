@@ -10,7 +10,7 @@ use crate::graph::model::{ResourceDesc, TextureFormat};
 /// The triangle-id texture (also the binding name `VisibilityShading` reads it by).
 pub const VISIBILITY: &str = "visibility";
 
-pub const SLOTS: &[SlotSpec] = &[
+pub(crate) const SLOTS: &[SlotSpec] = &[
     super::GEOMETRY_READ,
     SlotSpec::new(
         slot::DEPTH,

@@ -87,15 +87,15 @@ pub enum LightLoop {
     GroupList,
 }
 
-pub const VERTICES: &str = "vertices";
-pub const TRIANGLES: &str = "triangles";
-pub const MATERIAL_TRIANGLES: &str = "material_triangles";
+pub(crate) const VERTICES: &str = "vertices";
+pub(crate) const TRIANGLES: &str = "triangles";
+pub(crate) const MATERIAL_TRIANGLES: &str = "material_triangles";
 
 const fn import(name: &'static str, from: SceneResource) -> SlotSpec {
     SlotSpec::new(name, SlotType::Import(from), Access::Read, Usage::Bound)
 }
 
-pub const SLOTS: &[SlotSpec] = &[
+pub(crate) const SLOTS: &[SlotSpec] = &[
     SlotSpec::new(
         VISIBILITY,
         SlotType::ColorTexture,

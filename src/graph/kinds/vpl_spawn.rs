@@ -34,8 +34,8 @@ impl Default for VplSpawn {
     }
 }
 
-pub const SCENE_LIGHT_GEOMETRY: &str = "scene_light_geometry";
-pub const SCENE_LIGHT_PROPERTIES: &str = "scene_light_properties";
+pub(crate) const SCENE_LIGHT_GEOMETRY: &str = "scene_light_geometry";
+pub(crate) const SCENE_LIGHT_PROPERTIES: &str = "scene_light_properties";
 
 /// Most virtual lights a graph may make room for (64 bytes each in the light arrays).
 pub const MAX_VPLS: u32 = 1 << 22;
@@ -44,7 +44,7 @@ const fn sampled(name: &'static str) -> SlotSpec {
     SlotSpec::new(name, SlotType::ColorTexture, Access::Read, Usage::Sampled)
 }
 
-pub const SLOTS: &[SlotSpec] = &[
+pub(crate) const SLOTS: &[SlotSpec] = &[
     sampled(RSM_NORMAL),
     sampled(RSM_FLUX),
     sampled(RSM_POSITION),
