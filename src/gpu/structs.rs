@@ -205,7 +205,7 @@ pub struct GpuVertex {
 }
 
 impl GpuVertex {
-    pub const ATTRIBUTES: [wgpu::VertexAttribute; 4] =
+    pub(crate) const ATTRIBUTES: [wgpu::VertexAttribute; 4] =
         wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32x4];
     pub fn layout() -> wgpu::VertexBufferLayout<'static> {
         wgpu::VertexBufferLayout {

@@ -258,7 +258,7 @@ pub struct ShadowCompareReport {
     pub pairs: u64,
     /// Pairs whose filtered visibility is on the other side of one half from the ray's.
     pub disagree_pcf5: u64,
-    pub disagree_2x2: u64,
+    pub(crate) disagree_2x2: u64,
     /// Pairs partly lit by the 5×5 filter.
     pub penumbra_pcf5: u64,
 }
@@ -283,7 +283,7 @@ pub struct VplReport {
     pub dropped_lights: Vec<crate::indirect::rsm_views::DroppedRsmLight>,
     /// n² over every view, and those whose block captured any flux.
     pub candidates: u32,
-    pub with_flux: u32,
+    pub(crate) with_flux: u32,
     /// Appended after the scene's lights, and dropped (lowest flux first) for want of room.
     pub spawned: u32,
     pub dropped: u32,
@@ -325,11 +325,11 @@ pub struct RasterReport {
     pub pass: String,
     /// Entries used and capacity: fan-triangle records, tiles and blocks.
     pub records: u32,
-    pub records_capacity: u32,
+    pub(crate) records_capacity: u32,
     pub tiles: u32,
-    pub tiles_capacity: u32,
+    pub(crate) tiles_capacity: u32,
     pub blocks: u32,
-    pub blocks_capacity: u32,
+    pub(crate) blocks_capacity: u32,
     /// Rasterized serially for want of room: fan triangles without a record, tiles
     /// without a tile entry, blocks without a block entry.
     pub serial_triangles: u32,

@@ -4,7 +4,7 @@
 
 pub mod assets;
 mod compose;
-pub mod limits;
+pub(crate) mod limits;
 mod reflect;
 
 pub use compose::{Composed, ShaderError, ShaderLibrary};
