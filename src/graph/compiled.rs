@@ -8,12 +8,16 @@ use super::validate::CheckedGraph;
 use std::fmt::Write;
 use std::sync::Arc;
 
+/// A pass that runs, in schedule order, with its resolved slots.
 #[derive(Clone, Debug)]
 pub struct ScheduledPass {
+    /// The pass's name in the graph file.
     pub name: Name,
     /// Index into the graph file's passes.
     pub index: usize,
+    /// Its kind and parameters, as the graph file gives them.
     pub kind: PassKind,
+    /// Which resource fills each of its slots, resolved and checked at validation.
     pub roles: Arc<PassRoles>,
     /// Resources this pass writes first in the schedule: its attachments clear them,
     /// later writers load.
@@ -38,28 +42,39 @@ impl ScheduledPass {
     }
 }
 
+/// A pass dropped for this scene, and why.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CulledPass {
+    /// The pass's name in the graph file.
     pub name: Name,
+    /// Why it does not run.
     pub reason: CullReason,
 }
 
+/// A graph compiled for one scene and frame size: the schedule, the culled passes and the
+/// resource plan; plain data to print, compare and prepare on the GPU.
 #[derive(Clone, Debug)]
 pub struct CompiledGraph {
+    /// The validated graph it was compiled from.
     pub checked: CheckedGraph,
     /// Passes that run, in order.
     pub passes: Vec<ScheduledPass>,
+    /// Passes dropped for this scene, with their reasons.
     pub culled: Vec<CulledPass>,
+    /// Where every resource lives and which ones share memory.
     pub plan: ResourcePlan,
 }
 
 impl CompiledGraph {
+    /// The graph's name.
     pub fn name(&self) -> &str {
         &self.checked.desc.name
     }
+    /// The names of the passes that run, in schedule order.
     pub fn pass_names(&self) -> Vec<&str> {
         self.passes.iter().map(|p| p.name.as_str()).collect()
     }
+    /// Why `pass` was dropped, or `None` if it runs (or does not exist).
     pub fn culled_reason(&self, pass: &str) -> Option<&CullReason> {
         self.culled
             .iter()
@@ -78,6 +93,7 @@ impl CompiledGraph {
             .iter()
             .any(|p| matches!(p.kind, PassKind::LightCulling(_)))
     }
+    /// The name of the resource the frame presents.
     pub fn output(&self) -> &str {
         &self.checked.desc.output
     }

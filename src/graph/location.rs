@@ -6,8 +6,11 @@ use std::path::{Path, PathBuf};
 /// A file position, 1-based, printed as `file:line:col`.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Location {
+    /// The graph file.
     pub file: PathBuf,
+    /// 1-based line.
     pub line: usize,
+    /// 1-based column (in bytes).
     pub col: usize,
 }
 
@@ -20,11 +23,14 @@ impl fmt::Display for Location {
 /// The text of a graph file, with look-ups from names to positions.
 #[derive(Clone, Debug)]
 pub struct SourceText {
+    /// The graph file the text came from.
     pub file: PathBuf,
+    /// The file's whole text.
     pub text: String,
 }
 
 impl SourceText {
+    /// The text of `file`, for locating names in it.
     pub fn new(file: impl AsRef<Path>, text: impl Into<String>) -> Self {
         Self {
             file: file.as_ref().to_path_buf(),

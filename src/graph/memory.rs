@@ -9,6 +9,7 @@ use super::CompiledGraph;
 /// One resource a technique uses.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct MemoryItem {
+    /// The graph resource's name.
     pub resource: String,
     /// Bytes of its physical texture or buffer.
     pub bytes: u64,
@@ -19,14 +20,17 @@ pub struct MemoryItem {
     pub shares_with: Option<String>,
 }
 
+/// What one technique (transparency, MSAA) adds to a frame's memory, resource by resource.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct TechniqueMemory {
     /// "transparency" or "MSAA 4×".
     pub technique: String,
+    /// The resources its passes use.
     pub items: Vec<MemoryItem>,
 }
 
 impl TechniqueMemory {
+    /// Bytes the technique adds in all.
     pub fn added(&self) -> u64 {
         self.items.iter().map(|i| i.added).sum()
     }

@@ -18,10 +18,14 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(rename = "Graph", deny_unknown_fields)]
 pub struct GraphDesc {
+    /// The graph's name, shown in reports and the viewer.
     pub name: String,
+    /// Free text on what the graph does; ignored by the compiler.
     #[serde(default)]
     pub description: String,
+    /// The textures, buffers and scene imports the passes use.
     pub resources: Vec<ResourceDesc>,
+    /// The passes, in any order: they run in dependency order.
     pub passes: Vec<PassDesc>,
     /// The resource presented as the frame (a colour texture).
     pub output: Name,
@@ -34,21 +38,34 @@ pub struct GraphDesc {
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub enum ResourceDesc {
+    /// A texture the graph allocates.
     Texture {
+        /// The name passes read and write it by.
         name: Name,
+        /// Its texel format.
         format: TextureFormat,
+        /// Its size in texels, relative to the output by default.
         #[serde(default)]
         size: TextureSize,
+        /// MSAA sample count (1, 2, 4, 8 or 16 where the device allows; 1 by default).
         #[serde(default = "one")]
         samples: u32,
     },
+    /// A storage buffer the graph allocates.
     Buffer {
+        /// The name passes read and write it by.
         name: Name,
+        /// Its size in bytes; `Auto` lets the built-in pass that writes it size it.
         #[serde(default)]
         size: BufferSize,
     },
     /// Data owned by the scene, bound read-only.
-    Import { name: Name, from: SceneResource },
+    Import {
+        /// The name passes read it by.
+        name: Name,
+        /// Which scene data it is.
+        from: SceneResource,
+    },
 }
 
 fn one() -> u32 {
@@ -56,6 +73,7 @@ fn one() -> u32 {
 }
 
 impl ResourceDesc {
+    /// The resource's name as passes refer to it.
     pub fn name(&self) -> &str {
         self.shared_name()
     }
@@ -69,14 +87,23 @@ impl ResourceDesc {
     }
 }
 
+/// The texel formats graph textures can have; each maps to the wgpu format of the same
+/// name.
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum TextureFormat {
+    /// 8-bit RGBA in 0..=1 (LDR colour).
     Rgba8Unorm,
+    /// 16-bit float RGBA (HDR colour at half the memory of Rgba32Float).
     Rgba16Float,
+    /// 32-bit float RGBA (HDR colour, G-buffer channels).
     Rgba32Float,
+    /// One 32-bit float channel.
     R32Float,
+    /// Two 32-bit float channels.
     Rg32Float,
+    /// One 32-bit unsigned integer channel (triangle ids of the visibility buffer).
     R32Uint,
+    /// 32-bit float depth (depth prepass, G-buffer and shadow depth).
     Depth32Float,
     /// Half the memory of Depth32Float (shadow atlases: 512 MiB instead of 1 GiB at 16384²).
     Depth16Unorm,
@@ -104,6 +131,7 @@ impl TextureFormat {
     }
 }
 
+/// A texture's size, relative to the output (the frame) unless fixed.
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq)]
 pub enum TextureSize {
     /// The output's size.
@@ -111,9 +139,11 @@ pub enum TextureSize {
     Output,
     /// The output's size times a factor, rounded up, at least 1.
     Scaled(f32),
+    /// A fixed width and height in texels, independent of the output.
     Fixed(u32, u32),
 }
 
+/// A buffer's size in bytes, fixed or relative to the frame.
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub enum BufferSize {
@@ -121,13 +151,18 @@ pub enum BufferSize {
     /// culling pass's tile size and capacity).
     #[default]
     Auto,
+    /// A fixed number of bytes.
     Bytes(u64),
     /// `bytes` for every `tile`×`tile` tile of the output.
     PerTile {
+        /// The tile side in output pixels.
         tile: u32,
+        /// Bytes per tile.
         bytes: u64,
     },
+    /// Bytes per output pixel.
     PerPixel(u64),
+    /// Bytes per light of the scene (at least one light).
     PerLight(u64),
 }
 
@@ -157,11 +192,17 @@ pub enum SceneResource {
 /// A scene feature a pass can be conditional on (`when:`).
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
 pub enum SceneFeature {
+    /// The scene has blended (transparent) materials.
     Transparent,
+    /// The scene has alpha-masked materials.
     AlphaMask,
+    /// The scene has lights that cast shadows.
     ShadowCasters,
+    /// The scene has indirect lights (light bounced through reflective shadow maps).
     IndirectLights,
+    /// The scene has spot lights.
     SpotLights,
+    /// The scene has at least one light.
     Lights,
     /// Not a scene feature: refused at validation (MSAA is chosen by the graph's
     /// textures, `samples: 4`, so a condition on it would be constant). Kept in the enum
@@ -170,6 +211,7 @@ pub enum SceneFeature {
 }
 
 impl SceneFeature {
+    /// Whether the scene has this feature; always false for `Msaa`.
     pub fn holds(self, f: &crate::scene::SceneFeatures) -> bool {
         match self {
             SceneFeature::Transparent => f.has_transparent,
@@ -183,15 +225,22 @@ impl SceneFeature {
     }
 }
 
+/// One pass of the graph file: its kind and parameters, what it reads and writes, and when
+/// it runs.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(rename = "Pass", deny_unknown_fields)]
 pub struct PassDesc {
+    /// The pass's unique name; errors and timings use it.
     pub name: Name,
+    /// What the pass does, with its parameters.
     pub kind: PassKind,
+    /// Resources it reads; `slot=resource` entries name the slot of a built-in kind.
     #[serde(default)]
     pub reads: Vec<Name>,
+    /// Resources it writes; `slot=resource` entries name the slot of a built-in kind.
     #[serde(default)]
     pub writes: Vec<Name>,
+    /// A scene feature the pass needs: the pass is dropped when the scene lacks it.
     #[serde(default)]
     pub when: Option<SceneFeature>,
     /// `slot=resource` entries of reads and writes, split off by the parser: (slot,
@@ -236,7 +285,10 @@ pub enum CullVariant {
     /// 2.5D: 32 depth cells, a light survives if its cells meet the tile's occupied cells.
     DepthMask,
     /// A 3D grid: `slices` exponential depth slices per tile, one list per cell.
-    Clustered { slices: u32 },
+    Clustered {
+        /// Exponential depth slices per tile.
+        slices: u32,
+    },
 }
 
 impl CullVariant {
@@ -261,21 +313,26 @@ pub enum LightSource {
     Culled,
 }
 
+/// How many workgroups a `Compute` pass dispatches.
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
 #[serde(deny_unknown_fields)]
 pub enum Dispatch {
     /// One invocation per output pixel, in workgroups of the given size.
     PerPixel {
+        /// The workgroup's size in x and y (must match the shader's `@workgroup_size`).
         workgroup: (u32, u32),
     },
     /// One workgroup per `tile`×`tile` tile.
     PerTile {
+        /// The tile side in output pixels.
         tile: u32,
     },
     /// One invocation per light, in workgroups of `workgroup`.
     PerLight {
+        /// The workgroup's size in x (must match the shader's `@workgroup_size`).
         workgroup: u32,
     },
+    /// Fixed workgroup counts in x, y and z.
     Fixed(u32, u32, u32),
 }
 
@@ -293,7 +350,9 @@ pub(super) fn default_fragment_entry() -> String {
 pub struct GenericShader<'a> {
     /// The WGSL file, relative to the shader root.
     pub file: &'a str,
+    /// The entry point's name (`main` for compute, `fs_main` for fullscreen by default).
     pub entry: &'a str,
+    /// Compute or fragment.
     pub stage: naga::ShaderStage,
 }
 

@@ -8,10 +8,13 @@ use std::fmt;
 use std::ops::Deref;
 use std::sync::Arc;
 
+/// A resource or pass name, shared between the compile steps as a reference-counted string;
+/// compares, hashes and derefs like `str`.
 #[derive(Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Name(Arc<str>);
 
 impl Name {
+    /// The name as text.
     pub fn as_str(&self) -> &str {
         &self.0
     }

@@ -14,20 +14,30 @@ use std::sync::Arc;
 /// What a physical resource is; two graph resources may share one only if these are equal.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum PhysicalDesc {
+    /// A texture of this format, size and sample count.
     Texture {
+        /// Its texel format.
         format: TextureFormat,
+        /// Width in texels.
         width: u32,
+        /// Height in texels.
         height: u32,
+        /// MSAA sample count.
         samples: u32,
     },
+    /// A buffer of this size.
     Buffer {
+        /// Its size in bytes.
         bytes: u64,
     },
 }
 
+/// One texture or buffer the frame allocates, serving one or more graph resources in turn.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PhysicalResource {
+    /// What is allocated.
     pub desc: PhysicalDesc,
+    /// Every usage the resources it serves need (empty for buffers).
     pub texture_usage: wgpu::TextureUsages,
     pub(crate) buffer_usage: wgpu::BufferUsages,
     /// Graph resources this one serves, in order of use.
@@ -36,13 +46,16 @@ pub struct PhysicalResource {
     pub last_use: usize,
 }
 
+/// Where a graph resource lives in the frame and when it is used.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PlannedResource {
+    /// The graph resource's name.
     pub name: Name,
     /// Index into [`ResourcePlan::physical`].
     pub physical: usize,
     /// First and last schedule position that uses it (inclusive).
     pub first: usize,
+    /// The last schedule position that uses it (inclusive).
     pub last: usize,
     /// No running pass writes it (its writers were culled): cleared to zero each frame.
     pub absent: bool,
@@ -51,13 +64,19 @@ pub struct PlannedResource {
     pub layout: Option<BufferLayout>,
 }
 
+/// Where every graph resource of a compiled graph lives: the plan's allocations and which
+/// resources share them.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ResourcePlan {
+    /// One entry per graph resource the compiled graph uses.
     pub resources: Vec<PlannedResource>,
+    /// The textures and buffers to allocate, indexed by `PlannedResource::physical`;
+    /// several resources may share one.
     pub physical: Vec<PhysicalResource>,
 }
 
 impl ResourcePlan {
+    /// The planned resource named `name`.
     pub fn get(&self, name: &str) -> Option<&PlannedResource> {
         self.resources.iter().find(|r| r.name == name)
     }
@@ -83,8 +102,12 @@ impl ResourcePlan {
 /// Sizes the plan needs from outside the graph.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrameSize {
+    /// Output width in pixels.
     pub width: u32,
+    /// Output height in pixels.
     pub height: u32,
+    /// Lights the scene's light buffers hold (VPL room included): sizes per-light buffers
+    /// and light lists.
     pub lights: u32,
 }
 

@@ -23,6 +23,7 @@ pub struct PassRoles {
 }
 
 impl PassRoles {
+    /// The resource filling `slot` of a built-in kind, if the pass filled it.
     pub fn slot(&self, slot: &str) -> Option<&str> {
         self.slots.get(slot).map(Name::as_str)
     }

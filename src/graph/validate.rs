@@ -13,9 +13,11 @@ use std::sync::Arc;
 /// A graph that passed validation: its roles resolved and its shaders composed.
 #[derive(Clone, Debug)]
 pub struct CheckedGraph {
+    /// The graph as parsed.
     pub desc: GraphDesc,
+    /// Its text, for error positions in later steps.
     pub source: SourceText,
-    pub deps: DepGraph,
+    pub(crate) deps: DepGraph,
     /// Per pass, in declaration order.
     /// Shared with the scheduled passes of every compile.
     pub roles: Vec<Arc<PassRoles>>,
@@ -26,6 +28,9 @@ pub struct CheckedGraph {
     pub(crate) ids: PassIds,
 }
 
+/// Checks a parsed graph against the shaders in `shaders` (names, references, slots,
+/// formats, sizes, pass order, shader bindings), reporting every error found, each with its
+/// file position.
 pub fn validate(
     desc: GraphDesc,
     source: SourceText,

@@ -54,7 +54,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     ),
 ];
 
-pub fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     let format = |name: &str| match ctx.graph.resources.get(name) {
         Some(ResourceDesc::Texture {
             format, samples, ..

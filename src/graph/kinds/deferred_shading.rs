@@ -12,6 +12,8 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
 #[serde(deny_unknown_fields)]
 pub struct DeferredShading {
+    /// Where the light lists come from: every light (`AllLights`, the default) or a culling
+    /// pass's lists (`Culled`).
     #[serde(default)]
     pub lights: LightSource,
 }
@@ -49,7 +51,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     super::g_buffer::G_UV_GRAD_READ,
 ];
 
-pub fn check(p: &DeferredShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check(p: &DeferredShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     check_light_source(ctx, p.lights, errors);
     super::check_shadow_mask(ctx, errors);
     super::check_shadow_atlas(ctx, errors);

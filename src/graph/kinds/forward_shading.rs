@@ -12,6 +12,8 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
 #[serde(deny_unknown_fields)]
 pub struct ForwardShading {
+    /// Where the light lists come from: every light (`AllLights`, the default) or a culling
+    /// pass's lists (`Culled`).
     #[serde(default)]
     pub lights: LightSource,
 }
@@ -60,6 +62,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
 /// How a shading pass shadows its lights, from the slots it filled.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Shadows {
+    /// No shadows: every light is unshadowed.
     None,
     /// Reads the per-pixel hit mask.
     Mask,
@@ -91,7 +94,7 @@ pub fn shadows(roles: &crate::graph::PassRoles, plan: &crate::graph::ResourcePla
     }
 }
 
-pub fn check(p: &ForwardShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check(p: &ForwardShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     check_light_source(ctx, p.lights, errors);
     match (ctx.slot(BVH_NODES), ctx.slot(BVH_TRIANGLES)) {
         (Some(_), None) | (None, Some(_)) => errors.push(

@@ -63,7 +63,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     .optional(),
 ];
 
-pub fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     let targets = [G_POSITION, G_NORMAL, G_GEOMETRIC, G_SURFACE, G_UV_GRAD];
     for s in targets {
         if let Some(name) = ctx.slot(s) {
@@ -95,7 +95,7 @@ pub fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
 
 /// `g_surface` and `g_uv_grad` come together: textures are sampled at the stored uv
 /// with the stored derivatives.
-pub fn check_surface_pair(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check_surface_pair(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     match (ctx.slot(G_SURFACE), ctx.slot(G_UV_GRAD)) {
         (Some(one), None) | (None, Some(one)) => errors.push(ctx.mismatch(
             one,
@@ -109,7 +109,7 @@ pub fn check_surface_pair(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
 /// packed layout rebuilds positions on the pixel centre's view ray, which is not where
 /// an edge sample's surface lies (MSAA interpolates at the centroid), and ray-cast
 /// shadows' jobs read a single-sample G-buffer.
-pub fn check_msaa_layout(ctx: &KindCtx, at: &str, errors: &mut Vec<GraphError>) {
+pub(crate) fn check_msaa_layout(ctx: &KindCtx, at: &str, errors: &mut Vec<GraphError>) {
     if ctx.slot(G_NORMAL).is_none() {
         errors.push(ctx.mismatch(
             at,

@@ -7,31 +7,40 @@ use super::{light_linked_list, reflective_shadow_maps, shadow_atlas, shadow_ray_
 /// buffer so readers never search for the producer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BufferLayout {
+    /// Tiled light lists of a `LightCulling` pass.
     LightLists(ListLayout),
     /// Per-pixel light linked lists: heads and the link pool.
     LightLinks(light_linked_list::LinkLayout),
     /// Ray-cast shadow jobs: a header and room for `capacity` jobs.
     ShadowJobs {
+        /// Jobs the buffer has room for.
         capacity: u64,
     },
     /// A 128-bit hit mask per pixel.
     ShadowMask {
+        /// Pixels of the mask.
         pixels: u64,
     },
     /// A light array with room for `lights` entries of `stride` bytes (scene lights and
     /// virtual lights after them).
     Lights {
+        /// Light entries.
         lights: u64,
+        /// Bytes per entry.
         stride: u64,
     },
     /// A reflective shadow map's view table.
     RsmViews {
+        /// Views the table holds.
         max_views: u64,
     },
     /// A shadow atlas's view table, and how shading filters the atlas.
     ShadowViews {
+        /// Shadow-casting lights the table holds.
         lights: u32,
+        /// Views the table holds.
         max_views: u64,
+        /// How shading samples the atlas.
         filter: shadow_atlas::ShadowFilter,
     },
 }
@@ -40,12 +49,19 @@ pub enum BufferLayout {
 /// between a buffer's writer and its readers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Contents {
+    /// Tiled light lists of a `LightCulling` pass.
     LightLists,
+    /// Per-pixel light linked lists of a `LightLinkedList` pass.
     LightLinks,
+    /// Ray-cast shadow jobs of a `ShadowRayJobs` pass.
     ShadowJobs,
+    /// The per-pixel hit mask of a `ShadowRayJobs` pass.
     ShadowMask,
+    /// A light array a `VplSpawn` pass wrote.
     Lights,
+    /// A `ReflectiveShadowMaps` pass's view table.
     RsmViews,
+    /// A `ShadowAtlas` pass's view table.
     ShadowViews,
 }
 
@@ -64,6 +80,7 @@ impl Contents {
 }
 
 impl BufferLayout {
+    /// What the buffer holds, without its sizes.
     pub fn contents(&self) -> Contents {
         match self {
             BufferLayout::LightLists(_) => Contents::LightLists,
@@ -75,6 +92,7 @@ impl BufferLayout {
             BufferLayout::ShadowViews { .. } => Contents::ShadowViews,
         }
     }
+    /// The buffer's size in bytes.
     pub fn bytes(&self) -> u64 {
         match self {
             BufferLayout::LightLists(l) => l.bytes(),

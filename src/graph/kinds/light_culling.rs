@@ -30,6 +30,7 @@ use serde::{Deserialize, Serialize};
 pub struct LightCulling {
     /// Pixels per tile side: 8 or 16 (one workgroup of tile×tile invocations).
     pub tile: u32,
+    /// How a tile is bounded in depth (`Frustum` by default).
     #[serde(default)]
     pub variant: CullVariant,
     /// How the lists are stored: `Fixed` (the default) or `Compact(max_indices: N)`
@@ -65,11 +66,14 @@ pub enum ListMode {
     /// again to be filled into the pool after the slots. The slots take at most half the
     /// array (see `ListLayout::scratch_per_list`); `scratch: 0` fills every list.
     Compact {
+        /// Light indices all lists may hold together (4 bytes each).
         max_indices: u32,
         #[serde(
             default = "default_scratch",
             skip_serializing_if = "is_default_scratch"
         )]
+        /// Light indices each list's own slot holds before it spills into the pool (256 by
+        /// default).
         scratch: u32,
     },
 }
@@ -135,10 +139,15 @@ impl LightCulling {
 pub struct ListLayout {
     /// Pixels per tile side.
     pub tile: u32,
+    /// How tiles were bounded in depth.
     pub variant: CullVariant,
+    /// Tiles across the frame.
     pub tiles_x: u32,
+    /// Tiles down the frame.
     pub tiles_y: u32,
+    /// Lists per tile: 1, 2 for HalfZ, or the slice count for Clustered.
     pub lists_per_tile: u32,
+    /// Fixed or compact storage, as the graph asks.
     pub storage: ListStorage,
 }
 
@@ -148,8 +157,18 @@ pub struct ListLayout {
 /// [`ListLayout::scratch_per_list`]) for the lists that need no fill.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ListStorage {
-    Fixed { capacity: u32 },
-    Compact { max_indices: u32, scratch: u32 },
+    /// Room for `capacity` lights in every list.
+    Fixed {
+        /// Most lights a list holds.
+        capacity: u32,
+    },
+    /// One flat array for all lists.
+    Compact {
+        /// Light indices all lists may hold together.
+        max_indices: u32,
+        /// Each list's own slot, in light indices, as the graph asks.
+        scratch: u32,
+    },
 }
 
 impl ListLayout {
@@ -158,6 +177,7 @@ impl ListLayout {
     pub const ENTRY_WORDS: u32 = 4;
     /// Lists per workgroup of the compact layout's scan (256 invocations × 4 lists).
     pub const SCAN_BLOCK: u32 = 1024;
+    /// The layout of `tile`-pixel tiles over a `width`×`height` frame.
     pub fn new(
         tile: u32,
         variant: CullVariant,
@@ -178,9 +198,11 @@ impl ListLayout {
             storage,
         }
     }
+    /// Lists over the whole frame: tiles times lists per tile.
     pub fn lists(&self) -> u32 {
         self.tiles_x * self.tiles_y * self.lists_per_tile
     }
+    /// The word offset where the index pool starts (after the header and list entries).
     pub fn pool_offset_words(&self) -> u32 {
         Self::HEADER_WORDS + Self::ENTRY_WORDS * self.lists()
     }
@@ -249,7 +271,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     .optional(),
 ];
 
-pub fn check(p: &LightCulling, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check(p: &LightCulling, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     super::check_float_depth_samples(ctx, errors);
     if let (Some(depth), Some(t)) = (ctx.slot(slot::DEPTH), ctx.slot(slot::TRANSPARENT_DEPTH)) {
         let (ds, ts) = (ctx.samples(depth), ctx.samples(t));

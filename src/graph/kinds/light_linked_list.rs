@@ -48,9 +48,11 @@ impl LightLinkedList {
 /// and far view depth as two f16 (rounded outwards), the light index, the next link.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LinkLayout {
+    /// Output pixels per list-pixel side (the pass's `scale`).
     pub scale: u32,
-    /// List pixels per side.
+    /// List pixels across.
     pub width: u32,
+    /// List pixels down.
     pub height: u32,
     /// Links the pool holds.
     pub pool: u64,
@@ -59,18 +61,23 @@ pub struct LinkLayout {
 impl LinkLayout {
     pub(crate) const HEADER_WORDS: u64 = 4;
     pub(crate) const LINK_WORDS: u64 = 3;
+    /// List pixels (one head link each).
     pub fn pixels(&self) -> u64 {
         self.width as u64 * self.height as u64
     }
+    /// The word offset where the link pool starts (after the header and heads).
     pub fn pool_offset_words(&self) -> u64 {
         Self::HEADER_WORDS + self.pixels()
     }
+    /// Bytes of the head links.
     pub fn head_bytes(&self) -> u64 {
         4 * self.pixels()
     }
+    /// Bytes of the link pool (12 bytes a link).
     pub fn pool_bytes(&self) -> u64 {
         4 * Self::LINK_WORDS * self.pool
     }
+    /// Bytes of the whole buffer: header, heads and pool.
     pub fn bytes(&self) -> u64 {
         4 * Self::HEADER_WORDS + self.head_bytes() + self.pool_bytes()
     }
@@ -97,7 +104,7 @@ pub const SCALES: [u32; 4] = [1, 2, 4, 8];
 /// a u32 word index at 8192² / 64).
 pub const MAX_LINKS_PER_PIXEL: u32 = 1024;
 
-pub fn check(p: &LightLinkedList, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check(p: &LightLinkedList, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     if let Some(depth) = ctx.slot(slot::DEPTH) {
         if ctx.samples(depth) > 1 {
             errors.push(ctx.mismatch(

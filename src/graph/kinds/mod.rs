@@ -87,20 +87,26 @@ macro_rules! graph_side {
             $( $(#[$doc])* $kind $( ($module::$ty) )?, )*
             /// A compute shader the graph file names; bindings are matched by name.
             Compute {
+                /// The WGSL file, relative to the shader root.
                 shader: String,
+                /// The entry point (`main` unless given).
                 #[serde(default = "super::model::default_entry")]
                 entry: String,
+                /// How many workgroups it dispatches.
                 dispatch: super::model::Dispatch,
             },
             /// A full-screen triangle with a fragment shader; bindings matched by name.
             Fullscreen {
+                /// The WGSL file, relative to the shader root.
                 shader: String,
+                /// The fragment entry point (`fs_main` unless given).
                 #[serde(default = "super::model::default_fragment_entry")]
                 entry: String,
             },
         }
 
         impl PassKind {
+            /// The kind's name as graph files spell it (`"LightCulling"`, `"Compute"`).
             pub fn label(&self) -> &'static str {
                 match self {
                     $( PassKind::$kind { .. } => stringify!($kind), )*
@@ -127,7 +133,7 @@ macro_rules! graph_side {
             }
             /// The rules of a built-in kind; `None` for generic kinds, which bind by
             /// reflected shader binding names instead (see `roles.rs`).
-            pub fn rules(&self) -> Option<&dyn KindRules> {
+            pub(crate) fn rules(&self) -> Option<&dyn KindRules> {
                 Some(match self {
                     $( PassKind::$kind $( ($params) )? => {
                         kind_value!($($params)? ; $module::$kind)
@@ -151,7 +157,7 @@ pub use slots::*;
 
 /// What a built-in kind tells validation and planning, implemented by its parameters
 /// (or the unit struct its module names after a kind without any).
-pub trait KindRules {
+pub(crate) trait KindRules {
     /// Its slot table.
     fn slots(&self) -> &'static [SlotSpec];
     /// Its own checks, after its slots were matched.
@@ -195,7 +201,7 @@ pub fn buffer_layout(kind: &PassKind, slot: &str, frame: FrameSize) -> Option<Bu
 }
 
 /// A matched pass, for its kind's checks.
-pub struct KindCtx<'a> {
+pub(crate) struct KindCtx<'a> {
     pub roles: &'a PassRoles,
     pub pass: &'a PassDesc,
     pub(crate) graph: &'a RoleCtx<'a>,
@@ -278,7 +284,7 @@ pub(crate) fn is_float_depth(resource: Option<&ResourceDesc>) -> bool {
 
 /// A `DepthValues` slot filled with an R32Float texture: single-sample (compute stores
 /// one value a pixel), else an error naming the pass and resource.
-pub fn check_float_depth_samples(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check_float_depth_samples(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     if let Some(depth) = ctx.slot(slot::DEPTH) {
         if ctx.is_float_depth(depth) && ctx.samples(depth) > 1 {
             errors.push(ctx.mismatch(
@@ -293,7 +299,7 @@ pub fn check_float_depth_samples(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
 }
 
 /// A shading pass that reads a shadow mask must read the culled lists it numbers.
-pub fn check_shadow_mask(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check_shadow_mask(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     if let (Some(mask), None) = (
         ctx.slot(shadow_ray_jobs::SHADOW_MASK),
         ctx.slot(slot::LIGHT_LISTS),
@@ -306,7 +312,7 @@ pub fn check_shadow_mask(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
 }
 
 /// A shading pass samples an atlas through its view table, and shadows one way only.
-pub fn check_shadow_atlas(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check_shadow_atlas(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     use shadow_atlas::{SHADOW_ATLAS, SHADOW_VIEWS};
     match (ctx.slot(SHADOW_ATLAS), ctx.slot(SHADOW_VIEWS)) {
         (Some(atlas), None) => errors.push(ctx.mismatch(
@@ -334,7 +340,7 @@ pub fn check_shadow_atlas(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
 }
 
 /// A read shadow atlas is one a ShadowAtlas pass can have written.
-pub fn check_shadow_atlas_texture(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check_shadow_atlas_texture(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     if let Some(atlas) = ctx.slot(shadow_atlas::SHADOW_ATLAS) {
         if shadow_atlas::atlas_side(ctx.graph.resources.get(atlas).copied()).is_none() {
             errors.push(ctx.mismatch(
@@ -346,7 +352,7 @@ pub fn check_shadow_atlas_texture(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
 }
 
 /// What every shading pass (forward or deferred) needs to read its lights.
-pub fn check_light_source(
+pub(crate) fn check_light_source(
     ctx: &KindCtx,
     lights: super::model::LightSource,
     errors: &mut Vec<GraphError>,

@@ -39,6 +39,7 @@ impl Default for ReflectiveShadowMaps {
 }
 
 impl ReflectiveShadowMaps {
+    /// Views the table has room for: six per indirect light (`max_lights`).
     pub fn max_views(&self) -> u64 {
         6 * self.max_lights as u64
     }
@@ -104,7 +105,7 @@ pub fn fixed_size(desc: Option<&ResourceDesc>) -> Option<(u32, u32, TextureForma
     }
 }
 
-pub fn check(p: &ReflectiveShadowMaps, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check(p: &ReflectiveShadowMaps, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     if !(p.tile.is_power_of_two() && (4..=1024).contains(&p.tile)) {
         errors.push(ctx.bad(format!(
             "tile {} must be a power of two in 4..=1024",

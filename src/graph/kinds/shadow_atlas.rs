@@ -87,6 +87,7 @@ impl Default for ShadowAtlas {
     }
 }
 
+/// The slot (and WGSL binding name) of the atlas depth texture.
 pub const SHADOW_ATLAS: &str = "shadow_atlas";
 pub(crate) const SHADOW_VIEWS: &str = "shadow_views";
 
@@ -102,6 +103,7 @@ pub fn view_table_bytes(lights: u32, max_views: u64) -> u64 {
 }
 
 impl ShadowAtlas {
+    /// Views the table has room for: six per shadow-casting light (`max_lights`).
     pub fn max_views(&self) -> u64 {
         6 * self.max_lights as u64
     }
@@ -130,7 +132,7 @@ pub fn atlas_side(desc: Option<&ResourceDesc>) -> Option<u32> {
     }
 }
 
-pub fn check(p: &ShadowAtlas, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check(p: &ShadowAtlas, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     let pow2 = |v: u32| v.is_power_of_two() && (4..=16384).contains(&v);
     if !pow2(p.min_tile) || !pow2(p.max_tile) || p.min_tile > p.max_tile {
         errors.push(ctx.bad(format!(

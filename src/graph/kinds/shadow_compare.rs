@@ -45,7 +45,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     SlotSpec::new(SHADOW_ERRORS, SlotType::Buffer, Access::Write, Usage::Bound),
 ];
 
-pub fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     ctx.require_single_rgba32f(
         &[G_POSITION, G_NORMAL],
         "the comparison reads world positions and shading normals from single-sample Rgba32Float G-buffer textures",

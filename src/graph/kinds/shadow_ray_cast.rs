@@ -51,7 +51,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Write, Usage::Bound),
 ];
 
-pub fn check(p: &ShadowRayCast, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check(p: &ShadowRayCast, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     if !(p.normal_offset.is_finite() && (0.0..=0.1).contains(&p.normal_offset)) {
         errors.push(ctx.bad(format!(
             "normal_offset {} must be in [0, 0.1]",

@@ -62,7 +62,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Write, Usage::Bound),
 ];
 
-pub fn check(p: &ShadowRayJobs, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check(p: &ShadowRayJobs, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     if !(p.jobs_per_pixel.is_finite() && p.jobs_per_pixel > 0.0 && p.jobs_per_pixel <= 128.0) {
         errors.push(ctx.bad(format!(
             "jobs_per_pixel {} must be in (0, 128] (at most 128 casters a pixel)",

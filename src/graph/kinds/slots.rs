@@ -13,6 +13,8 @@ pub mod slot {
     pub(crate) const COLOR: &str = "color";
     pub(crate) const LIGHT_GEOMETRY: &str = "light_geometry";
     pub(crate) const LIGHT_PROPERTIES: &str = "light_properties";
+    /// The per-tile light lists a `LightCulling` pass writes (also `LightLinkedList`'s
+    /// links).
     pub const LIGHT_LISTS: &str = "light_lists";
     /// The nearest transparent depth a culling pass bounds its tiles with.
     pub const TRANSPARENT_DEPTH: &str = "transparent_depth";
@@ -21,6 +23,7 @@ pub mod slot {
 /// What a slot takes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SlotType {
+    /// A depth texture (Depth32Float or Depth16Unorm).
     DepthTexture,
     /// A depth texture, or a single-sample R32Float texture of depth values (what a
     /// compute-only frame writes: compute cannot store depth formats). Only kinds whose
@@ -28,7 +31,9 @@ pub enum SlotType {
     DepthValues,
     /// Any texture that is not depth (the kind's checks narrow the format).
     ColorTexture,
+    /// A storage buffer the graph declares.
     Buffer,
+    /// A scene import of this kind.
     Import(SceneResource),
     /// A light array: the scene's import, or (by name only) a buffer a `VplSpawn` pass
     /// wrote with the scene's lights and its virtual lights after them.
@@ -65,7 +70,9 @@ impl SlotType {
 /// Which of the pass's lists a slot's resource belongs in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Access {
+    /// The resource goes in the pass's reads.
     Read,
+    /// The resource goes in the pass's writes.
     Write,
     /// Reads or writes: a depth attachment that is tested against, or written first.
     ReadOrWrite,
@@ -111,10 +118,14 @@ pub enum Usage {
 /// One row of a kind's slot table.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SlotSpec {
+    /// The slot's name: what `slot=resource` entries and same-named resources match.
     pub name: &'static str,
+    /// What resource the slot takes.
     pub ty: SlotType,
     pub(crate) access: Access,
+    /// Whether the pass runs without it.
     pub optional: bool,
+    /// How the pass's GPU work uses the resource (for texture usages).
     pub usage: Usage,
     /// A read buffer's contract: what its writer must publish on it (one of these);
     /// empty: anything. Checked by validation (`contracts.rs`).
@@ -122,6 +133,8 @@ pub struct SlotSpec {
 }
 
 impl SlotSpec {
+    /// A required slot that reads or writes (`access`) a resource of type `ty`, used as
+    /// `usage`.
     pub const fn new(name: &'static str, ty: SlotType, access: Access, usage: Usage) -> Self {
         Self {
             name,
@@ -132,6 +145,7 @@ impl SlotSpec {
             needs: &[],
         }
     }
+    /// The same slot, optional.
     pub const fn optional(self) -> Self {
         Self {
             optional: true,

@@ -15,6 +15,8 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
 #[serde(deny_unknown_fields)]
 pub struct TransparentShading {
+    /// Where the light lists come from: every light (`AllLights`, the default) or a culling
+    /// pass's lists (`Culled`).
     #[serde(default)]
     pub lights: LightSource,
 }
@@ -42,7 +44,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     ),
 ];
 
-pub fn check(p: &TransparentShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check(p: &TransparentShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     check_light_source(ctx, p.lights, errors);
     super::check_float_depth_samples(ctx, errors);
     if let (Some(c), Some(d)) = (ctx.slot(slot::COLOR), ctx.slot(slot::DEPTH)) {

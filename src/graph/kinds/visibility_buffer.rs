@@ -26,7 +26,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     ),
 ];
 
-pub fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     check_ids(ctx, errors);
     if let Some(depth) = ctx.slot(slot::DEPTH) {
         if ctx.samples(depth) > 1 {
@@ -39,7 +39,7 @@ pub fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
 }
 
 /// The id texture is a single-sample R32Uint texture (both kinds check it).
-pub fn check_ids(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check_ids(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     let Some(ids) = ctx.slot(VISIBILITY) else {
         return;
     };

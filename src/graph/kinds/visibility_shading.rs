@@ -18,8 +18,11 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
 #[serde(deny_unknown_fields)]
 pub struct VisibilityShading {
+    /// Where the light lists come from: every light (`AllLights`, the default) or a culling
+    /// pass's lists (`Culled`).
     #[serde(default)]
     pub lights: LightSource,
+    /// How a pixel walks its lights (`RangeFirst` by default).
     #[serde(default)]
     pub light_loop: LightLoop,
     /// Pixels per side of the shading workgroup: 8 or 16 (`Staged` takes 8). Its
@@ -32,6 +35,7 @@ pub struct VisibilityShading {
         skip_serializing_if = "Option::is_none"
     )]
     pub workgroup: Option<u32>,
+    /// Which tiles each material's dispatch covers (`PerMaterial` by default).
     #[serde(default)]
     pub materials: MaterialDispatch,
 }
@@ -117,7 +121,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     super::SHADOW_VIEWS_READ,
 ];
 
-pub fn check(p: &VisibilityShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check(p: &VisibilityShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     check_light_source(ctx, p.lights, errors);
     let side = p.workgroup_side();
     if !WORKGROUP_SIDES.contains(&side) {

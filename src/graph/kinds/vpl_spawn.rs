@@ -76,7 +76,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     ),
 ];
 
-pub fn check(p: &VplSpawn, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+pub(crate) fn check(p: &VplSpawn, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     if !(1..=MAX_VPLS).contains(&p.max_vpls) {
         errors.push(ctx.bad(format!("max_vpls {} must be in 1..={MAX_VPLS}", p.max_vpls)));
     }
