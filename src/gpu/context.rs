@@ -2,15 +2,22 @@ use super::pipeline_cache::DiskPipelineCache;
 use std::sync::Arc;
 use thiserror::Error;
 
+/// Why a GPU device could not be opened or read from.
 #[derive(Debug, Error)]
 pub enum GpuError {
+    /// No adapter matched (no GPU driver, or none wgpu supports); the message lists what
+    /// was tried.
     #[error("no GPU adapter found (on a machine without a GPU install Mesa's lavapipe: apt-get install mesa-vulkan-drivers): {0}")]
     NoAdapter(String),
+    /// The adapter refused the device request.
     #[error("could not open a device on adapter {adapter}: {source}")]
     Device {
+        /// The adapter's name.
         adapter: String,
+        /// wgpu's error.
         source: wgpu::RequestDeviceError,
     },
+    /// Mapping a buffer for readback failed.
     #[error("GPU readback failed: {0}")]
     Readback(String),
 }
@@ -50,8 +57,11 @@ impl ContextOptions {
 /// A headless wgpu device and queue, plus what the adapter can do. Clones share them.
 #[derive(Clone)]
 pub struct GpuContext {
+    /// The adapter the device was opened on.
     pub adapter: wgpu::Adapter,
+    /// The device every pass records and creates resources on.
     pub device: wgpu::Device,
+    /// The queue frames are submitted to.
     pub queue: wgpu::Queue,
     /// Whether per-pass GPU timestamps can be recorded.
     pub has_timestamps: bool,

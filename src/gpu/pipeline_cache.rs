@@ -18,18 +18,26 @@ use thiserror::Error;
 const MAGIC: &[u8] = b"lightgraph pipeline cache\n";
 const FORMAT: u32 = 1;
 
+/// Why a pipeline cache file was not used (each case is a warning and an empty cache, never
+/// a failure).
 #[derive(Debug, Error)]
 pub enum PipelineCacheFileError {
+    /// The file could not be read.
     #[error("{}: {source}", path.display())]
     Io {
+        /// The file.
         path: PathBuf,
+        /// The operating system's error.
         #[source]
         source: std::io::Error,
     },
+    /// The file does not start with this format's header.
     #[error("not a lightgraph pipeline cache (or an older format)")]
     NotOurs,
+    /// The file is cut short or its checksum does not match (what was wrong).
     #[error("truncated or corrupt: {0}")]
     Corrupt(&'static str),
+    /// The file was made on another adapter or driver (the key it names).
     #[error("made for another adapter or driver ({0})")]
     Foreign(String),
 }
@@ -109,7 +117,10 @@ pub enum CacheLoad {
     /// No file yet: an empty cache.
     Empty,
     /// The file's data was accepted by wgpu and the driver (`bytes` of it).
-    Loaded { bytes: usize },
+    Loaded {
+        /// Bytes of pipeline data loaded.
+        bytes: usize,
+    },
     /// The file was unusable and ignored (the warning says why).
     Ignored(String),
     /// The file was whole and ours, but wgpu or the driver refused its data (another
@@ -212,10 +223,12 @@ impl DiskPipelineCache {
         })
     }
 
+    /// The wgpu pipeline cache, to pass to pipeline descriptors.
     pub fn cache(&self) -> &wgpu::PipelineCache {
         &self.cache
     }
 
+    /// The cache file on disk.
     pub fn path(&self) -> &Path {
         &self.path
     }

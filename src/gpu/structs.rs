@@ -5,24 +5,39 @@ use crate::scene::{Camera, Light, LightShape};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
+/// Per-frame uniforms every pass reads (`Frame` in `shaders/common/types.wgsl`): camera
+/// matrices, frame size and light count.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuFrame {
+    /// World to view space, column-major.
     pub view: [[f32; 4]; 4],
+    /// View to clip space, column-major.
     pub proj: [[f32; 4]; 4],
+    /// World to clip space (`proj * view`).
     pub view_proj: [[f32; 4]; 4],
+    /// Clip to view space, for reconstructing positions from depth.
     pub inv_proj: [[f32; 4]; 4],
+    /// The camera's world position; `w` is 1.
     pub camera_pos: [f32; 4],
+    /// Ambient light added to every lit surface; `w` is unused.
     pub ambient: [f32; 4],
+    /// The frame's width and height in pixels.
     pub size: [u32; 2],
+    /// Lights in the light buffers, VPLs included once spawned.
     pub light_count: u32,
+    /// Padding to WGSL's alignment; always 0.
     pub _pad0: u32,
+    /// The camera's near plane distance (world units).
     pub near: f32,
+    /// The camera's far plane distance (world units).
     pub far: f32,
+    /// Padding to WGSL's alignment; always 0.
     pub _pad1: [f32; 2],
 }
 
 impl GpuFrame {
+    /// The uniforms for `camera` at `width`×`height` pixels with `light_count` lights.
     pub fn new(camera: &Camera, ambient: Vec3, width: u32, height: u32, light_count: u32) -> Self {
         let view = camera.view();
         let proj = camera.projection(width as f32 / height as f32);
@@ -41,6 +56,7 @@ impl GpuFrame {
             _pad1: [0.0; 2],
         }
     }
+    /// The view matrix as a glam matrix.
     pub fn view_matrix(&self) -> Mat4 {
         Mat4::from_cols_array_2d(&self.view)
     }
@@ -50,9 +66,13 @@ impl GpuFrame {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 pub struct GpuLightGeometry {
+    /// World position.
     pub position: [f32; 3],
+    /// Distance (world units) at which the light's falloff reaches zero.
     pub range: f32,
+    /// Spot direction (unit vector); zero for point lights.
     pub direction: [f32; 3],
+    /// Cosine of the spot cone's outer half-angle; -1 for point lights.
     pub cos_outer: f32,
 }
 
@@ -60,10 +80,16 @@ pub struct GpuLightGeometry {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 pub struct GpuLightProperties {
+    /// Linear colour times intensity.
     pub color: [f32; 3],
+    /// Cosine of the spot cone's inner half-angle, where the falloff to the outer cone
+    /// starts; -1 for point lights.
     pub cos_inner: f32,
+    /// The light's flag bits (`Light::flags`), passed through to the shaders.
     pub flags: u32,
+    /// Which material type bits the light lights (`Light::material_mask`).
     pub material_mask: u32,
+    /// Padding to WGSL's alignment; always 0.
     pub _pad: [u32; 2],
 }
 
@@ -71,19 +97,26 @@ pub struct GpuLightProperties {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 pub struct GpuListParams {
+    /// Tiles across the frame.
     pub tiles_x: u32,
+    /// Tiles down the frame.
     pub tiles_y: u32,
+    /// The tile side in pixels.
     pub tile: u32,
+    /// Lists per tile: 1, 2 for HalfZ, or the slice count for Clustered.
     pub lists_per_tile: u32,
     /// Fixed lists' capacity; 0 for compact lists.
     pub capacity: u32,
+    /// The culling variant's code ([`crate::graph::CullVariant::code`]).
     pub variant: u32,
+    /// Word offset of the index pool in the list buffer (compact lists).
     pub pool_offset: u32,
     /// Light indices the pool holds (saturating at u32::MAX).
     pub pool_indices: u32,
 }
 
 impl GpuListParams {
+    /// The parameters of a culling pass's list `layout`.
     pub fn new(layout: &crate::graph::ListLayout) -> Self {
         Self {
             tiles_x: layout.tiles_x,
@@ -116,13 +149,21 @@ impl GpuListParams {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 pub struct GpuLinkParams {
+    /// Resolution divisor of the head grid against the frame (`scale` of the pass).
     pub scale: u32,
+    /// Head grid width in pixels.
     pub width: u32,
+    /// Head grid height in pixels.
     pub height: u32,
+    /// Word offset of the link pool in the buffer.
     pub pool_offset: u32,
+    /// Links the pool holds.
     pub pool: u32,
+    /// Padding to WGSL's alignment; always 0.
     pub _pad0: u32,
+    /// Padding to WGSL's alignment; always 0.
     pub _pad1: u32,
+    /// Padding to WGSL's alignment; always 0.
     pub _pad2: u32,
 }
 
@@ -198,15 +239,20 @@ pub fn gpu_light(l: &Light) -> (GpuLightGeometry, GpuLightProperties) {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuVertex {
+    /// Object-space position.
     pub position: [f32; 3],
+    /// Object-space normal.
     pub normal: [f32; 3],
+    /// Texture coordinates (glTF TEXCOORD_0).
     pub uv: [f32; 2],
+    /// Object-space tangent; `w` is the bitangent sign (glTF TANGENT).
     pub tangent: [f32; 4],
 }
 
 impl GpuVertex {
     pub(crate) const ATTRIBUTES: [wgpu::VertexAttribute; 4] =
         wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32x4];
+    /// The vertex buffer layout render pipelines draw meshes with (locations 0..=3).
     pub fn layout() -> wgpu::VertexBufferLayout<'static> {
         wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<GpuVertex>() as u64,
