@@ -9,15 +9,20 @@ use crate::scene::{AlphaMode, Scene, SurfaceMaterial};
 use std::path::PathBuf;
 use wgpu::util::DeviceExt;
 
+/// One scene material compiled for the GPU: its generated WGSL, its textures uploaded and
+/// bound, and what pipelines need to know about it.
 #[derive(Clone)]
 pub struct MaterialProgram {
+    /// The material's name (from the scene or material file).
     pub name: String,
     /// Generated WGSL, included as `<material>`.
     pub wgsl: String,
     /// The same for compute shaders (textures sampled with explicit derivatives, see
     /// `WgslOptions::sample_grad`); None when `wgsl` has no textures, so serves as is.
     pub compute_wgsl: Option<String>,
+    /// How the material blends: opaque, alpha-masked or blended.
     pub alpha_mode: AlphaMode,
+    /// Whether back faces are drawn (and lit) too.
     pub double_sided: bool,
     /// Group 2's sampler and textures by binding name; None without textures.
     pub(super) textures: Option<BindingSet>,
@@ -33,6 +38,8 @@ impl MaterialProgram {
         self.compute_wgsl.as_deref().unwrap_or(&self.wgsl)
     }
 
+    /// Generates `material`'s WGSL and uploads its textures (with mip levels) for bind
+    /// group 2.
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,

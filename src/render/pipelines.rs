@@ -32,9 +32,12 @@ fn with_driver_cache<R>(cache: Option<wgpu::PipelineCache>, f: impl FnOnce() -> 
     result
 }
 
+/// What a pipeline is built from; equal keys share one pipeline in the [`PipelineCache`].
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct PipelineKey {
+    /// The WGSL file, relative to the shader root.
     pub shader: String,
+    /// `#define`s the shader was composed with (name to value).
     pub defines: BTreeMap<String, String>,
     /// Generated code's text (materials), part of the key so an edit rebuilds.
     pub virtual_code: BTreeMap<String, String>,
@@ -112,9 +115,12 @@ impl PipelineBuild {
     }
 }
 
+/// A built render or compute pipeline, shared between the passes that use it.
 #[derive(Clone)]
 pub enum Pipeline {
+    /// A render pipeline (raster passes).
     Render(Arc<wgpu::RenderPipeline>),
+    /// A compute pipeline.
     Compute(Arc<wgpu::ComputePipeline>),
 }
 
@@ -220,9 +226,12 @@ impl ForkBuilds {
     }
 }
 
+/// Render and compute pipelines by [`PipelineKey`], with counters and build times; shared
+/// across frames and hot reloads so only what changed is rebuilt.
 #[derive(Default)]
 pub struct PipelineCache {
     pipelines: HashMap<PipelineKey, Entry>,
+    /// Pipelines built since the cache was made.
     pub builds: usize,
     hits: usize,
     misses: usize,
@@ -284,6 +293,7 @@ fn stop_fork() -> ShaderError {
 pub struct GpuStateAtBuild {
     /// `None`: nothing was built.
     pub busy: Option<bool>,
+    /// How long waiting for the GPU took.
     pub wait: Duration,
 }
 
@@ -513,9 +523,11 @@ impl PipelineCache {
         Ok((pipeline, bindings))
     }
 
+    /// Pipelines the cache holds.
     pub fn len(&self) -> usize {
         self.pipelines.len()
     }
+    /// Whether the cache holds no pipeline.
     pub fn is_empty(&self) -> bool {
         self.pipelines.is_empty()
     }

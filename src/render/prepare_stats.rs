@@ -4,6 +4,8 @@
 use super::pipelines::{CacheCounters, GpuStateAtBuild, PipelineBuild};
 use std::time::Duration;
 
+/// What one prepare did: pipelines found in or added to the cache, physical resources
+/// reused or created, and the time each step took.
 #[derive(Clone, Debug, Default)]
 pub struct PrepareStats {
     /// Pipelines the cache already held.

@@ -18,6 +18,8 @@ struct PresentParams {
 /// What the present pass offers its shader, by binding name.
 const OFFERED: [&str; 2] = ["hdr", "params"];
 
+/// Draws a graph's HDR output into a colour target, scaled and tonemapped like the PNG
+/// output (for windows and embedding applications).
 pub struct Presenter {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,

@@ -5,7 +5,9 @@ use crate::graph::{ListLayout, ListStorage};
 /// Per culling pass: what its lists held this frame.
 #[derive(Clone, Debug)]
 pub struct CullingReport {
+    /// The culling pass's name in the graph.
     pub pass: String,
+    /// The list buffer's layout (tiles, lists per tile, storage) this frame.
     pub layout: ListLayout,
     /// Lists (tiles, halves or clusters) that lost lights: past the capacity (fixed
     /// lists), or past the end of the index array (compact lists).
@@ -126,7 +128,9 @@ impl CullingReport {
 /// Per light linked list pass: what its pool held this frame.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct LinkReport {
+    /// The light linked list pass's name in the graph.
     pub pass: String,
+    /// The buffer's layout (head resolution, pool size) this frame.
     pub layout: crate::graph::kinds::light_linked_list::LinkLayout,
     /// Links the list pixels wanted (kept plus dropped).
     pub links_wanted: u64,
@@ -147,6 +151,7 @@ impl LinkReport {
     pub fn head_bytes(&self) -> u64 {
         self.layout.head_bytes()
     }
+    /// Bytes of the whole buffer: header, heads and pool.
     pub fn bytes(&self) -> u64 {
         self.layout.bytes()
     }
@@ -155,17 +160,24 @@ impl LinkReport {
 /// Per-pixel light statistics over pixels that hold geometry.
 #[derive(Clone, Debug, Default)]
 pub struct LightStats {
+    /// Pixels with geometry that were counted.
     pub pixels: u64,
+    /// Lights listed for those pixels (what the shading loop visits), summed.
     pub listed_total: u64,
+    /// Lights that actually reach those pixels (range test per pixel), summed.
     pub exact_total: u64,
+    /// The most lights listed for one pixel.
     pub max_listed: u32,
+    /// The most lights actually reaching one pixel.
     pub max_exact: u32,
 }
 
 impl LightStats {
+    /// Lights listed per counted pixel, on average.
     pub fn avg_listed(&self) -> f64 {
         self.listed_total as f64 / self.pixels.max(1) as f64
     }
+    /// Lights actually reaching a counted pixel, on average.
     pub fn avg_exact(&self) -> f64 {
         self.exact_total as f64 / self.pixels.max(1) as f64
     }
@@ -193,6 +205,7 @@ impl LightStats {
 /// Per ray-cast shadow job pass: what this frame asked of it.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ShadowReport {
+    /// The ShadowRayJobs pass's name in the graph.
     pub pass: String,
     /// Jobs the pixels asked for: one ray each, unless dropped.
     pub jobs_wanted: u64,
@@ -200,9 +213,13 @@ pub struct ShadowReport {
     pub jobs_dropped: u64,
     /// Pixels with more than 128 shadow-casting lights (the rest lit unshadowed).
     pub overflow_pixels: u64,
+    /// Jobs the job buffer holds (`jobs_per_pixel` times the frame's pixels).
     pub capacity: u64,
+    /// Bytes of the job buffer.
     pub job_bytes: u64,
+    /// Bytes of the per-pixel hit mask.
     pub mask_bytes: u64,
+    /// Pixels of the frame the mask covers.
     pub pixels: u64,
 }
 
@@ -216,22 +233,29 @@ impl ShadowReport {
 /// Per shadow atlas pass: what this frame's allocation gave and refused.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AtlasReport {
+    /// The ShadowAtlas pass's name in the graph.
     pub pass: String,
     /// The atlas's side in texels.
     pub side: u32,
     /// Bytes of the atlas texture and of its view table.
     pub atlas_bytes: u64,
+    /// Bytes of the per-view table (matrices and tile rectangles) the shading reads.
     pub table_bytes: u64,
     /// Shadow-casting lights in view, with a tile each, and without room.
     pub shadowed: Vec<crate::shadow::atlas::AtlasLight>,
+    /// Shadow-casting lights that found no tile, and why.
     pub dropped: Vec<crate::shadow::atlas::DroppedLight>,
     /// Shadow-casting lights whose range misses the camera's frustum.
     pub off_screen: u32,
+    /// Depth views rendered into the atlas (six per point light or wide spot light, else one).
     pub views: u32,
+    /// How many times every tile was halved so that all requests fit the atlas.
     pub halvings: u32,
+    /// Atlas texels covered by tiles.
     pub used_texels: u64,
     /// Draw calls and triangles over all views after culling chunks per view.
     pub draws: u64,
+    /// Triangles drawn over all views after culling chunks per view.
     pub triangles: u64,
 }
 
@@ -253,6 +277,7 @@ impl AtlasReport {
 /// Per ShadowCompare pass: the atlas against ray-cast shadows, per (pixel, light) pair.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ShadowCompareReport {
+    /// The ShadowCompare pass's name in the graph.
     pub pass: String,
     /// Pairs of a pixel and a shadow-casting light that reaches it.
     pub pairs: u64,
@@ -264,9 +289,12 @@ pub struct ShadowCompareReport {
 }
 
 impl ShadowCompareReport {
+    /// The fraction of pairs where the 5×5 PCF visibility disagrees with the ray, in 0..=1.
     pub fn error_pcf5(&self) -> f64 {
         self.disagree_pcf5 as f64 / self.pairs.max(1) as f64
     }
+    /// The fraction of pairs where the hardware 2×2 comparison filter disagrees with the
+    /// ray, in 0..=1.
     pub fn error_2x2(&self) -> f64 {
         self.disagree_2x2 as f64 / self.pairs.max(1) as f64
     }
@@ -275,9 +303,11 @@ impl ShadowCompareReport {
 /// Per VplSpawn pass: the virtual lights this frame made, kept and dropped.
 #[derive(Clone, Debug, PartialEq)]
 pub struct VplReport {
+    /// The VplSpawn pass's name in the graph.
     pub pass: String,
     /// Indirect lights with map views, and their views.
     pub lights: u32,
+    /// Reflective shadow map views those lights rendered.
     pub views: u32,
     /// Indirect lights that got no views (atlas full, n not dividing the tile...).
     pub dropped_lights: Vec<crate::indirect::rsm_views::DroppedRsmLight>,
@@ -286,6 +316,7 @@ pub struct VplReport {
     pub(crate) with_flux: u32,
     /// Appended after the scene's lights, and dropped (lowest flux first) for want of room.
     pub spawned: u32,
+    /// VPLs dropped for want of room (lowest flux first).
     pub dropped: u32,
     /// Room for VPLs (the graph's max_vpls).
     pub room: u32,
@@ -295,6 +326,8 @@ pub struct VplReport {
 
 /// The report's lines for `render` (a full room or a dropped light is a warning).
 impl VplReport {
+    /// One summary line, then a warning line for a full room and for each light that
+    /// spawned nothing.
     pub fn lines(&self) -> Vec<String> {
         let v = self;
         let mut lines = vec![format!(
@@ -322,18 +355,23 @@ impl VplReport {
 /// found it full), but serial work is slow: a non-zero count is a warning.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RasterReport {
+    /// The ComputeRaster pass's name in the graph.
     pub pass: String,
     /// Entries used and capacity: fan-triangle records, tiles and blocks.
     pub records: u32,
     pub(crate) records_capacity: u32,
+    /// Tile entries used.
     pub tiles: u32,
     pub(crate) tiles_capacity: u32,
+    /// Block entries used.
     pub blocks: u32,
     pub(crate) blocks_capacity: u32,
     /// Rasterized serially for want of room: fan triangles without a record, tiles
     /// without a tile entry, blocks without a block entry.
     pub serial_triangles: u32,
+    /// Tiles rasterized serially because the tile list was full.
     pub serial_tiles: u32,
+    /// Blocks rasterized serially because the block list was full.
     pub serial_blocks: u32,
 }
 
@@ -368,18 +406,30 @@ impl RasterReport {
 /// What a pass counted on the GPU (or decided on the CPU for this frame).
 #[derive(Clone, Debug)]
 pub enum PassReport {
+    /// A pass that ran another way on this device.
     Fallback(FallbackReport),
+    /// Light lists of a LightCulling pass.
     Culling(CullingReport),
+    /// Jobs of a ShadowRayJobs pass.
     Shadow(ShadowReport),
+    /// The allocation of a ShadowAtlas pass.
     Atlas(AtlasReport),
+    /// The disagreement counted by a ShadowCompare pass.
     ShadowCompare(ShadowCompareReport),
+    /// The pool of a LightLinkedList pass.
     Links(LinkReport),
+    /// The virtual lights of a VplSpawn pass.
     Vpl(VplReport),
+    /// The work lists of a ComputeRaster pass.
     Raster(RasterReport),
 }
 
+/// What rendering one frame returns: the read-back image and what its passes counted on the
+/// GPU.
 pub struct FrameResult {
+    /// The image's width in pixels.
     pub width: u32,
+    /// The image's height in pixels.
     pub height: u32,
     /// Linear HDR RGBA, row-major.
     pub image: Vec<[f32; 4]>,
@@ -387,13 +437,22 @@ pub struct FrameResult {
     pub pass_ms: Option<Vec<(String, f64)>>,
     /// Passes that ran another way on this device (see [`FallbackReport`]).
     pub fallbacks: Vec<FallbackReport>,
+    /// One report per LightCulling pass, in graph order.
     pub culling: Vec<CullingReport>,
+    /// One report per LightLinkedList pass.
     pub links: Vec<LinkReport>,
+    /// One report per ShadowRayJobs pass.
     pub shadows: Vec<ShadowReport>,
+    /// One report per ShadowAtlas pass.
     pub atlases: Vec<AtlasReport>,
+    /// One report per ShadowCompare pass.
     pub shadow_compare: Vec<ShadowCompareReport>,
+    /// One report per VplSpawn pass.
     pub vpls: Vec<VplReport>,
+    /// One report per ComputeRaster pass.
     pub rasters: Vec<RasterReport>,
+    /// Listed against exact lights per pixel, when the frame was rendered with light
+    /// statistics.
     pub light_stats: Option<LightStats>,
 }
 
@@ -403,6 +462,7 @@ pub struct FrameResult {
 /// for the compute path (timings included).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct FallbackReport {
+    /// The pass's name in the graph.
     pub pass: String,
     /// The adapter, as `GpuContext::adapter_name` gives it.
     pub adapter: String,

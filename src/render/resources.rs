@@ -13,7 +13,10 @@ pub enum Physical {
     Buffer(wgpu::Buffer),
 }
 
+/// The physical textures and buffers of a prepared frame, one per entry of the plan's
+/// `physical`, possibly taken over from the frame it replaces.
 pub struct FrameResources {
+    /// The allocated textures and buffers, indexed like `ResourcePlan::physical`.
     pub physical: Vec<Physical>,
     /// What each physical resource was created as (to match it against a later plan).
     descs: Vec<PhysicalResource>,
@@ -54,6 +57,7 @@ fn match_pool(plan: &[PhysicalResource], pool: &[PhysicalResource]) -> Vec<Optio
 }
 
 impl FrameResources {
+    /// Creates every resource of `plan`.
     pub fn create(device: &wgpu::Device, plan: &ResourcePlan) -> Self {
         Self::create_reusing(device, plan, None)
     }
@@ -95,18 +99,21 @@ impl FrameResources {
         self.physical.len() - self.reused
     }
 
+    /// The view of graph texture `name` (`None` for buffers or unknown names).
     pub fn view(&self, plan: &ResourcePlan, name: &str) -> Option<&wgpu::TextureView> {
         match &self.physical[plan.get(name)?.physical] {
             Physical::Texture { view, .. } => Some(view),
             Physical::Buffer(_) => None,
         }
     }
+    /// The texture behind graph resource `name` (`None` for buffers or unknown names).
     pub fn texture(&self, plan: &ResourcePlan, name: &str) -> Option<&wgpu::Texture> {
         match &self.physical[plan.get(name)?.physical] {
             Physical::Texture { texture, .. } => Some(texture),
             Physical::Buffer(_) => None,
         }
     }
+    /// The buffer behind graph resource `name` (`None` for textures or unknown names).
     pub fn buffer(&self, plan: &ResourcePlan, name: &str) -> Option<&wgpu::Buffer> {
         match &self.physical[plan.get(name)?.physical] {
             Physical::Buffer(b) => Some(b),

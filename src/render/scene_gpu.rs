@@ -14,17 +14,23 @@ const LIGHT_BYTES: usize = 32;
 const _: () = assert!(std::mem::size_of::<GpuLightGeometry>() == LIGHT_BYTES);
 const _: () = assert!(std::mem::size_of::<GpuLightProperties>() == LIGHT_BYTES);
 
+/// One uploaded mesh: its vertex and index buffers, material and shadow-culling data.
 #[derive(Clone)]
 pub struct GpuMesh {
+    /// Vertices ([`crate::gpu::structs::GpuVertex`]), world space.
     pub vertices: wgpu::Buffer,
+    /// Triangle indices (u32) in the scene's order.
     pub indices: wgpu::Buffer,
+    /// Indices to draw (three per triangle).
     pub index_count: u32,
+    /// Index into [`SceneGpu::materials`].
     pub material: usize,
     /// World-space bounds (min, max) of the vertices: for culling per shadow view.
     pub bounds: [glam::Vec3; 2],
     /// The triangles reordered into spatial chunks (`shadow::chunks`), drawn by shadow
     /// views, which cull chunk by chunk.
     pub shadow_indices: wgpu::Buffer,
+    /// The spatial chunks of `shadow_indices`, with their bounds.
     pub chunks: std::sync::Arc<[crate::shadow::chunks::Chunk]>,
     /// This mesh's index in `Scene::meshes` (empty meshes are not uploaded).
     pub scene_mesh: usize,
@@ -37,9 +43,15 @@ pub struct GpuMesh {
 /// beside the live one.
 #[derive(Clone)]
 pub struct SceneGpu {
+    /// The uploaded meshes, in scene order.
     pub meshes: Vec<GpuMesh>,
+    /// One compiled material per scene material, indexed by `GpuMesh::material`.
     pub materials: Vec<MaterialProgram>,
+    /// The `light_geometry` storage buffer ([`crate::gpu::structs::GpuLightGeometry`] per
+    /// light).
     pub light_geometry: wgpu::Buffer,
+    /// The `light_properties` storage buffer ([`crate::gpu::structs::GpuLightProperties`]
+    /// per light).
     pub light_properties: wgpu::Buffer,
     /// Lights at upload. After [`SceneGpu::write_lights`] a prepared frame's count is the
     /// one passes read (`PreparedFrame::update_lights`).
@@ -58,8 +70,11 @@ pub struct SceneGpu {
 /// The shadow BVH's two storage buffers and what building it found.
 #[derive(Clone)]
 pub struct GpuBvh {
+    /// The BVH nodes (`bvh_nodes` binding).
     pub nodes: wgpu::Buffer,
+    /// The triangles in leaf order (`bvh_triangles` binding).
     pub triangles: wgpu::Buffer,
+    /// What the build found: triangles kept and skipped, and the tree's shape.
     pub stats: crate::shadow::BuildStats,
 }
 
@@ -196,6 +211,8 @@ impl SceneGpu {
         self.bvh.get().and_then(|b| b.as_ref().ok())
     }
 
+    /// Uploads geometry and lights with materials already compiled (hot reload reuses the
+    /// live ones).
     pub fn upload_with(
         device: &wgpu::Device,
         scene: &Scene,

@@ -22,7 +22,9 @@
 /// `wgpu::util::TextureDataOrder::LayerMajor` expects for one layer.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MipChain {
+    /// Mip levels in the chain, level 0 included.
     pub levels: u32,
+    /// RGBA8 texels of every level, largest first.
     pub rgba8: Vec<u8>,
 }
 

@@ -25,11 +25,18 @@ pub const NO_TRIANGLE: u32 = u32::MAX;
 /// Floats per vertex in the merged `vertices` buffer.
 pub const VERTEX_FLOATS: u32 = (std::mem::size_of::<GpuVertex>() / 4) as u32;
 
+/// The scene's opaque meshes merged into storage buffers, for passes that fetch vertices by
+/// triangle id (visibility buffer shading, compute rasterization).
 pub struct VisibilityGeometry {
+    /// Every merged vertex, [`VERTEX_FLOATS`] floats each, in world space.
     pub vertices: wgpu::Buffer,
+    /// Three vertex indices per triangle; a visibility id indexes it.
     pub triangles: wgpu::Buffer,
+    /// Each material's `[first, end)` triangle ids, as u32 pairs.
     pub material_triangles: wgpu::Buffer,
+    /// Triangles merged.
     pub triangle_count: u32,
+    /// Vertices merged.
     pub vertex_count: u32,
     /// `[first, end)` triangle ids of each scene material, as in `material_triangles`.
     pub material_ranges: Vec<[u32; 2]>,

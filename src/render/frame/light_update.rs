@@ -13,14 +13,38 @@ use std::sync::atomic::Ordering;
 /// Why a light update was refused; nothing was written.
 #[derive(Debug, thiserror::Error)]
 pub enum LightUpdateError {
+    /// More lights than the light buffers have room for.
     #[error("light update of {count} lights is over the capacity of {capacity} set at upload (SceneGpu::upload_with_light_capacity)")]
-    OverCapacity { count: usize, capacity: u32 },
+    OverCapacity {
+        /// Lights in the update.
+        count: usize,
+        /// Room in the light buffers, set at upload.
+        capacity: u32,
+    },
+    /// A light has a value the shaders cannot use (not finite, negative range...).
     #[error("light update: light {index}: {problem}")]
-    BadLight { index: usize, problem: String },
+    BadLight {
+        /// The light's index in the update.
+        index: usize,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// A light needs a scene feature (shadows, spot cones, indirect light) that the graph was compiled without.
     #[error("light update: light {index} adds {feature}, which the scene had none of when the graph was compiled (passes for it were dropped or specialised away): compile and prepare again")]
-    NewFeature { index: usize, feature: &'static str },
+    NewFeature {
+        /// The light's index in the update.
+        index: usize,
+        /// The feature it adds.
+        feature: &'static str,
+    },
+    /// A pass's per-light state cannot take the new lights.
     #[error("light update: pass '{pass}' cannot follow moving lights: {problem}")]
-    Pass { pass: String, problem: String },
+    Pass {
+        /// The pass's name.
+        pass: String,
+        /// Why not.
+        problem: String,
+    },
 }
 
 impl PreparedFrame {

@@ -78,8 +78,12 @@ fn at_pass(graph: &CompiledGraph, sp: &crate::graph::ScheduledPass, e: RenderErr
     }
 }
 
+/// A compiled graph prepared on the GPU: its resources, pipelines and bind groups, ready to
+/// render or record as often as wanted.
 pub struct PreparedFrame {
+    /// The compiled graph it was prepared from.
     pub graph: CompiledGraph,
+    /// The frame size it was prepared for.
     pub size: FrameSize,
     resources: FrameResources,
     frame_uniform: wgpu::Buffer,
