@@ -128,7 +128,9 @@ pub enum RootSource {
 /// The folder project files are looked for in first, if any, and why it was chosen.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Project {
+    /// The folder, or `None` when only the built-in files are used.
     pub root: Option<PathBuf>,
+    /// How the folder was chosen.
     pub source: RootSource,
 }
 

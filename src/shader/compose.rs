@@ -5,23 +5,41 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
+/// An error loading, composing or compiling a WGSL shader, naming the file and line in the
+/// original source.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum ShaderError {
+    /// The shader file could not be read.
     #[error("{file}: cannot read shader: {message}")]
-    Io { file: PathBuf, message: String },
+    Io {
+        /// The shader file.
+        file: PathBuf,
+        /// Why it could not be read.
+        message: String,
+    },
+    /// An `#include`, `#define` or `#if` directive is malformed or cannot be resolved
+    /// (missing file, include cycle, too deep).
     #[error("{file}:{line}: {message}")]
     Directive {
+        /// The file holding the directive.
         file: PathBuf,
+        /// Its 1-based line.
         line: usize,
+        /// What is wrong.
         message: String,
     },
     /// naga rejected the WGSL; `line`/`col` are in the original file.
     #[error("{file}:{line}:{col}: {message}\n    {source_line}")]
     Invalid {
+        /// The original file (after following includes back).
         file: PathBuf,
+        /// 1-based line in that file.
         line: usize,
+        /// 1-based column.
         col: usize,
+        /// naga's message.
         message: String,
+        /// The offending source line, shown under the message.
         source_line: String,
     },
 }
@@ -41,6 +59,7 @@ pub struct ShaderLibrary {
 /// A shader after includes and defines, with a map from each line back to its origin.
 #[derive(Clone, Debug)]
 pub struct Composed {
+    /// The composed WGSL source, ready for naga.
     pub text: String,
     /// For line i (0-based) of `text`: the file it came from and its 1-based line there.
     pub origin: Vec<(PathBuf, usize)>,

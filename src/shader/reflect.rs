@@ -3,35 +3,52 @@ use naga::{AddressSpace, ImageClass, StorageAccess, TypeInner};
 /// What a shader binding is, as far as matching it against a graph resource goes.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum BindingKind {
+    /// A `var<uniform>` buffer.
     Uniform,
+    /// A `var<storage>` buffer.
     Storage {
+        /// `read_write` access (otherwise `read`).
         writable: bool,
     },
     /// `texture_2d<f32>` and friends; `multisampled` for `texture_multisampled_2d`.
     SampledTexture {
+        /// Whether it is `texture_multisampled_2d`.
         multisampled: bool,
         /// `f32`, `u32` (visibility ids) or `i32` texels.
         kind: naga::ScalarKind,
     },
+    /// A `texture_depth_2d` (or multisampled depth) texture.
     DepthTexture {
+        /// Whether it is `texture_depth_multisampled_2d`.
         multisampled: bool,
     },
+    /// A `texture_storage_2d`.
     StorageTexture {
+        /// Its texel format.
         format: naga::StorageFormat,
+        /// `write` or `read_write` access.
         writable: bool,
         /// `read_write` (with `writable`), or `read`.
         readable: bool,
     },
+    /// A `sampler` or `sampler_comparison`.
     Sampler {
+        /// Whether it is a `sampler_comparison`.
         comparison: bool,
     },
 }
 
+/// One `@group @binding` resource a shader declares, with its variable name (what generic
+/// passes match resources by).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ReflectedBinding {
+    /// The WGSL variable name.
     pub name: String,
+    /// Its `@group` index.
     pub group: u32,
+    /// Its `@binding` index.
     pub binding: u32,
+    /// What kind of resource it binds.
     pub kind: BindingKind,
 }
 
