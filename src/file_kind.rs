@@ -4,13 +4,20 @@
 
 use std::path::Path;
 
+/// What kind of input file a path holds, as `lightgraph validate` checks it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FileKind {
+    /// A render graph (`Graph(...)` in RON).
     Graph,
+    /// A scene (`Scene(...)` in RON).
     Scene,
+    /// A material (an anonymous `(...)` RON struct).
     Material,
+    /// A glTF model (`.gltf` or `.glb`).
     Gltf,
+    /// A WGSL shader (`.wgsl`).
     Shader,
+    /// A benchmark sweep (`Sweep(...)` in RON).
     Sweep,
 }
 

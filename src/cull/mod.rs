@@ -9,17 +9,24 @@ use glam::{Mat4, Vec2, Vec3};
 /// A light as culling sees it, in view space.
 #[derive(Clone, Copy, Debug)]
 pub struct ViewLight {
+    /// Centre in view space (the camera looks down -z).
     pub position: Vec3,
+    /// Distance (world units) at which the light's falloff reaches zero.
     pub range: f32,
     /// Unit axis for spots; ignored when `cos_outer <= -1` (point light).
     pub direction: Vec3,
+    /// Cosine of the spot cone's outer half-angle; -1 for point lights.
     pub cos_outer: f32,
 }
 
 /// The four side planes of a tile (through the eye, normals inward) and its corner rays.
 #[derive(Clone, Copy, Debug)]
 pub struct TileFrustum {
+    /// Inward unit normals of the four side planes, each through the eye and two consecutive
+    /// corner rays.
     pub planes: [Vec3; 4],
+    /// View-space rays through the tile's corners (top-left, top-right, bottom-right,
+    /// bottom-left), reaching the far plane.
     pub rays: [Vec3; 4],
 }
 

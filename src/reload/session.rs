@@ -27,7 +27,9 @@ use std::time::{Duration, Instant};
 
 /// Where the scene comes from: a file that is watched and reloaded, or a fixed scene.
 pub enum SceneSource {
+    /// A scene file (RON or glTF), reloaded when it or what it references changes.
     File(PathBuf),
+    /// A scene given once, never reloaded.
     Fixed(Box<Scene>),
 }
 
@@ -66,6 +68,7 @@ pub struct ReloadTimings {
 /// What one reload did.
 #[derive(Debug)]
 pub struct Reload {
+    /// The files whose change started this reload.
     pub changed: Vec<PathBuf>,
     /// Time from the batch's arrival to the new frame, or the error that kept the last
     /// good frame. The watcher's debounce came before `received` and is not included:
@@ -81,6 +84,7 @@ pub struct Reload {
     /// What was reloaded: `graph`, `scene`, `material <name>`, `shaders`; empty when the
     /// batch touched nothing the frame uses.
     pub rebuilt: Vec<String>,
+    /// Where the time went.
     pub timings: ReloadTimings,
 }
 
@@ -93,7 +97,11 @@ fn material_key(name: &str) -> String {
     format!("{MATERIAL}{name}")
 }
 
+/// A live frame that follows its files: watches the graph, scene, shaders and materials,
+/// and rebuilds only what a change touches, keeping the last good frame while an edit is
+/// broken.
 pub struct ReloadSession {
+    /// The renderer every rebuild uses.
     pub renderer: Renderer,
     graph_path: PathBuf,
     source: SceneSource,
