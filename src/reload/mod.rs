@@ -17,9 +17,9 @@
 //! }
 //! ```
 
-mod deps;
-mod session;
-mod watcher;
+pub mod deps;
+pub mod session;
+pub mod watcher;
 
 pub use deps::DependencyIndex;
 pub use session::{Reload, ReloadSession, ReloadTimings, SceneSource};
