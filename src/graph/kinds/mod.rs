@@ -1,5 +1,5 @@
 //! Built-in pass kinds, one file each: its parameters, its slot table and its checks
-//! (a [`KindRules`] impl). This file holds the registry of kinds (`built_in_kinds!`),
+//! (a `KindRules` impl). This file holds the registry of kinds (`built_in_kinds!`),
 //! which generates `PassKind` and every dispatch over it, and the rows and checks
 //! several kinds share; `matching.rs` holds the slot matcher they all use and
 //! `contracts.rs` the checks of read buffers against their writers. Generic kinds
