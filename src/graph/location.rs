@@ -39,7 +39,7 @@ impl SourceText {
     }
 
     /// Location of a byte offset.
-    pub fn at_offset(&self, offset: usize) -> Location {
+    pub(crate) fn at_offset(&self, offset: usize) -> Location {
         let offset = offset.min(self.text.len());
         let before = &self.text[..offset];
         let line = before.matches('\n').count() + 1;
@@ -76,13 +76,13 @@ impl SourceText {
     }
 
     /// Where a pass or resource named `name` is declared (start of file if not found).
-    pub fn of_declaration(&self, name: &str) -> Location {
+    pub(crate) fn of_declaration(&self, name: &str) -> Location {
         self.at_offset(self.declaration(name).unwrap_or(0))
     }
 
     /// Where pass `pass` mentions `word` (a resource name in its reads/writes, a shader
     /// path, ...); falls back to the pass declaration.
-    pub fn in_pass(&self, pass: &str, word: &str) -> Location {
+    pub(crate) fn in_pass(&self, pass: &str, word: &str) -> Location {
         let Some(start) = self.declaration(pass) else {
             return self.at_offset(0);
         };
@@ -103,7 +103,7 @@ impl SourceText {
     }
 
     /// The name of the pass whose text contains `offset` (for parse errors).
-    pub fn pass_around(&self, offset: usize) -> Option<String> {
+    pub(crate) fn pass_around(&self, offset: usize) -> Option<String> {
         let before = &self.text[..offset.min(self.text.len())];
         let i = before.rfind("Pass(")?;
         let after = &self.text[i..];

@@ -78,7 +78,7 @@ impl ResourceDesc {
         self.shared_name()
     }
     /// The name as shared text, for the compile steps to keep without copying it.
-    pub fn shared_name(&self) -> &Name {
+    pub(crate) fn shared_name(&self) -> &Name {
         match self {
             ResourceDesc::Texture { name, .. }
             | ResourceDesc::Buffer { name, .. }
@@ -251,7 +251,7 @@ pub struct PassDesc {
 
 impl PassDesc {
     /// The slot a `slot=resource` entry named for `resource`.
-    pub fn explicit_slot(&self, resource: &str) -> Option<&str> {
+    pub(crate) fn explicit_slot(&self, resource: &str) -> Option<&str> {
         self.named_slots
             .iter()
             .find(|(_, r)| r == resource)
@@ -260,7 +260,7 @@ impl PassDesc {
 
     /// Splits `slot=resource` entries of reads and writes into `named_slots`, leaving
     /// plain resource names in the lists.
-    pub fn split_named_slots(&mut self) {
+    pub(crate) fn split_named_slots(&mut self) {
         for list in [&mut self.reads, &mut self.writes] {
             for entry in list.iter_mut() {
                 if let Some((slot, resource)) = entry.split_once('=') {
@@ -358,7 +358,7 @@ pub struct GenericShader<'a> {
 
 impl PassKind {
     /// The WGSL file a generic pass runs, relative to the shader root.
-    pub fn shader_file(&self) -> Option<&str> {
+    pub(crate) fn shader_file(&self) -> Option<&str> {
         self.generic_shader().map(|g| g.file)
     }
 }

@@ -81,14 +81,14 @@ impl ResourcePlan {
         self.resources.iter().find(|r| r.name == name)
     }
     /// The light-list layout of a planned buffer a culling pass writes.
-    pub fn list_layout(&self, name: &str) -> Option<ListLayout> {
+    pub(crate) fn list_layout(&self, name: &str) -> Option<ListLayout> {
         match self.get(name)?.layout? {
             BufferLayout::LightLists(l) => Some(l),
             _ => None,
         }
     }
     /// The linked-list layout of a planned buffer a LightLinkedList pass writes.
-    pub fn link_layout(
+    pub(crate) fn link_layout(
         &self,
         name: &str,
     ) -> Option<crate::graph::kinds::light_linked_list::LinkLayout> {

@@ -28,7 +28,7 @@ impl PassRoles {
         self.slots.get(slot).map(Name::as_str)
     }
     /// The slot `resource` fills, if any.
-    pub fn slot_of(&self, resource: &str) -> Option<&'static str> {
+    pub(crate) fn slot_of(&self, resource: &str) -> Option<&'static str> {
         self.slots
             .iter()
             .find(|(_, r)| *r == resource)

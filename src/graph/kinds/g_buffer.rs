@@ -11,11 +11,11 @@ use crate::graph::error::GraphError;
 pub(crate) const G_POSITION: &str = "g_position";
 pub(crate) const G_NORMAL: &str = "g_normal";
 /// Geometric (face) normals facing the viewer, for ray-cast shadows' origin offset.
-pub const G_GEOMETRIC: &str = "g_geometric";
+pub(crate) const G_GEOMETRIC: &str = "g_geometric";
 /// The material's surface inputs: uv, the tangent's angle about the normal, handedness.
-pub const G_SURFACE: &str = "g_surface";
+pub(crate) const G_SURFACE: &str = "g_surface";
 /// The uv's screen derivatives (d/dx, d/dy), the mip footprint textures are sampled with.
-pub const G_UV_GRAD: &str = "g_uv_grad";
+pub(crate) const G_UV_GRAD: &str = "g_uv_grad";
 
 pub(crate) const SLOTS: &[SlotSpec] = &[
     super::GEOMETRY_READ,
@@ -125,7 +125,7 @@ pub(crate) fn check_msaa_layout(ctx: &KindCtx, at: &str, errors: &mut Vec<GraphE
 }
 
 /// Ray-cast shadows' reads of the unpacked G-buffer: world positions, geometric normals.
-pub const G_POSITION_READ: SlotSpec = SlotSpec::new(
+pub(crate) const G_POSITION_READ: SlotSpec = SlotSpec::new(
     G_POSITION,
     SlotType::ColorTexture,
     Access::Read,
@@ -139,7 +139,7 @@ pub(crate) const G_GEOMETRIC_READ: SlotSpec = SlotSpec::new(
 );
 
 /// Deferred shading's reads of the surface targets.
-pub const G_SURFACE_READ: SlotSpec = SlotSpec::new(
+pub(crate) const G_SURFACE_READ: SlotSpec = SlotSpec::new(
     G_SURFACE,
     SlotType::ColorTexture,
     Access::Read,

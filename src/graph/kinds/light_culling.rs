@@ -82,12 +82,12 @@ pub(crate) const DEFAULT_CAPACITY: u32 = 256;
 /// Scratch slot of compact lists, in light indices: at 1920×1080 with 16-pixel tiles
 /// fixed lists of 256 held every tile of harada's 3,072 lights, so none is filled twice
 /// there; 8 MiB of the shipped 64 MiB bound.
-pub const DEFAULT_SCRATCH: u32 = 256;
+pub(crate) const DEFAULT_SCRATCH: u32 = 256;
 /// Largest scratch slot: as fixed lists' capacity.
-pub const MAX_SCRATCH: u32 = 4096;
+pub(crate) const MAX_SCRATCH: u32 = 4096;
 /// Largest `max_indices`: the index array's words stay addressable by u32 with room
 /// for the header and entries.
-pub const MAX_INDICES_LIMIT: u32 = 1 << 30;
+pub(crate) const MAX_INDICES_LIMIT: u32 = 1 << 30;
 
 fn default_coarse() -> u32 {
     4
@@ -174,9 +174,9 @@ pub enum ListStorage {
 impl ListLayout {
     pub(crate) const HEADER_WORDS: u32 = 4;
     /// Words per list entry: offset, count, and the view-depth range it covers (f32 bits).
-    pub const ENTRY_WORDS: u32 = 4;
+    pub(crate) const ENTRY_WORDS: u32 = 4;
     /// Lists per workgroup of the compact layout's scan (256 invocations × 4 lists).
-    pub const SCAN_BLOCK: u32 = 1024;
+    pub(crate) const SCAN_BLOCK: u32 = 1024;
     /// The layout of `tile`-pixel tiles over a `width`×`height` frame.
     pub fn new(
         tile: u32,
@@ -230,7 +230,7 @@ impl ListLayout {
         }
     }
     /// Compact lists: the indices all scratch slots take at the start of the pool.
-    pub fn scratch_indices(&self) -> u64 {
+    pub(crate) fn scratch_indices(&self) -> u64 {
         self.scratch_per_list() as u64 * self.lists() as u64
     }
     /// Scan blocks of the compact layout (0 for fixed lists).

@@ -27,7 +27,7 @@ fn default_links_per_pixel() -> u32 {
 }
 
 /// The slot it writes (the WGSL binding name).
-pub const LIGHT_LINKS: &str = "light_links";
+pub(crate) const LIGHT_LINKS: &str = "light_links";
 
 impl LightLinkedList {
     pub(crate) fn link_layout(&self, width: u32, height: u32) -> LinkLayout {
@@ -99,10 +99,10 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
 
 /// Scales whose list pixels tile a 8- or 16-pixel culling tile exactly, so each list
 /// pixel reads one tile's list.
-pub const SCALES: [u32; 4] = [1, 2, 4, 8];
+pub(crate) const SCALES: [u32; 4] = [1, 2, 4, 8];
 /// Most links a list pixel may reserve on average (the pool must stay addressable by
 /// a u32 word index at 8192² / 64).
-pub const MAX_LINKS_PER_PIXEL: u32 = 1024;
+pub(crate) const MAX_LINKS_PER_PIXEL: u32 = 1024;
 
 pub(crate) fn check(p: &LightLinkedList, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     if let Some(depth) = ctx.slot(slot::DEPTH) {

@@ -115,7 +115,7 @@ macro_rules! graph_side {
                 }
             }
             /// The shader a generic pass runs; `None` for built-in kinds.
-            pub fn generic_shader(&self) -> Option<super::model::GenericShader<'_>> {
+            pub(crate) fn generic_shader(&self) -> Option<super::model::GenericShader<'_>> {
                 use super::model::GenericShader;
                 match self {
                     $( PassKind::$kind { .. } => None, )*
@@ -196,7 +196,7 @@ fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
 }
 
 /// The layout a built-in pass gives a buffer it writes into `slot`.
-pub fn buffer_layout(kind: &PassKind, slot: &str, frame: FrameSize) -> Option<BufferLayout> {
+pub(crate) fn buffer_layout(kind: &PassKind, slot: &str, frame: FrameSize) -> Option<BufferLayout> {
     kind.rules()?.buffer_layout(slot, frame)
 }
 

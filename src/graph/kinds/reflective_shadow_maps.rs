@@ -57,7 +57,7 @@ pub(crate) const RSM_VIEWS: &str = "rsm_views";
 pub const VIEW_VEC4S: u64 = 8;
 
 /// Bytes of a view table with room for `max_views`: a header vec4, then the views.
-pub fn view_table_bytes(max_views: u64) -> u64 {
+pub(crate) fn view_table_bytes(max_views: u64) -> u64 {
     16 * (1 + VIEW_VEC4S * max_views)
 }
 
@@ -93,7 +93,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
 ];
 
 /// The (width, height) of a fixed-size single-sample texture.
-pub fn fixed_size(desc: Option<&ResourceDesc>) -> Option<(u32, u32, TextureFormat)> {
+pub(crate) fn fixed_size(desc: Option<&ResourceDesc>) -> Option<(u32, u32, TextureFormat)> {
     match desc? {
         ResourceDesc::Texture {
             size: TextureSize::Fixed(w, h),

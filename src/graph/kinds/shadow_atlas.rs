@@ -98,7 +98,7 @@ pub const VIEW_VEC4S: u64 = 6;
 /// Bytes of a view table for `lights` scene lights and `max_views` views: a header
 /// vec4, the views, then one u32 per light (its first view + 1, 0 for none; bit 31 for
 /// six faces).
-pub fn view_table_bytes(lights: u32, max_views: u64) -> u64 {
+pub(crate) fn view_table_bytes(lights: u32, max_views: u64) -> u64 {
     16 * (1 + VIEW_VEC4S * max_views + (lights.max(1) as u64).div_ceil(4))
 }
 
@@ -121,7 +121,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
 ];
 
 /// The atlas texture's side, if it is a single-sample square of a fixed power-of-two size.
-pub fn atlas_side(desc: Option<&ResourceDesc>) -> Option<u32> {
+pub(crate) fn atlas_side(desc: Option<&ResourceDesc>) -> Option<u32> {
     match desc? {
         ResourceDesc::Texture {
             size: TextureSize::Fixed(w, h),

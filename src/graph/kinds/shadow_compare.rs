@@ -13,7 +13,7 @@ use crate::graph::error::GraphError;
 pub(crate) const SHADOW_ERRORS: &str = "shadow_errors";
 /// Counters: pairs, disagreeing pairs with 5×5 PCF, with the 2×2 tap, pairs in a 5×5
 /// penumbra (0 < visibility < 1).
-pub const ERROR_WORDS: u64 = 4;
+pub(crate) const ERROR_WORDS: u64 = 4;
 
 pub(crate) const SLOTS: &[SlotSpec] = &[
     G_POSITION_READ,

@@ -21,7 +21,7 @@ pub struct ShadowRayCast {
 }
 
 /// The default origin offset (also what naive tracing in the light loop uses).
-pub const DEFAULT_NORMAL_OFFSET: f32 = 1e-4;
+pub(crate) const DEFAULT_NORMAL_OFFSET: f32 = 1e-4;
 
 fn default_normal_offset() -> f32 {
     DEFAULT_NORMAL_OFFSET

@@ -28,11 +28,11 @@ pub(crate) const SHADOW_MASK: &str = "shadow_mask";
 
 /// Words before the jobs: wanted, dropped, pixels over 128 casters, unused, then the
 /// indirect dispatch (x, y, z, unused).
-pub const JOB_HEADER_WORDS: u64 = 8;
+pub(crate) const JOB_HEADER_WORDS: u64 = 8;
 /// A job: pixel index, then light index | caster number << 24.
-pub const JOB_WORDS: u64 = 2;
+pub(crate) const JOB_WORDS: u64 = 2;
 /// Mask words a pixel (128 casters).
-pub const MASK_WORDS: u64 = 4;
+pub(crate) const MASK_WORDS: u64 = 4;
 
 impl ShadowRayJobs {
     /// Jobs the buffer holds at `width`×`height`.
@@ -42,7 +42,7 @@ impl ShadowRayJobs {
 }
 
 /// Bytes of a job buffer holding `capacity` jobs.
-pub fn job_buffer_bytes(capacity: u64) -> u64 {
+pub(crate) fn job_buffer_bytes(capacity: u64) -> u64 {
     4 * (JOB_HEADER_WORDS + JOB_WORDS * capacity)
 }
 

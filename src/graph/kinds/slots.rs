@@ -17,7 +17,7 @@ pub mod slot {
     /// links).
     pub const LIGHT_LISTS: &str = "light_lists";
     /// The nearest transparent depth a culling pass bounds its tiles with.
-    pub const TRANSPARENT_DEPTH: &str = "transparent_depth";
+    pub(crate) const TRANSPARENT_DEPTH: &str = "transparent_depth";
 }
 
 /// What a slot takes.
@@ -163,7 +163,7 @@ impl SlotSpec {
 
 /// Rows several kinds share: the scene's geometry (optional; drawn, never bound) and the
 /// two light arrays, read.
-pub const GEOMETRY_READ: SlotSpec = SlotSpec::new(
+pub(crate) const GEOMETRY_READ: SlotSpec = SlotSpec::new(
     slot::GEOMETRY,
     SlotType::Import(SceneResource::Geometry),
     Access::Read,
@@ -184,7 +184,7 @@ pub(crate) const LIGHT_PROPERTIES_READ: SlotSpec = SlotSpec::new(
 );
 /// The tile lists of a `LightCulling` pass (or a `LightLinkedList`'s links), read by the
 /// passes that walk them; optional: without them a pass visits every light.
-pub const LIGHT_LISTS_READ: SlotSpec = SlotSpec::new(
+pub(crate) const LIGHT_LISTS_READ: SlotSpec = SlotSpec::new(
     slot::LIGHT_LISTS,
     SlotType::Buffer,
     Access::Read,
@@ -194,7 +194,7 @@ pub const LIGHT_LISTS_READ: SlotSpec = SlotSpec::new(
 .needs(&[Contents::LightLists, Contents::LightLinks]);
 
 /// Rows every shading pass shares: a ShadowAtlas pass's atlas and view table, read.
-pub const SHADOW_ATLAS_READ: SlotSpec = SlotSpec::new(
+pub(crate) const SHADOW_ATLAS_READ: SlotSpec = SlotSpec::new(
     shadow_atlas::SHADOW_ATLAS,
     SlotType::DepthTexture,
     Access::Read,

@@ -56,7 +56,7 @@ pub enum MaterialDispatch {
 }
 
 /// Workgroup sides the shader is built for.
-pub const WORKGROUP_SIDES: [u32; 2] = [8, 16];
+pub(crate) const WORKGROUP_SIDES: [u32; 2] = [8, 16];
 
 impl VisibilityShading {
     /// The workgroup's side in pixels: as asked, else 16 (8 for `Staged`, which needs

@@ -38,7 +38,7 @@ pub(crate) const SCENE_LIGHT_GEOMETRY: &str = "scene_light_geometry";
 pub(crate) const SCENE_LIGHT_PROPERTIES: &str = "scene_light_properties";
 
 /// Most virtual lights a graph may make room for (64 bytes each in the light arrays).
-pub const MAX_VPLS: u32 = 1 << 22;
+pub(crate) const MAX_VPLS: u32 = 1 << 22;
 
 const fn sampled(name: &'static str) -> SlotSpec {
     SlotSpec::new(name, SlotType::ColorTexture, Access::Read, Usage::Sampled)
