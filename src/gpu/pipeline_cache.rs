@@ -100,7 +100,7 @@ pub fn decode<'a>(key: &str, bytes: &'a [u8]) -> Result<&'a [u8], PipelineCacheF
 }
 
 /// The folder pipeline caches are kept in, or `None` when disabled or there is no home.
-pub fn default_dir() -> Option<PathBuf> {
+pub(crate) fn default_dir() -> Option<PathBuf> {
     let non_empty = |v: &str| std::env::var_os(v).filter(|s| !s.is_empty());
     if let Some(dir) = non_empty("LIGHTGRAPH_PIPELINE_CACHE_DIR") {
         return (dir != "off").then(|| PathBuf::from(dir));
@@ -239,7 +239,7 @@ impl DiskPipelineCache {
     }
 
     /// Bytes the cache holds now (what a save would write).
-    pub fn held_bytes(&self) -> usize {
+    pub(crate) fn held_bytes(&self) -> usize {
         self.cache.get_data().map_or(0, |d| d.len())
     }
 
@@ -281,7 +281,7 @@ impl DiskPipelineCache {
     }
 
     /// [`save`](Self::save), logging instead of failing: the cache only saves time.
-    pub fn save_or_warn(&self) {
+    pub(crate) fn save_or_warn(&self) {
         if let Err(e) = self.save() {
             log::warn!("pipeline cache: not saved: {e}");
         }

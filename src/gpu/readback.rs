@@ -22,7 +22,7 @@ pub fn read_buffer(
 }
 
 /// Reads `len` bytes from `offset` of a buffer (COPY_SRC; both multiples of 4).
-pub fn read_buffer_range(
+pub(crate) fn read_buffer_range(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     buffer: &wgpu::Buffer,
@@ -68,7 +68,7 @@ fn map_and_copy(
 
 /// Reads a single-sample 2D texture with 16 bytes per texel (Rgba32Float) back
 /// as tightly packed rows of `[f32; 4]`.
-pub fn read_rgba32f(
+pub(crate) fn read_rgba32f(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     texture: &wgpu::Texture,

@@ -205,7 +205,7 @@ pub fn light_buffers(lights: &[Light]) -> (Vec<GpuLightGeometry>, Vec<GpuLightPr
 }
 
 /// One light as culling and shading read it (what [`light_buffers`] writes per light).
-pub fn gpu_light(l: &Light) -> (GpuLightGeometry, GpuLightProperties) {
+pub(crate) fn gpu_light(l: &Light) -> (GpuLightGeometry, GpuLightProperties) {
     let (direction, cos_outer, cos_inner) = match l.shape {
         LightShape::Point => (Vec3::ZERO, -1.0, -1.0),
         LightShape::Spot {
