@@ -34,7 +34,7 @@ pub struct MaterialProgram {
 
 impl MaterialProgram {
     /// The material code a compute shader includes.
-    pub fn wgsl_for_compute(&self) -> &str {
+    pub(crate) fn wgsl_for_compute(&self) -> &str {
         self.compute_wgsl.as_deref().unwrap_or(&self.wgsl)
     }
 
@@ -171,7 +171,7 @@ impl MaterialProgram {
 
     /// The program for one scene material, and the files it was read from (the override
     /// RON and its texture files; none for a material mapped from glTF).
-    pub fn for_surface(
+    pub(crate) fn for_surface(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         scene: &Scene,

@@ -299,7 +299,7 @@ pub struct GpuStateAtBuild {
 
 impl PipelineCache {
     /// An empty cache whose builds use (and fill) the driver's pipeline cache `driver`.
-    pub fn with_driver_cache(driver: Option<Arc<DiskPipelineCache>>) -> Self {
+    pub(crate) fn with_driver_cache(driver: Option<Arc<DiskPipelineCache>>) -> Self {
         Self {
             driver,
             parallel_builds: true,
@@ -326,12 +326,12 @@ impl PipelineCache {
     }
 
     /// How many distinct pipelines `pass` asked for in the last generation (0: unknown).
-    pub fn pipelines_of_pass_last_time(&self, pass: &str) -> usize {
+    pub(crate) fn pipelines_of_pass_last_time(&self, pass: &str) -> usize {
         self.keys_last_generation.get(pass).copied().unwrap_or(0)
     }
 
     /// Whether this `ForkMode::Only` fork's build raised no validation error.
-    pub fn fork_build_clean(&self) -> bool {
+    pub(crate) fn fork_build_clean(&self) -> bool {
         self.fork_build_clean
     }
 
@@ -360,7 +360,7 @@ impl PipelineCache {
     }
 
     /// Adds the wall time of a parallel build phase.
-    pub fn add_build_wall(&mut self, wall: Duration) {
+    pub(crate) fn add_build_wall(&mut self, wall: Duration) {
         self.build_wall += wall;
     }
 
@@ -370,7 +370,7 @@ impl PipelineCache {
     }
 
     /// Notes now whether the GPU is busy, before builds on other threads begin.
-    pub fn note_gpu_state_now(&mut self, device: &wgpu::Device) {
+    pub(crate) fn note_gpu_state_now(&mut self, device: &wgpu::Device) {
         self.note_gpu_state(device);
     }
 
@@ -390,7 +390,7 @@ impl PipelineCache {
 
     /// Marks what forks built and nothing asked for as plain entries: a later request is
     /// a hit, as it would have been after a sequential build.
-    pub fn settle_prebuilt(&mut self) {
+    pub(crate) fn settle_prebuilt(&mut self) {
         for e in self.pipelines.values_mut() {
             e.prebuilt = None;
         }
@@ -398,7 +398,7 @@ impl PipelineCache {
 
     /// Saves the driver's pipeline cache if it holds anything new (after a reload's
     /// builds; it is saved on exit too). A failure is logged: the cache only saves time.
-    pub fn save_driver_cache(&self) {
+    pub(crate) fn save_driver_cache(&self) {
         if let Some(d) = &self.driver {
             d.save_or_warn();
         }
@@ -419,7 +419,7 @@ impl PipelineCache {
 
     /// Like [`get_or_build`](Self::get_or_build), handing `build` the shader's reflected
     /// bindings (to make its layout from) and returning them with the pipeline.
-    pub fn get_or_build_reflected(
+    pub(crate) fn get_or_build_reflected(
         &mut self,
         shaders: &ShaderLibrary,
         key: PipelineKey,
@@ -557,7 +557,7 @@ impl PipelineCache {
     }
 
     /// Whether the GPU was busy when this generation's first build began.
-    pub fn gpu_state_at_build(&self) -> GpuStateAtBuild {
+    pub(crate) fn gpu_state_at_build(&self) -> GpuStateAtBuild {
         GpuStateAtBuild {
             busy: self.gpu_busy,
             wait: self.gpu_wait,

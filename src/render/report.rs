@@ -186,7 +186,7 @@ impl LightStats {
         self.listed_total as f64 / self.exact_total.max(1) as f64
     }
     /// Sums the (listed, exact) counts of every pixel that holds either.
-    pub fn from_counts(counts: &[[u32; 2]]) -> Self {
+    pub(crate) fn from_counts(counts: &[[u32; 2]]) -> Self {
         let mut s = LightStats::default();
         for &[listed, exact] in counts {
             if listed == 0 && exact == 0 {

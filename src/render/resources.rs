@@ -64,7 +64,7 @@ impl FrameResources {
 
     /// Like [`create`](Self::create), taking what fits from `pool` (the resources of a
     /// frame this one replaces; both may be alive at once, the handles are shared).
-    pub fn create_reusing(
+    pub(crate) fn create_reusing(
         device: &wgpu::Device,
         plan: &ResourcePlan,
         pool: Option<&FrameResources>,

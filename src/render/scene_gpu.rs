@@ -314,7 +314,7 @@ impl SceneGpu {
 
     /// Mesh indices of blended (glTF `alphaMode: BLEND`) geometry, in scene order: the
     /// transparency passes draw these, sorted per frame by view depth.
-    pub fn transparent_draws(&self) -> Vec<usize> {
+    pub(crate) fn transparent_draws(&self) -> Vec<usize> {
         (0..self.meshes.len())
             .filter(|&i| self.materials[self.meshes[i].material].alpha_mode == AlphaMode::Blend)
             .collect()
