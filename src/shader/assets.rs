@@ -23,7 +23,7 @@ static MATERIALS: Dir<'static> = include_dir!("$CARGO_MANIFEST_DIR/materials");
 pub const FOLDERS: [&str; 3] = ["shaders", "graphs", "materials"];
 
 /// The prefix of a built-in file's path: `<built-in>/graphs/forward_plus.ron`.
-pub const BUILTIN_PREFIX: &str = "<built-in>";
+pub(crate) const BUILTIN_PREFIX: &str = "<built-in>";
 
 /// The environment variable that names the root when `--root` is not given.
 pub const ROOT_ENV: &str = "LIGHTGRAPH_ROOT";
@@ -55,7 +55,7 @@ pub fn builtin(rel: &str) -> Option<&'static str> {
 
 /// Every built-in file under folder `dir` (`"shaders"`, `"graphs"` or `"materials"`), as
 /// paths relative to a root (`graphs/forward_plus.ron`), sorted.
-pub fn builtin_files(dir: &str) -> Vec<String> {
+pub(crate) fn builtin_files(dir: &str) -> Vec<String> {
     fn walk(d: &Dir<'static>, top: &str, out: &mut Vec<String>) {
         for f in d.files() {
             out.push(format!(
@@ -76,12 +76,12 @@ pub fn builtin_files(dir: &str) -> Vec<String> {
 }
 
 /// The name a built-in file goes by: `<built-in>/<rel>`.
-pub fn builtin_path(rel: &str) -> PathBuf {
+pub(crate) fn builtin_path(rel: &str) -> PathBuf {
     PathBuf::from(format!("{BUILTIN_PREFIX}/{}", rel.replace('\\', "/")))
 }
 
 /// If `path` is a built-in file's name (`<built-in>/<rel>`), `rel`.
-pub fn builtin_rel(path: &Path) -> Option<String> {
+pub(crate) fn builtin_rel(path: &Path) -> Option<String> {
     let rest = path.strip_prefix(BUILTIN_PREFIX).ok()?;
     Some(rest.to_string_lossy().replace('\\', "/"))
 }
@@ -135,7 +135,7 @@ pub struct Project {
 }
 
 /// Whether `dir` has any of shaders/, graphs/, materials/.
-pub fn has_project_folders(dir: &Path) -> bool {
+pub(crate) fn has_project_folders(dir: &Path) -> bool {
     FOLDERS.iter().any(|f| dir.join(f).is_dir())
 }
 
@@ -150,7 +150,7 @@ fn absolute(dir: &Path) -> PathBuf {
 
 impl Project {
     /// Built-in files only.
-    pub fn builtin_only() -> Self {
+    pub(crate) fn builtin_only() -> Self {
         Self {
             root: None,
             source: RootSource::BuiltIn,
@@ -243,7 +243,7 @@ impl Project {
 
     /// Where shader files are looked for first: `<root>/shaders`, or
     /// `<built-in>/shaders` with no root.
-    pub fn shader_dir(&self) -> PathBuf {
+    pub(crate) fn shader_dir(&self) -> PathBuf {
         match &self.root {
             Some(r) => r.join("shaders"),
             None => builtin_path("shaders"),
