@@ -51,7 +51,7 @@ pub fn read_text(path: &Path, cap: u64) -> io::Result<String> {
 }
 
 /// `text` without a leading UTF-8 byte-order mark (editors on Windows write one).
-pub fn strip_bom(text: &str) -> &str {
+pub(crate) fn strip_bom(text: &str) -> &str {
     text.strip_prefix('\u{feff}').unwrap_or(text)
 }
 
