@@ -5,8 +5,7 @@ use thiserror::Error;
 /// Why a GPU device could not be opened or read from.
 #[derive(Debug, Error)]
 pub enum GpuError {
-    /// No adapter matched (no GPU driver, or none wgpu supports); the message lists what
-    /// was tried.
+    /// No adapter was found (no GPU driver wgpu supports); the message is wgpu's.
     #[error("no GPU adapter found (on a machine without a GPU install Mesa's lavapipe: apt-get install mesa-vulkan-drivers): {0}")]
     NoAdapter(String),
     /// The adapter refused the device request.

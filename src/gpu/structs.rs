@@ -24,7 +24,7 @@ pub struct GpuFrame {
     pub ambient: [f32; 4],
     /// The frame's width and height in pixels.
     pub size: [u32; 2],
-    /// Lights in the light buffers, VPLs included once spawned.
+    /// Lights the passes loop over: the scene upload's count, or the last light update's.
     pub light_count: u32,
     /// Padding to WGSL's alignment; always 0.
     pub _pad0: u32,
@@ -109,7 +109,7 @@ pub struct GpuListParams {
     pub capacity: u32,
     /// The culling variant's code ([`crate::graph::CullVariant::code`]).
     pub variant: u32,
-    /// Word offset of the index pool in the list buffer (compact lists).
+    /// Word offset of the index pool in the list buffer (after the header and entries).
     pub pool_offset: u32,
     /// Light indices the pool holds (saturating at u32::MAX).
     pub pool_indices: u32,
@@ -239,13 +239,13 @@ pub(crate) fn gpu_light(l: &Light) -> (GpuLightGeometry, GpuLightProperties) {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuVertex {
-    /// Object-space position.
+    /// World-space position (scene meshes are stored transformed).
     pub position: [f32; 3],
-    /// Object-space normal.
+    /// World-space normal.
     pub normal: [f32; 3],
     /// Texture coordinates (glTF TEXCOORD_0).
     pub uv: [f32; 2],
-    /// Object-space tangent; `w` is the bitangent sign (glTF TANGENT).
+    /// World-space tangent; `w` is the bitangent sign (glTF TANGENT).
     pub tangent: [f32; 4],
 }
 
