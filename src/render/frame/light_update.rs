@@ -29,7 +29,8 @@ pub enum LightUpdateError {
         /// What is wrong with it.
         problem: String,
     },
-    /// A light needs a scene feature (shadows, spot cones, indirect light) that the graph was compiled without.
+    /// A light needs a scene feature (shadows, spot cones, indirect light) that the graph
+    /// was compiled without.
     #[error("light update: light {index} adds {feature}, which the scene had none of when the graph was compiled (passes for it were dropped or specialised away): compile and prepare again")]
     NewFeature {
         /// The light's index in the update.
