@@ -17,8 +17,8 @@ pub enum ShaderError {
         /// Why it could not be read.
         message: String,
     },
-    /// An `#include`, `#define` or `#if` directive is malformed or cannot be resolved
-    /// (missing file, include cycle, too deep).
+    /// A preprocessor directive (`#include`, `#if`, `#else`, `#endif`) is malformed,
+    /// unmatched, names nothing, or nests includes too deep.
     #[error("{file}:{line}: {message}")]
     Directive {
         /// The file holding the directive.
