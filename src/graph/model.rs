@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(rename = "Graph", deny_unknown_fields)]
 pub struct GraphDesc {
-    /// The graph's name, shown in reports and the viewer.
+    /// The graph's name, used in reports and the Graphviz output.
     pub name: String,
     /// Free text on what the graph does; ignored by the compiler.
     #[serde(default)]
@@ -162,7 +162,7 @@ pub enum BufferSize {
     },
     /// Bytes per output pixel.
     PerPixel(u64),
-    /// Bytes per light of the scene (at least one light).
+    /// Bytes per light the frame is sized for (`FrameSize::lights`, at least one).
     PerLight(u64),
 }
 
