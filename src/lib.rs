@@ -35,6 +35,8 @@
 //! [`render::PreparedFrame::update_lights`]. The `examples/` folder has each of these as
 //! a program; docs/architecture.md describes the steps.
 
+#![warn(missing_docs)]
+
 #[cfg(feature = "bench")]
 pub mod bench;
 pub mod cull;
