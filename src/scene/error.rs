@@ -44,7 +44,7 @@ pub enum SceneError {
 }
 
 impl SceneError {
-    pub fn invalid(
+    pub(crate) fn invalid(
         file: impl Into<PathBuf>,
         element: impl fmt::Display,
         message: impl fmt::Display,
@@ -57,7 +57,7 @@ impl SceneError {
         }
     }
 
-    pub fn io(file: impl Into<PathBuf>, source: std::io::Error) -> Self {
+    pub(crate) fn io(file: impl Into<PathBuf>, source: std::io::Error) -> Self {
         SceneError::Io {
             file: file.into(),
             source,
@@ -66,7 +66,7 @@ impl SceneError {
 
     /// The error with the line and column where the scene file `file`, whose text is
     /// `text`, writes the element it names (when it names one of that file's).
-    pub fn located_in(self, file: &std::path::Path, text: &str) -> Self {
+    pub(crate) fn located_in(self, file: &std::path::Path, text: &str) -> Self {
         self.located_by(file, |element, _| super::locate::locate(text, element))
     }
 

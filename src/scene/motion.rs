@@ -41,15 +41,15 @@ fn up() -> Vec3 {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct KeyframePath {
-    pub points: Vec<Vec3>,
-    pub period: f32,
+    pub(crate) points: Vec<Vec3>,
+    pub(crate) period: f32,
     #[serde(default)]
-    pub interpolation: Interpolation,
+    pub(crate) interpolation: Interpolation,
 }
 
 /// How a path moves between its points.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Interpolation {
+pub(crate) enum Interpolation {
     /// Straight segments.
     #[default]
     Linear,
@@ -77,11 +77,11 @@ pub struct LightMotion {
 }
 
 /// Most keyframes a path may have (a scene file is read whole; this bounds one path).
-pub const MAX_PATH_POINTS: usize = 1 << 16;
+pub(crate) const MAX_PATH_POINTS: usize = 1 << 16;
 
 impl Motion {
     /// Checks the parameters; the message names the bad field.
-    pub fn check(&self) -> Result<(), String> {
+    pub(crate) fn check(&self) -> Result<(), String> {
         if let Some(o) = &self.orbit {
             if !o.centre.is_finite() {
                 return Err(format!("orbit centre {} is not finite", o.centre));

@@ -42,7 +42,7 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// Most lights a scene file may produce in total.
-pub const MAX_SCENE_LIGHTS: u64 = 1 << 20;
+pub(crate) const MAX_SCENE_LIGHTS: u64 = 1 << 20;
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, rename = "Scene")]
@@ -51,19 +51,19 @@ pub struct SceneFile {
     pub name: Option<String>,
     /// A built-in scene (`atrium`, `harada`, `depth_discontinuity`) to start from.
     #[serde(default)]
-    pub builtin: Option<String>,
+    pub(crate) builtin: Option<String>,
     #[serde(default)]
-    pub models: Vec<Model>,
+    pub(crate) models: Vec<Model>,
     /// Default: the built-in's camera, else the first model's camera, else fitted to bounds.
     #[serde(default)]
     pub camera: Option<CameraSpec>,
     #[serde(default)]
     pub lights: Vec<LightSpec>,
     #[serde(default)]
-    pub light_sets: Vec<LightSetSpec>,
+    pub(crate) light_sets: Vec<LightSetSpec>,
     /// Keep the lights of the built-in scene and of the glTF models (KHR_lights_punctual).
     #[serde(default = "yes")]
-    pub keep_model_lights: bool,
+    pub(crate) keep_model_lights: bool,
     /// Imported material name → material RON path (kept as written, for the material module).
     #[serde(default)]
     pub material_overrides: std::collections::BTreeMap<String, PathBuf>,
@@ -83,7 +83,7 @@ fn yes() -> bool {
 /// A glTF model placed in the scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Model {
+pub(crate) struct Model {
     /// .gltf or .glb, relative to the scene file.
     pub path: PathBuf,
     #[serde(default)]
@@ -91,17 +91,17 @@ pub struct Model {
     /// Every light of this model (KHR_lights_punctual, kept with `keep_model_lights`)
     /// casts ray-cast shadows.
     #[serde(default)]
-    pub lights_cast_shadows: bool,
+    pub(crate) lights_cast_shadows: bool,
 }
 
 /// Scale, then rotation (Euler XYZ, degrees), then translation.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Transform {
+pub(crate) struct Transform {
     #[serde(default)]
     pub translation: Vec3,
     #[serde(default)]
-    pub rotation_deg: Vec3,
+    pub(crate) rotation_deg: Vec3,
     #[serde(default = "one")]
     pub scale: Vec3,
 }
@@ -121,7 +121,7 @@ impl Default for Transform {
 }
 
 impl Transform {
-    pub fn matrix(&self) -> Mat4 {
+    pub(crate) fn matrix(&self) -> Mat4 {
         let r = self.rotation_deg;
         Mat4::from_scale_rotation_translation(
             self.scale,
@@ -182,14 +182,14 @@ pub struct LightSpec {
     #[serde(default = "one")]
     pub color: Vec3,
     #[serde(default)]
-    pub spot: Option<SpotSpec>,
+    pub(crate) spot: Option<SpotSpec>,
     #[serde(default)]
-    pub casts_shadow: bool,
+    pub(crate) casts_shadow: bool,
     #[serde(default)]
-    pub indirect: bool,
+    pub(crate) indirect: bool,
     /// Art controls of the light's virtual point lights (only with `indirect: true`).
     #[serde(default)]
-    pub vpl: Option<super::VplControls>,
+    pub(crate) vpl: Option<super::VplControls>,
     #[serde(default = "all")]
     pub material_mask: u32,
     /// How the light moves and flickers over time.
@@ -203,15 +203,15 @@ fn all() -> u32 {
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct SpotSpec {
-    pub direction: Vec3,
+pub(crate) struct SpotSpec {
+    pub(crate) direction: Vec3,
     #[serde(default)]
-    pub inner_deg: f32,
-    pub outer_deg: f32,
+    pub(crate) inner_deg: f32,
+    pub(crate) outer_deg: f32,
 }
 
 impl LightSpec {
-    pub fn to_light(&self) -> Light {
+    pub(crate) fn to_light(&self) -> Light {
         let mut flags = 0;
         if self.casts_shadow {
             flags |= light_flags::CASTS_SHADOW;
@@ -239,7 +239,7 @@ impl LightSpec {
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub enum LightSetSpec {
+pub(crate) enum LightSetSpec {
     Random(RandomLights),
     Amd(AmdLights),
 }
@@ -264,7 +264,7 @@ pub fn parse_scene_file(text: &str, file: &Path) -> Result<SceneFile, SceneError
 }
 
 /// Loads a scene RON file: parses it and builds the scene.
-pub fn load_scene_file(path: &Path) -> Result<Loaded, SceneError> {
+pub(crate) fn load_scene_file(path: &Path) -> Result<Loaded, SceneError> {
     let text = crate::files::read_text(path, crate::files::caps::RON)
         .map_err(|e| SceneError::io(path, e))?;
     let spec = parse_scene_file(&text, path)?;

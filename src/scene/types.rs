@@ -69,10 +69,10 @@ pub struct SurfaceMaterial {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SlotSampling {
     pub base_color: TextureSampling,
-    pub metallic_roughness: TextureSampling,
+    pub(crate) metallic_roughness: TextureSampling,
     pub normal: TextureSampling,
     pub emissive: TextureSampling,
-    pub occlusion: TextureSampling,
+    pub(crate) occlusion: TextureSampling,
 }
 
 impl Default for SurfaceMaterial {
@@ -187,7 +187,7 @@ impl Default for Camera {
 /// reconstructed from depth through the inverse view-projection differ from pixel to pixel,
 /// and the tile frustums the culling builds from neighbouring pixel rays are not degenerate.
 /// Far narrower lenses collapse them (1e-6° rendered half or all black).
-pub const MIN_FOV_Y_DEG: f32 = 1.0;
+pub(crate) const MIN_FOV_Y_DEG: f32 = 1.0;
 /// Largest far / near ratio, 2^24. The depth of the projection (standard Z, f32 depth) is
 /// about 1 − near/z, and one ulp of values just under 1 is 2^-24: a surface at z keeps a
 /// depth below the far plane's only while near·(1/z − 1/far) ≥ 2^-24. At the limit every
@@ -199,7 +199,7 @@ pub const MAX_FAR_OVER_NEAR: f32 = 16_777_216.0;
 impl Camera {
     /// Why a lens (vertical field of view in degrees, near and far planes in metres) is
     /// refused, naming the field; None when it is within the limits above.
-    pub fn lens_error(fov_y_deg: f32, near: f32, far: f32) -> Option<String> {
+    pub(crate) fn lens_error(fov_y_deg: f32, near: f32, far: f32) -> Option<String> {
         // A perspective projection ends below 180°.
         if !(MIN_FOV_Y_DEG..180.0).contains(&fov_y_deg) {
             return Some(format!(
@@ -351,7 +351,7 @@ impl Scene {
     }
 
     /// Axis-aligned bounds of all geometry, or `None` for an empty scene.
-    /// Adds a [`headlight`](super::lights::headlight) when the scene has no lights but has
+    /// Adds a `headlight` when the scene has no lights but has
     /// geometry; returns it so that the caller can say so (the library never prints).
     pub fn add_headlight_if_unlit(&mut self) -> Option<Light> {
         if !self.lights.is_empty() {
