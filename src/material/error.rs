@@ -6,9 +6,9 @@ use thiserror::Error;
 /// A position in a material file (1-based line and column).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Location {
-    pub file: PathBuf,
-    pub line: usize,
-    pub col: usize,
+    pub(crate) file: PathBuf,
+    pub(crate) line: usize,
+    pub(crate) col: usize,
 }
 
 impl std::fmt::Display for Location {

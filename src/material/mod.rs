@@ -1,7 +1,7 @@
 //! Layered BRDF materials (RON model, WGSL generation, f64 reference).
 //!
 //! A material file (`materials/*.ron`, see [`model::MaterialDesc`]) is parsed and validated
-//! ([`parse`]), its out-of-range values are clamped or flagged ([`sanitize`]), and it
+//! (`parse`), its out-of-range values are clamped or flagged (`sanitize`), and it
 //! compiles to WGSL ([`wgsl`]) that plugs into the forward light loop through
 //! `material_setup` / `material_eval` / `material_emission` / `material_alpha`.
 //! [`reference`](mod@reference) is the f64 CPU implementation the tests compare the GPU against.
@@ -27,12 +27,12 @@
 //! specular peaks), error |gpu − ref| / max(|ref|, 1e-3): every lobe ≤ 7.3e-5, layered
 //! materials ≤ 4.9e-5 (see `tests/material_gpu.rs`).
 
-pub mod error;
+pub(crate) mod error;
 mod gltf_map;
 pub mod model;
-pub mod parse;
+pub(crate) mod parse;
 pub mod reference;
-pub mod sanitize;
+pub(crate) mod sanitize;
 pub mod wgsl;
 
 pub use error::{Location, MaterialError};
@@ -105,7 +105,7 @@ pub struct TextureSlot {
 
 /// The WGSL name of the material's `k`-th distinct sampler: `material_sampler` (binding
 /// 0) for the first, then `material_sampler{k}` at bindings after the textures.
-pub fn sampler_wgsl_name(k: usize) -> String {
+pub(crate) fn sampler_wgsl_name(k: usize) -> String {
     if k == 0 {
         "material_sampler".into()
     } else {
@@ -200,7 +200,7 @@ impl Material {
         &self.slots
     }
     /// The distinct samplers of the texture slots in first-use order, and for each slot
-    /// the index of its sampler (see [`sampler_wgsl_name`]).
+    /// the index of its sampler (see `sampler_wgsl_name`).
     pub fn samplers(&self) -> (Vec<model::SamplerDesc>, Vec<usize>) {
         let mut distinct: Vec<model::SamplerDesc> = Vec::new();
         let of_slot = self
@@ -239,7 +239,7 @@ impl Material {
         Ok(code)
     }
     /// The material's code as the renderer composes it: the lobe library by `#include`.
-    pub fn renderer_wgsl(&self, options: &WgslOptions) -> Result<String, MaterialError> {
+    pub(crate) fn renderer_wgsl(&self, options: &WgslOptions) -> Result<String, MaterialError> {
         self.wgsl_with(&WgslOptions {
             include_library: true,
             ..options.clone()

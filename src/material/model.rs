@@ -22,26 +22,26 @@ pub struct MaterialDesc {
     pub double_sided: bool,
     /// Texture slots by name; bindings follow the name order (BTreeMap).
     #[serde(default)]
-    pub textures: BTreeMap<String, TextureDesc>,
+    pub(crate) textures: BTreeMap<String, TextureDesc>,
     /// Coverage (glTF: base colour alpha × texture alpha). Default 1.
     #[serde(default = "one_scalar")]
-    pub alpha: Scalar,
+    pub(crate) alpha: Scalar,
     /// Emitted radiance. Default black.
     #[serde(default)]
     pub emissive: Option<Color>,
     #[serde(default)]
-    pub normal_map: Option<NormalMap>,
+    pub(crate) normal_map: Option<NormalMap>,
     #[serde(default)]
-    pub occlusion: Option<Occlusion>,
+    pub(crate) occlusion: Option<Occlusion>,
     /// Top layer first.
     pub layers: Vec<Layer>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct TextureDesc {
+pub(crate) struct TextureDesc {
     /// Path relative to the material file.
-    pub file: String,
+    pub(crate) file: String,
     /// sRGB-encoded colour data (base colour, emissive) rather than linear data.
     #[serde(default)]
     pub srgb: bool,
@@ -131,7 +131,7 @@ impl Default for UvTransform {
 
 impl UvTransform {
     /// The rows of the 2×3 matrix T R S of the glTF extension.
-    pub fn matrix(&self) -> [[f32; 3]; 2] {
+    pub(crate) fn matrix(&self) -> [[f32; 3]; 2] {
         let (s, c) = self.rotation.sin_cos();
         let (sx, sy) = self.scale;
         [
@@ -159,8 +159,8 @@ pub struct TextureSampling {
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct NormalMap {
-    pub texture: String,
+pub(crate) struct NormalMap {
+    pub(crate) texture: String,
     #[serde(default = "one_f32")]
     pub scale: f32,
 }
@@ -169,12 +169,12 @@ pub struct NormalMap {
 /// renderer as `material_occlusion(m)`, it does not scale `material_eval` (direct light).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Occlusion {
-    pub texture: String,
+pub(crate) struct Occlusion {
+    pub(crate) texture: String,
     #[serde(default)]
-    pub channel: Channel,
+    pub(crate) channel: Channel,
     #[serde(default = "one_f32")]
-    pub strength: f32,
+    pub(crate) strength: f32,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -185,22 +185,22 @@ pub struct Layer {
     /// Index of refraction of the layer's interface; `None` (or 1) means no interface
     /// Fresnel. Also bends the path used for absorption.
     #[serde(default)]
-    pub ior: Option<f32>,
+    pub(crate) ior: Option<f32>,
     /// Scales the interface Fresnel in `1 - F * weight` (e.g. clearcoat amount).
     #[serde(default = "one_f32")]
-    pub weight: f32,
+    pub(crate) weight: f32,
     /// How the interface Fresnel scales what reaches the layers below.
     #[serde(default)]
     pub coupling: Coupling,
     /// Fraction of the non-reflected light that goes on to the next layer.
     #[serde(default = "one_f32")]
-    pub transmission: f32,
+    pub(crate) transmission: f32,
     /// Thickness of the layer for Beer-Lambert absorption (same unit as `absorption`⁻¹).
     #[serde(default)]
-    pub thickness: f32,
+    pub(crate) thickness: f32,
     /// Absorption coefficient per unit thickness, per channel.
     #[serde(default)]
-    pub absorption: (f32, f32, f32),
+    pub(crate) absorption: (f32, f32, f32),
     pub lobes: Vec<Lobe>,
 }
 
@@ -287,7 +287,7 @@ impl Lobe {
         }
     }
 
-    pub fn weight(&self) -> f32 {
+    pub(crate) fn weight(&self) -> f32 {
         match *self {
             Lobe::Lambert { weight, .. }
             | Lobe::OrenNayar { weight, .. }
@@ -313,7 +313,7 @@ impl Channel {
     pub fn index(self) -> usize {
         self as usize
     }
-    pub fn swizzle(self) -> &'static str {
+    pub(crate) fn swizzle(self) -> &'static str {
         ["x", "y", "z", "w"][self as usize]
     }
 }
@@ -386,7 +386,7 @@ fn one_scalar() -> Scalar {
 
 impl Scalar {
     /// Names of the textures this expression reads.
-    pub fn textures<'a>(&'a self, out: &mut Vec<&'a str>) {
+    pub(crate) fn textures<'a>(&'a self, out: &mut Vec<&'a str>) {
         match self {
             Scalar::Val(_) => {}
             Scalar::Expr(ScalarExpr::Tex { texture, .. }) => out.push(texture),
@@ -400,7 +400,7 @@ impl Scalar {
 }
 
 impl Color {
-    pub fn textures<'a>(&'a self, out: &mut Vec<&'a str>) {
+    pub(crate) fn textures<'a>(&'a self, out: &mut Vec<&'a str>) {
         match self {
             Color::Rgb(..) => {}
             Color::Expr(ColorExpr::Tex { texture, .. }) => out.push(texture),

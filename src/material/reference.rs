@@ -54,13 +54,13 @@ fn max0(a: V3) -> V3 {
 /// What the lobes need about (n, v, l); see `LgDirs` in the WGSL.
 #[derive(Clone, Copy, Debug)]
 pub struct Dirs {
-    pub h: V3,
+    pub(crate) h: V3,
     pub nl: f64,
     pub nv: f64,
     pub nh: f64,
     pub vh: f64,
     pub s2: f64,
-    pub lv: f64,
+    pub(crate) lv: f64,
 }
 
 pub fn dirs(n: V3, v: V3, l: V3) -> Dirs {
