@@ -22,13 +22,13 @@ use serde::Deserialize;
 /// One variation of the sweep's scenes. Applied after the sweep's light count, in field order.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct SceneCase {
+pub(crate) struct SceneCase {
     /// Rows name the scene `scene/name`.
     pub name: String,
     /// If given (even empty), these light sets (scene-RON syntax: `Random(...)`, `Amd(...)`,
     /// placed in the scene's bounds) replace the scene's lights.
     #[serde(default)]
-    pub light_sets: Option<Vec<LightSetSpec>>,
+    pub(crate) light_sets: Option<Vec<LightSetSpec>>,
     /// If given (even empty), these explicit lights (scene-RON syntax) replace the scene's
     /// lights; with `light_sets` they follow the sets' lights.
     #[serde(default)]
@@ -48,7 +48,7 @@ pub struct SceneCase {
     /// Moves the camera's eye to this light's centre (index into the lights after the fields
     /// above), keeping the view direction.
     #[serde(default)]
-    pub camera_at_light: Option<usize>,
+    pub(crate) camera_at_light: Option<usize>,
 }
 
 impl SceneCase {

@@ -1,6 +1,6 @@
 //! Benchmark sweeps: scenes × light counts × resolutions × graphs. The graphs of a point
 //! are timed together on the GPU (warmed up by time, then interleaved rounds: see
-//! [`super::timing`]) and each is compared with the reference image of the same scene
+//! `bench::timing`) and each is compared with the reference image of the same scene
 //! (brute force unless the sweep names another graph).
 
 use super::cases::SceneCase;
@@ -22,7 +22,7 @@ use thiserror::Error;
 #[serde(rename = "Sweep", deny_unknown_fields)]
 pub struct Sweep {
     /// `builtin:NAME` or a scene file path (relative to the sweep file).
-    pub scenes: Vec<String>,
+    pub(crate) scenes: Vec<String>,
     /// Graph files, relative to the project's graphs/ folder.
     pub graphs: Vec<String>,
     /// Light counts; empty keeps each scene's own lights. Lights are placed uniformly
@@ -33,7 +33,7 @@ pub struct Sweep {
     /// centre), applied after the light count: see [`SceneCase`]. Empty runs the scenes as
     /// they are.
     #[serde(default)]
-    pub cases: Vec<SceneCase>,
+    pub(crate) cases: Vec<SceneCase>,
     pub resolutions: Vec<(u32, u32)>,
     /// Warm-up frames every graph of a point runs at least.
     #[serde(default = "default_warmup")]
@@ -50,7 +50,7 @@ pub struct Sweep {
     pub rounds: u32,
     /// Above this many lights the reference is not run (no error columns).
     #[serde(default = "default_brute_force_limit")]
-    pub brute_force_limit: u32,
+    pub(crate) brute_force_limit: u32,
     /// The graph whose image the error columns compare against, like `graphs` (default
     /// `brute_force.ron`). Brute force does not trace shadows: name a shadow-tracing graph to
     /// compare ray-cast shadows with something shadowed.
@@ -59,15 +59,15 @@ pub struct Sweep {
     /// Per-graph exceptions to `reference`: graph → its reference graph, e.g.
     /// `{"raycast_shadows.ron": "raycast_shadows_naive.ron"}`. Keys must be in `graphs`.
     #[serde(default)]
-    pub references: BTreeMap<String, String>,
+    pub(crate) references: BTreeMap<String, String>,
     /// Render an extra frame per point for the light statistics (the listed/exact column);
     /// it costs as much as a brute-force frame.
     #[serde(default = "yes")]
-    pub light_stats: bool,
+    pub(crate) light_stats: bool,
     /// Seconds of light motion between frames: every warm-up and timed frame first moves
     /// the lights there (`PreparedFrame::update_lights`). See [`crate::bench::animate`].
     #[serde(default)]
-    pub animate: Option<f64>,
+    pub(crate) animate: Option<f64>,
 }
 
 fn yes() -> bool {
@@ -225,7 +225,7 @@ impl Sweep {
     }
 
     /// The timing settings.
-    pub fn method(&self) -> timing::Method {
+    pub(crate) fn method(&self) -> timing::Method {
         timing::Method {
             warmup_frames: self.warmup,
             warmup_seconds: self.warmup_seconds,
@@ -285,7 +285,7 @@ pub enum SweepEvent<'a> {
 }
 
 /// How many NaN / Inf pixels a row lists by position (all are counted).
-pub const NON_FINITE_EXAMPLES: usize = 16;
+pub(crate) const NON_FINITE_EXAMPLES: usize = 16;
 
 /// Runs the sweep; `progress` hears when each point starts and ends.
 pub fn run(

@@ -121,15 +121,15 @@ pub struct ReloadSample {
     /// settle time for a saved file or the debounce otherwise).
     pub watch_ms: f64,
     /// Reading and uploading changed materials / scene.
-    pub assets_ms: f64,
+    pub(crate) assets_ms: f64,
     /// Parsing, validating and compiling the graph.
-    pub graph_ms: f64,
+    pub(crate) graph_ms: f64,
     /// Composing shader sources and validating them with naga.
     pub shader_compose_ms: f64,
     /// Creating shader modules and pipelines.
     pub pipeline_build_ms: f64,
     /// The rest of prepare: resources, bind groups, layouts.
-    pub prepare_other_ms: f64,
+    pub(crate) prepare_other_ms: f64,
     /// Executing the frame and reading it back.
     pub render_ms: f64,
     /// The same frame rendered again right after (not part of the latency): what of
@@ -137,7 +137,7 @@ pub struct ReloadSample {
     pub rerender_ms: f64,
     /// Composing and building, wall time (less than the sum of the two with parallel
     /// builds).
-    pub build_wall_ms: f64,
+    pub(crate) build_wall_ms: f64,
     /// Of `pipeline_build_ms`: `create_shader_module`.
     pub shader_module_ms: f64,
     /// Of `pipeline_build_ms`: `create_render/compute_pipeline` (with layouts).
@@ -145,21 +145,21 @@ pub struct ReloadSample {
     /// Whether the GPU still had earlier frames' work when the first build began.
     pub gpu_busy_at_build: Option<bool>,
     /// Waiting for the GPU before building (only with `wait_for_idle_before_build`).
-    pub gpu_wait_before_build_ms: f64,
+    pub(crate) gpu_wait_before_build_ms: f64,
     /// Each pipeline built: pass, shader and material, and its times.
-    pub builds: Vec<PipelineBuild>,
+    pub(crate) builds: Vec<PipelineBuild>,
     /// Of `render_ms`: encoding and `queue.submit`.
     pub record_submit_ms: f64,
     /// Of `render_ms`: submit returned → GPU done (blocking poll).
     pub gpu_wait_ms: f64,
     /// The GPU's time for the frame, from pass timestamps (NaN without timestamps).
-    pub gpu_frame_ms: f64,
+    pub(crate) gpu_frame_ms: f64,
     /// Of `render_ms`: copying, mapping and converting the Rgba32Float output.
     pub image_readback_ms: f64,
     /// Of `render_ms`: timestamps, culling reports and statistics read back.
-    pub reports_readback_ms: f64,
+    pub(crate) reports_readback_ms: f64,
     /// The same frame again: submit returned → GPU done.
-    pub rerender_gpu_wait_ms: f64,
+    pub(crate) rerender_gpu_wait_ms: f64,
     pub pipelines_built: usize,
     pub resources_created: usize,
     pub resources_reused: usize,
@@ -434,7 +434,7 @@ pub struct Startup {
     pub shader_compose_ms: f64,
     pub pipeline_build_ms: f64,
     /// The driver's pipeline cache on disk: where, and what opening it found.
-    pub pipeline_cache: String,
+    pub(crate) pipeline_cache: String,
 }
 
 /// A benchmark run: the session's start and every timed edit.

@@ -17,9 +17,9 @@ pub struct KindSummary {
     /// Edit → new frame read back.
     pub total: TimingSummary,
     /// (column name, median ms) for each part of the breakdown.
-    pub parts: Vec<(&'static str, f64)>,
+    pub(crate) parts: Vec<(&'static str, f64)>,
     /// (column name, median ms) for the parts of pipeline build and render.
-    pub details: Vec<(&'static str, f64)>,
+    pub(crate) details: Vec<(&'static str, f64)>,
     /// Samples whose first build began with the GPU still busy, of those that built.
     pub gpu_busy_at_build: (usize, usize),
     pub pipelines_built: f64,
@@ -98,10 +98,10 @@ pub fn summarize_kinds(samples: &[ReloadSample]) -> Vec<KindSummary> {
 pub struct PipelineSummary {
     pub kind: EditKind,
     pub name: String,
-    pub builds: usize,
-    pub compose_ms: f64,
-    pub module_ms: f64,
-    pub create_ms: f64,
+    pub(crate) builds: usize,
+    pub(crate) compose_ms: f64,
+    pub(crate) module_ms: f64,
+    pub(crate) create_ms: f64,
 }
 
 pub fn summarize_pipelines(samples: &[ReloadSample]) -> Vec<PipelineSummary> {

@@ -131,7 +131,7 @@ impl BenchRow {
     }
 
     /// Sum of the per-pass median times, if any pass was timed.
-    pub fn passes_ms_total(&self) -> Option<f64> {
+    pub(crate) fn passes_ms_total(&self) -> Option<f64> {
         (!self.pass_ms.is_empty()).then(|| self.pass_ms.iter().map(|(_, t)| t.median).sum())
     }
 }
