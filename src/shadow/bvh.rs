@@ -139,21 +139,21 @@ pub struct BuildStats {
     /// Everything: gathering triangles, the obvhs build, flattening.
     pub build_time: Duration,
     /// Reading the scene's triangles (and skipping the bad ones) and their boxes.
-    pub gather_time: Duration,
+    pub(crate) gather_time: Duration,
     /// The obvhs PLOC build and reinsertion alone.
     pub core_build_time: Duration,
     /// SAH leaf collapse and flattening into [`ShadowBvh::nodes`] / `triangles`.
-    pub flatten_time: Duration,
+    pub(crate) flatten_time: Duration,
     /// Surface-area-heuristic cost of the tree: expected triangle tests plus
     /// `traversal_cost` × inner-node visits for a random ray through the root box.
-    pub sah_cost: f32,
+    pub(crate) sah_cost: f32,
 }
 
 /// What one traversal did (CPU twin only).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct TraversalStats {
-    pub nodes_visited: u32,
-    pub triangles_tested: u32,
+    pub(crate) nodes_visited: u32,
+    pub(crate) triangles_tested: u32,
     /// The stack would have overflowed, so the ray was re-cast stackless from the root.
     pub fell_back: bool,
 }

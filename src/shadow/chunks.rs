@@ -1,11 +1,11 @@
 //! Triangle chunks for culling per shadow view: a mesh's triangles reordered along a
-//! Morton curve of their centroids and cut into runs of at most [`CHUNK_TRIANGLES`], each
+//! Morton curve of their centroids and cut into runs of at most `CHUNK_TRIANGLES`, each
 //! with its bounds. A light's view then draws the runs its frustum touches instead of the
 //! whole mesh (a small light in a large room touches a few).
 
 use glam::Vec3;
 
-pub const CHUNK_TRIANGLES: usize = 128;
+pub(crate) const CHUNK_TRIANGLES: usize = 128;
 
 /// A run of `count` indices from `first` in the reordered index buffer.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -18,7 +18,7 @@ pub struct Chunk {
 
 /// The mesh's indices reordered into chunks, and the chunks. Triangles with an index
 /// past `positions` are left out (the draw would read garbage).
-pub fn chunk_triangles(positions: &[Vec3], indices: &[u32]) -> (Vec<u32>, Vec<Chunk>) {
+pub(crate) fn chunk_triangles(positions: &[Vec3], indices: &[u32]) -> (Vec<u32>, Vec<Chunk>) {
     let tris: Vec<[u32; 3]> = indices
         .chunks_exact(3)
         .map(|t| [t[0], t[1], t[2]])
