@@ -5,8 +5,8 @@
 
 mod animation;
 mod app;
-pub mod camera;
-pub mod overlay;
+pub(crate) mod camera;
+pub(crate) mod overlay;
 
 pub use app::run;
 pub use camera::{CameraController, CameraMode, Movement};
