@@ -44,7 +44,7 @@ pub struct Primary {
     pub n: Vec3,
     pub ng: Vec3,
     pub v: Vec3,
-    pub m: usize,
+    pub(crate) m: usize,
 }
 
 struct Hit {
