@@ -10,35 +10,51 @@ pub enum SceneError {
     /// A file could not be read.
     #[error("{}: cannot read file: {source}", file.display())]
     Io {
+        /// The file that could not be read.
         file: PathBuf,
+        /// The operating system's error.
         #[source]
         source: std::io::Error,
     },
     /// RON syntax or type error.
     #[error("{}:{line}:{col}: {message}", file.display())]
     Parse {
+        /// The scene file.
         file: PathBuf,
+        /// 1-based line of the error.
         line: usize,
+        /// 1-based column of the error.
         col: usize,
+        /// What the RON parser or serde reported.
         message: String,
     },
     /// Bad content: names the element (e.g. `mesh 0 ("box") primitive 1 accessor 3`),
     /// and where a scene file writes it when that is known.
     #[error("{}{}: {element}: {message}", file.display(), at_text(at))]
     Invalid {
+        /// The file holding the bad content.
         file: PathBuf,
+        /// Line and column (1-based) where the scene file writes the element, when known.
         at: Option<(usize, usize)>,
+        /// The element at fault, e.g. `mesh 0 ("box") primitive 1 accessor 3` or `light 3`.
         element: String,
+        /// What is wrong with it.
         message: String,
     },
     /// A count past a safety limit.
     #[error("{}{}: {element}: {what} {count} exceeds the limit of {limit}", file.display(), at_text(at))]
     Limit {
+        /// The file holding the element.
         file: PathBuf,
+        /// Line and column (1-based) where the scene file writes the element, when known.
         at: Option<(usize, usize)>,
+        /// The element whose count is too large.
         element: String,
+        /// What was counted, e.g. `triangle count after instancing`.
         what: &'static str,
+        /// The count found.
         count: u64,
+        /// The largest count allowed.
         limit: u64,
     },
 }

@@ -75,10 +75,12 @@ pub(crate) fn compute_tangents(
 /// Builds one mesh out of boxes, cylinders and swept profiles (for the built-in scenes).
 #[derive(Default)]
 pub struct MeshBuilder {
+    /// The mesh built so far; take it when done.
     pub mesh: Mesh,
 }
 
 impl MeshBuilder {
+    /// An empty mesh called `name` using material index `material` of the scene.
     pub fn new(name: &str, material: usize) -> Self {
         MeshBuilder {
             mesh: Mesh {
@@ -99,7 +101,14 @@ impl MeshBuilder {
 
     /// The four inward-facing walls of a room centred on the origin, `2hx` × `2hz` and `h`
     /// high from y = 0; `uv_x` tiles the walls along x, `uv_z` those along z.
-    pub(crate) fn inward_walls(&mut self, hx: f32, hz: f32, h: f32, uv_x: Vec2, uv_z: Vec2) -> &mut Self {
+    pub(crate) fn inward_walls(
+        &mut self,
+        hx: f32,
+        hz: f32,
+        h: f32,
+        uv_x: Vec2,
+        uv_z: Vec2,
+    ) -> &mut Self {
         self.quad(
             Vec3::new(-hx, 0.0, -hz),
             Vec3::X * 2.0 * hx,

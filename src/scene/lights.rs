@@ -16,10 +16,14 @@ pub struct Pcg32 {
 impl Pcg32 {
     const MUL: u64 = 6364136223846793005;
 
+    /// A generator seeded with `seed` on the default stream; the same seed gives the same
+    /// sequence on every platform.
     pub fn new(seed: u64) -> Self {
         Self::with_stream(seed, 0xda3e_39cb_94b9_5bdb)
     }
 
+    /// A generator seeded with `seed` on stream `stream`: different streams give independent
+    /// sequences for one seed.
     pub fn with_stream(seed: u64, stream: u64) -> Self {
         let mut rng = Pcg32 {
             state: 0,
@@ -31,6 +35,7 @@ impl Pcg32 {
         rng
     }
 
+    /// The next uniformly distributed 32-bit value.
     pub fn next_u32(&mut self) -> u32 {
         let old = self.state;
         self.state = old.wrapping_mul(Self::MUL).wrapping_add(self.inc);
@@ -49,6 +54,7 @@ impl Pcg32 {
         lo + (hi - lo) * self.next_f32()
     }
 
+    /// A point uniform in the box from `lo` to `hi` (per axis in [lo, hi)).
     pub fn vec3_in(&mut self, lo: Vec3, hi: Vec3) -> Vec3 {
         Vec3::new(
             self.range(lo.x, hi.x),
@@ -91,12 +97,15 @@ fn default_color() -> (Vec3, Vec3) {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RandomLights {
+    /// Number of lights.
     pub count: u32,
     /// Fraction of spot lights, 0 (all point) .. 1 (all spot).
     #[serde(default)]
     pub(crate) spot_fraction: f32,
     pub(crate) placement: Placement,
+    /// Range in metres, min ≤ max, min > 0.
     pub range: (f32, f32),
+    /// Intensity in candela, 0 ≤ min ≤ max.
     pub intensity: (f32, f32),
     /// Linear RGB, per channel.
     #[serde(default = "default_color")]
@@ -104,12 +113,14 @@ pub struct RandomLights {
     /// Spot (inner, outer) cone half-angles in degrees.
     #[serde(default = "default_spot_cone")]
     pub(crate) spot_cone_deg: (f32, f32),
+    /// PRNG seed (PCG32); the same seed gives the same lights on every platform.
     #[serde(default)]
     pub seed: u64,
     #[serde(default)]
     pub(crate) casts_shadow: bool,
     #[serde(default)]
     pub(crate) indirect: bool,
+    /// Material type bits the lights light (all by default).
     #[serde(default = "all_bits")]
     pub material_mask: u32,
     /// How every light of the set moves (each from its own position).
@@ -248,13 +259,16 @@ impl RandomLights {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AmdLights {
+    /// Point lights (default 2048).
     #[serde(default = "amd_count")]
     pub point_count: u32,
+    /// Spot lights (default 2048).
     #[serde(default = "amd_count")]
     pub spot_count: u32,
     /// How many of the first point and of the first spot lights cast shadows (sample: 12 + 12).
     #[serde(default)]
     pub shadow_casters: u32,
+    /// PRNG seed (default a fixed constant).
     #[serde(default = "amd_seed")]
     pub seed: u64,
     /// How every light of the set moves (each from its own position).

@@ -30,7 +30,10 @@ use std::path::Path;
 /// primitives, lights given a finite range...). The library never prints them.
 #[derive(Clone, Debug, Default)]
 pub struct Loaded {
+    /// The scene, ready for [`graph::compile`](crate::graph::compile) and
+    /// [`SceneGpu::upload`](crate::render::SceneGpu::upload).
     pub scene: Scene,
+    /// Non-fatal problems, one message each, for the caller to show.
     pub warnings: Vec<String>,
     /// Every file the scene was read from (scene file, glTF models, their buffers and
     /// images): what hot reload watches.

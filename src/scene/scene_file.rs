@@ -44,9 +44,13 @@ use std::path::{Path, PathBuf};
 /// Most lights a scene file may produce in total.
 pub(crate) const MAX_SCENE_LIGHTS: u64 = 1 << 20;
 
+/// A scene file (`scenes/*.ron`, written `Scene(...)`) as parsed; [`build_scene`] turns it
+/// into a [`Scene`]. docs/format.md describes every field.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, rename = "Scene")]
 pub struct SceneFile {
+    /// The scene's name in reports (default: the built-in's or first model's name, else the
+    /// file stem).
     #[serde(default)]
     pub name: Option<String>,
     /// A built-in scene (`atrium`, `harada`, `depth_discontinuity`) to start from.
@@ -57,6 +61,7 @@ pub struct SceneFile {
     /// Default: the built-in's camera, else the first model's camera, else fitted to bounds.
     #[serde(default)]
     pub camera: Option<CameraSpec>,
+    /// Explicit lights.
     #[serde(default)]
     pub lights: Vec<LightSpec>,
     #[serde(default)]
@@ -67,8 +72,11 @@ pub struct SceneFile {
     /// Imported material name → material RON path (kept as written, for the material module).
     #[serde(default)]
     pub material_overrides: std::collections::BTreeMap<String, PathBuf>,
+    /// Preferred output width and height, each 1..=16384 (default: the command's size).
     #[serde(default)]
     pub output_size: Option<(u32, u32)>,
+    /// Constant ambient radiance added to every surface; finite, ≥ 0 (default: the
+    /// built-in's, else zero).
     #[serde(default)]
     pub ambient: Option<Vec3>,
     /// The ray-cast shadow BVH's build quality: Fastest, VeryFast, Fast (default), Medium.
@@ -136,18 +144,27 @@ impl Transform {
     }
 }
 
+/// How the scene file places the camera (`camera:`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum CameraSpec {
+    /// An explicit perspective camera; needs finite `eye` ≠ `target`, `up` ≠ 0, 0 <
+    /// `fov_y_deg` < 180 and 0 < `near` < `far`.
     LookAt {
+        /// Camera position, metres.
         eye: Vec3,
+        /// The point looked at.
         target: Vec3,
+        /// Up direction (default `(0, 1, 0)`).
         #[serde(default = "up")]
         up: Vec3,
+        /// Vertical field of view in degrees (default 60).
         #[serde(default = "fov")]
         fov_y_deg: f32,
+        /// Near plane in metres (default 0.1).
         #[serde(default = "near")]
         near: f32,
+        /// Far plane in metres (default 100).
         #[serde(default = "far")]
         far: f32,
     },
@@ -174,11 +191,16 @@ fn far() -> f32 {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LightSpec {
+    /// Names the light in error messages.
     #[serde(default)]
     pub name: Option<String>,
+    /// Position in metres.
     pub position: Vec3,
+    /// Where the light's influence ends, metres; > 0.
     pub range: f32,
+    /// Intensity in candela; ≥ 0.
     pub intensity: f32,
+    /// Linear RGB colour, ≥ 0 (default white).
     #[serde(default = "one")]
     pub color: Vec3,
     #[serde(default)]
@@ -190,6 +212,7 @@ pub struct LightSpec {
     /// Art controls of the light's virtual point lights (only with `indirect: true`).
     #[serde(default)]
     pub(crate) vpl: Option<super::VplControls>,
+    /// Material type bits this light lights (a material's `type_bit`; default all).
     #[serde(default = "all")]
     pub material_mask: u32,
     /// How the light moves and flickers over time.
