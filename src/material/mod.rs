@@ -47,7 +47,12 @@ use std::sync::Arc;
 #[derive(Clone, Debug, PartialEq)]
 pub enum TextureSource {
     /// A file named in the RON (resolved against the material file's folder).
-    File { path: PathBuf, srgb: bool },
+    File {
+        /// The image file (PNG or JPEG).
+        path: PathBuf,
+        /// Whether the texels are sRGB-encoded colour rather than linear data.
+        srgb: bool,
+    },
     /// An image already decoded (glTF import).
     Image(Arc<TextureImage>),
 }
@@ -96,10 +101,15 @@ impl TextureSource {
 /// how it is sampled.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TextureSlot {
+    /// The texture's binding in `@group(2)` (1 and up; 0 is the first sampler).
     pub binding: u32,
+    /// The texture's name in the material file (and in the generated WGSL).
     pub name: String,
+    /// Where the pixels come from.
     pub source: TextureSource,
+    /// Wrap and filter modes of the sampler the slot reads through.
     pub sampler: model::SamplerDesc,
+    /// The uv transform applied before sampling, if any.
     pub transform: Option<model::UvTransform>,
 }
 
@@ -172,9 +182,11 @@ impl Material {
     pub fn desc(&self) -> &MaterialDesc {
         &self.desc
     }
+    /// The material's name (`name:` in the file, or the glTF material's name).
     pub fn name(&self) -> &str {
         &self.desc.name
     }
+    /// The material file, or `gltf:NAME` for a material mapped from glTF.
     pub fn path(&self) -> &Path {
         &self.path
     }

@@ -26,6 +26,8 @@ pub const SHADING_POINT_WGSL: &str = "struct ShadingPoint {
 };
 ";
 
+/// How [`Material::wgsl_with`](super::Material::wgsl_with) generates a material's WGSL; the
+/// default suits the forward and deferred fragment shaders.
 #[derive(Clone, Debug, Default)]
 pub struct WgslOptions {
     /// Sample textures with `textureSampleLevel(.., 0.0)` instead of `textureSample`, so the
