@@ -34,6 +34,7 @@ pub struct Sweep {
     /// they are.
     #[serde(default)]
     pub(crate) cases: Vec<SceneCase>,
+    /// Output sizes (width, height), each side 1..=16384.
     pub resolutions: Vec<(u32, u32)>,
     /// Warm-up frames every graph of a point runs at least.
     #[serde(default = "default_warmup")]
@@ -115,14 +116,24 @@ fn field_line(text: &str, field: &str) -> String {
         .map_or(String::new(), |i| format!("{}: ", i + 1))
 }
 
+/// Why a sweep stopped.
 #[derive(Debug, Error)]
 pub enum SweepError {
+    /// The sweep file could not be read or parsed.
     #[error("{file}: {message}")]
-    File { file: PathBuf, message: String },
+    File {
+        /// The sweep file.
+        file: PathBuf,
+        /// What is wrong, with the line where known.
+        message: String,
+    },
+    /// A scene could not be loaded or a case not applied: (scene, reason).
     #[error("scene {0}: {1}")]
     Scene(String, String),
+    /// A graph could not be checked or compiled: (graph, reason).
     #[error("graph {0}: {1}")]
     Graph(String, String),
+    /// Rendering a point failed on the GPU.
     #[error(transparent)]
     Render(#[from] RenderError),
 }
@@ -272,14 +283,20 @@ pub fn with_light_count(scene: &Scene, count: u32) -> Scene {
 pub enum SweepEvent<'a> {
     /// Point `index` (from 0) of `total` is starting; `point` names it.
     Start {
+        /// 0-based index of the point.
         index: usize,
+        /// Number of points in the sweep.
         total: usize,
+        /// The point's label: scene, graph, light count and size.
         point: &'a str,
     },
     /// `done` points of `total` have finished, the last one gave `row`.
     Done {
+        /// Points finished so far.
         done: usize,
+        /// Number of points in the sweep.
         total: usize,
+        /// The finished point's measurement.
         row: &'a BenchRow,
     },
 }

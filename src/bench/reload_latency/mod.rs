@@ -26,23 +26,39 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 use thiserror::Error;
 
+/// Why the hot-reload latency benchmark stopped.
 #[derive(Debug, Error)]
 pub enum ReloadBenchError {
+    /// Copying or writing a file of the work folder failed.
     #[error("{}: {source}", path.display())]
     Io {
+        /// The file.
         path: PathBuf,
+        /// The operating system's error.
         #[source]
         source: std::io::Error,
     },
+    /// The line an edit changes is not in the copied file (the project's file differs).
     #[error("{}: the text to edit is not there: {what}", file.display())]
-    EditTarget { file: PathBuf, what: String },
+    EditTarget {
+        /// The file.
+        file: PathBuf,
+        /// The text that was looked for.
+        what: String,
+    },
+    /// The reload session could not start (scene, graph or first frame failed).
     #[error("starting the reload session: {0}")]
     Session(String),
+    /// An edit's reload failed: the edited file no longer compiled or rendered.
     #[error("{kind} edit {index}: {}: {message}", file.display())]
     Reload {
+        /// Which kind of edit.
         kind: EditKind,
+        /// 0-based index of the edit among those of its kind.
         index: usize,
+        /// The edited file.
         file: PathBuf,
+        /// The reload's error.
         message: String,
     },
 }
@@ -54,14 +70,20 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> ReloadBenchError + '_ {
     }
 }
 
+/// Which project file an edit changes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum EditKind {
+    /// `common/lighting.wgsl`: the range window's scale (rebuilds every pipeline that
+    /// includes it).
     Shader,
+    /// `materials/car_paint.ron`: the pigment's red (rebuilds the pipelines of that material).
     Material,
+    /// `graphs/forward_plus.ron`: the culling pass's list capacity (recompiles the graph).
     Graph,
 }
 
 impl EditKind {
+    /// Every kind, in the order the benchmark edits them.
     pub const ALL: [EditKind; 3] = [EditKind::Shader, EditKind::Material, EditKind::Graph];
 }
 
@@ -75,6 +97,7 @@ impl std::fmt::Display for EditKind {
     }
 }
 
+/// Settings of a hot-reload latency run ([`run`]).
 #[derive(Clone, Debug)]
 pub struct ReloadBenchConfig {
     /// Where shaders/, graphs/ and materials/ are looked for first (the built-in copies
@@ -82,8 +105,11 @@ pub struct ReloadBenchConfig {
     pub project: PathBuf,
     /// An empty folder to copy them into and edit there.
     pub work: PathBuf,
+    /// Frame width in pixels.
     pub width: u32,
+    /// Frame height in pixels.
     pub height: u32,
+    /// Random lights in the scene.
     pub lights: u32,
     /// Edits of each kind.
     pub repeats: usize,
@@ -110,7 +136,9 @@ pub struct ReloadBenchConfig {
 /// One timed edit, in milliseconds.
 #[derive(Clone, Debug)]
 pub struct ReloadSample {
+    /// Which kind of edit.
     pub kind: EditKind,
+    /// 0-based index of the edit among those of its kind.
     pub index: usize,
     /// File write returned → the new frame's GPU work done: what a viewer shows (it
     /// presents the output texture without reading it back). The headline.
@@ -160,8 +188,11 @@ pub struct ReloadSample {
     pub(crate) reports_readback_ms: f64,
     /// The same frame again: submit returned → GPU done.
     pub(crate) rerender_gpu_wait_ms: f64,
+    /// Pipelines the reload built (the rest came from the session's cache).
     pub pipelines_built: usize,
+    /// GPU resources the reload created.
     pub resources_created: usize,
+    /// GPU resources the reload kept from the frame before.
     pub resources_reused: usize,
 }
 
@@ -429,9 +460,13 @@ pub fn run(
 /// pipeline cache on disk, the builds here are where it shows.
 #[derive(Clone, Debug, Default)]
 pub struct Startup {
+    /// Starting the session, from the first file read to the first frame read back.
     pub total_ms: f64,
+    /// Pipelines built for the first frame.
     pub pipelines_built: usize,
+    /// Composing shader sources and validating them with naga.
     pub shader_compose_ms: f64,
+    /// Creating shader modules and pipelines.
     pub pipeline_build_ms: f64,
     /// The driver's pipeline cache on disk: where, and what opening it found.
     pub(crate) pipeline_cache: String,
@@ -439,7 +474,9 @@ pub struct Startup {
 
 /// A benchmark run: the session's start and every timed edit.
 pub struct BenchRun {
+    /// What starting the session cost.
     pub startup: Startup,
+    /// Every timed edit, in the order made.
     pub samples: Vec<ReloadSample>,
 }
 
