@@ -58,9 +58,11 @@ pub(crate) struct AtlasView {
 /// A shadowed light: its first view and whether it has six.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct AtlasLight {
+    /// The light's index in the scene.
     pub light: u32,
     pub(crate) first_view: u32,
     pub(crate) cube: bool,
+    /// Side of each of its tiles, texels.
     pub tile: u32,
 }
 
@@ -73,11 +75,14 @@ pub enum DropReason {
     NoRoom,
 }
 
+/// A shadow-casting light in view that got no tile this frame: it is lit unshadowed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct DroppedLight {
+    /// The light's index in the scene.
     pub light: u32,
     /// The tile side it asked for before any halving.
     pub wanted: u32,
+    /// Why it was dropped.
     pub reason: DropReason,
 }
 

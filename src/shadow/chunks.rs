@@ -10,9 +10,13 @@ pub(crate) const CHUNK_TRIANGLES: usize = 128;
 /// A run of `count` indices from `first` in the reordered index buffer.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Chunk {
+    /// Index of the chunk's first index in the reordered index buffer.
     pub first: u32,
+    /// Number of indices (three per triangle, at most 3 × 128).
     pub count: u32,
+    /// Low corner of the bounds of the chunk's triangles, world space.
     pub min: Vec3,
+    /// High corner of the bounds of the chunk's triangles, world space.
     pub max: Vec3,
 }
 
