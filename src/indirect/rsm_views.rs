@@ -25,7 +25,10 @@ pub(crate) struct RsmView {
 /// An indirect light that got no views, and why.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DroppedRsmLight {
+    /// The light's index in the scene.
     pub light: u32,
+    /// Why it got none (past `max_lights`, no room left, or its VPL `n` does not divide
+    /// the tile).
     pub reason: String,
 }
 
@@ -84,7 +87,13 @@ pub(crate) fn light_views(l: &Light) -> Vec<(Mat4, Vec3, f32)> {
 /// Lays out the views of every indirect light of `scene` on `tile`-texel tiles of a
 /// `width`×`height` atlas, at most `max_lights` lights; a light whose views do not fit,
 /// or whose n does not divide the tile, is dropped with its reason.
-pub(crate) fn layout(scene: &Scene, tile: u32, width: u32, height: u32, max_lights: u32) -> RsmLayout {
+pub(crate) fn layout(
+    scene: &Scene,
+    tile: u32,
+    width: u32,
+    height: u32,
+    max_lights: u32,
+) -> RsmLayout {
     let cols = width / tile.max(1);
     let cells = cols * (height / tile.max(1));
     let mut out = RsmLayout::default();
