@@ -17,14 +17,17 @@ pub enum CameraMode {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Movement {
     pub(crate) right: f32,
-    pub up: f32,
+    pub(crate) up: f32,
     pub(crate) forward: f32,
     /// Shift held: move faster.
     pub(crate) fast: bool,
 }
 
+/// The viewer's camera state: orbit or fly, driven by mouse drags, the wheel and held keys;
+/// [`CameraController::camera`] gives the scene camera for a frame.
 #[derive(Clone, Debug)]
 pub struct CameraController {
+    /// Orbit or fly; switch at any time without the view jumping.
     pub mode: CameraMode,
     target: Vec3,
     /// Radians around world up; 0 looks down -Z.
@@ -77,6 +80,7 @@ impl CameraController {
         forward(self.yaw, self.pitch)
     }
 
+    /// Eye position in world space.
     pub fn eye(&self) -> Vec3 {
         self.target - self.forward() * self.distance
     }
