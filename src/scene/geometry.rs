@@ -237,7 +237,7 @@ impl MeshBuilder {
     }
 
     /// Applies a transform to everything added so far.
-    pub fn transform(&mut self, rotation: Quat, translation: Vec3) -> &mut Self {
+    pub(crate) fn transform(&mut self, rotation: Quat, translation: Vec3) -> &mut Self {
         let m = Mat4::from_rotation_translation(rotation, translation);
         self.mesh
             .positions

@@ -106,10 +106,10 @@ pub struct RandomLights {
     /// Range in metres, min ≤ max, min > 0.
     pub range: (f32, f32),
     /// Intensity in candela, 0 ≤ min ≤ max.
-    pub intensity: (f32, f32),
+    pub(crate) intensity: (f32, f32),
     /// Linear RGB, per channel.
     #[serde(default = "default_color")]
-    pub color: (Vec3, Vec3),
+    pub(crate) color: (Vec3, Vec3),
     /// Spot (inner, outer) cone half-angles in degrees.
     #[serde(default = "default_spot_cone")]
     pub(crate) spot_cone_deg: (f32, f32),

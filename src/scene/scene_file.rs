@@ -71,14 +71,14 @@ pub struct SceneFile {
     pub(crate) keep_model_lights: bool,
     /// Imported material name → material RON path (kept as written, for the material module).
     #[serde(default)]
-    pub material_overrides: std::collections::BTreeMap<String, PathBuf>,
+    pub(crate) material_overrides: std::collections::BTreeMap<String, PathBuf>,
     /// Preferred output width and height, each 1..=16384 (default: the command's size).
     #[serde(default)]
-    pub output_size: Option<(u32, u32)>,
+    pub(crate) output_size: Option<(u32, u32)>,
     /// Constant ambient radiance added to every surface; finite, ≥ 0 (default: the
     /// built-in's, else zero).
     #[serde(default)]
-    pub ambient: Option<Vec3>,
+    pub(crate) ambient: Option<Vec3>,
     /// The ray-cast shadow BVH's build quality: Fastest, VeryFast, Fast (default), Medium.
     #[serde(default)]
     pub shadow_bvh: Option<super::BuildQuality>,
@@ -95,7 +95,7 @@ pub(crate) struct Model {
     /// .gltf or .glb, relative to the scene file.
     pub path: PathBuf,
     #[serde(default)]
-    pub transform: Transform,
+    pub(crate) transform: Transform,
     /// Every light of this model (KHR_lights_punctual, kept with `keep_model_lights`)
     /// casts ray-cast shadows.
     #[serde(default)]
@@ -195,14 +195,14 @@ pub struct LightSpec {
     #[serde(default)]
     pub name: Option<String>,
     /// Position in metres.
-    pub position: Vec3,
+    pub(crate) position: Vec3,
     /// Where the light's influence ends, metres; > 0.
     pub range: f32,
     /// Intensity in candela; ≥ 0.
-    pub intensity: f32,
+    pub(crate) intensity: f32,
     /// Linear RGB colour, ≥ 0 (default white).
     #[serde(default = "one")]
-    pub color: Vec3,
+    pub(crate) color: Vec3,
     #[serde(default)]
     pub(crate) spot: Option<SpotSpec>,
     #[serde(default)]

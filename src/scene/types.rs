@@ -100,7 +100,7 @@ pub struct SlotSampling {
     /// Sampler and uv transform of `normal_texture`.
     pub normal: TextureSampling,
     /// Sampler and uv transform of `emissive_texture`.
-    pub emissive: TextureSampling,
+    pub(crate) emissive: TextureSampling,
     pub(crate) occlusion: TextureSampling,
 }
 

@@ -12,7 +12,7 @@ pub(crate) struct Expansion {
     pub(crate) node_instances: u64,
     /// Mesh primitives drawn (one mesh per primitive instance in the scene).
     pub(crate) primitives: u64,
-    pub triangles: u64,
+    pub(crate) triangles: u64,
 }
 
 impl Expansion {
