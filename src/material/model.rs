@@ -19,13 +19,13 @@ pub struct MaterialDesc {
     pub name: String,
     /// The material's type bit for light material masks (Leo demo). Default 1.
     #[serde(default = "one_u32")]
-    pub type_bit: u32,
+    pub(crate) type_bit: u32,
     /// How the surface lets light through (default `Opaque`).
     #[serde(default)]
-    pub alpha_mode: AlphaMode,
+    pub(crate) alpha_mode: AlphaMode,
     /// Back faces are drawn and shaded too (default `false`).
     #[serde(default)]
-    pub double_sided: bool,
+    pub(crate) double_sided: bool,
     /// Texture slots by name; bindings follow the name order (BTreeMap).
     #[serde(default)]
     pub(crate) textures: BTreeMap<String, TextureDesc>,
@@ -34,7 +34,7 @@ pub struct MaterialDesc {
     pub(crate) alpha: Scalar,
     /// Emitted radiance. Default black.
     #[serde(default)]
-    pub emissive: Option<Color>,
+    pub(crate) emissive: Option<Color>,
     #[serde(default)]
     pub(crate) normal_map: Option<NormalMap>,
     #[serde(default)]
@@ -50,13 +50,13 @@ pub(crate) struct TextureDesc {
     pub(crate) file: String,
     /// sRGB-encoded colour data (base colour, emissive) rather than linear data.
     #[serde(default)]
-    pub srgb: bool,
+    pub(crate) srgb: bool,
     /// Wrap and filter modes (a glTF sampler). Default: repeat, trilinear.
     #[serde(default)]
-    pub sampler: SamplerDesc,
+    pub(crate) sampler: SamplerDesc,
     /// A transform of the uv before sampling (glTF `KHR_texture_transform`).
     #[serde(default)]
-    pub transform: Option<UvTransform>,
+    pub(crate) transform: Option<UvTransform>,
 }
 
 /// How a texture is sampled: glTF's sampler (wrapS/wrapT, magFilter, minFilter).
