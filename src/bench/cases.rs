@@ -38,13 +38,13 @@ pub(crate) struct SceneCase {
     pub range: Option<f32>,
     /// Every light's intensity, in candela.
     #[serde(default)]
-    pub intensity: Option<f32>,
+    pub(crate) intensity: Option<f32>,
     /// The camera's near plane.
     #[serde(default)]
-    pub near: Option<f32>,
+    pub(crate) near: Option<f32>,
     /// The camera's far plane.
     #[serde(default)]
-    pub far: Option<f32>,
+    pub(crate) far: Option<f32>,
     /// Moves the camera's eye to this light's centre (index into the lights after the fields
     /// above), keeping the view direction.
     #[serde(default)]
@@ -81,7 +81,7 @@ impl SceneCase {
     }
 
     /// The scene with this case applied; the message says what does not fit the scene.
-    pub fn apply(&self, scene: &Scene) -> Result<Scene, String> {
+    pub(crate) fn apply(&self, scene: &Scene) -> Result<Scene, String> {
         let mut s = scene.clone();
         if self.light_sets.is_some() || self.lights.is_some() {
             let bounds = s.bounds();

@@ -56,7 +56,7 @@ pub struct Sweep {
     /// `brute_force.ron`). Brute force does not trace shadows: name a shadow-tracing graph to
     /// compare ray-cast shadows with something shadowed.
     #[serde(default = "default_reference")]
-    pub reference: String,
+    pub(crate) reference: String,
     /// Per-graph exceptions to `reference`: graph → its reference graph, e.g.
     /// `{"raycast_shadows.ron": "raycast_shadows_naive.ron"}`. Keys must be in `graphs`.
     #[serde(default)]

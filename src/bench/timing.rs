@@ -16,10 +16,10 @@ use std::time::{Duration, Instant};
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Method {
     pub(crate) warmup_frames: u32,
-    pub warmup_seconds: f64,
-    pub rounds: u32,
+    pub(crate) warmup_seconds: f64,
+    pub(crate) rounds: u32,
     /// Timed frames per graph over all rounds.
-    pub frames: u32,
+    pub(crate) frames: u32,
 }
 
 impl Method {
@@ -40,7 +40,7 @@ impl Method {
 #[derive(Clone, Debug, Default)]
 pub(crate) struct GraphTimes {
     /// Whole-frame GPU time of every timed frame, ms (the sum of its passes).
-    pub frames: Vec<f64>,
+    pub(crate) frames: Vec<f64>,
     /// Every pass's GPU time per frame, ms, in schedule order.
     pub(crate) per_pass: Vec<(String, Vec<f64>)>,
     /// The median frame of each round, ms.
@@ -51,9 +51,9 @@ pub(crate) struct GraphTimes {
 #[derive(Clone, Debug)]
 pub(crate) struct PointTimes {
     /// Per graph, in the order given.
-    pub graphs: Vec<GraphTimes>,
+    pub(crate) graphs: Vec<GraphTimes>,
     /// Wall-clock time the warm-up took.
-    pub warmup: Duration,
+    pub(crate) warmup: Duration,
     pub(crate) clock_start: Option<SmClock>,
     pub(crate) clock_end: Option<SmClock>,
 }

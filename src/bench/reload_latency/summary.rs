@@ -23,13 +23,13 @@ pub struct KindSummary {
     /// (column name, median ms) for the parts of pipeline build and render.
     pub(crate) details: Vec<(&'static str, f64)>,
     /// Samples whose first build began with the GPU still busy, of those that built.
-    pub gpu_busy_at_build: (usize, usize),
+    pub(crate) gpu_busy_at_build: (usize, usize),
     /// Median pipelines built per edit.
-    pub pipelines_built: f64,
+    pub(crate) pipelines_built: f64,
     /// Median GPU resources kept from the frame before per edit.
-    pub resources_reused: f64,
+    pub(crate) resources_reused: f64,
     /// Median GPU resources created per edit.
-    pub resources_created: f64,
+    pub(crate) resources_created: f64,
 }
 
 type Part = (&'static str, fn(&ReloadSample) -> f64);
@@ -103,7 +103,7 @@ pub fn summarize_kinds(samples: &[ReloadSample]) -> Vec<KindSummary> {
 /// median of its compose, module and pipeline-creation times (ms).
 pub struct PipelineSummary {
     /// The edit kind that made the builds.
-    pub kind: EditKind,
+    pub(crate) kind: EditKind,
     /// The pipeline, as `pass: shader material`.
     pub name: String,
     pub(crate) builds: usize,
