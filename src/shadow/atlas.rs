@@ -47,9 +47,9 @@ pub(crate) struct AtlasView {
     /// Cube face (0 +X, 1 −X, 2 +Y, 3 −Y, 4 +Z, 5 −Z), or 0 for a spot tile.
     pub(crate) face: u8,
     /// Top-left texel and side.
-    pub x: u32,
-    pub y: u32,
-    pub tile: u32,
+    pub(crate) x: u32,
+    pub(crate) y: u32,
+    pub(crate) tile: u32,
     pub(crate) view_proj: Mat4,
     /// World size of one texel at unit distance along the view axis.
     pub(crate) texel_scale: f32,

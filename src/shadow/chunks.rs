@@ -15,9 +15,9 @@ pub struct Chunk {
     /// Number of indices (three per triangle, at most 3 × 128).
     pub count: u32,
     /// Low corner of the bounds of the chunk's triangles, world space.
-    pub min: Vec3,
+    pub(crate) min: Vec3,
     /// High corner of the bounds of the chunk's triangles, world space.
-    pub max: Vec3,
+    pub(crate) max: Vec3,
 }
 
 /// The mesh's indices reordered into chunks, and the chunks. Triangles with an index
