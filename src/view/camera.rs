@@ -81,7 +81,7 @@ impl CameraController {
     }
 
     /// Eye position in world space.
-    pub fn eye(&self) -> Vec3 {
+    pub(crate) fn eye(&self) -> Vec3 {
         self.target - self.forward() * self.distance
     }
 

@@ -13,9 +13,9 @@ pub(crate) struct FrameInfo {
     pub lights: usize,
     pub(crate) render_size: [u32; 2],
     /// Smoothed GPU milliseconds per pass; `None` without timestamp queries.
-    pub pass_ms: Option<Vec<(String, f64)>>,
+    pub(crate) pass_ms: Option<Vec<(String, f64)>>,
     /// Smoothed CPU milliseconds per displayed frame.
-    pub frame_ms: f64,
+    pub(crate) frame_ms: f64,
     pub(crate) culling: Vec<CullingReport>,
     pub(crate) light_stats: Option<LightStats>,
     /// The error of the last reload (file:line), shown until a good save.
@@ -35,7 +35,7 @@ pub(crate) enum OverlayAction {
 
 pub(crate) struct Overlay {
     /// Graph files offered as variants, with the one in use.
-    pub graphs: Vec<PathBuf>,
+    pub(crate) graphs: Vec<PathBuf>,
     pub(crate) current_graph: PathBuf,
     pub(crate) camera_mode: CameraMode,
     pub exposure_ev: f32,
