@@ -12,8 +12,8 @@ pub(crate) struct RsmView {
     pub light: u32,
     pub(crate) view_proj: Mat4,
     /// Texel origin of its tile in the atlas.
-    pub x: u32,
-    pub y: u32,
+    pub(crate) x: u32,
+    pub(crate) y: u32,
     /// Solid angle of a texel on the view's axis (steradians).
     pub(crate) texel_solid_angle: f32,
     pub axis: Vec3,
@@ -29,7 +29,7 @@ pub struct DroppedRsmLight {
     pub light: u32,
     /// Why it got none (past `max_lights`, no room left, or its VPL `n` does not divide
     /// the tile).
-    pub reason: String,
+    pub(crate) reason: String,
 }
 
 #[derive(Clone, Debug, Default, PartialEq)]
