@@ -10,10 +10,10 @@ use crate::scene::motion::{animate_into, LightMotion, Motion, Orbit};
 use crate::scene::Scene;
 
 /// Degrees per second of the orbit given to lights without motion.
-pub const ORBIT_DEG_PER_S: f32 = 30.0;
+pub(crate) const ORBIT_DEG_PER_S: f32 = 30.0;
 
 /// The scene's motion, or every light orbiting the centre of its bounds.
-pub fn motion_for(scene: &Scene) -> Vec<LightMotion> {
+pub(crate) fn motion_for(scene: &Scene) -> Vec<LightMotion> {
     if scene.has_motion() {
         return scene.light_motion.clone();
     }
@@ -34,7 +34,7 @@ pub fn motion_for(scene: &Scene) -> Vec<LightMotion> {
 
 /// [`timing::time_point`] with the lights moved before every frame; afterwards every
 /// frame is given the scene's own lights back (what the reference images show).
-pub fn time_moving(
+pub(crate) fn time_moving(
     frames: &[&PreparedFrame],
     scene: &Scene,
     gpu: &SceneGpu,

@@ -22,13 +22,13 @@ use serde::Deserialize;
 /// One variation of the sweep's scenes. Applied after the sweep's light count, in field order.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct SceneCase {
+pub(crate) struct SceneCase {
     /// Rows name the scene `scene/name`.
     pub name: String,
     /// If given (even empty), these light sets (scene-RON syntax: `Random(...)`, `Amd(...)`,
     /// placed in the scene's bounds) replace the scene's lights.
     #[serde(default)]
-    pub light_sets: Option<Vec<LightSetSpec>>,
+    pub(crate) light_sets: Option<Vec<LightSetSpec>>,
     /// If given (even empty), these explicit lights (scene-RON syntax) replace the scene's
     /// lights; with `light_sets` they follow the sets' lights.
     #[serde(default)]
@@ -38,17 +38,17 @@ pub struct SceneCase {
     pub range: Option<f32>,
     /// Every light's intensity, in candela.
     #[serde(default)]
-    pub intensity: Option<f32>,
+    pub(crate) intensity: Option<f32>,
     /// The camera's near plane.
     #[serde(default)]
-    pub near: Option<f32>,
+    pub(crate) near: Option<f32>,
     /// The camera's far plane.
     #[serde(default)]
-    pub far: Option<f32>,
+    pub(crate) far: Option<f32>,
     /// Moves the camera's eye to this light's centre (index into the lights after the fields
     /// above), keeping the view direction.
     #[serde(default)]
-    pub camera_at_light: Option<usize>,
+    pub(crate) camera_at_light: Option<usize>,
 }
 
 impl SceneCase {
@@ -81,7 +81,7 @@ impl SceneCase {
     }
 
     /// The scene with this case applied; the message says what does not fit the scene.
-    pub fn apply(&self, scene: &Scene) -> Result<Scene, String> {
+    pub(crate) fn apply(&self, scene: &Scene) -> Result<Scene, String> {
         let mut s = scene.clone();
         if self.light_sets.is_some() || self.lights.is_some() {
             let bounds = s.bounds();

@@ -8,9 +8,9 @@ use std::time::{Duration, Instant};
 
 /// One reading of the first GPU's clocks, MHz.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct SmClock {
-    pub mhz: u32,
-    pub max_mhz: u32,
+pub(crate) struct SmClock {
+    pub(crate) mhz: u32,
+    pub(crate) max_mhz: u32,
 }
 
 /// How long a reading may take before it is given up (a hung driver must not hang the
@@ -19,7 +19,7 @@ const TIMEOUT: Duration = Duration::from_secs(3);
 
 /// The first GPU's current and maximum SM clock, or `None` where `nvidia-smi` is missing,
 /// fails or is slow (any adapter but NVIDIA's, lavapipe).
-pub fn read() -> Option<SmClock> {
+pub(crate) fn read() -> Option<SmClock> {
     let mut child = Command::new("nvidia-smi")
         .args([
             "--query-gpu=clocks.sm,clocks.max.sm",

@@ -196,7 +196,7 @@ pub struct NonFinitePixel {
     /// Row (0 at the top).
     pub y: u32,
     /// Linear RGB as rendered.
-    pub rgb: [f32; 3],
+    pub(crate) rgb: [f32; 3],
 }
 
 impl NonFinitePixel {
@@ -428,11 +428,11 @@ pub fn heat_color(t: f32) -> [u8; 3] {
 /// Colour of pixels that are NaN in either image in [`difference_heatmap`] (bright green).
 pub const HEATMAP_NAN_COLOR: [u8; 3] = [0, 255, 0];
 /// Colour of pixels that are infinite (and not NaN) in either image (cyan).
-pub const HEATMAP_INF_COLOR: [u8; 3] = [0, 255, 255];
+pub(crate) const HEATMAP_INF_COLOR: [u8; 3] = [0, 255, 255];
 
 /// Per-pixel heat map of the largest absolute channel difference `max_c |a_c − b_c|`, as tightly
 /// packed RGB8 (the ramp is [`heat_color`]; non-finite pixels get [`HEATMAP_NAN_COLOR`] /
-/// [`HEATMAP_INF_COLOR`], colours the ramp never produces). Returns the pixels and the difference
+/// `HEATMAP_INF_COLOR`, colours the ramp never produces). Returns the pixels and the difference
 /// that maps to the top of the ramp.
 pub fn difference_heatmap<P: HdrPixel>(
     reference: &[P],

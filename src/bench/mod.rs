@@ -2,19 +2,19 @@
 //! project's one tonemapper, HDR image I/O (EXR, tonemapped PNG), and reports (CSV, Markdown,
 //! PNG plots). Only the sweeps and the hot-reload latency benchmark need a GPU.
 
-pub mod animate;
-pub mod cases;
-pub mod gpu_clock;
+pub(crate) mod animate;
+pub(crate) mod cases;
+pub(crate) mod gpu_clock;
 pub mod heatmap;
 pub mod image_io;
 pub mod metrics;
-pub mod pixel;
+pub(crate) mod pixel;
 pub mod progress;
 pub mod reload_latency;
 pub mod report;
 pub mod sweep;
 mod sweep_columns;
-pub mod timing;
+pub(crate) mod timing;
 pub mod tonemap;
 
 pub use image_io::{

@@ -1,6 +1,6 @@
 //! Benchmark sweeps: scenes × light counts × resolutions × graphs. The graphs of a point
 //! are timed together on the GPU (warmed up by time, then interleaved rounds: see
-//! [`super::timing`]) and each is compared with the reference image of the same scene
+//! `bench::timing`) and each is compared with the reference image of the same scene
 //! (brute force unless the sweep names another graph).
 
 use super::cases::SceneCase;
@@ -22,7 +22,7 @@ use thiserror::Error;
 #[serde(rename = "Sweep", deny_unknown_fields)]
 pub struct Sweep {
     /// `builtin:NAME` or a scene file path (relative to the sweep file).
-    pub scenes: Vec<String>,
+    pub(crate) scenes: Vec<String>,
     /// Graph files, relative to the project's graphs/ folder.
     pub graphs: Vec<String>,
     /// Light counts; empty keeps each scene's own lights. Lights are placed uniformly
@@ -33,7 +33,8 @@ pub struct Sweep {
     /// centre), applied after the light count: see [`SceneCase`]. Empty runs the scenes as
     /// they are.
     #[serde(default)]
-    pub cases: Vec<SceneCase>,
+    pub(crate) cases: Vec<SceneCase>,
+    /// Output sizes (width, height), each side 1..=16384.
     pub resolutions: Vec<(u32, u32)>,
     /// Warm-up frames every graph of a point runs at least.
     #[serde(default = "default_warmup")]
@@ -50,24 +51,24 @@ pub struct Sweep {
     pub rounds: u32,
     /// Above this many lights the reference is not run (no error columns).
     #[serde(default = "default_brute_force_limit")]
-    pub brute_force_limit: u32,
+    pub(crate) brute_force_limit: u32,
     /// The graph whose image the error columns compare against, like `graphs` (default
     /// `brute_force.ron`). Brute force does not trace shadows: name a shadow-tracing graph to
     /// compare ray-cast shadows with something shadowed.
     #[serde(default = "default_reference")]
-    pub reference: String,
+    pub(crate) reference: String,
     /// Per-graph exceptions to `reference`: graph → its reference graph, e.g.
     /// `{"raycast_shadows.ron": "raycast_shadows_naive.ron"}`. Keys must be in `graphs`.
     #[serde(default)]
-    pub references: BTreeMap<String, String>,
+    pub(crate) references: BTreeMap<String, String>,
     /// Render an extra frame per point for the light statistics (the listed/exact column);
     /// it costs as much as a brute-force frame.
     #[serde(default = "yes")]
-    pub light_stats: bool,
+    pub(crate) light_stats: bool,
     /// Seconds of light motion between frames: every warm-up and timed frame first moves
     /// the lights there (`PreparedFrame::update_lights`). See [`crate::bench::animate`].
     #[serde(default)]
-    pub animate: Option<f64>,
+    pub(crate) animate: Option<f64>,
 }
 
 fn yes() -> bool {
@@ -115,14 +116,24 @@ fn field_line(text: &str, field: &str) -> String {
         .map_or(String::new(), |i| format!("{}: ", i + 1))
 }
 
+/// Why a sweep stopped.
 #[derive(Debug, Error)]
 pub enum SweepError {
+    /// The sweep file could not be read or parsed.
     #[error("{file}: {message}")]
-    File { file: PathBuf, message: String },
+    File {
+        /// The sweep file.
+        file: PathBuf,
+        /// What is wrong, with the line where known.
+        message: String,
+    },
+    /// A scene could not be loaded or a case not applied: (scene, reason).
     #[error("scene {0}: {1}")]
     Scene(String, String),
+    /// A graph could not be checked or compiled: (graph, reason).
     #[error("graph {0}: {1}")]
     Graph(String, String),
+    /// Rendering a point failed on the GPU.
     #[error(transparent)]
     Render(#[from] RenderError),
 }
@@ -225,7 +236,7 @@ impl Sweep {
     }
 
     /// The timing settings.
-    pub fn method(&self) -> timing::Method {
+    pub(crate) fn method(&self) -> timing::Method {
         timing::Method {
             warmup_frames: self.warmup,
             warmup_seconds: self.warmup_seconds,
@@ -272,20 +283,26 @@ pub fn with_light_count(scene: &Scene, count: u32) -> Scene {
 pub enum SweepEvent<'a> {
     /// Point `index` (from 0) of `total` is starting; `point` names it.
     Start {
+        /// 0-based index of the point.
         index: usize,
+        /// Number of points in the sweep.
         total: usize,
+        /// The point's label: scene, graph, light count and size.
         point: &'a str,
     },
     /// `done` points of `total` have finished, the last one gave `row`.
     Done {
+        /// Points finished so far.
         done: usize,
+        /// Number of points in the sweep.
         total: usize,
+        /// The finished point's measurement.
         row: &'a BenchRow,
     },
 }
 
 /// How many NaN / Inf pixels a row lists by position (all are counted).
-pub const NON_FINITE_EXAMPLES: usize = 16;
+pub(crate) const NON_FINITE_EXAMPLES: usize = 16;
 
 /// Runs the sweep; `progress` hears when each point starts and ends.
 pub fn run(

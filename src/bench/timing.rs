@@ -14,21 +14,21 @@ use std::time::{Duration, Instant};
 
 /// The sweep's timing settings.
 #[derive(Clone, Copy, Debug)]
-pub struct Method {
-    pub warmup_frames: u32,
-    pub warmup_seconds: f64,
-    pub rounds: u32,
+pub(crate) struct Method {
+    pub(crate) warmup_frames: u32,
+    pub(crate) warmup_seconds: f64,
+    pub(crate) rounds: u32,
     /// Timed frames per graph over all rounds.
-    pub frames: u32,
+    pub(crate) frames: u32,
 }
 
 impl Method {
     /// Rounds that run: `rounds`, at least 1, at most one a timed frame.
-    pub fn round_count(&self) -> u32 {
+    pub(crate) fn round_count(&self) -> u32 {
         self.rounds.max(1).min(self.frames)
     }
     /// Frames each graph runs in one round: `frames` split over the rounds, rounded up.
-    pub fn frames_per_round(&self) -> u32 {
+    pub(crate) fn frames_per_round(&self) -> u32 {
         match self.round_count() {
             0 => 0,
             r => self.frames.div_ceil(r),
@@ -38,28 +38,28 @@ impl Method {
 
 /// One graph's timings on a point (empty where the adapter has no timestamps).
 #[derive(Clone, Debug, Default)]
-pub struct GraphTimes {
+pub(crate) struct GraphTimes {
     /// Whole-frame GPU time of every timed frame, ms (the sum of its passes).
-    pub frames: Vec<f64>,
+    pub(crate) frames: Vec<f64>,
     /// Every pass's GPU time per frame, ms, in schedule order.
-    pub per_pass: Vec<(String, Vec<f64>)>,
+    pub(crate) per_pass: Vec<(String, Vec<f64>)>,
     /// The median frame of each round, ms.
-    pub round_medians: Vec<f64>,
+    pub(crate) round_medians: Vec<f64>,
 }
 
 /// What timing one point gave.
 #[derive(Clone, Debug)]
-pub struct PointTimes {
+pub(crate) struct PointTimes {
     /// Per graph, in the order given.
-    pub graphs: Vec<GraphTimes>,
+    pub(crate) graphs: Vec<GraphTimes>,
     /// Wall-clock time the warm-up took.
-    pub warmup: Duration,
-    pub clock_start: Option<SmClock>,
-    pub clock_end: Option<SmClock>,
+    pub(crate) warmup: Duration,
+    pub(crate) clock_start: Option<SmClock>,
+    pub(crate) clock_end: Option<SmClock>,
 }
 
 /// Warms up and times `frames` (one per graph of a point) by [`Method`].
-pub fn time_point(
+pub(crate) fn time_point(
     frames: &[&PreparedFrame],
     renderer: &Renderer,
     method: &Method,
@@ -69,7 +69,7 @@ pub fn time_point(
 
 /// [`time_point`] calling `before(graph)` ahead of every frame it runs (warm-up and
 /// timed), e.g. to move the lights.
-pub fn time_point_with(
+pub(crate) fn time_point_with(
     frames: &[&PreparedFrame],
     renderer: &Renderer,
     method: &Method,

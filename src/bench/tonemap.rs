@@ -26,7 +26,7 @@ pub struct Tonemap {
     /// Exposure in stops: the linear input is multiplied by `2^exposure_ev`.
     pub exposure_ev: f32,
     /// The tone curve.
-    pub curve: ToneCurve,
+    pub(crate) curve: ToneCurve,
 }
 
 impl Tonemap {
@@ -36,7 +36,7 @@ impl Tonemap {
     }
 
     /// Tonemap one linear channel to display-linear `[0, 1]` (before the sRGB transfer function).
-    pub fn map_channel(&self, x: f32) -> f32 {
+    pub(crate) fn map_channel(&self, x: f32) -> f32 {
         if x.is_nan() {
             return 0.0;
         }
@@ -66,7 +66,7 @@ impl Tonemap {
     }
 
     /// Tonemap a linear RGB value to display-linear RGB in `[0, 1]`.
-    pub fn map_rgb(&self, rgb: [f32; 3]) -> [f32; 3] {
+    pub(crate) fn map_rgb(&self, rgb: [f32; 3]) -> [f32; 3] {
         rgb.map(|c| self.map_channel(c))
     }
 
@@ -106,7 +106,7 @@ pub fn srgb_to_linear(x: f32) -> f32 {
 }
 
 /// Round a `[0, 1]` value to 8 bits.
-pub fn quantize8(x: f32) -> u8 {
+pub(crate) fn quantize8(x: f32) -> u8 {
     (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
 }
 

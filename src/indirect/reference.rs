@@ -16,6 +16,7 @@ use glam::{Mat4, Vec3, Vec4};
 /// What went wrong building the reference.
 #[derive(Debug, thiserror::Error)]
 pub enum ReferenceError {
+    /// The scene's BVH (used for the reference's rays) could not be built.
     #[error("the reference's BVH could not be built: {0}")]
     Bvh(#[from] crate::shadow::ShadowError),
 }
@@ -40,11 +41,15 @@ pub struct OneBounce<'a> {
 /// the camera), the direction to the eye, and the scene's material index.
 #[derive(Clone, Copy, Debug)]
 pub struct Primary {
+    /// Hit position, world space.
     pub x: Vec3,
+    /// Shading normal (unit, facing the camera).
     pub n: Vec3,
+    /// Geometric normal (unit, facing the camera).
     pub ng: Vec3,
+    /// Unit direction from the hit to the eye.
     pub v: Vec3,
-    pub m: usize,
+    pub(crate) m: usize,
 }
 
 struct Hit {
@@ -55,6 +60,8 @@ struct Hit {
 }
 
 impl<'a> OneBounce<'a> {
+    /// Prepares `scene` for tracing: builds its BVH and maps each material to its receiver
+    /// BRDF.
     pub fn new(scene: &'a Scene) -> Result<Self, ReferenceError> {
         let bvh = ShadowBvh::build(scene)?;
         let mut triangles = Vec::new();
@@ -368,14 +375,19 @@ pub fn relative_mse(a: &[Vec3], b: &[Vec3]) -> f64 {
 /// error is a defect (a singularity), not the approximation's spread-out error.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct WorstPixel {
+    /// Index of the worst pixel, row-major.
     pub index: usize,
+    /// Its value in `a`.
     pub value: Vec3,
+    /// Its value in `b`, the reference.
     pub reference: Vec3,
     /// Its (a − b)² over Σ (a − b)²
     pub share: f64,
+    /// Pixels of `a` with a NaN or infinite channel (left out of the sums).
     pub non_finite: usize,
 }
 
+/// The [`WorstPixel`] of image `a` against reference `b` (pixels row-major, same length).
 pub fn worst_pixel(a: &[Vec3], b: &[Vec3]) -> WorstPixel {
     let mut w = WorstPixel::default();
     let (mut total, mut worst) = (0.0f64, -1.0f64);

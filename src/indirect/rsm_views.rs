@@ -8,33 +8,36 @@ use glam::{Mat4, Vec3};
 
 /// One view of one light.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RsmView {
+pub(crate) struct RsmView {
     pub light: u32,
-    pub view_proj: Mat4,
+    pub(crate) view_proj: Mat4,
     /// Texel origin of its tile in the atlas.
-    pub x: u32,
-    pub y: u32,
+    pub(crate) x: u32,
+    pub(crate) y: u32,
     /// Solid angle of a texel on the view's axis (steradians).
-    pub texel_solid_angle: f32,
+    pub(crate) texel_solid_angle: f32,
     pub axis: Vec3,
-    pub controls: VplControls,
+    pub(crate) controls: VplControls,
     /// Index of its first VPL candidate (n² candidates a view).
-    pub first_candidate: u32,
+    pub(crate) first_candidate: u32,
 }
 
 /// An indirect light that got no views, and why.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DroppedRsmLight {
+    /// The light's index in the scene.
     pub light: u32,
-    pub reason: String,
+    /// Why it got none (past `max_lights`, no room left, or its VPL `n` does not divide
+    /// the tile).
+    pub(crate) reason: String,
 }
 
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct RsmLayout {
-    pub views: Vec<RsmView>,
-    pub dropped: Vec<DroppedRsmLight>,
+pub(crate) struct RsmLayout {
+    pub(crate) views: Vec<RsmView>,
+    pub(crate) dropped: Vec<DroppedRsmLight>,
     /// n² summed over the views: VPL candidates a frame.
-    pub candidates: u32,
+    pub(crate) candidates: u32,
     /// Indirect lights with views.
     pub lights: u32,
 }
@@ -50,7 +53,7 @@ const FACES: [(Vec3, Vec3); 6] = [
 ];
 
 /// Views of one light: (view-projection, axis, tan of the half field of view).
-pub fn light_views(l: &Light) -> Vec<(Mat4, Vec3, f32)> {
+pub(crate) fn light_views(l: &Light) -> Vec<(Mat4, Vec3, f32)> {
     let near = (l.range * 1e-3).max(1e-4);
     let view = |dir: Vec3, up: Vec3, half: f32| {
         let up = if dir.cross(up).length_squared() < 1e-6 {
@@ -84,7 +87,13 @@ pub fn light_views(l: &Light) -> Vec<(Mat4, Vec3, f32)> {
 /// Lays out the views of every indirect light of `scene` on `tile`-texel tiles of a
 /// `width`×`height` atlas, at most `max_lights` lights; a light whose views do not fit,
 /// or whose n does not divide the tile, is dropped with its reason.
-pub fn layout(scene: &Scene, tile: u32, width: u32, height: u32, max_lights: u32) -> RsmLayout {
+pub(crate) fn layout(
+    scene: &Scene,
+    tile: u32,
+    width: u32,
+    height: u32,
+    max_lights: u32,
+) -> RsmLayout {
     let cols = width / tile.max(1);
     let cells = cols * (height / tile.max(1));
     let mut out = RsmLayout::default();
@@ -140,7 +149,7 @@ pub fn layout(scene: &Scene, tile: u32, width: u32, height: u32, max_lights: u32
 
 /// The view table the map and spawn shaders read (`VIEW_VEC4S` vec4 a view after a
 /// header of (views, tile, width, height)), as u32 words.
-pub fn view_table(
+pub(crate) fn view_table(
     layout: &RsmLayout,
     tile: u32,
     width: u32,

@@ -1,7 +1,7 @@
 //! Layered BRDF materials (RON model, WGSL generation, f64 reference).
 //!
 //! A material file (`materials/*.ron`, see [`model::MaterialDesc`]) is parsed and validated
-//! ([`parse`]), its out-of-range values are clamped or flagged ([`sanitize`]), and it
+//! (`parse`), its out-of-range values are clamped or flagged (`sanitize`), and it
 //! compiles to WGSL ([`wgsl`]) that plugs into the forward light loop through
 //! `material_setup` / `material_eval` / `material_emission` / `material_alpha`.
 //! [`reference`](mod@reference) is the f64 CPU implementation the tests compare the GPU against.
@@ -27,12 +27,12 @@
 //! specular peaks), error |gpu − ref| / max(|ref|, 1e-3): every lobe ≤ 7.3e-5, layered
 //! materials ≤ 4.9e-5 (see `tests/material_gpu.rs`).
 
-pub mod error;
+pub(crate) mod error;
 mod gltf_map;
 pub mod model;
-pub mod parse;
+pub(crate) mod parse;
 pub mod reference;
-pub mod sanitize;
+pub(crate) mod sanitize;
 pub mod wgsl;
 
 pub use error::{Location, MaterialError};
@@ -47,7 +47,12 @@ use std::sync::Arc;
 #[derive(Clone, Debug, PartialEq)]
 pub enum TextureSource {
     /// A file named in the RON (resolved against the material file's folder).
-    File { path: PathBuf, srgb: bool },
+    File {
+        /// The image file (PNG or JPEG).
+        path: PathBuf,
+        /// Whether the texels are sRGB-encoded colour rather than linear data.
+        srgb: bool,
+    },
     /// An image already decoded (glTF import).
     Image(Arc<TextureImage>),
 }
@@ -96,16 +101,21 @@ impl TextureSource {
 /// how it is sampled.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TextureSlot {
+    /// The texture's binding in `@group(2)` (1 and up; 0 is the first sampler).
     pub binding: u32,
+    /// The texture's name in the material file (and in the generated WGSL).
     pub name: String,
+    /// Where the pixels come from.
     pub source: TextureSource,
+    /// Wrap and filter modes of the sampler the slot reads through.
     pub sampler: model::SamplerDesc,
+    /// The uv transform applied before sampling, if any.
     pub transform: Option<model::UvTransform>,
 }
 
 /// The WGSL name of the material's `k`-th distinct sampler: `material_sampler` (binding
 /// 0) for the first, then `material_sampler{k}` at bindings after the textures.
-pub fn sampler_wgsl_name(k: usize) -> String {
+pub(crate) fn sampler_wgsl_name(k: usize) -> String {
     if k == 0 {
         "material_sampler".into()
     } else {
@@ -172,9 +182,11 @@ impl Material {
     pub fn desc(&self) -> &MaterialDesc {
         &self.desc
     }
+    /// The material's name (`name:` in the file, or the glTF material's name).
     pub fn name(&self) -> &str {
         &self.desc.name
     }
+    /// The material file, or `gltf:NAME` for a material mapped from glTF.
     pub fn path(&self) -> &Path {
         &self.path
     }
@@ -200,7 +212,7 @@ impl Material {
         &self.slots
     }
     /// The distinct samplers of the texture slots in first-use order, and for each slot
-    /// the index of its sampler (see [`sampler_wgsl_name`]).
+    /// the index of its sampler (see `sampler_wgsl_name`).
     pub fn samplers(&self) -> (Vec<model::SamplerDesc>, Vec<usize>) {
         let mut distinct: Vec<model::SamplerDesc> = Vec::new();
         let of_slot = self
@@ -239,7 +251,7 @@ impl Material {
         Ok(code)
     }
     /// The material's code as the renderer composes it: the lobe library by `#include`.
-    pub fn renderer_wgsl(&self, options: &WgslOptions) -> Result<String, MaterialError> {
+    pub(crate) fn renderer_wgsl(&self, options: &WgslOptions) -> Result<String, MaterialError> {
         self.wgsl_with(&WgslOptions {
             include_library: true,
             ..options.clone()

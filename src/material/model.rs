@@ -8,49 +8,55 @@ use crate::scene::AlphaMode;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
+/// A material file (`materials/*.ron`) as written: a stack of layers over shared textures,
+/// alpha and emission. Parse one with [`Material::load`](super::Material::load);
+/// docs/format.md describes every field.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialDesc {
+    /// The material's name in messages (default empty).
     #[serde(default)]
     pub name: String,
     /// The material's type bit for light material masks (Leo demo). Default 1.
     #[serde(default = "one_u32")]
-    pub type_bit: u32,
+    pub(crate) type_bit: u32,
+    /// How the surface lets light through (default `Opaque`).
     #[serde(default)]
-    pub alpha_mode: AlphaMode,
+    pub(crate) alpha_mode: AlphaMode,
+    /// Back faces are drawn and shaded too (default `false`).
     #[serde(default)]
-    pub double_sided: bool,
+    pub(crate) double_sided: bool,
     /// Texture slots by name; bindings follow the name order (BTreeMap).
     #[serde(default)]
-    pub textures: BTreeMap<String, TextureDesc>,
+    pub(crate) textures: BTreeMap<String, TextureDesc>,
     /// Coverage (glTF: base colour alpha × texture alpha). Default 1.
     #[serde(default = "one_scalar")]
-    pub alpha: Scalar,
+    pub(crate) alpha: Scalar,
     /// Emitted radiance. Default black.
     #[serde(default)]
-    pub emissive: Option<Color>,
+    pub(crate) emissive: Option<Color>,
     #[serde(default)]
-    pub normal_map: Option<NormalMap>,
+    pub(crate) normal_map: Option<NormalMap>,
     #[serde(default)]
-    pub occlusion: Option<Occlusion>,
+    pub(crate) occlusion: Option<Occlusion>,
     /// Top layer first.
     pub layers: Vec<Layer>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct TextureDesc {
+pub(crate) struct TextureDesc {
     /// Path relative to the material file.
-    pub file: String,
+    pub(crate) file: String,
     /// sRGB-encoded colour data (base colour, emissive) rather than linear data.
     #[serde(default)]
-    pub srgb: bool,
+    pub(crate) srgb: bool,
     /// Wrap and filter modes (a glTF sampler). Default: repeat, trilinear.
     #[serde(default)]
-    pub sampler: SamplerDesc,
+    pub(crate) sampler: SamplerDesc,
     /// A transform of the uv before sampling (glTF `KHR_texture_transform`).
     #[serde(default)]
-    pub transform: Option<UvTransform>,
+    pub(crate) transform: Option<UvTransform>,
 }
 
 /// How a texture is sampled: glTF's sampler (wrapS/wrapT, magFilter, minFilter).
@@ -63,8 +69,10 @@ pub struct SamplerDesc {
     /// Along v (glTF `wrapT`).
     #[serde(default)]
     pub wrap_v: Wrap,
+    /// Filter where the texture is magnified (default `Linear`).
     #[serde(default)]
     pub mag_filter: Filter,
+    /// Filter within a mip level where it is minified (default `Linear`).
     #[serde(default)]
     pub min_filter: Filter,
     /// Between mip levels; `None` samples level 0 only (glTF minFilter NEAREST or LINEAR).
@@ -110,11 +118,13 @@ pub enum MipmapFilter {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct UvTransform {
+    /// Added last (default `(0, 0)`).
     #[serde(default)]
     pub offset: (f32, f32),
     /// Radians, counter-clockwise in uv space (clockwise as the image shows it).
     #[serde(default)]
     pub rotation: f32,
+    /// Multiplies u and v first (default `(1, 1)`).
     #[serde(default = "ones2")]
     pub scale: (f32, f32),
 }
@@ -131,7 +141,7 @@ impl Default for UvTransform {
 
 impl UvTransform {
     /// The rows of the 2×3 matrix T R S of the glTF extension.
-    pub fn matrix(&self) -> [[f32; 3]; 2] {
+    pub(crate) fn matrix(&self) -> [[f32; 3]; 2] {
         let (s, c) = self.rotation.sin_cos();
         let (sx, sy) = self.scale;
         [
@@ -153,14 +163,16 @@ impl UvTransform {
 /// How one texture slot of a glTF material is sampled (its sampler and transform).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TextureSampling {
+    /// The slot's wrap and filter modes.
     pub sampler: SamplerDesc,
+    /// The slot's uv transform, if any (`KHR_texture_transform`).
     pub transform: Option<UvTransform>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct NormalMap {
-    pub texture: String,
+pub(crate) struct NormalMap {
+    pub(crate) texture: String,
     #[serde(default = "one_f32")]
     pub scale: f32,
 }
@@ -169,38 +181,42 @@ pub struct NormalMap {
 /// renderer as `material_occlusion(m)`, it does not scale `material_eval` (direct light).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Occlusion {
-    pub texture: String,
+pub(crate) struct Occlusion {
+    pub(crate) texture: String,
     #[serde(default)]
-    pub channel: Channel,
+    pub(crate) channel: Channel,
     #[serde(default = "one_f32")]
-    pub strength: f32,
+    pub(crate) strength: f32,
 }
 
+/// One layer of a material: weighted lobes, summed, under an interface that passes light on
+/// to the next layer.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Layer {
+    /// The layer's name in messages (default empty).
     #[serde(default)]
     pub name: String,
     /// Index of refraction of the layer's interface; `None` (or 1) means no interface
     /// Fresnel. Also bends the path used for absorption.
     #[serde(default)]
-    pub ior: Option<f32>,
+    pub(crate) ior: Option<f32>,
     /// Scales the interface Fresnel in `1 - F * weight` (e.g. clearcoat amount).
     #[serde(default = "one_f32")]
-    pub weight: f32,
+    pub(crate) weight: f32,
     /// How the interface Fresnel scales what reaches the layers below.
     #[serde(default)]
     pub coupling: Coupling,
     /// Fraction of the non-reflected light that goes on to the next layer.
     #[serde(default = "one_f32")]
-    pub transmission: f32,
+    pub(crate) transmission: f32,
     /// Thickness of the layer for Beer-Lambert absorption (same unit as `absorption`⁻¹).
     #[serde(default)]
-    pub thickness: f32,
+    pub(crate) thickness: f32,
     /// Absorption coefficient per unit thickness, per channel.
     #[serde(default)]
-    pub absorption: (f32, f32, f32),
+    pub(crate) absorption: (f32, f32, f32),
+    /// The layer's weighted lobes, summed.
     pub lobes: Vec<Lobe>,
 }
 
@@ -223,59 +239,80 @@ pub enum Coupling {
 pub enum Lobe {
     /// ρ/π.
     Lambert {
+        /// Scales the lobe (default 1).
         #[serde(default = "one_f32")]
         weight: f32,
+        /// Albedo, linear RGB.
         color: Color,
     },
     /// Fujii's improved Oren-Nayar; `roughness` is σ in [0, 1].
     OrenNayar {
+        /// Scales the lobe (default 1).
         #[serde(default = "one_f32")]
         weight: f32,
+        /// Albedo, linear RGB.
         color: Color,
+        /// σ in [0, 1].
         roughness: Scalar,
     },
     /// glTF Appendix B microfacet lobe: GGX D, height-correlated Smith V, Schlick F
     /// from `f0` or, when absent, from `ior` (default 1.5).
     Ggx {
+        /// Scales the lobe (default 1).
         #[serde(default = "one_f32")]
         weight: f32,
+        /// Perceptual roughness in [0, 1].
         roughness: Scalar,
+        /// Reflectance at normal incidence; takes precedence over `ior`.
         #[serde(default)]
         f0: Option<Color>,
+        /// IOR for the Fresnel term when `f0` is absent (default 1.5).
         #[serde(default)]
         ior: Option<f32>,
     },
     /// Anisotropic GGX (αt = α(1 + a), αb = α(1 − a)), along the tangent.
     AnisoGgx {
+        /// Scales the lobe (default 1).
         #[serde(default = "one_f32")]
         weight: f32,
+        /// Perceptual roughness in [0, 1].
         roughness: Scalar,
+        /// Anisotropy a in [−1, 1]: positive stretches the highlight along the tangent.
         anisotropy: Scalar,
+        /// Reflectance at normal incidence; takes precedence over `ior`.
         #[serde(default)]
         f0: Option<Color>,
+        /// IOR for the Fresnel term when `f0` is absent (default 1.5).
         #[serde(default)]
         ior: Option<f32>,
     },
     /// A monochrome GGX on the geometric normal (not the normal map), F0 from `ior`
     /// (default 1.5).
     Clearcoat {
+        /// Scales the lobe (default 1).
         #[serde(default = "one_f32")]
         weight: f32,
+        /// Perceptual roughness in [0, 1].
         roughness: Scalar,
+        /// IOR of the coat (default 1.5).
         #[serde(default)]
         ior: Option<f32>,
     },
     /// Charlie sheen (Estevez & Kulla's D and fitted Λ visibility with their terminator
     /// softening; see `shaders/material/lobes.wgsl`).
     Sheen {
+        /// Scales the lobe (default 1).
         #[serde(default = "one_f32")]
         weight: f32,
+        /// Sheen colour, linear RGB.
         color: Color,
+        /// Perceptual roughness in [0, 1].
         roughness: Scalar,
     },
 }
 
 impl Lobe {
+    /// The variant's name as written in RON (`"Ggx"`, ...), for messages.
     pub fn kind(&self) -> &'static str {
         match self {
             Lobe::Lambert { .. } => "Lambert",
@@ -287,7 +324,7 @@ impl Lobe {
         }
     }
 
-    pub fn weight(&self) -> f32 {
+    pub(crate) fn weight(&self) -> f32 {
         match *self {
             Lobe::Lambert { weight, .. }
             | Lobe::OrenNayar { weight, .. }
@@ -302,18 +339,23 @@ impl Lobe {
 /// A texture channel.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Channel {
+    /// Red.
     #[default]
     R,
+    /// Green (glTF roughness).
     G,
+    /// Blue (glTF metallic).
     B,
+    /// Alpha.
     A,
 }
 
 impl Channel {
+    /// The channel's index in an RGBA texel (R = 0 .. A = 3).
     pub fn index(self) -> usize {
         self as usize
     }
-    pub fn swizzle(self) -> &'static str {
+    pub(crate) fn swizzle(self) -> &'static str {
         ["x", "y", "z", "w"][self as usize]
     }
 }
@@ -322,22 +364,30 @@ impl Channel {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(untagged)]
 pub enum Scalar {
+    /// A constant.
     Val(f32),
+    /// An expression over texture channels.
     Expr(ScalarExpr),
 }
 
+/// A scalar expression over texture channels (written without the `Expr` wrapper).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum ScalarExpr {
     /// `scale * texture.channel`.
     Tex {
+        /// A slot name from `textures`.
         texture: String,
+        /// The channel read (default `R`).
         #[serde(default)]
         channel: Channel,
+        /// Multiplies the channel (default 1).
         #[serde(default = "one_f32")]
         scale: f32,
     },
+    /// `1 − x`.
     OneMinus(Box<Scalar>),
+    /// `a × b`.
     Mul(Box<Scalar>, Box<Scalar>),
 }
 
@@ -345,23 +395,31 @@ pub enum ScalarExpr {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(untagged)]
 pub enum Color {
+    /// A linear RGB constant, `(r, g, b)`.
     Rgb(f32, f32, f32),
+    /// An expression over textures.
     Expr(ColorExpr),
 }
 
+/// A colour expression over textures (written without the `Expr` wrapper).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum ColorExpr {
     /// `scale * texture.rgb`.
     Tex {
+        /// A slot name from `textures`.
         texture: String,
+        /// Multiplies the texel's rgb (default `(1, 1, 1)`).
         #[serde(default = "ones3")]
         scale: (f32, f32, f32),
     },
     /// `a * (1 - t) + b * t` (WGSL `mix`).
     Mix {
+        /// The colour at t = 0.
         a: Box<Color>,
+        /// The colour at t = 1.
         b: Box<Color>,
+        /// The blend factor.
         t: Scalar,
     },
     /// `color * scalar`.
@@ -386,7 +444,7 @@ fn one_scalar() -> Scalar {
 
 impl Scalar {
     /// Names of the textures this expression reads.
-    pub fn textures<'a>(&'a self, out: &mut Vec<&'a str>) {
+    pub(crate) fn textures<'a>(&'a self, out: &mut Vec<&'a str>) {
         match self {
             Scalar::Val(_) => {}
             Scalar::Expr(ScalarExpr::Tex { texture, .. }) => out.push(texture),
@@ -400,7 +458,7 @@ impl Scalar {
 }
 
 impl Color {
-    pub fn textures<'a>(&'a self, out: &mut Vec<&'a str>) {
+    pub(crate) fn textures<'a>(&'a self, out: &mut Vec<&'a str>) {
         match self {
             Color::Rgb(..) => {}
             Color::Expr(ColorExpr::Tex { texture, .. }) => out.push(texture),

@@ -17,7 +17,7 @@ fn loc(path: &Path, line: usize, col: usize) -> Location {
 }
 
 /// 1-based line and column (in characters) of a byte offset.
-pub fn line_col(src: &str, offset: usize) -> (usize, usize) {
+pub(crate) fn line_col(src: &str, offset: usize) -> (usize, usize) {
     let before = &src[..offset.min(src.len())];
     let line = before.matches('\n').count() + 1;
     let start = before.rfind('\n').map_or(0, |i| i + 1);
@@ -66,7 +66,7 @@ fn locate(src: &str, path: &Path, needle: &str, nth: usize) -> Location {
 }
 
 /// RON to the model, with syntax and type errors at ron's position.
-pub fn parse_desc(src: &str, path: &Path) -> Result<MaterialDesc, MaterialError> {
+pub(crate) fn parse_desc(src: &str, path: &Path) -> Result<MaterialDesc, MaterialError> {
     let desc: MaterialDesc = ron::Options::default().from_str(src).map_err(|e| {
         let at = loc(path, e.span.start.line, e.span.start.col);
         match e.code {
@@ -114,8 +114,8 @@ pub fn parse_desc(src: &str, path: &Path) -> Result<MaterialDesc, MaterialError>
 
 /// Most layers in a material, and lobes in a layer: compile time grows faster than
 /// linearly with them (4,000 layers took 6 s).
-pub const MAX_LAYERS: usize = 32;
-pub const MAX_LOBES_PER_LAYER: usize = 8;
+pub(crate) const MAX_LAYERS: usize = 32;
+pub(crate) const MAX_LOBES_PER_LAYER: usize = 8;
 
 /// Semantic checks that serde cannot express.
 fn check(desc: &MaterialDesc, src: &str, path: &Path) -> Result<(), MaterialError> {
@@ -196,12 +196,12 @@ fn check(desc: &MaterialDesc, src: &str, path: &Path) -> Result<(), MaterialErro
 
 /// Why an alpha cutoff is refused, if it is: coverage lies in [0, 1], so a cutoff outside
 /// it keeps every fragment or none, and a non-finite one is no WGSL literal at all.
-pub fn alpha_cutoff_rule(cutoff: f32) -> Option<&'static str> {
+pub(crate) fn alpha_cutoff_rule(cutoff: f32) -> Option<&'static str> {
     (!(0.0..=1.0).contains(&cutoff)).then_some("must be a finite number in 0..=1")
 }
 
 /// Names of the textures a lobe reads.
-pub fn lobe_textures<'a>(lobe: &'a Lobe, out: &mut Vec<&'a str>) {
+pub(crate) fn lobe_textures<'a>(lobe: &'a Lobe, out: &mut Vec<&'a str>) {
     match lobe {
         Lobe::Lambert { color, .. } => color.textures(out),
         Lobe::OrenNayar {
@@ -236,7 +236,7 @@ pub fn lobe_textures<'a>(lobe: &'a Lobe, out: &mut Vec<&'a str>) {
 }
 
 /// Texture slots of a RON material: its declared files, in name order, which must exist.
-pub fn file_slots(
+pub(crate) fn file_slots(
     desc: &MaterialDesc,
     src: &str,
     path: &Path,

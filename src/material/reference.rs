@@ -13,18 +13,23 @@ use super::model::{Color, ColorExpr, Lobe, Scalar, ScalarExpr};
 use super::Material;
 use std::collections::BTreeMap;
 
+/// A 3-vector in f64, the reference's vector type.
 pub type V3 = [f64; 3];
 
 /// The constants of the lobe library, at the f32 values the GPU uses.
 pub const ALPHA_MIN: f64 = 0.002f32 as f64;
+/// Smallest sheen α (perceptual roughness 0.1), as `lg_sheen` clamps it.
 pub const SHEEN_ALPHA_MIN: f64 = 0.01f32 as f64;
+/// Smallest cosine a lobe sees (`nl`, `nv`, refracted cosines are clamped up to it).
 pub const COS_MIN: f64 = 1e-4f32 as f64;
 const INV_PI: f64 = std::f64::consts::FRAC_1_PI;
 const PI: f64 = std::f64::consts::PI;
 
+/// Dot product.
 pub fn dot(a: V3, b: V3) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
+/// Cross product.
 pub fn cross(a: V3, b: V3) -> V3 {
     [
         a[1] * b[2] - a[2] * b[1],
@@ -32,15 +37,19 @@ pub fn cross(a: V3, b: V3) -> V3 {
         a[0] * b[1] - a[1] * b[0],
     ]
 }
+/// Component-wise sum.
 pub fn add(a: V3, b: V3) -> V3 {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
+/// `a` scaled by `s`.
 pub fn scale(a: V3, s: f64) -> V3 {
     [a[0] * s, a[1] * s, a[2] * s]
 }
+/// Component-wise product.
 pub fn mul(a: V3, b: V3) -> V3 {
     [a[0] * b[0], a[1] * b[1], a[2] * b[2]]
 }
+/// `a` scaled to unit length.
 pub fn normalize(a: V3) -> V3 {
     scale(a, 1.0 / dot(a, a).sqrt())
 }
@@ -54,15 +63,22 @@ fn max0(a: V3) -> V3 {
 /// What the lobes need about (n, v, l); see `LgDirs` in the WGSL.
 #[derive(Clone, Copy, Debug)]
 pub struct Dirs {
-    pub h: V3,
+    pub(crate) h: V3,
+    /// n·l clamped to [`COS_MIN`] ..= 1.
     pub nl: f64,
+    /// n·v clamped to [`COS_MIN`] ..= 1.
     pub nv: f64,
+    /// n·h clamped to [0, 1].
     pub nh: f64,
+    /// v·h computed as |l + v| / 2 (symmetric in l and v), in [0, 1].
     pub vh: f64,
+    /// |n × h|², the squared sine of the half-vector angle, from the cross product (no 1 −
+    /// (n·h)² cancellation).
     pub s2: f64,
-    pub lv: f64,
+    pub(crate) lv: f64,
 }
 
+/// The [`Dirs`] of unit normal `n`, view `v` and light `l` (`lg_dirs` in the WGSL).
 pub fn dirs(n: V3, v: V3, l: V3) -> Dirs {
     let hs = add(l, v);
     let big = hs[0].abs().max(hs[1].abs()).max(hs[2].abs());
@@ -89,11 +105,13 @@ pub fn alpha(roughness: f64) -> f64 {
     (r * r).max(ALPHA_MIN)
 }
 
+/// Schlick F0 of a dielectric of index `ior` (against air): ((ior − 1) / (ior + 1))².
 pub fn ior_f0(ior: f64) -> f64 {
     let r = (ior - 1.0) / (ior + 1.0);
     r * r
 }
 
+/// Schlick Fresnel at cosine `vh`, per channel.
 pub fn schlick(f0: V3, vh: f64) -> V3 {
     let m5 = (1.0 - vh).powi(5);
     [
@@ -114,6 +132,7 @@ pub fn d_ggx(nh: f64, s2: f64, a: f64) -> f64 {
     r * r * INV_PI
 }
 
+/// Height-correlated Smith visibility V = G / (4 n·l n·v) for GGX α `a`.
 pub fn v_smith(nl: f64, nv: f64, a: f64) -> f64 {
     let a2 = a * a;
     let gv = nl * (nv * nv * (1.0 - a2) + a2).sqrt();
@@ -121,10 +140,12 @@ pub fn v_smith(nl: f64, nv: f64, a: f64) -> f64 {
     0.5 / (gv + gl)
 }
 
+/// The Lambert lobe, ρ/π.
 pub fn lambert(color: V3) -> V3 {
     scale(color, INV_PI)
 }
 
+/// The isotropic GGX lobe (D · V · F) for reflectance `f0` and α `a`.
 pub fn ggx(f0: V3, a: f64, d: &Dirs) -> V3 {
     scale(
         schlick(f0, d.vh),
@@ -132,6 +153,7 @@ pub fn ggx(f0: V3, a: f64, d: &Dirs) -> V3 {
     )
 }
 
+/// The anisotropic GGX lobe along tangent `t` and bitangent `b` (αt = α(1 + a), αb = α(1 − a)).
 #[allow(clippy::too_many_arguments)]
 pub fn ggx_aniso(f0: V3, a: f64, anisotropy: f64, t: V3, b: V3, v: V3, l: V3, d: &Dirs) -> V3 {
     let an = anisotropy.clamp(-1.0, 1.0);
@@ -176,6 +198,7 @@ pub fn sheen_lambda(c: f64, a: f64) -> f64 {
     (l * (1.0 + 2.0 * m8)).exp()
 }
 
+/// The Charlie sheen lobe (Estevez & Kulla D and fitted visibility) for perceptual `roughness`.
 pub fn sheen(color: V3, roughness: f64, d: &Dirs) -> V3 {
     let r = roughness.clamp(0.0, 1.0);
     let a = (r * r).max(SHEEN_ALPHA_MIN);
@@ -189,6 +212,7 @@ pub fn sheen(color: V3, roughness: f64, d: &Dirs) -> V3 {
     scale(color, dist * vis)
 }
 
+/// Fujii's improved Oren–Nayar lobe; `roughness` is σ in [0, 1].
 pub fn oren_nayar(color: V3, roughness: f64, d: &Dirs) -> V3 {
     let sigma = roughness.clamp(0.0, 1.0);
     let s = d.lv - d.nl * d.nv;
@@ -250,6 +274,7 @@ pub fn tangent(n: V3, tangent: [f64; 4]) -> V3 {
     [1.0 + s * n[0] * n[0] * a, s * b, -s * n[0]]
 }
 
+/// `lg_bitangent`: n × t, flipped when the tangent's handedness `w` is negative.
 pub fn bitangent(n: V3, t: V3, w: f64) -> V3 {
     scale(cross(n, t), if w < 0.0 { -1.0 } else { 1.0 })
 }
@@ -259,12 +284,16 @@ pub fn bitangent(n: V3, t: V3, w: f64) -> V3 {
 /// texel values by texture name (a texture not listed reads as (1, 1, 1, 1)).
 #[derive(Clone, Debug, Default)]
 pub struct Surface {
+    /// Shading normal, unit length.
     pub n: V3,
+    /// Mesh tangent: xyz and handedness w (all zero for none).
     pub tangent: [f64; 4],
+    /// Texel values (RGBA, linear) by texture name; a missing name reads (1, 1, 1, 1).
     pub texels: BTreeMap<String, [f64; 4]>,
 }
 
 impl Surface {
+    /// A surface with normal `n`, no tangent and every texture reading (1, 1, 1, 1).
     pub fn new(n: V3) -> Self {
         Self {
             n,
@@ -276,6 +305,7 @@ impl Surface {
     }
 }
 
+/// Evaluates a scalar parameter at a surface (texture expressions read `at.texels`).
 pub fn scalar(s: &Scalar, at: &Surface) -> f64 {
     match s {
         Scalar::Val(x) => *x as f64,
@@ -289,6 +319,7 @@ pub fn scalar(s: &Scalar, at: &Surface) -> f64 {
     }
 }
 
+/// Evaluates a colour parameter at a surface, linear RGB.
 pub fn color(c: &Color, at: &Surface) -> V3 {
     match c {
         Color::Rgb(r, g, b) => [*r as f64, *g as f64, *b as f64],

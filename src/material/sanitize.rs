@@ -5,7 +5,7 @@
 use super::model::{Color, ColorExpr, Lobe, MaterialDesc, Scalar, ScalarExpr};
 
 /// Largest weight or colour component kept (past it values are clamped).
-pub const MAX_GAIN: f32 = 64.0;
+pub(crate) const MAX_GAIN: f32 = 64.0;
 const MAX_BIG: f32 = 1e6;
 
 #[derive(Clone, Copy)]
@@ -108,7 +108,7 @@ impl Ctx {
 }
 
 /// Clamps what must be clamped, returns one message per questionable value.
-pub fn sanitize(desc: &mut MaterialDesc) -> Vec<String> {
+pub(crate) fn sanitize(desc: &mut MaterialDesc) -> Vec<String> {
     let mut cx = Ctx {
         warnings: Vec::new(),
     };

@@ -14,7 +14,7 @@ pub const LOBE_LIBRARY: &str = include_str!("../../shaders/material/lobes.wgsl")
 
 /// The line that stands for the lobe library in code generated with
 /// `WgslOptions::include_library`.
-pub const LOBE_LIBRARY_INCLUDE: &str = "#include \"material/lobes.wgsl\"";
+pub(crate) const LOBE_LIBRARY_INCLUDE: &str = "#include \"material/lobes.wgsl\"";
 
 /// What the forward shader declares before including a material (the contract).
 pub const SHADING_POINT_WGSL: &str = "struct ShadingPoint {
@@ -26,6 +26,8 @@ pub const SHADING_POINT_WGSL: &str = "struct ShadingPoint {
 };
 ";
 
+/// How [`Material::wgsl_with`](super::Material::wgsl_with) generates a material's WGSL; the
+/// default suits the forward and deferred fragment shaders.
 #[derive(Clone, Debug, Default)]
 pub struct WgslOptions {
     /// Sample textures with `textureSampleLevel(.., 0.0)` instead of `textureSample`, so the
@@ -114,7 +116,7 @@ impl Gen<'_> {
 }
 
 /// The material's WGSL (not validated; see [`Material::wgsl`]).
-pub fn generate(m: &Material, opts: &WgslOptions) -> String {
+pub(crate) fn generate(m: &Material, opts: &WgslOptions) -> String {
     let desc = m.desc();
     let slots = m.texture_slots();
     let g = Gen {
@@ -399,7 +401,7 @@ pub fn generate(m: &Material, opts: &WgslOptions) -> String {
 }
 
 /// Parses and validates `code` (after the `ShadingPoint` declaration) with naga.
-pub fn validate(code: &str, material: &str) -> Result<(), MaterialError> {
+pub(crate) fn validate(code: &str, material: &str) -> Result<(), MaterialError> {
     let full = format!("{SHADING_POINT_WGSL}\n{code}");
     if let Some(line) = crate::shader::limits::longest_statement_over_limit(&full) {
         return Err(MaterialError::Wgsl {

@@ -40,10 +40,10 @@ fn material(
 
 /// Material type bits of the built-in scenes (for light material masks).
 pub mod type_bits {
-    pub const FLOOR: u32 = 1;
-    pub const STONE: u32 = 2;
-    pub const METAL: u32 = 4;
-    pub const WALL: u32 = 8;
+    pub(crate) const FLOOR: u32 = 1;
+    pub(crate) const STONE: u32 = 2;
+    pub(crate) const METAL: u32 = 4;
+    pub(crate) const WALL: u32 = 8;
 }
 
 /// A subdivided horizontal floor (y = `y`) over `min..max` in x/z, facing +Y.

@@ -20,7 +20,7 @@ const ROWS: u32 = 6;
 const STEP_X: f32 = 3.4;
 const STEP_Z: f32 = 2.8;
 /// Shadow-casting point lights.
-pub const LIGHTS: u32 = 512;
+pub(crate) const LIGHTS: u32 = 512;
 
 fn material(
     name: &str,
@@ -107,7 +107,7 @@ fn room(floor: &mut MeshBuilder, walls: &mut MeshBuilder) {
 
 /// A room of 30 × 20 × 5 m with 8 × 6 tables, four chairs at each (192 chairs, slightly
 /// jittered), 512 shadow-casting point lights between floor and ceiling; 1280×720.
-pub fn chairs() -> Scene {
+pub(crate) fn chairs() -> Scene {
     use type_bits::*;
     let materials = vec![
         material("chairs_floor", Vec3::new(0.5, 0.45, 0.4), 0.5, 0.0, FLOOR),

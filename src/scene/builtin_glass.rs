@@ -10,7 +10,7 @@ use super::types::{AlphaMode, Camera, Scene, SurfaceMaterial};
 use glam::{Vec2, Vec3, Vec4};
 
 /// Lights in the scene.
-pub const LIGHTS: u32 = 48;
+pub(crate) const LIGHTS: u32 = 48;
 
 fn opaque(name: &str, rgb: Vec3, type_bit: u32) -> SurfaceMaterial {
     SurfaceMaterial {
@@ -34,7 +34,7 @@ fn glass(name: &str, rgba: Vec4) -> SurfaceMaterial {
     }
 }
 
-pub fn glass_scene() -> Scene {
+pub(crate) fn glass_scene() -> Scene {
     let materials = vec![
         opaque("glass/floor", Vec3::splat(0.5), type_bits::FLOOR),
         opaque("glass/wall", Vec3::new(0.6, 0.6, 0.65), type_bits::WALL),

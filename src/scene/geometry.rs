@@ -4,7 +4,7 @@ use super::types::Mesh;
 use glam::{Mat4, Quat, Vec2, Vec3, Vec4};
 
 /// Area-weighted vertex normals of a triangle list. Vertices no triangle touches get +Y.
-pub fn compute_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
+pub(crate) fn compute_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
     let mut n = vec![Vec3::ZERO; positions.len()];
     for t in indices.chunks_exact(3) {
         let [a, b, c] = [t[0] as usize, t[1] as usize, t[2] as usize];
@@ -19,7 +19,7 @@ pub fn compute_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
 }
 
 /// Any unit vector perpendicular to `n`.
-pub fn any_perpendicular(n: Vec3) -> Vec3 {
+pub(crate) fn any_perpendicular(n: Vec3) -> Vec3 {
     let a = if n.x.abs() < 0.9 { Vec3::X } else { Vec3::Y };
     (a - n * n.dot(a)).try_normalize().unwrap_or(Vec3::X)
 }
@@ -27,7 +27,7 @@ pub fn any_perpendicular(n: Vec3) -> Vec3 {
 /// Tangents by per-triangle accumulation of the UV-space derivatives (MikkTSpace-like: tangent
 /// and bitangent accumulated per vertex, Gram-Schmidt against the normal, handedness in w).
 /// Without UVs (or with degenerate UVs) a tangent perpendicular to the normal is chosen.
-pub fn compute_tangents(
+pub(crate) fn compute_tangents(
     positions: &[Vec3],
     normals: &[Vec3],
     uvs: &[Vec2],
@@ -75,10 +75,12 @@ pub fn compute_tangents(
 /// Builds one mesh out of boxes, cylinders and swept profiles (for the built-in scenes).
 #[derive(Default)]
 pub struct MeshBuilder {
+    /// The mesh built so far; take it when done.
     pub mesh: Mesh,
 }
 
 impl MeshBuilder {
+    /// An empty mesh called `name` using material index `material` of the scene.
     pub fn new(name: &str, material: usize) -> Self {
         MeshBuilder {
             mesh: Mesh {
@@ -99,7 +101,14 @@ impl MeshBuilder {
 
     /// The four inward-facing walls of a room centred on the origin, `2hx` × `2hz` and `h`
     /// high from y = 0; `uv_x` tiles the walls along x, `uv_z` those along z.
-    pub fn inward_walls(&mut self, hx: f32, hz: f32, h: f32, uv_x: Vec2, uv_z: Vec2) -> &mut Self {
+    pub(crate) fn inward_walls(
+        &mut self,
+        hx: f32,
+        hz: f32,
+        h: f32,
+        uv_x: Vec2,
+        uv_z: Vec2,
+    ) -> &mut Self {
         self.quad(
             Vec3::new(-hx, 0.0, -hz),
             Vec3::X * 2.0 * hx,
@@ -186,7 +195,7 @@ impl MeshBuilder {
     /// A semicircular arch in the plane spanned by `across` (unit, horizontal) and +Y, centred
     /// at `center` (the springing line), inner radius `r0`, outer `r1`, thickness `depth`
     /// along `across × Y`.
-    pub fn arch(
+    pub(crate) fn arch(
         &mut self,
         center: Vec3,
         across: Vec3,
@@ -214,7 +223,7 @@ impl MeshBuilder {
     }
 
     /// A planar quad from four points (counter-clockwise from the front).
-    pub fn quad_pts(&mut self, p: [Vec3; 4]) -> &mut Self {
+    pub(crate) fn quad_pts(&mut self, p: [Vec3; 4]) -> &mut Self {
         let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
         let base = self.mesh.positions.len() as u32;
         let uvs = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y];
@@ -228,7 +237,7 @@ impl MeshBuilder {
     }
 
     /// Applies a transform to everything added so far.
-    pub fn transform(&mut self, rotation: Quat, translation: Vec3) -> &mut Self {
+    pub(crate) fn transform(&mut self, rotation: Quat, translation: Vec3) -> &mut Self {
         let m = Mat4::from_rotation_translation(rotation, translation);
         self.mesh
             .positions

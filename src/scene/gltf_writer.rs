@@ -31,11 +31,19 @@ pub enum ImageStorage {
 /// One triangle primitive; attributes are accessor indices from the `add_*` methods.
 #[derive(Clone, Debug, Default)]
 pub struct PrimitiveDesc {
+    /// Accessor of the vertex positions (`POSITION`, from [`GltfWriter::add_positions`]).
     pub positions: usize,
+    /// Accessor of the vertex normals (`NORMAL`).
     pub normals: Option<usize>,
+    /// Accessor of the texture coordinates (`TEXCOORD_0`).
     pub uvs: Option<usize>,
+    /// Accessor of the tangents (`TANGENT`, xyz and handedness w).
     pub tangents: Option<usize>,
+    /// Accessor of the indices (from [`GltfWriter::add_indices`]); `None` for a non-indexed
+    /// primitive.
     pub indices: Option<usize>,
+    /// Material index (from [`GltfWriter::add_material`]); `None` leaves the glTF default
+    /// material.
     pub material: Option<usize>,
     /// glTF primitive mode (4 = triangles).
     pub mode: Option<u32>,
@@ -44,20 +52,31 @@ pub struct PrimitiveDesc {
 /// A metallic-roughness material.
 #[derive(Clone, Debug)]
 pub struct MaterialDesc {
+    /// Material name (`name`).
     pub name: String,
+    /// Linear RGBA `baseColorFactor`.
     pub base_color: Vec4,
+    /// `metallicFactor`, 0..1.
     pub metallic: f32,
+    /// `roughnessFactor`, 0..1.
     pub roughness: f32,
+    /// Linear RGB `emissiveFactor`.
     pub emissive: Vec3,
     /// "OPAQUE", "MASK" or "BLEND".
     pub alpha_mode: &'static str,
+    /// `alphaCutoff` of `MASK` materials (the glTF default 0.5 when `None`).
     pub alpha_cutoff: Option<f32>,
+    /// `doubleSided`.
     pub double_sided: bool,
     /// Texture indices from [`GltfWriter::add_texture_bytes`].
     pub base_color_texture: Option<usize>,
+    /// `metallicRoughnessTexture` (roughness in G, metallic in B).
     pub metallic_roughness_texture: Option<usize>,
+    /// `normalTexture`.
     pub normal_texture: Option<usize>,
+    /// `emissiveTexture`.
     pub emissive_texture: Option<usize>,
+    /// `occlusionTexture`.
     pub occlusion_texture: Option<usize>,
     /// Members of the material's `extensions` object, as JSON text
     /// (`"KHR_materials_unlit":{}`).
@@ -92,13 +111,21 @@ impl Default for MaterialDesc {
 /// A node: TRS, optional mesh / camera / light, children.
 #[derive(Clone, Debug, Default)]
 pub struct NodeDesc {
+    /// Node name.
     pub name: Option<String>,
+    /// Translation, written when given.
     pub translation: Option<Vec3>,
+    /// Rotation quaternion, written when given.
     pub rotation: Option<Quat>,
+    /// Scale, written when given.
     pub scale: Option<Vec3>,
+    /// Mesh index (from [`GltfWriter::add_mesh`]).
     pub mesh: Option<usize>,
+    /// Camera index (from [`GltfWriter::add_camera`]).
     pub camera: Option<usize>,
+    /// KHR_lights_punctual light index (from [`GltfWriter::add_light`]).
     pub light: Option<usize>,
+    /// Child node indices (from [`GltfWriter::add_node`]).
     pub children: Vec<usize>,
 }
 
@@ -143,6 +170,7 @@ fn arr(v: &[f32]) -> String {
 }
 
 impl GltfWriter {
+    /// An empty document: no meshes, nodes or buffer data.
     pub fn new() -> Self {
         Self::default()
     }
@@ -187,15 +215,20 @@ impl GltfWriter {
         self.accessors.len() - 1
     }
 
+    /// Adds a VEC3 float accessor with min/max (as glTF requires for `POSITION`); returns
+    /// its index.
     pub fn add_positions(&mut self, p: &[Vec3]) -> usize {
         self.float_accessor(bytemuck::cast_slice(p), 3, "VEC3", true)
     }
+    /// Adds a VEC3 float accessor (normals); returns its index.
     pub fn add_vec3(&mut self, v: &[Vec3]) -> usize {
         self.float_accessor(bytemuck::cast_slice(v), 3, "VEC3", false)
     }
+    /// Adds a VEC2 float accessor (texture coordinates); returns its index.
     pub fn add_vec2(&mut self, v: &[Vec2]) -> usize {
         self.float_accessor(bytemuck::cast_slice(v), 2, "VEC2", false)
     }
+    /// Adds a VEC4 float accessor (tangents); returns its index.
     pub fn add_vec4(&mut self, v: &[Vec4]) -> usize {
         self.float_accessor(bytemuck::cast_slice(v), 4, "VEC4", false)
     }
@@ -216,6 +249,7 @@ impl GltfWriter {
         self.accessors.len() - 1
     }
 
+    /// Adds a mesh of these primitives; returns the mesh index.
     pub fn add_mesh(&mut self, name: &str, prims: &[PrimitiveDesc]) -> usize {
         let ps: Vec<String> = prims
             .iter()
@@ -274,6 +308,7 @@ impl GltfWriter {
         self.add_mesh(name, &[prim])
     }
 
+    /// Adds a metallic-roughness material; returns its index.
     pub fn add_material(&mut self, m: &MaterialDesc) -> usize {
         let tex = |key: &str, i: Option<usize>| {
             i.map(
@@ -380,6 +415,8 @@ impl GltfWriter {
         self.add_texture_bytes(name, encode_png(img), storage)
     }
 
+    /// Adds a perspective camera (`yfov` in radians, `znear`, optional `zfar`; infinite when
+    /// `None`); returns its index.
     pub fn add_camera(&mut self, yfov: f32, znear: f32, zfar: Option<f32>) -> usize {
         let far = zfar.map(|f| format!(",\"zfar\":{f:?}")).unwrap_or_default();
         self.cameras.push(format!(
@@ -418,6 +455,8 @@ impl GltfWriter {
         self.lights.len() - 1
     }
 
+    /// Adds a node; returns its index (make it a root with [`GltfWriter::add_root`], or a
+    /// child of another node).
     pub fn add_node(&mut self, n: &NodeDesc) -> usize {
         let mut s = String::from("{");
         let mut fields = Vec::new();

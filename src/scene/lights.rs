@@ -16,10 +16,14 @@ pub struct Pcg32 {
 impl Pcg32 {
     const MUL: u64 = 6364136223846793005;
 
+    /// A generator seeded with `seed` on the default stream; the same seed gives the same
+    /// sequence on every platform.
     pub fn new(seed: u64) -> Self {
         Self::with_stream(seed, 0xda3e_39cb_94b9_5bdb)
     }
 
+    /// A generator seeded with `seed` on stream `stream`: different streams give independent
+    /// sequences for one seed.
     pub fn with_stream(seed: u64, stream: u64) -> Self {
         let mut rng = Pcg32 {
             state: 0,
@@ -31,6 +35,7 @@ impl Pcg32 {
         rng
     }
 
+    /// The next uniformly distributed 32-bit value.
     pub fn next_u32(&mut self) -> u32 {
         let old = self.state;
         self.state = old.wrapping_mul(Self::MUL).wrapping_add(self.inc);
@@ -40,7 +45,7 @@ impl Pcg32 {
     }
 
     /// Uniform in [0, 1) with 24 bits of precision.
-    pub fn next_f32(&mut self) -> f32 {
+    pub(crate) fn next_f32(&mut self) -> f32 {
         (self.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0)
     }
 
@@ -49,6 +54,7 @@ impl Pcg32 {
         lo + (hi - lo) * self.next_f32()
     }
 
+    /// A point uniform in the box from `lo` to `hi` (per axis in [lo, hi)).
     pub fn vec3_in(&mut self, lo: Vec3, hi: Vec3) -> Vec3 {
         Vec3::new(
             self.range(lo.x, hi.x),
@@ -69,7 +75,7 @@ impl Pcg32 {
 /// Where a random light set is placed.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub enum Placement {
+pub(crate) enum Placement {
     /// Uniformly in this box.
     Box { min: Vec3, max: Vec3 },
     /// Uniformly in the scene's bounding box, grown by `margin` on every side (may be negative).
@@ -91,25 +97,30 @@ fn default_color() -> (Vec3, Vec3) {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RandomLights {
+    /// Number of lights.
     pub count: u32,
     /// Fraction of spot lights, 0 (all point) .. 1 (all spot).
     #[serde(default)]
-    pub spot_fraction: f32,
-    pub placement: Placement,
+    pub(crate) spot_fraction: f32,
+    pub(crate) placement: Placement,
+    /// Range in metres, min ≤ max, min > 0.
     pub range: (f32, f32),
-    pub intensity: (f32, f32),
+    /// Intensity in candela, 0 ≤ min ≤ max.
+    pub(crate) intensity: (f32, f32),
     /// Linear RGB, per channel.
     #[serde(default = "default_color")]
-    pub color: (Vec3, Vec3),
+    pub(crate) color: (Vec3, Vec3),
     /// Spot (inner, outer) cone half-angles in degrees.
     #[serde(default = "default_spot_cone")]
-    pub spot_cone_deg: (f32, f32),
+    pub(crate) spot_cone_deg: (f32, f32),
+    /// PRNG seed (PCG32); the same seed gives the same lights on every platform.
     #[serde(default)]
     pub seed: u64,
     #[serde(default)]
-    pub casts_shadow: bool,
+    pub(crate) casts_shadow: bool,
     #[serde(default)]
-    pub indirect: bool,
+    pub(crate) indirect: bool,
+    /// Material type bits the lights light (all by default).
     #[serde(default = "all_bits")]
     pub material_mask: u32,
     /// How every light of the set moves (each from its own position).
@@ -141,7 +152,7 @@ impl RandomLights {
     }
 
     /// Checks the parameters; the message names the bad field.
-    pub fn check(&self) -> Result<(), String> {
+    pub(crate) fn check(&self) -> Result<(), String> {
         let finite = |v: f32| v.is_finite();
         let pair = |name: &str, (a, b): (f32, f32), positive: bool| -> Result<(), String> {
             if !finite(a) || !finite(b) {
@@ -193,7 +204,7 @@ impl RandomLights {
 
     /// Generates the lights. `bounds` is the scene's bounding box (used by
     /// [`Placement::SceneBounds`]; an empty scene uses the unit box).
-    pub fn generate(&self, bounds: Option<(Vec3, Vec3)>) -> Vec<Light> {
+    pub(crate) fn generate(&self, bounds: Option<(Vec3, Vec3)>) -> Vec<Light> {
         let (lo, hi) = match self.placement {
             Placement::Box { min, max } => (min, max),
             Placement::SceneBounds { margin } => {
@@ -248,13 +259,16 @@ impl RandomLights {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AmdLights {
+    /// Point lights (default 2048).
     #[serde(default = "amd_count")]
     pub point_count: u32,
+    /// Spot lights (default 2048).
     #[serde(default = "amd_count")]
     pub spot_count: u32,
     /// How many of the first point and of the first spot lights cast shadows (sample: 12 + 12).
     #[serde(default)]
     pub shadow_casters: u32,
+    /// PRNG seed (default a fixed constant).
     #[serde(default = "amd_seed")]
     pub seed: u64,
     /// How every light of the set moves (each from its own position).
@@ -270,9 +284,9 @@ fn amd_seed() -> u64 {
 }
 
 /// The fixed seed of [`amd_lights`].
-pub const AMD_SEED: u64 = 0x4D44_7469_6C65_6421; // "AMDtiled!"-ish
+pub(crate) const AMD_SEED: u64 = 0x4D44_7469_6C65_6421; // "AMDtiled!"-ish
 /// Light radius as a fraction of |half-extent| of the scene box.
-pub const AMD_RADIUS_FACTOR: f32 = 0.075;
+pub(crate) const AMD_RADIUS_FACTOR: f32 = 0.075;
 /// cos of the spot cone half-angle (35.26°).
 pub const AMD_SPOT_COS: f32 = 0.8165;
 
@@ -366,7 +380,7 @@ pub fn amd_camera(bounds: (Vec3, Vec3)) -> Camera {
 
 /// A camera looking at the whole box from the +Z side, slightly above (for scenes without
 /// one).
-pub fn fit_camera(bounds: (Vec3, Vec3)) -> Camera {
+pub(crate) fn fit_camera(bounds: (Vec3, Vec3)) -> Camera {
     let (lo, hi) = bounds;
     let c = (lo + hi) * 0.5;
     let radius = ((hi - lo) * 0.5).length().max(1e-3);
@@ -430,7 +444,7 @@ pub fn check_light(l: &Light) -> Result<(), String> {
 /// are lit (a light inside the bounds leaves closed models such as the Khronos Box dark).
 /// About unit irradiance at the centre of the bounds; the range reaches twice past the
 /// farthest corner, so the range window dims nothing visible by more than ~12%.
-pub fn headlight(camera: &Camera, bounds: (Vec3, Vec3)) -> Light {
+pub(crate) fn headlight(camera: &Camera, bounds: (Vec3, Vec3)) -> Light {
     let (lo, hi) = bounds;
     let centre = (lo + hi) * 0.5;
     let to_centre = (centre - camera.eye).length();

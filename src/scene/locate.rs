@@ -181,7 +181,7 @@ pub(super) fn tokens(text: &str) -> Vec<(Token<'_>, Location)> {
 /// Where `element` (an error's element description) is written in the scene file `text`:
 /// the start of the list entry, map key or field it names; None when it names no field of
 /// the top-level struct or the text does not have it.
-pub fn locate(text: &str, element: &str) -> Option<Location> {
+pub(crate) fn locate(text: &str, element: &str) -> Option<Location> {
     let path = element_path(element)?;
     let field = match &path {
         Path::Field(f) | Path::Index(f, _) | Path::Key(f, _) => *f,

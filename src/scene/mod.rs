@@ -4,8 +4,8 @@
 //! [`builtin`] has the procedural scenes; [`lights`] the procedural light sets.
 
 pub mod builtin;
-pub mod builtin_chairs;
-pub mod builtin_glass;
+pub(crate) mod builtin_chairs;
+pub(crate) mod builtin_glass;
 mod error;
 pub mod geometry;
 pub mod gltf_import;
@@ -14,11 +14,11 @@ pub mod lights;
 mod locate;
 mod model_budget;
 pub mod motion;
-pub mod ranges;
+pub(crate) mod ranges;
 pub mod scene_file;
 pub mod tangent_space;
 mod types;
-pub mod vpl;
+pub(crate) mod vpl;
 
 pub use error::SceneError;
 pub use types::*;
@@ -30,11 +30,14 @@ use std::path::Path;
 /// primitives, lights given a finite range...). The library never prints them.
 #[derive(Clone, Debug, Default)]
 pub struct Loaded {
+    /// The scene, ready for [`graph::compile`](crate::graph::compile) and
+    /// [`SceneGpu::upload`](crate::render::SceneGpu::upload).
     pub scene: Scene,
+    /// Non-fatal problems, one message each, for the caller to show.
     pub warnings: Vec<String>,
     /// Every file the scene was read from (scene file, glTF models, their buffers and
     /// images): what hot reload watches.
-    pub files: Vec<std::path::PathBuf>,
+    pub(crate) files: Vec<std::path::PathBuf>,
 }
 
 /// Loads a scene file, dispatching on the extension: `.ron` (scene file), `.gltf`, `.glb`.

@@ -7,14 +7,14 @@ use super::gltf_import::ImportLimits;
 use std::path::Path;
 
 #[derive(Default)]
-pub struct ModelBudget {
+pub(crate) struct ModelBudget {
     full: ImportLimits,
     used: Expansion,
 }
 
 impl ModelBudget {
     /// The limits for the next model.
-    pub fn limits(&self) -> ImportLimits {
+    pub(crate) fn limits(&self) -> ImportLimits {
         ImportLimits {
             max_nodes: self.full.max_nodes.saturating_sub(self.used.node_instances),
             max_primitives: self
@@ -26,12 +26,12 @@ impl ModelBudget {
         }
     }
 
-    pub fn record(&mut self, e: Expansion) {
+    pub(crate) fn record(&mut self, e: Expansion) {
         self.used = self.used.saturating_add(e);
     }
 
     /// A model's limit error, restated as the scene's when earlier models used part of it.
-    pub fn explain(&self, scene_file: &Path, element: &str, e: SceneError) -> SceneError {
+    pub(crate) fn explain(&self, scene_file: &Path, element: &str, e: SceneError) -> SceneError {
         let SceneError::Limit {
             file, what, count, ..
         } = &e

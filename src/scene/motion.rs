@@ -12,10 +12,13 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Motion {
+    /// A circle about an axis.
     #[serde(default)]
     pub orbit: Option<Orbit>,
+    /// Keyframed offsets from the light's position, looping.
     #[serde(default)]
     pub path: Option<KeyframePath>,
+    /// Seeded noise on the intensity.
     #[serde(default)]
     pub flicker: Option<Flicker>,
 }
@@ -25,7 +28,9 @@ pub struct Motion {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Orbit {
+    /// A point on the axis, world space; finite.
     pub centre: Vec3,
+    /// The axis direction (default +Y); finite and non-zero, normalised when used.
     #[serde(default = "up")]
     pub axis: Vec3,
     /// Degrees per second (counter-clockwise looking down the axis).
@@ -41,15 +46,15 @@ fn up() -> Vec3 {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct KeyframePath {
-    pub points: Vec<Vec3>,
-    pub period: f32,
+    pub(crate) points: Vec<Vec3>,
+    pub(crate) period: f32,
     #[serde(default)]
-    pub interpolation: Interpolation,
+    pub(crate) interpolation: Interpolation,
 }
 
 /// How a path moves between its points.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Interpolation {
+pub(crate) enum Interpolation {
     /// Straight segments.
     #[default]
     Linear,
@@ -62,8 +67,11 @@ pub enum Interpolation {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Flicker {
+    /// Relative depth of the noise, 0..=1 (the intensity stays ≥ 0).
     pub amplitude: f32,
+    /// New random values per second; finite, ≥ 0.
     pub frequency: f32,
+    /// Seeds the noise, together with the light's index in its set (default 0).
     #[serde(default)]
     pub seed: u64,
 }
@@ -71,17 +79,20 @@ pub struct Flicker {
 /// A motion applied to `count` consecutive lights of a scene from `first`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightMotion {
+    /// Index of the first light in [`Scene::lights`](super::Scene::lights).
     pub first: u32,
+    /// Number of consecutive lights that move.
     pub count: u32,
+    /// How they move.
     pub motion: Motion,
 }
 
 /// Most keyframes a path may have (a scene file is read whole; this bounds one path).
-pub const MAX_PATH_POINTS: usize = 1 << 16;
+pub(crate) const MAX_PATH_POINTS: usize = 1 << 16;
 
 impl Motion {
     /// Checks the parameters; the message names the bad field.
-    pub fn check(&self) -> Result<(), String> {
+    pub(crate) fn check(&self) -> Result<(), String> {
         if let Some(o) = &self.orbit {
             if !o.centre.is_finite() {
                 return Err(format!("orbit centre {} is not finite", o.centre));

@@ -13,16 +13,16 @@ use std::path::Path;
 /// triangle differs from the same at the origin only along its edges; at 1e7 the spacing
 /// is a metre, such geometry collapses and rendered black). Squared distances stay far
 /// below f32's range.
-pub const MAX_COORDINATE: f32 = 1e5;
+pub(crate) const MAX_COORDINATE: f32 = 1e5;
 /// Largest texture coordinate magnitude. f32 spacing at 4096 is 2^-11 of a texture
 /// repeat, a texel of a 2048-texel texture: interpolated UVs past it land on texels at
 /// random (3e38 overflowed to Inf in the sampling and shaded a triangle grey).
-pub const MAX_UV: f32 = 4096.0;
+pub(crate) const MAX_UV: f32 = 4096.0;
 /// Largest light range, in metres (the fallback light reaches twice the scene diagonal).
-pub const MAX_RANGE: f32 = 1e8;
+pub(crate) const MAX_RANGE: f32 = 1e8;
 /// Largest intensity × colour channel of a light, in candela. A light this bright at
 /// 1 cm from a mirror-like lobe still stays below f32's maximum of 3.4e38.
-pub const MAX_LIGHT_POWER: f32 = 1e15;
+pub(crate) const MAX_LIGHT_POWER: f32 = 1e15;
 
 impl Scene {
     /// Checks every vertex, light and the camera against the limits above; `file` names
@@ -70,7 +70,7 @@ fn in_range(p: glam::Vec3) -> bool {
 }
 
 /// A light's position, reach and power after every transform.
-pub fn check_light_range(l: &Light) -> Result<(), String> {
+pub(crate) fn check_light_range(l: &Light) -> Result<(), String> {
     if !in_range(l.position) {
         return Err(format!(
             "position {:?} is not finite or beyond ±{MAX_COORDINATE:e} m",
@@ -94,7 +94,7 @@ pub fn check_light_range(l: &Light) -> Result<(), String> {
 }
 
 /// The view basis must exist: eye and target distinct and in range, up not along the view.
-pub fn check_camera(c: &Camera) -> Result<(), String> {
+pub(crate) fn check_camera(c: &Camera) -> Result<(), String> {
     if !in_range(c.eye) || !in_range(c.target) {
         return Err(format!(
             "eye {:?} and target {:?} must be finite and within ±{MAX_COORDINATE:e} m",

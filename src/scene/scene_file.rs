@@ -42,35 +42,43 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// Most lights a scene file may produce in total.
-pub const MAX_SCENE_LIGHTS: u64 = 1 << 20;
+pub(crate) const MAX_SCENE_LIGHTS: u64 = 1 << 20;
 
+/// A scene file (`scenes/*.ron`, written `Scene(...)`) as parsed; [`build_scene`] turns it
+/// into a [`Scene`]. docs/format.md describes every field.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, rename = "Scene")]
 pub struct SceneFile {
+    /// The scene's name in reports (default: the built-in's or first model's name, else the
+    /// file stem).
     #[serde(default)]
     pub name: Option<String>,
     /// A built-in scene (`atrium`, `harada`, `depth_discontinuity`) to start from.
     #[serde(default)]
-    pub builtin: Option<String>,
+    pub(crate) builtin: Option<String>,
     #[serde(default)]
-    pub models: Vec<Model>,
+    pub(crate) models: Vec<Model>,
     /// Default: the built-in's camera, else the first model's camera, else fitted to bounds.
     #[serde(default)]
     pub camera: Option<CameraSpec>,
+    /// Explicit lights.
     #[serde(default)]
     pub lights: Vec<LightSpec>,
     #[serde(default)]
-    pub light_sets: Vec<LightSetSpec>,
+    pub(crate) light_sets: Vec<LightSetSpec>,
     /// Keep the lights of the built-in scene and of the glTF models (KHR_lights_punctual).
     #[serde(default = "yes")]
-    pub keep_model_lights: bool,
+    pub(crate) keep_model_lights: bool,
     /// Imported material name → material RON path (kept as written, for the material module).
     #[serde(default)]
-    pub material_overrides: std::collections::BTreeMap<String, PathBuf>,
+    pub(crate) material_overrides: std::collections::BTreeMap<String, PathBuf>,
+    /// Preferred output width and height, each 1..=16384 (default: the command's size).
     #[serde(default)]
-    pub output_size: Option<(u32, u32)>,
+    pub(crate) output_size: Option<(u32, u32)>,
+    /// Constant ambient radiance added to every surface; finite, ≥ 0 (default: the
+    /// built-in's, else zero).
     #[serde(default)]
-    pub ambient: Option<Vec3>,
+    pub(crate) ambient: Option<Vec3>,
     /// The ray-cast shadow BVH's build quality: Fastest, VeryFast, Fast (default), Medium.
     #[serde(default)]
     pub shadow_bvh: Option<super::BuildQuality>,
@@ -83,25 +91,25 @@ fn yes() -> bool {
 /// A glTF model placed in the scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Model {
+pub(crate) struct Model {
     /// .gltf or .glb, relative to the scene file.
     pub path: PathBuf,
     #[serde(default)]
-    pub transform: Transform,
+    pub(crate) transform: Transform,
     /// Every light of this model (KHR_lights_punctual, kept with `keep_model_lights`)
     /// casts ray-cast shadows.
     #[serde(default)]
-    pub lights_cast_shadows: bool,
+    pub(crate) lights_cast_shadows: bool,
 }
 
 /// Scale, then rotation (Euler XYZ, degrees), then translation.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Transform {
+pub(crate) struct Transform {
     #[serde(default)]
     pub translation: Vec3,
     #[serde(default)]
-    pub rotation_deg: Vec3,
+    pub(crate) rotation_deg: Vec3,
     #[serde(default = "one")]
     pub scale: Vec3,
 }
@@ -121,7 +129,7 @@ impl Default for Transform {
 }
 
 impl Transform {
-    pub fn matrix(&self) -> Mat4 {
+    pub(crate) fn matrix(&self) -> Mat4 {
         let r = self.rotation_deg;
         Mat4::from_scale_rotation_translation(
             self.scale,
@@ -136,18 +144,27 @@ impl Transform {
     }
 }
 
+/// How the scene file places the camera (`camera:`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum CameraSpec {
+    /// An explicit perspective camera; needs finite `eye` ≠ `target`, `up` ≠ 0, 0 <
+    /// `fov_y_deg` < 180 and 0 < `near` < `far`.
     LookAt {
+        /// Camera position, metres.
         eye: Vec3,
+        /// The point looked at.
         target: Vec3,
+        /// Up direction (default `(0, 1, 0)`).
         #[serde(default = "up")]
         up: Vec3,
+        /// Vertical field of view in degrees (default 60).
         #[serde(default = "fov")]
         fov_y_deg: f32,
+        /// Near plane in metres (default 0.1).
         #[serde(default = "near")]
         near: f32,
+        /// Far plane in metres (default 100).
         #[serde(default = "far")]
         far: f32,
     },
@@ -174,22 +191,28 @@ fn far() -> f32 {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LightSpec {
+    /// Names the light in error messages.
     #[serde(default)]
     pub name: Option<String>,
-    pub position: Vec3,
+    /// Position in metres.
+    pub(crate) position: Vec3,
+    /// Where the light's influence ends, metres; > 0.
     pub range: f32,
-    pub intensity: f32,
+    /// Intensity in candela; ≥ 0.
+    pub(crate) intensity: f32,
+    /// Linear RGB colour, ≥ 0 (default white).
     #[serde(default = "one")]
-    pub color: Vec3,
+    pub(crate) color: Vec3,
     #[serde(default)]
-    pub spot: Option<SpotSpec>,
+    pub(crate) spot: Option<SpotSpec>,
     #[serde(default)]
-    pub casts_shadow: bool,
+    pub(crate) casts_shadow: bool,
     #[serde(default)]
-    pub indirect: bool,
+    pub(crate) indirect: bool,
     /// Art controls of the light's virtual point lights (only with `indirect: true`).
     #[serde(default)]
-    pub vpl: Option<super::VplControls>,
+    pub(crate) vpl: Option<super::VplControls>,
+    /// Material type bits this light lights (a material's `type_bit`; default all).
     #[serde(default = "all")]
     pub material_mask: u32,
     /// How the light moves and flickers over time.
@@ -203,15 +226,15 @@ fn all() -> u32 {
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct SpotSpec {
-    pub direction: Vec3,
+pub(crate) struct SpotSpec {
+    pub(crate) direction: Vec3,
     #[serde(default)]
-    pub inner_deg: f32,
-    pub outer_deg: f32,
+    pub(crate) inner_deg: f32,
+    pub(crate) outer_deg: f32,
 }
 
 impl LightSpec {
-    pub fn to_light(&self) -> Light {
+    pub(crate) fn to_light(&self) -> Light {
         let mut flags = 0;
         if self.casts_shadow {
             flags |= light_flags::CASTS_SHADOW;
@@ -239,7 +262,7 @@ impl LightSpec {
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub enum LightSetSpec {
+pub(crate) enum LightSetSpec {
     Random(RandomLights),
     Amd(AmdLights),
 }
@@ -264,7 +287,7 @@ pub fn parse_scene_file(text: &str, file: &Path) -> Result<SceneFile, SceneError
 }
 
 /// Loads a scene RON file: parses it and builds the scene.
-pub fn load_scene_file(path: &Path) -> Result<Loaded, SceneError> {
+pub(crate) fn load_scene_file(path: &Path) -> Result<Loaded, SceneError> {
     let text = crate::files::read_text(path, crate::files::caps::RON)
         .map_err(|e| SceneError::io(path, e))?;
     let spec = parse_scene_file(&text, path)?;

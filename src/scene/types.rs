@@ -5,9 +5,14 @@ use serde::{Deserialize, Serialize};
 /// A triangle mesh already transformed to world space.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
+    /// Mesh name from the source file (glTF mesh or built-in part), for messages and
+    /// statistics.
     pub name: String,
+    /// Vertex positions in world space, metres.
     pub positions: Vec<Vec3>,
+    /// Unit vertex normals in world space, one per position.
     pub normals: Vec<Vec3>,
+    /// Texture coordinates (glTF `TEXCOORD_0`), one per position; empty when the mesh has none.
     pub uvs: Vec<Vec2>,
     /// xyz tangent, w handedness (glTF convention).
     pub tangents: Vec<Vec4>,
@@ -20,9 +25,12 @@ pub struct Mesh {
 /// How a surface lets light through (glTF `alphaMode`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub enum AlphaMode {
+    /// Fully opaque; alpha is ignored.
     #[default]
     Opaque,
+    /// Alpha-tested: fragments with alpha below the cutoff (0..1) are discarded.
     Mask(f32),
+    /// Alpha-blended; drawn by the transparency passes after the opaque ones.
     Blend,
 }
 
@@ -32,9 +40,14 @@ pub enum AlphaMode {
 pub struct TextureImage {
     /// File name or glTF image name, for messages.
     pub name: String,
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
+    /// Pixels row by row from the top, four bytes (R, G, B, A) each: `width * height * 4`
+    /// bytes.
     pub rgba8: Vec<u8>,
+    /// Whether the colour bytes are sRGB-encoded (alpha is always linear).
     pub srgb: bool,
 }
 
@@ -42,22 +55,35 @@ pub struct TextureImage {
 /// its layered model.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SurfaceMaterial {
+    /// Material name from the source file; scene files' `material_overrides` match it.
     pub name: String,
+    /// Linear RGBA base colour factor (glTF `baseColorFactor`), multiplied with the texture.
     pub base_color: Vec4,
+    /// Metalness factor, 0 (dielectric) to 1 (metal).
     pub metallic: f32,
+    /// Perceptual roughness factor, 0 (mirror) to 1.
     pub roughness: f32,
+    /// Linear emitted radiance factor (glTF `emissiveFactor` × `emissive_strength`).
     pub emissive: Vec3,
+    /// Whether the surface is opaque, alpha-tested or blended.
     pub alpha_mode: AlphaMode,
+    /// Whether back faces are lit and drawn (no back-face culling).
     pub double_sided: bool,
     /// Bit identifying the material type for light material masks (Leo demo).
     pub type_bit: u32,
+    /// Base colour texture (sRGB), multiplied with `base_color`.
     pub base_color_texture: Option<std::sync::Arc<TextureImage>>,
     /// glTF layout: roughness in G, metallic in B.
     pub metallic_roughness_texture: Option<std::sync::Arc<TextureImage>>,
+    /// Tangent-space normal map (linear).
     pub normal_texture: Option<std::sync::Arc<TextureImage>>,
+    /// Scale of the normal map's x and y (glTF `normalTexture.scale`).
     pub normal_scale: f32,
+    /// Emission texture (sRGB), multiplied with `emissive`.
     pub emissive_texture: Option<std::sync::Arc<TextureImage>>,
+    /// Ambient occlusion texture (linear, R channel).
     pub occlusion_texture: Option<std::sync::Arc<TextureImage>>,
+    /// How much the occlusion texture darkens ambient light, 0 (none) to 1 (full).
     pub occlusion_strength: f32,
     /// glTF `KHR_materials_unlit`: the base colour (× texture) shows as is, unlit.
     pub unlit: bool,
@@ -68,11 +94,14 @@ pub struct SurfaceMaterial {
 /// The sampler and uv transform of each texture slot of a [`SurfaceMaterial`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SlotSampling {
+    /// Sampler and uv transform of `base_color_texture`.
     pub base_color: TextureSampling,
-    pub metallic_roughness: TextureSampling,
+    pub(crate) metallic_roughness: TextureSampling,
+    /// Sampler and uv transform of `normal_texture`.
     pub normal: TextureSampling,
-    pub emissive: TextureSampling,
-    pub occlusion: TextureSampling,
+    /// Sampler and uv transform of `emissive_texture`.
+    pub(crate) emissive: TextureSampling,
+    pub(crate) occlusion: TextureSampling,
 }
 
 impl Default for SurfaceMaterial {
@@ -99,20 +128,27 @@ impl Default for SurfaceMaterial {
     }
 }
 
+/// The emission shape of a [`Light`]; both shapes fall off to zero at the light's range.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum LightShape {
+    /// Emits equally in all directions.
     Point,
     /// Cone angles in radians from the axis; `inner <= outer <= pi/2`.
     Spot {
+        /// Cone axis in world space (unit length).
         direction: Vec3,
+        /// Angle from the axis where the falloff starts, radians.
         inner_angle: f32,
+        /// Angle from the axis where the light reaches zero, radians.
         outer_angle: f32,
     },
 }
 
 /// Light flags (bit set).
 pub mod light_flags {
+    /// The light renders shadows (shadow maps or ray-cast shadows, as the graph has).
     pub const CASTS_SHADOW: u32 = 1;
+    /// The light bounces once: its reflective shadow map spawns virtual point lights.
     pub const INDIRECT: u32 = 2;
     /// A virtual point light spawned on the GPU (`LIGHT_VPL` in lighting.wgsl).
     pub const VPL: u32 = 4;
@@ -122,11 +158,18 @@ pub mod light_flags {
 /// candela, falloff window reaching exactly zero at `range`).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Light {
+    /// Position in world space, metres.
     pub position: Vec3,
+    /// Distance in metres at which the light's falloff window reaches zero; culling uses it
+    /// as the light's bounding sphere radius.
     pub range: f32,
+    /// Linear RGB colour, multiplied with `intensity`.
     pub color: Vec3,
+    /// Luminous intensity in candela.
     pub intensity: f32,
+    /// Point or spot.
     pub shape: LightShape,
+    /// Bit set of [`light_flags`] (`CASTS_SHADOW`, `INDIRECT`, `VPL`).
     #[serde(default)]
     pub flags: u32,
     /// Which material type bits this light lights.
@@ -139,6 +182,7 @@ fn all_materials() -> u32 {
 }
 
 impl Light {
+    /// A point light with no flags that lights every material (`material_mask` all ones).
     pub fn point(position: Vec3, range: f32, color: Vec3, intensity: f32) -> Self {
         Self {
             position,
@@ -155,13 +199,18 @@ impl Light {
 /// A perspective camera.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Camera {
+    /// Camera position in world space, metres.
     pub eye: Vec3,
+    /// Point the camera looks at, world space.
     pub target: Vec3,
+    /// World-space up direction (default +Y); need not be orthogonal to the view direction.
     #[serde(default = "default_up")]
     pub up: Vec3,
     /// Vertical field of view in radians.
     pub fov_y: f32,
+    /// Near plane distance in metres (> 0).
     pub near: f32,
+    /// Far plane distance in metres; `far / near` is at most [`MAX_FAR_OVER_NEAR`].
     pub far: f32,
 }
 
@@ -187,7 +236,7 @@ impl Default for Camera {
 /// reconstructed from depth through the inverse view-projection differ from pixel to pixel,
 /// and the tile frustums the culling builds from neighbouring pixel rays are not degenerate.
 /// Far narrower lenses collapse them (1e-6° rendered half or all black).
-pub const MIN_FOV_Y_DEG: f32 = 1.0;
+pub(crate) const MIN_FOV_Y_DEG: f32 = 1.0;
 /// Largest far / near ratio, 2^24. The depth of the projection (standard Z, f32 depth) is
 /// about 1 − near/z, and one ulp of values just under 1 is 2^-24: a surface at z keeps a
 /// depth below the far plane's only while near·(1/z − 1/far) ≥ 2^-24. At the limit every
@@ -199,7 +248,7 @@ pub const MAX_FAR_OVER_NEAR: f32 = 16_777_216.0;
 impl Camera {
     /// Why a lens (vertical field of view in degrees, near and far planes in metres) is
     /// refused, naming the field; None when it is within the limits above.
-    pub fn lens_error(fov_y_deg: f32, near: f32, far: f32) -> Option<String> {
+    pub(crate) fn lens_error(fov_y_deg: f32, near: f32, far: f32) -> Option<String> {
         // A perspective projection ends below 180°.
         if !(MIN_FOV_Y_DEG..180.0).contains(&fov_y_deg) {
             return Some(format!(
@@ -221,6 +270,7 @@ impl Camera {
         None
     }
 
+    /// World-to-view matrix (right-handed, looking down −Z).
     pub fn view(&self) -> Mat4 {
         Mat4::look_at_rh(self.eye, self.target, self.up)
     }
@@ -233,11 +283,17 @@ impl Camera {
 /// What a scene contains, for the graph's `when:` conditions.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SceneFeatures {
+    /// Some drawn material is alpha-blended (`AlphaMode::Blend`).
     pub has_transparent: bool,
+    /// Some drawn material is alpha-tested (`AlphaMode::Mask`).
     pub has_alpha_mask: bool,
+    /// Some light has `CASTS_SHADOW`.
     pub has_shadow_casters: bool,
+    /// Some light has `INDIRECT` (spawns virtual point lights).
     pub has_indirect_lights: bool,
+    /// Some light is a spot light.
     pub has_spot_lights: bool,
+    /// The scene has at least one light.
     pub has_lights: bool,
     /// Some light is a point light.
     pub has_point_lights: bool,
@@ -252,10 +308,15 @@ pub struct SceneFeatures {
 /// Everything needed to render a frame.
 #[derive(Clone, Debug, Default)]
 pub struct Scene {
+    /// Scene name (file stem or built-in name), used in reports and benchmark rows.
     pub name: String,
+    /// All meshes, in world space.
     pub meshes: Vec<Mesh>,
+    /// Materials that [`Mesh::material`] indexes.
     pub materials: Vec<SurfaceMaterial>,
+    /// The lights as placed (before any motion).
     pub lights: Vec<Light>,
+    /// The scene's camera.
     pub camera: Camera,
     /// Preferred output size, if the scene names one.
     pub output_size: Option<(u32, u32)>,
@@ -286,6 +347,8 @@ impl Scene {
             .unwrap_or_default()
     }
 
+    /// What the scene contains, for the graph's `when:` conditions: passes whose condition
+    /// is false are dropped at compile.
     pub fn features(&self) -> SceneFeatures {
         let uses = |f: &dyn Fn(&SurfaceMaterial) -> bool| {
             self.meshes
@@ -350,8 +413,7 @@ impl Scene {
         self.materials.iter().position(|m| m.name == name)
     }
 
-    /// Axis-aligned bounds of all geometry, or `None` for an empty scene.
-    /// Adds a [`headlight`](super::lights::headlight) when the scene has no lights but has
+    /// Adds a `headlight` when the scene has no lights but has
     /// geometry; returns it so that the caller can say so (the library never prints).
     pub fn add_headlight_if_unlit(&mut self) -> Option<Light> {
         if !self.lights.is_empty() {
@@ -362,6 +424,8 @@ impl Scene {
         Some(light)
     }
 
+    /// Axis-aligned bounds (min, max) of all geometry in world space, or `None` for an empty
+    /// scene.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         let mut it = self.meshes.iter().flat_map(|m| m.positions.iter().copied());
         let first = it.next()?;

@@ -55,7 +55,7 @@ impl Default for VplControls {
 }
 
 /// Largest n: 32×32 VPLs per view.
-pub const MAX_N: u32 = 32;
+pub(crate) const MAX_N: u32 = 32;
 
 impl VplControls {
     /// Checks every field; the message names it.

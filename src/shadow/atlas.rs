@@ -5,7 +5,7 @@
 //! - every shadow-casting light whose range sphere touches the camera's frustum asks for
 //!   a square tile of its screen-space diameter × `importance`, rounded up to a power of
 //!   two and clamped to `[min_tile, max_tile]`; a point light (or a spot wider than
-//!   [`CUBE_SPOT_ANGLE`]) asks for six such faces;
+//!   `CUBE_SPOT_ANGLE`) asks for six such faces;
 //! - requests are ranked: larger first, then spot before point, then nearer the camera,
 //!   then by light index (so the same view always allocates the same way);
 //! - past `max_lights`, the lowest ranked are dropped; then, while the tiles' total area
@@ -25,42 +25,44 @@ use glam::{Mat4, Vec3, Vec4};
 pub const GUARD_TEXELS: u32 = 3;
 /// Spot lights whose outer cone half-angle exceeds this take six faces like a point
 /// light: one perspective tile loses too much resolution towards the rim of a wide cone.
-pub const CUBE_SPOT_ANGLE: f32 = std::f32::consts::FRAC_PI_3;
+pub(crate) const CUBE_SPOT_ANGLE: f32 = std::f32::consts::FRAC_PI_3;
 /// The light's near plane as a fraction of its range.
-pub const NEAR_FRACTION: f32 = 0.002;
+pub(crate) const NEAR_FRACTION: f32 = 0.002;
 
 /// The allocator's knobs (the ShadowAtlas pass's parameters and its texture's size).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AtlasConfig {
+pub(crate) struct AtlasConfig {
     /// The atlas's side in texels (a power of two).
-    pub size: u32,
-    pub min_tile: u32,
-    pub max_tile: u32,
-    pub importance: f32,
-    pub max_lights: u32,
+    pub(crate) size: u32,
+    pub(crate) min_tile: u32,
+    pub(crate) max_tile: u32,
+    pub(crate) importance: f32,
+    pub(crate) max_lights: u32,
 }
 
 /// One rendered view: a square tile of the atlas and the projection that fills it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AtlasView {
+pub(crate) struct AtlasView {
     pub light: u32,
     /// Cube face (0 +X, 1 −X, 2 +Y, 3 −Y, 4 +Z, 5 −Z), or 0 for a spot tile.
-    pub face: u8,
+    pub(crate) face: u8,
     /// Top-left texel and side.
-    pub x: u32,
-    pub y: u32,
-    pub tile: u32,
-    pub view_proj: Mat4,
+    pub(crate) x: u32,
+    pub(crate) y: u32,
+    pub(crate) tile: u32,
+    pub(crate) view_proj: Mat4,
     /// World size of one texel at unit distance along the view axis.
-    pub texel_scale: f32,
+    pub(crate) texel_scale: f32,
 }
 
 /// A shadowed light: its first view and whether it has six.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct AtlasLight {
+    /// The light's index in the scene.
     pub light: u32,
-    pub first_view: u32,
-    pub cube: bool,
+    pub(crate) first_view: u32,
+    pub(crate) cube: bool,
+    /// Side of each of its tiles, texels.
     pub tile: u32,
 }
 
@@ -73,26 +75,29 @@ pub enum DropReason {
     NoRoom,
 }
 
+/// A shadow-casting light in view that got no tile this frame: it is lit unshadowed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct DroppedLight {
+    /// The light's index in the scene.
     pub light: u32,
     /// The tile side it asked for before any halving.
     pub wanted: u32,
+    /// Why it was dropped.
     pub reason: DropReason,
 }
 
 /// One frame's allocation.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct Allocation {
-    pub views: Vec<AtlasView>,
+pub(crate) struct Allocation {
+    pub(crate) views: Vec<AtlasView>,
     pub lights: Vec<AtlasLight>,
-    pub dropped: Vec<DroppedLight>,
+    pub(crate) dropped: Vec<DroppedLight>,
     /// Shadow-casting lights whose range does not reach the camera's frustum.
-    pub off_screen: u32,
+    pub(crate) off_screen: u32,
     /// How many times the tiles were halved to fit.
-    pub halvings: u32,
+    pub(crate) halvings: u32,
     /// Texels covered by tiles.
-    pub used_texels: u64,
+    pub(crate) used_texels: u64,
 }
 
 struct Request {
@@ -113,7 +118,7 @@ impl Request {
 
 /// The planes of a view-projection's frustum (wgpu depth 0..1), inward-facing, each
 /// `(n, d)` with `n·p + d >= 0` inside.
-pub fn frustum_planes(view_proj: Mat4) -> [Vec4; 6] {
+pub(crate) fn frustum_planes(view_proj: Mat4) -> [Vec4; 6] {
     let r = [
         view_proj.row(0),
         view_proj.row(1),
@@ -132,14 +137,14 @@ pub fn frustum_planes(view_proj: Mat4) -> [Vec4; 6] {
 }
 
 /// Whether a sphere touches the frustum (conservative near the corners).
-pub fn sphere_in_frustum(planes: &[Vec4; 6], center: Vec3, radius: f32) -> bool {
+pub(crate) fn sphere_in_frustum(planes: &[Vec4; 6], center: Vec3, radius: f32) -> bool {
     planes
         .iter()
         .all(|p| p.truncate().dot(center) + p.w >= -radius)
 }
 
 /// Whether an axis-aligned box touches the frustum (conservative near the corners).
-pub fn box_in_frustum(planes: &[Vec4; 6], min: Vec3, max: Vec3) -> bool {
+pub(crate) fn box_in_frustum(planes: &[Vec4; 6], min: Vec3, max: Vec3) -> bool {
     planes.iter().all(|p| {
         let n = p.truncate();
         let corner = Vec3::select(n.cmpge(Vec3::ZERO), max, min);
@@ -168,7 +173,7 @@ fn is_cube(light: &Light) -> bool {
 
 /// Allocates the atlas for every light with `CASTS_SHADOW` seen from `camera` rendering
 /// `width`×`height`.
-pub fn allocate(
+pub(crate) fn allocate(
     lights: &[Light],
     camera: &Camera,
     width: u32,

@@ -36,16 +36,19 @@ pub const MIN_DET: f32 = 1e-30;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct BvhNode {
+    /// Low corner of the node's bounding box, world space.
     pub min: [f32; 3],
     /// Inner: index of the right child (the left child is the next node). Leaf: first
     /// triangle.
     pub a: u32,
+    /// High corner of the node's bounding box, world space.
     pub max: [f32; 3],
     /// Inner: index of the first node after this subtree. Leaf: `LEAF_BIT | count`.
     pub b: u32,
 }
 
 impl BvhNode {
+    /// Whether the node is a leaf (`b` has [`LEAF_BIT`]).
     pub fn is_leaf(&self) -> bool {
         self.b & LEAF_BIT != 0
     }
@@ -63,29 +66,45 @@ impl BvhNode {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct BvhTriangle {
+    /// First vertex, world space.
     pub v0: [f32; 3],
     /// Index of the triangle in the scene: meshes in order, triangles in index order,
     /// skipped triangles counted too (so it maps back to mesh and triangle).
     pub id: u32,
+    /// Edge from `v0` to the second vertex (v1 − v0), precomputed for the ray–triangle test.
     pub e1: [f32; 3],
+    /// Padding to the WGSL struct's 16-byte alignment.
     pub _pad0: u32,
+    /// Edge from `v0` to the third vertex (v2 − v0).
     pub e2: [f32; 3],
+    /// Padding to the WGSL struct's 16-byte alignment.
     pub _pad1: u32,
 }
 
+/// Why a shadow BVH could not be built: the GPU addresses triangles and nodes with 31 bits.
 #[derive(Debug, Error, Clone, PartialEq, Eq)]
 pub enum ShadowError {
+    /// More triangles than 31-bit indices address.
     #[error("{count} shadow-casting triangles do not fit the 31-bit GPU indices")]
-    TooManyTriangles { count: usize },
+    TooManyTriangles {
+        /// Shadow-casting triangles in the scene.
+        count: usize,
+    },
+    /// More nodes than 31-bit indices address.
     #[error("the shadow BVH has {count} nodes, more than 31-bit GPU indices address")]
-    TooManyNodes { count: usize },
+    TooManyNodes {
+        /// Nodes the tree would have.
+        count: usize,
+    },
 }
 
 /// How hard the builder works; a scene file's choice, so it lives with the scene.
 pub use crate::scene::BuildQuality;
 
+/// How the shadow BVH is built ([`ShadowBvh::build_with`]); the default is what scenes get.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BuildOptions {
+    /// How hard the PLOC builder works (a scene file's `shadow_bvh`).
     pub quality: BuildQuality,
     /// Most triangles in a leaf (1..=255). Subtrees up to this size become leaves where
     /// the surface area heuristic says a leaf is cheaper.
@@ -132,28 +151,30 @@ pub struct BuildStats {
     /// Skipped: an index past the mesh's vertices (plus trailing indices that make no
     /// whole triangle).
     pub skipped_bad_index: usize,
+    /// Nodes in the flattened tree, inner and leaf.
     pub nodes: usize,
+    /// Leaf nodes.
     pub leaves: usize,
     /// Longest root-to-leaf path, in nodes (a lone root leaf is depth 1).
     pub max_depth: usize,
     /// Everything: gathering triangles, the obvhs build, flattening.
     pub build_time: Duration,
     /// Reading the scene's triangles (and skipping the bad ones) and their boxes.
-    pub gather_time: Duration,
+    pub(crate) gather_time: Duration,
     /// The obvhs PLOC build and reinsertion alone.
     pub core_build_time: Duration,
     /// SAH leaf collapse and flattening into [`ShadowBvh::nodes`] / `triangles`.
-    pub flatten_time: Duration,
+    pub(crate) flatten_time: Duration,
     /// Surface-area-heuristic cost of the tree: expected triangle tests plus
     /// `traversal_cost` × inner-node visits for a random ray through the root box.
-    pub sah_cost: f32,
+    pub(crate) sah_cost: f32,
 }
 
 /// What one traversal did (CPU twin only).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct TraversalStats {
-    pub nodes_visited: u32,
-    pub triangles_tested: u32,
+    pub(crate) nodes_visited: u32,
+    pub(crate) triangles_tested: u32,
     /// The stack would have overflowed, so the ray was re-cast stackless from the root.
     pub fell_back: bool,
 }
@@ -166,6 +187,7 @@ pub struct ShadowBvh {
     /// Never empty (storage bindings may not be): an empty scene has one zeroed
     /// triangle no leaf names. [`BuildStats::triangles`] is the real count.
     pub triangles: Vec<BvhTriangle>,
+    /// What the build did and how long it took.
     pub stats: BuildStats,
 }
 
@@ -231,6 +253,7 @@ impl ShadowBvh {
         Self::build_with(scene, &BuildOptions::default())
     }
 
+    /// Builds over every triangle of every mesh in the scene with the given options.
     pub fn build_with(scene: &Scene, options: &BuildOptions) -> Result<Self, ShadowError> {
         let start = Instant::now();
         let g = gather(

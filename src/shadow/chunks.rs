@@ -1,24 +1,28 @@
 //! Triangle chunks for culling per shadow view: a mesh's triangles reordered along a
-//! Morton curve of their centroids and cut into runs of at most [`CHUNK_TRIANGLES`], each
+//! Morton curve of their centroids and cut into runs of at most `CHUNK_TRIANGLES`, each
 //! with its bounds. A light's view then draws the runs its frustum touches instead of the
 //! whole mesh (a small light in a large room touches a few).
 
 use glam::Vec3;
 
-pub const CHUNK_TRIANGLES: usize = 128;
+pub(crate) const CHUNK_TRIANGLES: usize = 128;
 
 /// A run of `count` indices from `first` in the reordered index buffer.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Chunk {
+    /// Index of the chunk's first index in the reordered index buffer.
     pub first: u32,
+    /// Number of indices (three per triangle, at most 3 × 128).
     pub count: u32,
-    pub min: Vec3,
-    pub max: Vec3,
+    /// Low corner of the bounds of the chunk's triangles, world space.
+    pub(crate) min: Vec3,
+    /// High corner of the bounds of the chunk's triangles, world space.
+    pub(crate) max: Vec3,
 }
 
 /// The mesh's indices reordered into chunks, and the chunks. Triangles with an index
 /// past `positions` are left out (the draw would read garbage).
-pub fn chunk_triangles(positions: &[Vec3], indices: &[u32]) -> (Vec<u32>, Vec<Chunk>) {
+pub(crate) fn chunk_triangles(positions: &[Vec3], indices: &[u32]) -> (Vec<u32>, Vec<Chunk>) {
     let tris: Vec<[u32; 3]> = indices
         .chunks_exact(3)
         .map(|t| [t[0], t[1], t[2]])

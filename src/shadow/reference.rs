@@ -31,7 +31,12 @@ pub fn scene_triangles_f64(scene: &Scene) -> Vec<Triangle64> {
 
 /// The hit distance, if the ray hits the triangle at `0 < t < t_max` (two-sided;
 /// a ray parallel to the plane misses).
-pub fn hit_reference(tri: &Triangle64, origin: DVec3, dir: DVec3, t_max: f64) -> Option<f64> {
+pub(crate) fn hit_reference(
+    tri: &Triangle64,
+    origin: DVec3,
+    dir: DVec3,
+    t_max: f64,
+) -> Option<f64> {
     let e1 = tri[1] - tri[0];
     let e2 = tri[2] - tri[0];
     let p = dir.cross(e2);
@@ -128,8 +133,11 @@ pub fn grazing(tris: &[Triangle64], origin: DVec3, dir: DVec3, t_max: f64, eps: 
 /// Why a ray was excluded from an exact comparison, if it was.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Ambiguity {
+    /// The ray passes within the tolerance of a triangle edge ([`near_edge`]).
     NearEdge,
+    /// The ray starts or ends within the tolerance of a triangle ([`near_endpoint`]).
     NearEndpoint,
+    /// The ray runs nearly in the plane of a triangle it passes close to ([`grazing`]).
     Grazing,
 }
 
@@ -153,7 +161,7 @@ pub fn ambiguity(
 }
 
 /// Distance from `p` to the segment `[a, b]`.
-pub fn segment_point_distance(a: DVec3, b: DVec3, p: DVec3) -> f64 {
+pub(crate) fn segment_point_distance(a: DVec3, b: DVec3, p: DVec3) -> f64 {
     let ab = b - a;
     let len2 = ab.length_squared();
     let t = if len2 > 0.0 {
@@ -166,7 +174,7 @@ pub fn segment_point_distance(a: DVec3, b: DVec3, p: DVec3) -> f64 {
 
 /// Distance between segments `[p0, p1]` and `[q0, q1]`: the closest pair of points,
 /// minimising over the interior critical point and the four endpoint cases.
-pub fn segment_segment_distance(p0: DVec3, p1: DVec3, q0: DVec3, q1: DVec3) -> f64 {
+pub(crate) fn segment_segment_distance(p0: DVec3, p1: DVec3, q0: DVec3, q1: DVec3) -> f64 {
     let d1 = p1 - p0;
     let d2 = q1 - q0;
     let r = p0 - q0;

@@ -5,10 +5,10 @@ use crate::reload::ReloadSession;
 use crate::scene::Light;
 
 #[derive(Default)]
-pub struct LightClock {
+pub(crate) struct LightClock {
     /// Seconds of light motion shown.
-    pub time: f64,
-    pub paused: bool,
+    pub(crate) time: f64,
+    pub(crate) paused: bool,
     /// The lights at `time`, kept so that a frame allocates nothing.
     lights: Vec<Light>,
 }
@@ -16,7 +16,7 @@ pub struct LightClock {
 impl LightClock {
     /// Advances by `dt` seconds (unless paused) and moves the live frame's lights there.
     /// A scene without motion costs nothing.
-    pub fn advance(&mut self, session: &ReloadSession, dt: f64) -> Result<(), String> {
+    pub(crate) fn advance(&mut self, session: &ReloadSession, dt: f64) -> Result<(), String> {
         let scene = session.scene();
         if !scene.has_motion() || self.paused {
             return Ok(());

@@ -16,15 +16,18 @@ pub enum CameraMode {
 /// Keys held this frame, as a direction in camera space (x right, y up, z forward).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Movement {
-    pub right: f32,
-    pub up: f32,
-    pub forward: f32,
+    pub(crate) right: f32,
+    pub(crate) up: f32,
+    pub(crate) forward: f32,
     /// Shift held: move faster.
-    pub fast: bool,
+    pub(crate) fast: bool,
 }
 
+/// The viewer's camera state: orbit or fly, driven by mouse drags, the wheel and held keys;
+/// [`CameraController::camera`] gives the scene camera for a frame.
 #[derive(Clone, Debug)]
 pub struct CameraController {
+    /// Orbit or fly; switch at any time without the view jumping.
     pub mode: CameraMode,
     target: Vec3,
     /// Radians around world up; 0 looks down -Z.
@@ -33,7 +36,7 @@ pub struct CameraController {
     pitch: f32,
     distance: f32,
     /// Fly speed in scene units per second.
-    pub speed: f32,
+    pub(crate) speed: f32,
     /// Field of view and clip planes come from the scene's camera.
     lens: Camera,
 }
@@ -53,7 +56,7 @@ fn forward(yaw: f32, pitch: f32) -> Vec3 {
 
 impl CameraController {
     /// Starts where `camera` looks, in orbit mode.
-    pub fn new(camera: &Camera) -> Self {
+    pub(crate) fn new(camera: &Camera) -> Self {
         let offset = camera.target - camera.eye;
         let distance = offset.length().max(1e-3);
         let dir = offset / distance;
@@ -73,11 +76,12 @@ impl CameraController {
         }
     }
 
-    pub fn forward(&self) -> Vec3 {
+    pub(crate) fn forward(&self) -> Vec3 {
         forward(self.yaw, self.pitch)
     }
 
-    pub fn eye(&self) -> Vec3 {
+    /// Eye position in world space.
+    pub(crate) fn eye(&self) -> Vec3 {
         self.target - self.forward() * self.distance
     }
 
@@ -92,7 +96,7 @@ impl CameraController {
     }
 
     /// A mouse drag of `dx`, `dy` pixels.
-    pub fn drag(&mut self, dx: f32, dy: f32) {
+    pub(crate) fn drag(&mut self, dx: f32, dy: f32) {
         let eye = self.eye();
         self.yaw += dx * DRAG_RADIANS;
         self.pitch = (self.pitch - dy * DRAG_RADIANS).clamp(-PITCH_LIMIT, PITCH_LIMIT);
@@ -103,7 +107,7 @@ impl CameraController {
     }
 
     /// Mouse wheel: orbit moves closer or further, fly changes speed.
-    pub fn scroll(&mut self, lines: f32) {
+    pub(crate) fn scroll(&mut self, lines: f32) {
         let factor = 0.9f32.powf(lines);
         match self.mode {
             CameraMode::Orbit => self.distance = (self.distance * factor).max(1e-3),
@@ -112,7 +116,7 @@ impl CameraController {
     }
 
     /// Moves eye and target together for `dt` seconds (both modes; orbit pans).
-    pub fn travel(&mut self, m: Movement, dt: f32) {
+    pub(crate) fn travel(&mut self, m: Movement, dt: f32) {
         let f = self.forward();
         let right = f.cross(Vec3::Y).normalize_or_zero();
         let dir = right * m.right + Vec3::Y * m.up + f * m.forward;

@@ -7,40 +7,40 @@ use std::path::PathBuf;
 
 /// What the overlay shows; refreshed by the viewer.
 #[derive(Default)]
-pub struct FrameInfo {
+pub(crate) struct FrameInfo {
     pub adapter: String,
     pub scene: String,
     pub lights: usize,
-    pub render_size: [u32; 2],
+    pub(crate) render_size: [u32; 2],
     /// Smoothed GPU milliseconds per pass; `None` without timestamp queries.
-    pub pass_ms: Option<Vec<(String, f64)>>,
+    pub(crate) pass_ms: Option<Vec<(String, f64)>>,
     /// Smoothed CPU milliseconds per displayed frame.
-    pub frame_ms: f64,
-    pub culling: Vec<CullingReport>,
-    pub light_stats: Option<LightStats>,
+    pub(crate) frame_ms: f64,
+    pub(crate) culling: Vec<CullingReport>,
+    pub(crate) light_stats: Option<LightStats>,
     /// The error of the last reload (file:line), shown until a good save.
-    pub error: Option<String>,
+    pub(crate) error: Option<String>,
     /// The last successful reload, for example "lighting.wgsl: 85 ms".
-    pub last_reload: Option<String>,
+    pub(crate) last_reload: Option<String>,
 }
 
 /// A change the user asked for this frame.
 #[derive(Clone, Debug, PartialEq)]
-pub enum OverlayAction {
+pub(crate) enum OverlayAction {
     SelectGraph(PathBuf),
     CameraMode(CameraMode),
     /// Add or drop the per-pixel light statistics pass.
     LightStats(bool),
 }
 
-pub struct Overlay {
+pub(crate) struct Overlay {
     /// Graph files offered as variants, with the one in use.
-    pub graphs: Vec<PathBuf>,
-    pub current_graph: PathBuf,
-    pub camera_mode: CameraMode,
+    pub(crate) graphs: Vec<PathBuf>,
+    pub(crate) current_graph: PathBuf,
+    pub(crate) camera_mode: CameraMode,
     pub exposure_ev: f32,
-    pub visible: bool,
-    pub light_stats: bool,
+    pub(crate) visible: bool,
+    pub(crate) light_stats: bool,
 }
 
 fn graph_label(path: &std::path::Path) -> String {
@@ -51,7 +51,7 @@ fn graph_label(path: &std::path::Path) -> String {
 
 impl Overlay {
     /// Draws the overlay and returns what the user changed.
-    pub fn ui(&mut self, ctx: &egui::Context, info: &FrameInfo) -> Vec<OverlayAction> {
+    pub(crate) fn ui(&mut self, ctx: &egui::Context, info: &FrameInfo) -> Vec<OverlayAction> {
         let mut actions = Vec::new();
         if !self.visible {
             return actions;

@@ -26,23 +26,39 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 use thiserror::Error;
 
+/// Why the hot-reload latency benchmark stopped.
 #[derive(Debug, Error)]
 pub enum ReloadBenchError {
+    /// Copying or writing a file of the work folder failed.
     #[error("{}: {source}", path.display())]
     Io {
+        /// The file.
         path: PathBuf,
+        /// The operating system's error.
         #[source]
         source: std::io::Error,
     },
+    /// The line an edit changes is not in the copied file (the project's file differs).
     #[error("{}: the text to edit is not there: {what}", file.display())]
-    EditTarget { file: PathBuf, what: String },
+    EditTarget {
+        /// The file.
+        file: PathBuf,
+        /// The text that was looked for.
+        what: String,
+    },
+    /// The reload session could not start (scene, graph or first frame failed).
     #[error("starting the reload session: {0}")]
     Session(String),
+    /// An edit's reload failed: the edited file no longer compiled or rendered.
     #[error("{kind} edit {index}: {}: {message}", file.display())]
     Reload {
+        /// Which kind of edit.
         kind: EditKind,
+        /// 0-based index of the edit among those of its kind.
         index: usize,
+        /// The edited file.
         file: PathBuf,
+        /// The reload's error.
         message: String,
     },
 }
@@ -54,14 +70,20 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> ReloadBenchError + '_ {
     }
 }
 
+/// Which project file an edit changes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum EditKind {
+    /// `common/lighting.wgsl`: the range window's scale (rebuilds every pipeline that
+    /// includes it).
     Shader,
+    /// `materials/car_paint.ron`: the pigment's red (rebuilds the pipelines of that material).
     Material,
+    /// `graphs/forward_plus.ron`: the culling pass's list capacity (recompiles the graph).
     Graph,
 }
 
 impl EditKind {
+    /// Every kind, in the order the benchmark edits them.
     pub const ALL: [EditKind; 3] = [EditKind::Shader, EditKind::Material, EditKind::Graph];
 }
 
@@ -75,6 +97,7 @@ impl std::fmt::Display for EditKind {
     }
 }
 
+/// Settings of a hot-reload latency run ([`run`]).
 #[derive(Clone, Debug)]
 pub struct ReloadBenchConfig {
     /// Where shaders/, graphs/ and materials/ are looked for first (the built-in copies
@@ -82,8 +105,11 @@ pub struct ReloadBenchConfig {
     pub project: PathBuf,
     /// An empty folder to copy them into and edit there.
     pub work: PathBuf,
+    /// Frame width in pixels.
     pub width: u32,
+    /// Frame height in pixels.
     pub height: u32,
+    /// Random lights in the scene.
     pub lights: u32,
     /// Edits of each kind.
     pub repeats: usize,
@@ -110,7 +136,9 @@ pub struct ReloadBenchConfig {
 /// One timed edit, in milliseconds.
 #[derive(Clone, Debug)]
 pub struct ReloadSample {
+    /// Which kind of edit.
     pub kind: EditKind,
+    /// 0-based index of the edit among those of its kind.
     pub index: usize,
     /// File write returned → the new frame's GPU work done: what a viewer shows (it
     /// presents the output texture without reading it back). The headline.
@@ -121,15 +149,15 @@ pub struct ReloadSample {
     /// settle time for a saved file or the debounce otherwise).
     pub watch_ms: f64,
     /// Reading and uploading changed materials / scene.
-    pub assets_ms: f64,
+    pub(crate) assets_ms: f64,
     /// Parsing, validating and compiling the graph.
-    pub graph_ms: f64,
+    pub(crate) graph_ms: f64,
     /// Composing shader sources and validating them with naga.
     pub shader_compose_ms: f64,
     /// Creating shader modules and pipelines.
     pub pipeline_build_ms: f64,
     /// The rest of prepare: resources, bind groups, layouts.
-    pub prepare_other_ms: f64,
+    pub(crate) prepare_other_ms: f64,
     /// Executing the frame and reading it back.
     pub render_ms: f64,
     /// The same frame rendered again right after (not part of the latency): what of
@@ -137,7 +165,7 @@ pub struct ReloadSample {
     pub rerender_ms: f64,
     /// Composing and building, wall time (less than the sum of the two with parallel
     /// builds).
-    pub build_wall_ms: f64,
+    pub(crate) build_wall_ms: f64,
     /// Of `pipeline_build_ms`: `create_shader_module`.
     pub shader_module_ms: f64,
     /// Of `pipeline_build_ms`: `create_render/compute_pipeline` (with layouts).
@@ -145,23 +173,26 @@ pub struct ReloadSample {
     /// Whether the GPU still had earlier frames' work when the first build began.
     pub gpu_busy_at_build: Option<bool>,
     /// Waiting for the GPU before building (only with `wait_for_idle_before_build`).
-    pub gpu_wait_before_build_ms: f64,
+    pub(crate) gpu_wait_before_build_ms: f64,
     /// Each pipeline built: pass, shader and material, and its times.
-    pub builds: Vec<PipelineBuild>,
+    pub(crate) builds: Vec<PipelineBuild>,
     /// Of `render_ms`: encoding and `queue.submit`.
     pub record_submit_ms: f64,
     /// Of `render_ms`: submit returned → GPU done (blocking poll).
     pub gpu_wait_ms: f64,
     /// The GPU's time for the frame, from pass timestamps (NaN without timestamps).
-    pub gpu_frame_ms: f64,
+    pub(crate) gpu_frame_ms: f64,
     /// Of `render_ms`: copying, mapping and converting the Rgba32Float output.
     pub image_readback_ms: f64,
     /// Of `render_ms`: timestamps, culling reports and statistics read back.
-    pub reports_readback_ms: f64,
+    pub(crate) reports_readback_ms: f64,
     /// The same frame again: submit returned → GPU done.
-    pub rerender_gpu_wait_ms: f64,
+    pub(crate) rerender_gpu_wait_ms: f64,
+    /// Pipelines the reload built (the rest came from the session's cache).
     pub pipelines_built: usize,
+    /// GPU resources the reload created.
     pub resources_created: usize,
+    /// GPU resources the reload kept from the frame before.
     pub resources_reused: usize,
 }
 
@@ -429,17 +460,23 @@ pub fn run(
 /// pipeline cache on disk, the builds here are where it shows.
 #[derive(Clone, Debug, Default)]
 pub struct Startup {
+    /// Starting the session, from the first file read to the first frame read back.
     pub total_ms: f64,
+    /// Pipelines built for the first frame.
     pub pipelines_built: usize,
+    /// Composing shader sources and validating them with naga.
     pub shader_compose_ms: f64,
+    /// Creating shader modules and pipelines.
     pub pipeline_build_ms: f64,
     /// The driver's pipeline cache on disk: where, and what opening it found.
-    pub pipeline_cache: String,
+    pub(crate) pipeline_cache: String,
 }
 
 /// A benchmark run: the session's start and every timed edit.
 pub struct BenchRun {
+    /// What starting the session cost.
     pub startup: Startup,
+    /// Every timed edit, in the order made.
     pub samples: Vec<ReloadSample>,
 }
 

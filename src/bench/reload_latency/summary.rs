@@ -10,21 +10,26 @@ use std::time::Duration;
 
 /// Per kind: the summary of the total and the median of each part.
 pub struct KindSummary {
+    /// The edit kind summarised.
     pub kind: EditKind,
+    /// Number of edits of this kind.
     pub samples: usize,
     /// Edit → new frame on the GPU (what a viewer shows).
     pub frame: TimingSummary,
     /// Edit → new frame read back.
     pub total: TimingSummary,
     /// (column name, median ms) for each part of the breakdown.
-    pub parts: Vec<(&'static str, f64)>,
+    pub(crate) parts: Vec<(&'static str, f64)>,
     /// (column name, median ms) for the parts of pipeline build and render.
-    pub details: Vec<(&'static str, f64)>,
+    pub(crate) details: Vec<(&'static str, f64)>,
     /// Samples whose first build began with the GPU still busy, of those that built.
-    pub gpu_busy_at_build: (usize, usize),
-    pub pipelines_built: f64,
-    pub resources_reused: f64,
-    pub resources_created: f64,
+    pub(crate) gpu_busy_at_build: (usize, usize),
+    /// Median pipelines built per edit.
+    pub(crate) pipelines_built: f64,
+    /// Median GPU resources kept from the frame before per edit.
+    pub(crate) resources_reused: f64,
+    /// Median GPU resources created per edit.
+    pub(crate) resources_created: f64,
 }
 
 type Part = (&'static str, fn(&ReloadSample) -> f64);
@@ -61,6 +66,7 @@ fn median_of(values: Vec<f64>) -> f64 {
     summarize(&values).map_or(f64::NAN, |t| t.median)
 }
 
+/// One summary per edit kind that has samples, in [`EditKind::ALL`] order.
 pub fn summarize_kinds(samples: &[ReloadSample]) -> Vec<KindSummary> {
     EditKind::ALL
         .iter()
@@ -96,14 +102,17 @@ pub fn summarize_kinds(samples: &[ReloadSample]) -> Vec<KindSummary> {
 /// Per edit kind and pipeline (pass: shader `material`): how often it was built and the
 /// median of its compose, module and pipeline-creation times (ms).
 pub struct PipelineSummary {
-    pub kind: EditKind,
+    /// The edit kind that made the builds.
+    pub(crate) kind: EditKind,
+    /// The pipeline, as `pass: shader material`.
     pub name: String,
-    pub builds: usize,
-    pub compose_ms: f64,
-    pub module_ms: f64,
-    pub create_ms: f64,
+    pub(crate) builds: usize,
+    pub(crate) compose_ms: f64,
+    pub(crate) module_ms: f64,
+    pub(crate) create_ms: f64,
 }
 
+/// One summary per (edit kind, pipeline) built, sorted by kind then name.
 pub fn summarize_pipelines(samples: &[ReloadSample]) -> Vec<PipelineSummary> {
     let mut by: std::collections::BTreeMap<(EditKind, String), Vec<&PipelineBuild>> =
         Default::default();
@@ -125,6 +134,7 @@ pub fn summarize_pipelines(samples: &[ReloadSample]) -> Vec<PipelineSummary> {
         .collect()
 }
 
+/// Every sample as one CSV row (times in milliseconds), with a header line.
 pub fn to_csv(samples: &[ReloadSample]) -> String {
     let mut out = String::from(
         "kind,index,total_ms,watch_ms,assets_ms,graph_ms,shader_compose_ms,pipeline_build_ms,\

@@ -29,14 +29,18 @@ pub struct BenchRow {
     /// Timed rounds (each ran every graph of the point in turn) and the smallest and
     /// largest of this graph's round medians, ms: the spread between rounds.
     pub rounds: Option<u32>,
+    /// Smallest of this graph's round medians, ms.
     pub round_ms_min: Option<f64>,
+    /// Largest of this graph's round medians, ms.
     pub round_ms_max: Option<f64>,
     /// Wall-clock seconds the point's warm-up took (all its graphs together).
     pub warmup_s: Option<f64>,
     /// The GPU's SM clock before the point's warm-up and after its last round, and its
     /// maximum, MHz (`nvidia-smi`; `None` elsewhere).
     pub sm_mhz_start: Option<u32>,
+    /// SM clock after the point's last round, MHz.
     pub sm_mhz_end: Option<u32>,
+    /// The GPU's maximum SM clock, MHz.
     pub sm_mhz_max: Option<u32>,
     /// GPU time of each pass over the timed frames, ms, in schedule order (empty when untimed).
     pub pass_ms: Vec<(String, TimingSummary)>,
@@ -64,6 +68,8 @@ pub struct BenchRow {
     pub list_mib: Option<f64>,
     /// Light indices the lists hold, and (compact lists) the indices they wanted.
     pub list_indices: Option<u64>,
+    /// Light indices the compact lists wanted (more than `list_indices` when the index array
+    /// overflowed).
     pub list_indices_wanted: Option<u64>,
     /// Compact lists whose fill disagreed with their count, or whose offset is not the
     /// sum of the counts before them (0 unless something is wrong).
@@ -101,17 +107,24 @@ pub struct BenchRow {
     pub atlas_mib: Option<f64>,
     /// Shadow-casting lights in view given a tile, and those without room (unshadowed).
     pub atlas_shadowed: Option<u64>,
+    /// Shadow-casting lights in view left without a tile (lit unshadowed).
     pub atlas_dropped: Option<u64>,
+    /// Atlas views (tiles) rendered: one per spot light, six per point light or wide spot.
     pub atlas_views: Option<u64>,
     /// (pixel, light) pairs a ShadowCompare pass checked, and the fraction where the
     /// atlas disagrees with ray-cast shadows, per filter.
     pub shadow_pairs: Option<u64>,
+    /// Fraction of `shadow_pairs` where the atlas filtered with `Pcf5x5` (25 taps) disagrees
+    /// with ray-cast shadows.
     pub pair_error_pcf5: Option<f64>,
+    /// Fraction of `shadow_pairs` where the atlas filtered with `Hardware2x2` (one tap)
+    /// disagrees with ray-cast shadows.
     pub pair_error_2x2: Option<f64>,
     /// Light linked lists: heads and link pool, MiB.
     pub link_mib: Option<f64>,
     /// Links kept per list pixel, and the resolution divisor (1, 4, 8).
     pub links_per_list_pixel: Option<f64>,
+    /// The link pool's resolution divisor (1, 4 or 8).
     pub link_scale: Option<u32>,
     /// Links past the pool (those lights are missing at their pixels).
     pub links_dropped: Option<u64>,
@@ -131,7 +144,7 @@ impl BenchRow {
     }
 
     /// Sum of the per-pass median times, if any pass was timed.
-    pub fn passes_ms_total(&self) -> Option<f64> {
+    pub(crate) fn passes_ms_total(&self) -> Option<f64> {
         (!self.pass_ms.is_empty()).then(|| self.pass_ms.iter().map(|(_, t)| t.median).sum())
     }
 }

@@ -8,15 +8,15 @@ use gltf::json::{mesh::Mode, validation::Checked, Root};
 
 /// Totals after instancing.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Expansion {
-    pub node_instances: u64,
+pub(crate) struct Expansion {
+    pub(crate) node_instances: u64,
     /// Mesh primitives drawn (one mesh per primitive instance in the scene).
-    pub primitives: u64,
-    pub triangles: u64,
+    pub(crate) primitives: u64,
+    pub(crate) triangles: u64,
 }
 
 impl Expansion {
-    pub fn saturating_add(self, o: Expansion) -> Expansion {
+    pub(crate) fn saturating_add(self, o: Expansion) -> Expansion {
         Expansion {
             node_instances: self.node_instances.saturating_add(o.node_instances),
             primitives: self.primitives.saturating_add(o.primitives),

@@ -127,7 +127,7 @@ fn find(toks: &[(Token<'_>, Location)], i: usize, path: &[Step]) -> Option<Locat
 
 /// Where the .gltf JSON `text` writes what an error names: its element, or the
 /// validation path at the start of its message. None when the text has no such element.
-pub fn locate(text: &str, element: &str, message: &str) -> Option<Location> {
+pub(crate) fn locate(text: &str, element: &str, message: &str) -> Option<Location> {
     let toks = tokens(text);
     // The document is the first object (after a byte-order mark, if any).
     let root = toks.iter().position(|t| t.0 == Token::Open('{'))?;

@@ -38,7 +38,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// Extensions this importer understands; any other in `extensionsRequired` is refused.
-pub const SUPPORTED_EXTENSIONS: &[&str] = &[
+pub(crate) const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_lights_punctual",
     "KHR_materials_emissive_strength",
     "KHR_materials_unlit",
@@ -49,18 +49,18 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
 #[derive(Clone, Copy, Debug)]
 pub struct ImportLimits {
     /// Elements in one accessor.
-    pub max_accessor_count: u64,
+    pub(crate) max_accessor_count: u64,
     /// Triangles in the whole scene.
-    pub max_triangles: u64,
+    pub(crate) max_triangles: u64,
     /// Declared `byteLength` of one buffer.
-    pub max_buffer_bytes: u64,
+    pub(crate) max_buffer_bytes: u64,
     /// Nodes in the file, and node instances after instancing.
-    pub max_nodes: u64,
+    pub(crate) max_nodes: u64,
     /// Mesh primitives after instancing (each becomes a mesh with its own draw).
-    pub max_primitives: u64,
-    pub max_lights: u64,
+    pub(crate) max_primitives: u64,
+    pub(crate) max_lights: u64,
     /// Pixels in one decoded image.
-    pub max_image_pixels: u64,
+    pub(crate) max_image_pixels: u64,
 }
 
 impl Default for ImportLimits {
@@ -79,12 +79,12 @@ impl Default for ImportLimits {
 }
 
 /// Imports a .gltf or .glb file with default limits.
-pub fn import_gltf(path: &Path) -> Result<Loaded, SceneError> {
+pub(crate) fn import_gltf(path: &Path) -> Result<Loaded, SceneError> {
     import_gltf_with(path, &ImportLimits::default())
 }
 
 /// Imports a .gltf or .glb file. Relative URIs resolve against the file's folder.
-pub fn import_gltf_with(path: &Path, limits: &ImportLimits) -> Result<Loaded, SceneError> {
+pub(crate) fn import_gltf_with(path: &Path, limits: &ImportLimits) -> Result<Loaded, SceneError> {
     import_gltf_inner(path, limits)
         .map(|(l, has_camera, _)| with_camera_warning(l, has_camera, path))
 }
