@@ -4,7 +4,9 @@
 //! `shaders/forward/forward.wgsl` with `SHADE`. The opaque depth is a depth attachment,
 //! or a single-sample R32Float texture (a compute resolve's): then the pass has no depth
 //! attachment and each fragment loads the depth at its pixel and is discarded where the
-//! attachment's LessEqual test would have failed (`FLOAT_DEPTH`).
+//! attachment's LessEqual test would have failed (`FLOAT_DEPTH`). With the BVH in its
+//! reads, the light loop casts a shadow ray per fragment and casting light
+//! (`SHADOW_TRACE`).
 
 use super::{check_light_source, slot, Access, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
@@ -40,10 +42,15 @@ pub const SLOTS: &[SlotSpec] = &[
         Access::ReadOrWrite,
         Usage::Attachment,
     ),
+    // Ray-cast shadows on glass: each fragment casts its own ray to each caster against
+    // the BVH (a per-pixel mask holds the opaque surface's rays, not the glass's).
+    super::BVH_NODES_READ,
+    super::BVH_TRIANGLES_READ,
 ];
 
 pub fn check(p: &TransparentShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     check_light_source(ctx, p.lights, errors);
+    super::check_bvh_trace(ctx, errors);
     super::check_float_depth_samples(ctx, errors);
     if let (Some(c), Some(d)) = (ctx.slot(slot::COLOR), ctx.slot(slot::DEPTH)) {
         let (cs, ds) = (ctx.samples(c), ctx.samples(d));
