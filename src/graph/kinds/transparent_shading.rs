@@ -8,7 +8,10 @@
 //! reads, the light loop casts a shadow ray per fragment and casting light
 //! (`SHADOW_TRACE`).
 
-use super::{check_light_source, slot, Access, KindCtx, KindRules, SlotSpec, SlotType, Usage};
+use super::shadow_ray_jobs::SHADOW_MASK;
+use super::{
+    check_light_source, slot, Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage,
+};
 use crate::graph::error::GraphError;
 use crate::graph::model::LightSource;
 use serde::{Deserialize, Serialize};
@@ -43,14 +46,25 @@ pub const SLOTS: &[SlotSpec] = &[
         Usage::Attachment,
     ),
     // Ray-cast shadows on glass: each fragment casts its own ray to each caster against
-    // the BVH (a per-pixel mask holds the opaque surface's rays, not the glass's).
+    // the BVH.
     super::BVH_NODES_READ,
     super::BVH_TRIANGLES_READ,
+    // Only to refuse it by name: a ShadowRayJobs mask holds the rays of the opaque
+    // surface at each pixel, not of the glass in front of it.
+    SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound)
+        .optional()
+        .needs(&[Contents::ShadowMask]),
 ];
 
 pub fn check(p: &TransparentShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     check_light_source(ctx, p.lights, errors);
     super::check_bvh_trace(ctx, errors);
+    if let Some(mask) = ctx.slot(SHADOW_MASK) {
+        errors.push(ctx.mismatch(
+            mask,
+            "the shadow mask holds the rays of the opaque surface behind the glass: read bvh_nodes and bvh_triangles instead, and the glass traces its own shadow rays",
+        ));
+    }
     super::check_float_depth_samples(ctx, errors);
     if let (Some(c), Some(d)) = (ctx.slot(slot::COLOR), ctx.slot(slot::DEPTH)) {
         let (cs, ds) = (ctx.samples(c), ctx.samples(d));
@@ -85,7 +99,7 @@ impl KindRules for TransparentShading {
 
 #[cfg(test)]
 mod tests {
-    use crate::graph::kinds::test_support::{errors, validate};
+    use crate::graph::kinds::test_support::{errors, validate, CULL};
 
     const OPAQUE: &str = r#"Pass(name: "pre", kind: DepthPrepass, reads: ["geometry"], writes: ["depth"]),
         Pass(name: "s", kind: ForwardShading(), reads: ["depth", "lg", "lp"], writes: ["hdr"]),"#;
@@ -122,6 +136,35 @@ mod tests {
         let e = errors(&frame("hdr", "small"), "hdr");
         assert!(
             e.contains("TransparentShading needs a depth texture (or an R32Float texture of depths) in reads (slot 'depth')"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn traces_shadows_with_the_whole_bvh_and_refuses_the_mask() {
+        let glass = |reads: &str| {
+            format!(
+                r#"{OPAQUE} Pass(name: "t", kind: TransparentShading(), reads: ["geometry", "depth", "lg", "lp", "hdr", {reads}], writes: ["hdr"])"#
+            )
+        };
+        validate(&glass(r#""bn", "bt""#), "hdr").expect("glass tracing the BVH is valid");
+        let e = errors(&glass(r#""bn""#), "hdr");
+        assert!(
+            e.contains("pass 't': tracing shadows in the light loop needs both bvh_nodes and bvh_triangles"),
+            "{e}"
+        );
+        let e = errors(&glass(r#""bt""#), "hdr");
+        assert!(e.contains("needs both bvh_nodes and bvh_triangles"), "{e}");
+        let jobs = r#"Pass(name: "g", kind: GBuffer, reads: ["geometry", "depth"], writes: ["pos", "g_geometric=geo"]),
+            Pass(name: "j", kind: ShadowRayJobs(), reads: ["pos", "geo", "lg", "lp", "lists"], writes: ["jobs", "mask"]),"#;
+        let e = errors(
+            &format!(
+                r#"{OPAQUE} {CULL} {jobs} Pass(name: "t", kind: TransparentShading(lights: Culled), reads: ["geometry", "depth", "lg", "lp", "lists", "hdr", "mask"], writes: ["hdr"])"#
+            ),
+            "hdr",
+        );
+        assert!(
+            e.contains("pass 't', resource 'mask': the shadow mask holds the rays of the opaque surface behind the glass"),
             "{e}"
         );
     }
