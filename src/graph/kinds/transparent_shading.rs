@@ -6,7 +6,8 @@
 //! attachment and each fragment loads the depth at its pixel and is discarded where the
 //! attachment's LessEqual test would have failed (`FLOAT_DEPTH`). With the BVH in its
 //! reads, the light loop casts a shadow ray per fragment and casting light
-//! (`SHADOW_TRACE`).
+//! (`SHADOW_TRACE`); with a shadow atlas and its view table, it samples the atlas
+//! (`SHADOW_ATLAS`).
 
 use super::shadow_ray_jobs::SHADOW_MASK;
 use super::{
@@ -50,10 +51,15 @@ pub const SLOTS: &[SlotSpec] = &[
     super::BVH_NODES_READ,
     super::BVH_TRIANGLES_READ,
     // Only to refuse it by name: a ShadowRayJobs mask holds the rays of the opaque
-    // surface at each pixel, not of the glass in front of it.
+    // surface at each pixel, not of the glass in front of it. Before the view table, so
+    // a mask read by type lands here.
     SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound)
         .optional()
         .needs(&[Contents::ShadowMask]),
+    // Shadow maps on glass: a ShadowAtlas pass's atlas and view table, sampled per
+    // fragment.
+    super::SHADOW_ATLAS_READ,
+    super::SHADOW_VIEWS_READ,
 ];
 
 pub fn check(p: &TransparentShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
@@ -65,6 +71,7 @@ pub fn check(p: &TransparentShading, ctx: &KindCtx, errors: &mut Vec<GraphError>
             "the shadow mask holds the rays of the opaque surface behind the glass: read bvh_nodes and bvh_triangles instead, and the glass traces its own shadow rays",
         ));
     }
+    super::check_shadow_atlas(ctx, errors);
     super::check_float_depth_samples(ctx, errors);
     if let (Some(c), Some(d)) = (ctx.slot(slot::COLOR), ctx.slot(slot::DEPTH)) {
         let (cs, ds) = (ctx.samples(c), ctx.samples(d));
@@ -167,6 +174,17 @@ mod tests {
             e.contains("pass 't', resource 'mask': the shadow mask holds the rays of the opaque surface behind the glass"),
             "{e}"
         );
+        // Shadow maps instead: the atlas with its view table, and one source only.
+        let atlas = r#"Pass(name: "a", kind: ShadowAtlas(), reads: ["geometry"], writes: ["atlas", "shadow_views"]),"#;
+        validate(&format!("{atlas} {}", glass(r#""atlas", "shadow_views""#)), "hdr")
+            .expect("glass sampling the atlas is valid");
+        let e = errors(&format!("{atlas} {}", glass(r#""atlas""#)), "hdr");
+        assert!(e.contains("read the ShadowAtlas pass's shadow_views buffer too"), "{e}");
+        let e = errors(
+            &format!("{atlas} {}", glass(r#""atlas", "shadow_views", "bn", "bt""#)),
+            "hdr",
+        );
+        assert!(e.contains("a pass shadows its lights one way"), "{e}");
     }
 
     #[test]
