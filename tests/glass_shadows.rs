@@ -5,7 +5,8 @@
 //!   the segment to the light crosses the pane (edge pixels counted and left out);
 //! - glass receives the shadow of an opaque box between a casting light and the pane: a
 //!   pane pixel is black exactly where an f64 ray from it to the light hits the box, and
-//!   elsewhere keeps the light of the scene without the box;
+//!   elsewhere keeps the light of the scene without the box (glass tracing rays, and
+//!   glass sampling the atlas beyond its blur); a pane that casts too is unchanged;
 //! - the BVH leaves a glTF model's blended meshes out unless its model opts in, and every
 //!   triangle it keeps names its own scene triangle.
 
