@@ -272,6 +272,7 @@ fn triangle(name: &str, p: [Vec3; 3], material: usize) -> Mesh {
         uvs: vec![Vec2::ZERO; 3],
         tangents: vec![Vec3::X.extend(1.0); 3],
         indices: vec![0, 1, 2],
+        ..Default::default()
     }
 }
 

@@ -93,6 +93,8 @@ pub(super) enum MeshSet {
     /// Blended meshes, in scene order (sorted by view depth when recorded), drawn
     /// two-sided.
     Transparent,
+    /// What casts into shadow maps: the opaque set and the blended meshes that opt in.
+    ShadowCasters,
 }
 
 /// The meshes of a pass (opaque ones sorted by material) and the pass's group-0 bind group.
@@ -174,6 +176,7 @@ impl Renderer {
         let meshes = match set {
             MeshSet::Opaque => gpu.opaque_draws(),
             MeshSet::Transparent => gpu.transparent_draws(),
+            MeshSet::ShadowCasters => gpu.shadow_caster_draws(),
         };
         for mesh in meshes {
             let material_index = gpu.meshes[mesh].material;

@@ -37,6 +37,8 @@ pub struct GpuMesh {
     /// The visibility id of its first triangle (see `visibility_geometry`); 0 for
     /// blended meshes, which no visibility buffer holds.
     pub first_triangle: u32,
+    /// A blended mesh that still casts shadows (`Mesh::blended_casts_shadow`).
+    pub blended_casts_shadow: bool,
 }
 
 /// Cheap to clone (the GPU objects are shared handles): hot reload builds a changed copy
@@ -79,8 +81,8 @@ pub struct GpuBvh {
 }
 
 impl GpuBvh {
-    /// Builds the BVH over every triangle of `scene` (or an empty one when `full` is
-    /// false) and uploads it.
+    /// Builds the BVH over every shadow-casting triangle of `scene` (or an empty one when
+    /// `full` is false) and uploads it.
     pub fn build(
         device: &wgpu::Device,
         scene: &Scene,
@@ -268,6 +270,7 @@ impl SceneGpu {
                     chunks: chunks.into(),
                     scene_mesh,
                     first_triangle: 0,
+                    blended_casts_shadow: m.blended_casts_shadow,
                 }
             })
             .collect();
@@ -309,6 +312,18 @@ impl SceneGpu {
             .filter(|&i| self.materials[self.meshes[i].material].alpha_mode != AlphaMode::Blend)
             .collect();
         draws.sort_by_key(|&i| self.meshes[i].material);
+        draws
+    }
+
+    /// Mesh indices that cast shadows into shadow maps: the opaque draws, then the
+    /// blended meshes that opt in (`Scene::casts_shadow`, the BVH's rule).
+    pub fn shadow_caster_draws(&self) -> Vec<usize> {
+        let mut draws = self.opaque_draws();
+        draws.extend(
+            self.transparent_draws()
+                .into_iter()
+                .filter(|&i| self.meshes[i].blended_casts_shadow),
+        );
         draws
     }
 

@@ -7,7 +7,8 @@
 //!     models: [
 //!         (path: "../assets/cornell_box/scene.gltf",          // relative to this file
 //!          transform: (translation: (0, 0, 0), rotation_deg: (0, 90, 0), scale: (1, 1, 1)),
-//!          lights_cast_shadows: true),                         // its lights cast shadows
+//!          lights_cast_shadows: true,                          // its lights cast shadows
+//!          blended_cast_shadows: false),                       // its glass casts none
 //!     ],
 //!     // builtin: "atrium",                                     // or/and a built-in scene
 //!     camera: LookAt(eye: (0, 1, 6), target: (0, 1, 0), fov_y_deg: 50, near: 0.05, far: 100),
@@ -100,6 +101,10 @@ pub(crate) struct Model {
     /// casts ray-cast shadows.
     #[serde(default)]
     pub(crate) lights_cast_shadows: bool,
+    /// This model's blended meshes (glTF `alphaMode: BLEND`, glass) cast shadows like
+    /// opaque ones; by default they cast none.
+    #[serde(default)]
+    pub(crate) blended_cast_shadows: bool,
 }
 
 /// Scale, then rotation (Euler XYZ, degrees), then translation.
@@ -419,6 +424,7 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
         scene.materials.extend(sub.materials);
         scene.meshes.extend(sub.meshes.into_iter().map(|mut mesh| {
             mesh.material += offset;
+            mesh.blended_casts_shadow = model.blended_cast_shadows;
             mesh
         }));
         if spec.keep_model_lights {

@@ -20,6 +20,10 @@ pub struct Mesh {
     pub indices: Vec<u32>,
     /// Index into [`Scene::materials`].
     pub material: usize,
+    /// With a blended material (glass), still cast shadows (scene files:
+    /// `blended_cast_shadows` on a model). Blended meshes cast none by default; opaque and
+    /// alpha-masked meshes always do.
+    pub blended_casts_shadow: bool,
 }
 
 /// How a surface lets light through (glTF `alphaMode`).
@@ -401,6 +405,16 @@ impl Scene {
             self.lights = lights;
             self.light_motion.clear();
         }
+    }
+
+    /// Whether `mesh` casts shadows (is in the shadow BVH and drawn into shadow maps):
+    /// every mesh whose material is not blended, and blended ones that opt in.
+    pub fn casts_shadow(&self, mesh: &Mesh) -> bool {
+        mesh.blended_casts_shadow
+            || self
+                .materials
+                .get(mesh.material)
+                .is_none_or(|m| m.alpha_mode != AlphaMode::Blend)
     }
 
     /// Number of triangles over all meshes.

@@ -1,6 +1,6 @@
-//! A BVH over every scene triangle for any-hit shadow rays, built with `obvhs` (PLOC,
-//! single-threaded: the crate's `parallel` feature is off) and flattened into two
-//! GPU-ready arrays:
+//! A BVH over every shadow-casting scene triangle (blended meshes only where they opt in)
+//! for any-hit shadow rays, built with `obvhs` (PLOC, single-threaded: the crate's
+//! `parallel` feature is off) and flattened into two GPU-ready arrays:
 //!
 //! * [`BvhNode`], 32 bytes, in depth-first pre-order. The left child of an inner node is
 //!   the next node; `a` is the right child; `b` is the first node after the subtree (the
@@ -151,6 +151,9 @@ pub struct BuildStats {
     /// Skipped: an index past the mesh's vertices (plus trailing indices that make no
     /// whole triangle).
     pub skipped_bad_index: usize,
+    /// Left out: triangles of meshes that cast no shadow (blended meshes that did not opt
+    /// in, see [`Scene::casts_shadow`]). Counted in `input_triangles` too.
+    pub left_out_non_casting: usize,
     /// Nodes in the flattened tree, inner and leaf.
     pub nodes: usize,
     /// Leaf nodes.
@@ -197,16 +200,28 @@ struct Gathered {
     stats: BuildStats,
 }
 
-/// Every drawable triangle of the scene, in world space exactly as the renderer draws
-/// it (`Mesh::positions` are already world space; no transforms), with the skips counted.
-fn gather<'a>(meshes: impl Iterator<Item = (&'a [Vec3], &'a [u32])>) -> Gathered {
+/// One mesh for [`gather`]: its positions, its indices, and whether it casts shadows.
+type GatherMesh<'a> = (&'a [Vec3], &'a [u32], bool);
+
+/// Every drawable triangle of the casting meshes, in world space exactly as the renderer
+/// draws it (`Mesh::positions` are already world space; no transforms), with the skips
+/// counted. Ids count the triangles of every mesh, casting or not, so they stay scene
+/// triangle indices.
+fn gather<'a>(meshes: impl Iterator<Item = GatherMesh<'a>>) -> Gathered {
     let mut g = Gathered {
         tris: Vec::new(),
         ids: Vec::new(),
         stats: BuildStats::default(),
     };
     let mut id: u64 = 0;
-    for (positions, indices) in meshes {
+    for (positions, indices, casts) in meshes {
+        if !casts {
+            let count = indices.len() / 3;
+            g.stats.input_triangles += count;
+            g.stats.left_out_non_casting += count;
+            id += count as u64;
+            continue;
+        }
         g.stats.skipped_bad_index += usize::from(indices.len() % 3 != 0);
         for t in indices.chunks_exact(3) {
             g.stats.input_triangles += 1;
@@ -248,7 +263,9 @@ fn to_obvhs(v: Vec3) -> glam_obvhs::Vec3A {
 }
 
 impl ShadowBvh {
-    /// Builds over every triangle of every mesh in the scene with [`BuildOptions::default`].
+    /// Builds over every triangle of every mesh in the scene that casts shadows
+    /// ([`Scene::casts_shadow`]: not blended ones, unless they opt in) with
+    /// [`BuildOptions::default`].
     pub fn build(scene: &Scene) -> Result<Self, ShadowError> {
         Self::build_with(scene, &BuildOptions::default())
     }
@@ -256,12 +273,13 @@ impl ShadowBvh {
     /// Builds over every triangle of every mesh in the scene with the given options.
     pub fn build_with(scene: &Scene, options: &BuildOptions) -> Result<Self, ShadowError> {
         let start = Instant::now();
-        let g = gather(
-            scene
-                .meshes
-                .iter()
-                .map(|m| (m.positions.as_slice(), m.indices.as_slice())),
-        );
+        let g = gather(scene.meshes.iter().map(|m| {
+            (
+                m.positions.as_slice(),
+                m.indices.as_slice(),
+                scene.casts_shadow(m),
+            )
+        }));
         Self::finish(g, options, start)
     }
 
@@ -270,7 +288,11 @@ impl ShadowBvh {
         let start = Instant::now();
         let positions: Vec<Vec3> = tris.iter().flatten().copied().collect();
         let indices: Vec<u32> = (0..positions.len() as u32).collect();
-        let g = gather(std::iter::once((positions.as_slice(), indices.as_slice())));
+        let g = gather(std::iter::once((
+            positions.as_slice(),
+            indices.as_slice(),
+            true,
+        )));
         Self::finish(g, options, start)
     }
 

@@ -1,4 +1,4 @@
-//! Ray-cast shadows, CPU side: a BVH over every scene triangle, flattened into the
+//! Ray-cast shadows, CPU side: a BVH over every shadow-casting scene triangle, flattened into the
 //! GPU buffers `shaders/shadow/bvh.wgsl` traverses, a CPU twin of that traversal, and
 //! an f64 brute-force reference to test both against.
 //!

@@ -11,12 +11,12 @@ use glam::DVec3;
 /// A triangle in f64 (its three vertices).
 pub type Triangle64 = [DVec3; 3];
 
-/// Every triangle of the scene with valid indices and finite coordinates, in f64,
-/// degenerate ones included (the reference never hits a zero-area triangle, so keeping
-/// them checks that the BVH may skip them).
+/// Every triangle of the scene's shadow-casting meshes ([`Scene::casts_shadow`]) with
+/// valid indices and finite coordinates, in f64, degenerate ones included (the reference
+/// never hits a zero-area triangle, so keeping them checks that the BVH may skip them).
 pub fn scene_triangles_f64(scene: &Scene) -> Vec<Triangle64> {
     let mut out = Vec::with_capacity(scene.triangle_count());
-    for m in &scene.meshes {
+    for m in scene.meshes.iter().filter(|m| scene.casts_shadow(m)) {
         for t in m.indices.chunks_exact(3) {
             let p = |i: u32| m.positions.get(i as usize).copied();
             if let (Some(a), Some(b), Some(c)) = (p(t[0]), p(t[1]), p(t[2])) {

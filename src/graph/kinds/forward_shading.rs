@@ -1,11 +1,11 @@
 //! `ForwardShading`: the scene's materials through the light loop, into a colour target
 //! over the prepass depth. Runs `shaders/forward/forward.wgsl` with `SHADE`.
 
-use super::shadow_ray_cast::{BVH_NODES, BVH_TRIANGLES};
+use super::shadow_ray_cast::BVH_NODES;
 use super::shadow_ray_jobs::SHADOW_MASK;
 use super::{check_light_source, slot, Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
-use crate::graph::model::{LightSource, SceneResource};
+use crate::graph::model::LightSource;
 use serde::{Deserialize, Serialize};
 
 /// `ForwardShading(lights: Culled)`.
@@ -40,20 +40,8 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound)
         .optional()
         .needs(&[Contents::ShadowMask]),
-    SlotSpec::new(
-        BVH_NODES,
-        SlotType::Import(SceneResource::BvhNodes),
-        Access::Read,
-        Usage::Bound,
-    )
-    .optional(),
-    SlotSpec::new(
-        BVH_TRIANGLES,
-        SlotType::Import(SceneResource::BvhTriangles),
-        Access::Read,
-        Usage::Bound,
-    )
-    .optional(),
+    super::BVH_NODES_READ,
+    super::BVH_TRIANGLES_READ,
     // Shadow maps: a ShadowAtlas pass's atlas and view table.
     super::SHADOW_ATLAS_READ,
     super::SHADOW_VIEWS_READ,
@@ -96,15 +84,12 @@ pub fn shadows(roles: &crate::graph::PassRoles, plan: &crate::graph::ResourcePla
 
 pub(crate) fn check(p: &ForwardShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     check_light_source(ctx, p.lights, errors);
-    match (ctx.slot(BVH_NODES), ctx.slot(BVH_TRIANGLES)) {
-        (Some(_), None) | (None, Some(_)) => errors.push(
-            ctx.bad("tracing shadows in the light loop needs both bvh_nodes and bvh_triangles"),
-        ),
-        (Some(n), Some(_)) if ctx.slot(SHADOW_MASK).is_some() => errors.push(ctx.mismatch(
+    super::check_bvh_trace(ctx, errors);
+    if let (Some(n), Some(_)) = (ctx.slot(BVH_NODES), ctx.slot(SHADOW_MASK)) {
+        errors.push(ctx.mismatch(
             n,
             "a pass reads the shadow mask or traces the BVH, not both",
-        )),
-        _ => {}
+        ));
     }
     super::check_shadow_mask(ctx, errors);
     super::check_shadow_atlas(ctx, errors);

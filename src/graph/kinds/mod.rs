@@ -311,6 +311,16 @@ pub(crate) fn check_shadow_mask(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     }
 }
 
+/// A light loop that casts its own shadow rays binds the whole BVH.
+pub(crate) fn check_bvh_trace(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+    use shadow_ray_cast::{BVH_NODES, BVH_TRIANGLES};
+    if ctx.slot(BVH_NODES).is_some() != ctx.slot(BVH_TRIANGLES).is_some() {
+        errors.push(
+            ctx.bad("tracing shadows in the light loop needs both bvh_nodes and bvh_triangles"),
+        );
+    }
+}
+
 /// A shading pass samples an atlas through its view table, and shadows one way only.
 pub(crate) fn check_shadow_atlas(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     use shadow_atlas::{SHADOW_ATLAS, SHADOW_VIEWS};

@@ -209,3 +209,20 @@ pub(crate) const SHADOW_VIEWS_READ: SlotSpec = SlotSpec::new(
 )
 .optional()
 .needs(&[Contents::ShadowViews]);
+
+/// Rows of the shading passes that trace shadow rays in their light loop: the scene's
+/// BVH, both halves.
+pub(crate) const BVH_NODES_READ: SlotSpec = SlotSpec::new(
+    super::shadow_ray_cast::BVH_NODES,
+    SlotType::Import(SceneResource::BvhNodes),
+    Access::Read,
+    Usage::Bound,
+)
+.optional();
+pub(crate) const BVH_TRIANGLES_READ: SlotSpec = SlotSpec::new(
+    super::shadow_ray_cast::BVH_TRIANGLES,
+    SlotType::Import(SceneResource::BvhTriangles),
+    Access::Read,
+    Usage::Bound,
+)
+.optional();

@@ -4,9 +4,15 @@
 //! `shaders/forward/forward.wgsl` with `SHADE`. The opaque depth is a depth attachment,
 //! or a single-sample R32Float texture (a compute resolve's): then the pass has no depth
 //! attachment and each fragment loads the depth at its pixel and is discarded where the
-//! attachment's LessEqual test would have failed (`FLOAT_DEPTH`).
+//! attachment's LessEqual test would have failed (`FLOAT_DEPTH`). With the BVH in its
+//! reads, the light loop casts a shadow ray per fragment and casting light
+//! (`SHADOW_TRACE`); with a shadow atlas and its view table, it samples the atlas
+//! (`SHADOW_ATLAS`).
 
-use super::{check_light_source, slot, Access, KindCtx, KindRules, SlotSpec, SlotType, Usage};
+use super::shadow_ray_jobs::SHADOW_MASK;
+use super::{
+    check_light_source, slot, Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage,
+};
 use crate::graph::error::GraphError;
 use crate::graph::model::LightSource;
 use serde::{Deserialize, Serialize};
@@ -42,10 +48,32 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
         Access::ReadOrWrite,
         Usage::Attachment,
     ),
+    // Ray-cast shadows on glass: each fragment casts its own ray to each caster against
+    // the BVH.
+    super::BVH_NODES_READ,
+    super::BVH_TRIANGLES_READ,
+    // Only to refuse it by name: a ShadowRayJobs mask holds the rays of the opaque
+    // surface at each pixel, not of the glass in front of it. Before the view table, so
+    // a mask read by type lands here.
+    SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound)
+        .optional()
+        .needs(&[Contents::ShadowMask]),
+    // Shadow maps on glass: a ShadowAtlas pass's atlas and view table, sampled per
+    // fragment.
+    super::SHADOW_ATLAS_READ,
+    super::SHADOW_VIEWS_READ,
 ];
 
 pub(crate) fn check(p: &TransparentShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     check_light_source(ctx, p.lights, errors);
+    super::check_bvh_trace(ctx, errors);
+    if let Some(mask) = ctx.slot(SHADOW_MASK) {
+        errors.push(ctx.mismatch(
+            mask,
+            "the shadow mask holds the rays of the opaque surface behind the glass: read bvh_nodes and bvh_triangles instead, and the glass traces its own shadow rays",
+        ));
+    }
+    super::check_shadow_atlas(ctx, errors);
     super::check_float_depth_samples(ctx, errors);
     if let (Some(c), Some(d)) = (ctx.slot(slot::COLOR), ctx.slot(slot::DEPTH)) {
         let (cs, ds) = (ctx.samples(c), ctx.samples(d));
@@ -80,7 +108,7 @@ impl KindRules for TransparentShading {
 
 #[cfg(test)]
 mod tests {
-    use crate::graph::kinds::test_support::{errors, validate};
+    use crate::graph::kinds::test_support::{errors, validate, CULL};
 
     const OPAQUE: &str = r#"Pass(name: "pre", kind: DepthPrepass, reads: ["geometry"], writes: ["depth"]),
         Pass(name: "s", kind: ForwardShading(), reads: ["depth", "lg", "lp"], writes: ["hdr"]),"#;
@@ -119,6 +147,46 @@ mod tests {
             e.contains("TransparentShading needs a depth texture (or an R32Float texture of depths) in reads (slot 'depth')"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn traces_shadows_with_the_whole_bvh_and_refuses_the_mask() {
+        let glass = |reads: &str| {
+            format!(
+                r#"{OPAQUE} Pass(name: "t", kind: TransparentShading(), reads: ["geometry", "depth", "lg", "lp", "hdr", {reads}], writes: ["hdr"])"#
+            )
+        };
+        validate(&glass(r#""bn", "bt""#), "hdr").expect("glass tracing the BVH is valid");
+        let e = errors(&glass(r#""bn""#), "hdr");
+        assert!(
+            e.contains("pass 't': tracing shadows in the light loop needs both bvh_nodes and bvh_triangles"),
+            "{e}"
+        );
+        let e = errors(&glass(r#""bt""#), "hdr");
+        assert!(e.contains("needs both bvh_nodes and bvh_triangles"), "{e}");
+        let jobs = r#"Pass(name: "g", kind: GBuffer, reads: ["geometry", "depth"], writes: ["pos", "g_geometric=geo"]),
+            Pass(name: "j", kind: ShadowRayJobs(), reads: ["pos", "geo", "lg", "lp", "lists"], writes: ["jobs", "mask"]),"#;
+        let e = errors(
+            &format!(
+                r#"{OPAQUE} {CULL} {jobs} Pass(name: "t", kind: TransparentShading(lights: Culled), reads: ["geometry", "depth", "lg", "lp", "lists", "hdr", "mask"], writes: ["hdr"])"#
+            ),
+            "hdr",
+        );
+        assert!(
+            e.contains("pass 't', resource 'mask': the shadow mask holds the rays of the opaque surface behind the glass"),
+            "{e}"
+        );
+        // Shadow maps instead: the atlas with its view table, and one source only.
+        let atlas = r#"Pass(name: "a", kind: ShadowAtlas(), reads: ["geometry"], writes: ["atlas", "shadow_views"]),"#;
+        validate(&format!("{atlas} {}", glass(r#""atlas", "shadow_views""#)), "hdr")
+            .expect("glass sampling the atlas is valid");
+        let e = errors(&format!("{atlas} {}", glass(r#""atlas""#)), "hdr");
+        assert!(e.contains("read the ShadowAtlas pass's shadow_views buffer too"), "{e}");
+        let e = errors(
+            &format!("{atlas} {}", glass(r#""atlas", "shadow_views", "bn", "bt""#)),
+            "hdr",
+        );
+        assert!(e.contains("a pass shadows its lights one way"), "{e}");
     }
 
     #[test]

@@ -103,7 +103,7 @@ pub(super) fn prepare(
     };
     let draws = cx
         .renderer
-        .mesh_draws(cx.gpu, mode, MeshSet::Opaque, 1, &sp.name, &offered)?;
+        .mesh_draws(cx.gpu, mode, MeshSet::ShadowCasters, 1, &sp.name, &offered)?;
     let clear = tile_clear_pipeline(cx, &sp.name, format)?;
     let meshes = draws
         .meshes()

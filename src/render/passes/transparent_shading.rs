@@ -2,7 +2,8 @@
 //! back to front by the view depth of its bounds' centre, alpha-blended over the colour
 //! target, tested against the opaque depth (not written): as a read-only depth
 //! attachment, or (an R32Float depth, a compute resolve's) in the fragment shader, with
-//! no depth attachment. The order follows the camera (`set_view`).
+//! no depth attachment. The order follows the camera (`set_view`). Reading the BVH, each
+//! fragment traces its own shadow rays.
 
 use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::Name;
@@ -46,10 +47,12 @@ pub(super) fn prepare(
     let lists = cx.shading_lists(sp, p.lights, &mut offered)?;
     // Validation keeps an R32Float depth single-sample, as the colour target.
     let float_depth = cx.float_depth(depth);
+    // Validation admits the BVH (traced in the light loop) as the only shadow source.
+    let shadows = cx.shading_shadows(sp, &mut offered);
     let mode = DrawMode::Shade {
         lists,
         blend: true,
-        shadows: crate::graph::kinds::forward_shading::Shadows::None,
+        shadows,
         float_depth,
     };
     let draws = cx.renderer.mesh_draws(

@@ -222,6 +222,7 @@ impl Importer {
                 tangents,
                 indices,
                 material,
+                blended_casts_shadow: false,
             };
             if mikktspace {
                 crate::scene::tangent_space::mikktspace_tangents(&mut mesh);
