@@ -113,6 +113,16 @@ pub fn check_surface_source(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     };
     let (g, v) = (filled(&G_BUFFER_SURFACE), filled(&VISIBILITY_SURFACE));
     let list = |slots: &[&str]| slots.join(", ");
+    // Ids not named after their slot fill the G-buffer's by type order.
+    for s in G_BUFFER_SURFACE {
+        if let Some(name) = ctx.slot(s).filter(|n| is_ids(ctx, n)) {
+            errors.push(ctx.mismatch(
+                name,
+                format!("an R32Uint texture of triangle ids fills slot 'visibility', not '{s}': read it as \"visibility={name}\" (with vertices and triangles)"),
+            ));
+            return;
+        }
+    }
     if !g.is_empty() && !v.is_empty() {
         let resource = ctx.slot(v[0]).unwrap_or_default();
         errors.push(ctx.mismatch(
@@ -153,12 +163,7 @@ pub fn check_surface_source(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     if v.is_empty() {
         for s in G_BUFFER_SURFACE {
             let Some(name) = ctx.slot(s) else { continue };
-            if is_ids(ctx, name) {
-                errors.push(ctx.mismatch(
-                    name,
-                    format!("an R32Uint texture of triangle ids fills slot 'visibility', not '{s}': name it visibility=\"{name}\" and read vertices and triangles too"),
-                ));
-            } else if !ctx.is_single_rgba32f(name) {
+            if !ctx.is_single_rgba32f(name) {
                 errors.push(ctx.mismatch(
                     name,
                     "ray-cast shadows read world positions and geometric normals from single-sample Rgba32Float G-buffer textures (not the packed G-buffer)",
