@@ -19,7 +19,7 @@ use common::{cuboid, lambert, prepare_text, renderer, Rng};
 use glam::{DMat4, DVec3, DVec4, Vec3};
 use lightgraph::render::{FrameResult, PreparedFrame, Renderer, SceneGpu};
 use lightgraph::scene::geometry::MeshBuilder;
-use lightgraph::scene::{light_flags, AlphaMode, Camera, Light, LightShape, Scene};
+use lightgraph::scene::{light_flags, AlphaMode, Camera, Light, LightShape, Scene, SurfaceMaterial};
 use lightgraph::shadow::reference::near_edge;
 use lightgraph::shadow::{scene_triangles_f64, shadow_ray, ShadowBvh, Triangle64};
 use std::collections::BTreeMap;
@@ -107,6 +107,16 @@ fn shadow_scene(lights: usize, seed: u64) -> Scene {
     let mut cyl = MeshBuilder::new("column", 1);
     cyl.cylinder(Vec3::new(2.5, 0.0, -2.0), 0.6, 3.0, 24, 4);
     meshes.push(cyl.build());
+    // A double-sided wall seen from its back: its geometric normal must be turned to the
+    // eye for the lights in front to reach it.
+    let mut wall = MeshBuilder::new("back wall", 2);
+    wall.quad(
+        Vec3::new(-4.0, 0.0, -10.5),
+        Vec3::Y * 3.5,
+        Vec3::X * 8.0,
+        glam::Vec2::ONE,
+    );
+    meshes.push(wall.build());
     let lights = (0..lights)
         .map(|i| {
             let p = rng.vec3(Vec3::new(-6.0, 0.5, -10.0), Vec3::new(6.0, 5.0, 2.0));
@@ -135,6 +145,10 @@ fn shadow_scene(lights: usize, seed: u64) -> Scene {
         materials: vec![
             lambert("floor", Vec3::splat(0.7)),
             lambert("boxes", Vec3::new(0.8, 0.5, 0.3)),
+            SurfaceMaterial {
+                double_sided: true,
+                ..lambert("wall", Vec3::new(0.4, 0.6, 0.8))
+            },
         ],
         lights,
         camera: Camera {
@@ -478,7 +492,7 @@ fn shaded_image_equals_forward_plus_and_every_light_loop_agrees() {
         "{extra} pixels differ only with shadows"
     );
 
-    // Every light loop and the classified dispatch (two materials here) shade the same
+    // Every light loop and the classified dispatch (three materials here) shade the same
     // casters the same way.
     for kind in [
         "lights: Culled, light_loop: Forward",
