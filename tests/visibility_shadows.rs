@@ -19,7 +19,9 @@ use common::{cuboid, lambert, prepare_text, renderer, Rng};
 use glam::{DMat4, DVec3, DVec4, Vec3};
 use lightgraph::render::{FrameResult, PreparedFrame, Renderer, SceneGpu};
 use lightgraph::scene::geometry::MeshBuilder;
-use lightgraph::scene::{light_flags, AlphaMode, Camera, Light, LightShape, Scene, SurfaceMaterial};
+use lightgraph::scene::{
+    light_flags, AlphaMode, Camera, Light, LightShape, Scene, SurfaceMaterial,
+};
 use lightgraph::shadow::reference::near_edge;
 use lightgraph::shadow::{scene_triangles_f64, shadow_ray, ShadowBvh, Triangle64};
 use std::collections::BTreeMap;
@@ -31,8 +33,12 @@ const H: u32 = 64;
 const OFFSET: f32 = 1e-4;
 
 fn graph_text(name: &str) -> String {
-    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("graphs").join(name))
-        .unwrap()
+    std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("graphs")
+            .join(name),
+    )
+    .unwrap()
 }
 
 /// visibility_raycast_shadows.ron with its ids drawn by the hardware visibility buffer
@@ -305,28 +311,29 @@ fn compare_with_forward(
             match fwd[i].get(&light) {
                 Some(&h) if h == hidden => c.agree += 1,
                 Some(_) => {
-                    let (o, _, t_max) =
-                        shadow_ray(p.as_vec3(), ng.as_vec3(), l.position, OFFSET);
+                    let (o, _, t_max) = shadow_ray(p.as_vec3(), ng.as_vec3(), l.position, OFFSET);
                     let (o, lp) = (o.as_dvec3(), l.position.as_dvec3());
                     if near_edge(&tris, o, lp - o, t_max as f64, 1e-4) {
                         c.grazing += 1;
                     } else {
-                        c.failures
-                            .push(format!("pixel {pixel} light {light}: hidden {hidden} here, not in Forward+"));
+                        c.failures.push(format!(
+                            "pixel {pixel} light {light}: hidden {hidden} here, not in Forward+"
+                        ));
                     }
                 }
                 None if borderline(l, p, ng) => c.borderline += 1,
-                None => c
-                    .failures
-                    .push(format!("pixel {pixel}: light {light} has a job here, none in Forward+")),
+                None => c.failures.push(format!(
+                    "pixel {pixel}: light {light} has a job here, none in Forward+"
+                )),
             }
         }
         for &light in fwd[i].keys().filter(|l| !vis[i].contains_key(l)) {
             if borderline(&scene.lights[light as usize], p, ng) {
                 c.borderline += 1;
             } else {
-                c.failures
-                    .push(format!("pixel {pixel}: light {light} has a Forward+ job, none here"));
+                c.failures.push(format!(
+                    "pixel {pixel}: light {light} has a Forward+ job, none here"
+                ));
             }
         }
     }
@@ -396,11 +403,23 @@ fn check_against_forward_and_cpu(
         "{} pixels where the rasterizers disagree",
         c.raster_edge
     );
-    assert!(c.agree > 2_000, "too few rays to mean anything: {}", c.agree);
-    assert!(c.grazing * 100 < c.agree, "{} grazing of {}", c.grazing, c.agree);
+    assert!(
+        c.agree > 2_000,
+        "too few rays to mean anything: {}",
+        c.agree
+    );
+    assert!(
+        c.grazing * 100 < c.agree,
+        "{} grazing of {}",
+        c.grazing,
+        c.agree
+    );
     assert!(c.borderline * 100 < c.agree, "{} borderline", c.borderline);
     let hidden = vis.iter().flat_map(|m| m.values()).filter(|&&h| h).count();
-    assert!(hidden > 200, "only {hidden} hidden rays: nothing to compare");
+    assert!(
+        hidden > 200,
+        "only {hidden} hidden rays: nothing to compare"
+    );
 
     let (agree, grazing, failures) = compare_with_cpu_twin(scene, &surfaces, &ids, &vis);
     eprintln!("CPU twin: {agree} agree, {grazing} graze an edge");
@@ -445,7 +464,10 @@ fn hardware_visibility_masks_equal_forward_plus_and_the_cpu_twin() {
 /// least).
 fn differing(a: &[[f32; 4]], b: &[[f32; 4]], rel: f32) -> Vec<usize> {
     assert_eq!(a.len(), b.len());
-    let peak = b.iter().flat_map(|p| p[..3].iter().copied()).fold(0f32, f32::max);
+    let peak = b
+        .iter()
+        .flat_map(|p| p[..3].iter().copied())
+        .fold(0f32, f32::max);
     (0..a.len())
         .filter(|&i| {
             (0..3).any(|c| {
@@ -523,7 +545,11 @@ fn default_graph_with_casters_is_the_visibility_shadow_frame() {
     assert!(scene.features().has_shadow_casters && !scene.features().has_transparent);
     let mut r = renderer();
     let (d_prepared, d) = run(&mut r, &graph_text("default.ron"), &scene);
-    let (v_prepared, v) = run(&mut r, &graph_text("visibility_raycast_shadows.ron"), &scene);
+    let (v_prepared, v) = run(
+        &mut r,
+        &graph_text("visibility_raycast_shadows.ron"),
+        &scene,
+    );
     let names = |p: &PreparedFrame| -> Vec<String> {
         p.graph.passes.iter().map(|s| s.name.to_string()).collect()
     };
@@ -537,14 +563,19 @@ fn default_graph_with_casters_is_the_visibility_shadow_frame() {
         .filter(|(a, b)| a.map(f32::to_bits) != b.map(f32::to_bits))
         .count();
     assert_eq!(bits, 0, "{bits} pixels differ");
-    assert!(d.image.iter().any(|p| p[0] > 0.0), "a dark frame tests nothing");
+    assert!(
+        d.image.iter().any(|p| p[0] > 0.0),
+        "a dark frame tests nothing"
+    );
 }
 
 /// The gallery's textured glTF models (scenes/gallery.ron) without its glass,
 /// half of 512 of its lights casting shadows.
 fn textured_gltf_scene() -> Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/gallery.ron");
-    let mut s = lightgraph::scene::load(&path).expect("the gallery loads").scene;
+    let mut s = lightgraph::scene::load(&path)
+        .expect("the gallery loads")
+        .scene;
     let materials = s.materials.clone();
     s.meshes
         .retain(|m| materials[m.material].alpha_mode != AlphaMode::Blend);
