@@ -1,21 +1,30 @@
 // Ray-cast shadows: one invocation per job (pixel, light, caster number), an any-hit
 // ray from the pixel's offset position towards the light against the scene BVH; a hit
 // sets the caster's bit in the pixel's mask. Dispatched indirectly from the job count.
-// Defines: JOB_CAPACITY, SHADOW_NORMAL_OFFSET.
+// Surfaces come from the G-buffer or, with VISIBILITY_IDS, from the visibility buffer
+// (shadow/surface_source.wgsl), as job creation read them.
+// Defines: JOB_CAPACITY, SHADOW_NORMAL_OFFSET, VISIBILITY_IDS.
 
 #include "common/types.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
 @group(0) @binding(2) var<storage, read> shadow_jobs: array<u32>;
+#if VISIBILITY_IDS
+@group(0) @binding(3) var visibility: texture_2d<u32>;
+@group(0) @binding(4) var<storage, read> vertices: array<f32>;
+@group(0) @binding(8) var<storage, read> triangles: array<u32>;
+#else
 @group(0) @binding(3) var g_position: texture_2d<f32>;
 @group(0) @binding(4) var g_geometric: texture_2d<f32>;
+#endif
 @group(0) @binding(5) var<storage, read> bvh_nodes: array<BvhNode>;
 @group(0) @binding(6) var<storage, read> bvh_triangles: array<BvhTriangle>;
 @group(0) @binding(7) var<storage, read_write> shadow_mask: array<atomic<u32>>;
 
 #include "shadow/bvh.wgsl"
 #include "common/shadows.wgsl"
+#include "shadow/surface_source.wgsl"
 
 const JOB_HEADER_WORDS: u32 = 8u;
 
@@ -34,9 +43,8 @@ fn main(
     let light = packed & 0xffffffu;
     let caster = packed >> 24u;
     let xy = vec2<u32>(pixel % frame.size.x, pixel / frame.size.x);
-    let p = textureLoad(g_position, xy, 0).xyz;
-    let ng = textureLoad(g_geometric, xy, 0).xyz;
-    let origin = shadow_origin(p, ng);
+    let s = shadow_surface(xy);
+    let origin = shadow_origin(s.position, s.ng);
     let light_pos = light_geometry[light].position;
     if (bvh_occluded(origin, light_pos - origin, shadow_t_max(origin, light_pos))) {
         atomicOr(&shadow_mask[pixel * SHADOW_MASK_WORDS + caster / 32u], 1u << (caster % 32u));

@@ -12,7 +12,10 @@
 // Job buffer (src/graph/kinds/shadow_ray_jobs.rs, ShadowJobLayout): words 0..4 jobs wanted,
 // jobs dropped (buffer full), pixels with more than 128 casters, unused; 4..8 the
 // indirect dispatch (x, y, z, unused); then two words a job.
-// Defines: TILE-free; JOB_CAPACITY, LIGHT_LISTS, SHADOW_NORMAL_OFFSET.
+// Surfaces come from the G-buffer (g_position, g_geometric) or, with VISIBILITY_IDS, from
+// a visibility buffer's triangle ids, rebuilt by visibility/surface.wgsl as visibility
+// shading rebuilds them.
+// Defines: TILE-free; JOB_CAPACITY, LIGHT_LISTS, SHADOW_NORMAL_OFFSET, VISIBILITY_IDS.
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"
@@ -22,13 +25,20 @@
 @group(0) @binding(2) var<storage, read> light_properties: array<LightProperties>;
 @group(0) @binding(3) var<storage, read> light_lists: array<u32>;
 @group(0) @binding(4) var<uniform> list_params: ListParams;
+#if VISIBILITY_IDS
+@group(0) @binding(5) var visibility: texture_2d<u32>;
+@group(0) @binding(6) var<storage, read> vertices: array<f32>;
+@group(0) @binding(9) var<storage, read> triangles: array<u32>;
+#else
 @group(0) @binding(5) var g_position: texture_2d<f32>;
 @group(0) @binding(6) var g_geometric: texture_2d<f32>;
+#endif
 @group(0) @binding(7) var<storage, read_write> shadow_jobs: array<atomic<u32>>;
 @group(0) @binding(8) var<storage, read_write> shadow_mask: array<u32>;
 
 #include "common/light_lists.wgsl"
 #include "common/shadows.wgsl"
+#include "shadow/surface_source.wgsl"
 
 const JOB_HEADER_WORDS: u32 = 8u;
 const GROUP_SIZE: u32 = 256u;
@@ -57,12 +67,12 @@ fn load_pixel(xy: vec2<u32>) -> Pixel {
     if (!px.valid) {
         return px;
     }
-    let g = textureLoad(g_position, xy, 0);
-    px.valid = g.w >= 0.0;
+    let s = shadow_surface(xy);
+    px.valid = s.valid;
     px.index = xy.y * frame.size.x + xy.x;
-    px.position = g.xyz;
-    px.ng = textureLoad(g_geometric, xy, 0).xyz;
-    let view_z = -(frame.view * vec4<f32>(g.xyz, 1.0)).z;
+    px.position = s.position;
+    px.ng = s.ng;
+    let view_z = -(frame.view * vec4<f32>(s.position, 1.0)).z;
     px.range = light_range(vec2<f32>(xy) + 0.5, view_z);
     return px;
 }

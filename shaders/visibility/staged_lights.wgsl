@@ -17,9 +17,33 @@ fn surface_unlit(p: ShadingPoint, m: MaterialSample) -> vec3<f32> {
     return material_emission(m) + frame.ambient.rgb * material_eval(m, p.normal);
 }
 
+#if SHADOWS
+// The shaded pixel (its mask's index) and its next caster number: casters are the
+// shadow-casting lights that reach it (radiance > 0), numbered in list order whatever
+// the material takes, as job creation and shade_surface number them.
+var<private> shadow_pixel: u32;
+var<private> shadow_caster: u32;
+#endif
+
 // Light (g, props) at reach r added to `color`, when the material takes it and it
-// gives radiance, as shade_surface adds it.
+// gives radiance (and, with SHADOWS, its caster bit says it is not hidden), as
+// shade_surface adds it.
 fn add_reached(color: vec3<f32>, g: LightGeometry, props: LightProperties, r: LightReach, m: MaterialSample) -> vec3<f32> {
+#if SHADOWS
+    if ((props.flags & LIGHT_CASTS_SHADOW) != 0u) {
+        let inc = incident_reached(g, props, r);
+        if (!any(inc.radiance > vec3<f32>(0.0))) {
+            return color;
+        }
+        let caster = shadow_caster;
+        shadow_caster += 1u;
+        // The mask reads neither position.
+        if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u || !shadow_visible(shadow_pixel, caster, g.position, g.position)) {
+            return color;
+        }
+        return color + inc.radiance * material_eval(m, inc.dir);
+    }
+#endif
     if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
         return color;
     }
@@ -135,7 +159,12 @@ fn stage(slot: u32, l: ListedLight) {
     // dist_sq >= 0 rejects a light the material does not take; a NaN dist_sq goes on to
     // add_reached, which skips it.
     var beyond = reject_beyond(l.g.range);
-    if ((l.props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
+    var untaken = (l.props.material_mask & MATERIAL_TYPE_BIT) == 0u;
+#if SHADOWS
+    // A caster the material does not take still takes its caster number (add_reached).
+    untaken = untaken && (l.props.flags & LIGHT_CASTS_SHADOW) == 0u;
+#endif
+    if (untaken) {
         beyond = -1.0;
     }
     staged_reach[slot] = vec4<f32>(l.g.position, beyond);

@@ -1,9 +1,10 @@
 // A pixel's surface point rebuilt from its triangle in the merged geometry
 // (src/render/visibility_geometry.rs): the shading point at the pixel centre and, for
 // textured materials (MATERIAL_TEXTURED), the uv derivatives the material samples with.
-// Shared by visibility shading and the compute rasterizer's alpha test, so both see the
-// same surface. Needs `frame`, `vertices` and `triangles` bound, and the material code
-// (which declares material_uv_ddx and material_uv_ddy) in the module.
+// Shared by visibility shading, the compute rasterizer's alpha test and the ray-cast
+// shadow passes (surface_geometry), so all see the same surface. Needs `frame`,
+// `vertices` and `triangles` bound, and with MATERIAL_TEXTURED the material code (which
+// declares material_uv_ddx and material_uv_ddy) in the module.
 
 struct ShadingPoint {
     position: vec3<f32>,
@@ -49,35 +50,72 @@ fn bary_at(e: Edges, q: vec2<f32>) -> vec3<f32> {
     return b / (b.x + b.y + b.z);
 }
 
-// Triangle `tri`'s surface at pixel `id`'s centre (the triangle's plane extended where
-// the centre lies outside it).
-fn surface_point(id: vec2<u32>, tri: u32) -> ShadingPoint {
-    let a = fetch(triangles[3u * tri]);
-    let b = fetch(triangles[3u * tri + 1u]);
-    let c = fetch(triangles[3u * tri + 2u]);
-    let ca = frame.view_proj * vec4<f32>(a.position, 1.0);
-    let cb = frame.view_proj * vec4<f32>(b.position, 1.0);
-    let cc = frame.view_proj * vec4<f32>(c.position, 1.0);
-    let h0 = ca.xyw;
-    let h1 = cb.xyw;
-    let h2 = cc.xyw;
-    let e = Edges(cross(h1, h2), cross(h2, h0), cross(h0, h1));
-    // The pixel centre in NDC, and one pixel's step along x and y (NDC y points up).
+// Triangle `tri` at pixel `id`'s centre: its vertices, the edge functions and the
+// centre's barycentrics (the triangle's plane extended where the centre lies outside it).
+struct PixelTriangle {
+    a: Vertex,
+    b: Vertex,
+    c: Vertex,
+    e: Edges,
+    // det(H)'s sign: front faces wind counter-clockwise in NDC.
+    front: bool,
+    w: vec3<f32>,
+};
+
+fn pixel_triangle(id: vec2<u32>, tri: u32) -> PixelTriangle {
+    var t: PixelTriangle;
+    t.a = fetch(triangles[3u * tri]);
+    t.b = fetch(triangles[3u * tri + 1u]);
+    t.c = fetch(triangles[3u * tri + 2u]);
+    let h0 = (frame.view_proj * vec4<f32>(t.a.position, 1.0)).xyw;
+    let h1 = (frame.view_proj * vec4<f32>(t.b.position, 1.0)).xyw;
+    let h2 = (frame.view_proj * vec4<f32>(t.c.position, 1.0)).xyw;
+    t.e = Edges(cross(h1, h2), cross(h2, h0), cross(h0, h1));
+    t.front = dot(h0, t.e.e0) > 0.0;
+    // The pixel centre in NDC (NDC y points up).
     let size = vec2<f32>(frame.size);
     let pixel = vec2<f32>(id) + 0.5;
     let q = vec2<f32>(pixel.x / size.x * 2.0 - 1.0, 1.0 - pixel.y / size.y * 2.0);
-    let step = vec2<f32>(2.0 / size.x, -2.0 / size.y);
-    let w = bary_at(e, q);
+    t.w = bary_at(t.e, q);
+    return t;
+}
 
+// The surface point at the pixel centre: where the camera ray through it meets the
+// triangle's plane.
+fn pixel_position(t: PixelTriangle) -> vec3<f32> {
+    return t.w.x * t.a.position + t.w.y * t.b.position + t.w.z * t.c.position;
+}
+
+// What a shadow ray starts from (shadow/shadow_ray_jobs.wgsl, shadow_ray_cast.wgsl): the
+// point visibility shading shades, and the triangle's normal facing the eye (the
+// G-buffer's `g_geometric`).
+struct SurfaceGeometry {
+    position: vec3<f32>,
+    ng: vec3<f32>,
+};
+
+fn surface_geometry(id: vec2<u32>, tri: u32) -> SurfaceGeometry {
+    let t = pixel_triangle(id, tri);
+    let position = pixel_position(t);
+    let n = normalize(cross(t.b.position - t.a.position, t.c.position - t.a.position));
+    let ng = select(n, -n, dot(n, frame.camera_pos.xyz - position) < 0.0);
+    return SurfaceGeometry(position, ng);
+}
+
+// Triangle `tri`'s surface at pixel `id`'s centre.
+fn surface_point(id: vec2<u32>, tri: u32) -> ShadingPoint {
+    let t = pixel_triangle(id, tri);
+    let a = t.a;
+    let b = t.b;
+    let c = t.c;
+    let w = t.w;
     var p: ShadingPoint;
-    p.position = w.x * a.position + w.y * b.position + w.z * c.position;
+    p.position = pixel_position(t);
     p.view = normalize(frame.camera_pos.xyz - p.position);
-    // Front faces wind counter-clockwise in NDC (the pipelines' FrontFace::Ccw): the
-    // sign of det(H); back faces (double-sided materials) flip the normal as
-    // forward.wgsl's shading_point does.
-    let front = dot(h0, e.e0) > 0.0;
+    // Front faces wind counter-clockwise in NDC (the pipelines' FrontFace::Ccw); back
+    // faces (double-sided materials) flip the normal as forward.wgsl's shading_point does.
     var n = normalize(w.x * a.normal + w.y * b.normal + w.z * c.normal);
-    if (!front) {
+    if (!t.front) {
         n = -n;
     }
     p.normal = n;
@@ -89,6 +127,10 @@ fn surface_point(id: vec2<u32>, tri: u32) -> ShadingPoint {
     // right and one down, taken as the rasterizer's coarse derivatives are, across the
     // pixel's 2×2 quad from its top-left pixel (the triangle's plane extended there, as
     // helper invocations do), so the level matches textureSample in forward shading.
+    let e = t.e;
+    let size = vec2<f32>(frame.size);
+    // One pixel's step along x and y in NDC.
+    let step = vec2<f32>(2.0 / size.x, -2.0 / size.y);
     let corner = vec2<f32>(id & vec2<u32>(~1u)) + 0.5;
     let q0 = vec2<f32>(corner.x / size.x * 2.0 - 1.0, 1.0 - corner.y / size.y * 2.0);
     let uv0 = uv * bary_at(e, q0);

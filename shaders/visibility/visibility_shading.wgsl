@@ -15,7 +15,9 @@
 // visibility/staged_lights.wgsl), RANGE_FIRST (the per-pixel cursor with the range test
 // before the light's properties; with UNIFORM_LIST the workgroup's one tile list, found
 // from the workgroup id, so the compiler sees the walk as uniform), or neither
-// (common/light_loop.wgsl's shade_surface, as forward shading runs it).
+// (common/light_loop.wgsl's shade_surface, as forward shading runs it). SHADOWS with
+// SHADOW_MASK: each shadow-casting light is looked up in a ray-cast mask
+// (shadow/shadow_ray_cast.wgsl), casters numbered as job creation numbers them.
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"
@@ -36,6 +38,9 @@
 @group(0) @binding(7) var<storage, read> triangles: array<u32>;
 @group(0) @binding(8) var<storage, read> material_triangles: array<vec2<u32>>;
 @group(0) @binding(9) var hdr: texture_storage_2d<rgba32float, write>;
+#if SHADOW_MASK
+@group(0) @binding(10) var<storage, read> shadow_mask: array<u32>;
+#endif
 #if CLASSIFIED
 @group(0) @binding(11) var<storage, read> material_tiles: array<u32>;
 @group(0) @binding(12) var<storage, read> material_tile_counts: array<u32>;
@@ -44,6 +49,9 @@
 #include "common/light_lists.wgsl"
 
 #include "visibility/surface.wgsl"
+#if SHADOWS
+#include "common/shadows.wgsl"
+#endif
 
 // Material code generated with WgslOptions::sample_grad when it has textures: it samples
 // with material_uv_ddx / material_uv_ddy, set by surface_point before material_setup.
@@ -140,6 +148,9 @@ fn main(
     // surface rebuilt in a branch and shaded after it came out one ulp off in a few
     // pixels on lavapipe (the compiler fuses the arithmetic differently). A warp with
     // any pixel of this material pays for the rebuild anyway.
+#if SHADOWS
+    shadow_pixel = id.y * frame.size.x + id.x;
+#endif
     let s = rebuild(id.xy, select(range.x, tri, shades));
     let color = staged_lights(surface_unlit(s.p, s.m), shades, s.p, s.m, lane, group_list(tile));
     if (shades) {
@@ -177,6 +188,9 @@ fn main(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group
     if (tri < range.x || tri >= range.y) {
         return;
     }
+#if SHADOWS
+    shadow_pixel = id.y * frame.size.x + id.x;
+#endif
     let s = rebuild(id.xy, tri);
 #if RANGE_FIRST
 #if UNIFORM_LIST

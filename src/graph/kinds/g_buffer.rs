@@ -124,15 +124,9 @@ pub(crate) fn check_msaa_layout(ctx: &KindCtx, at: &str, errors: &mut Vec<GraphE
     }
 }
 
-/// Ray-cast shadows' reads of the unpacked G-buffer: world positions, geometric normals.
+/// The shadow atlas comparison's read of the unpacked G-buffer's world positions.
 pub(crate) const G_POSITION_READ: SlotSpec = SlotSpec::new(
     G_POSITION,
-    SlotType::ColorTexture,
-    Access::Read,
-    Usage::Sampled,
-);
-pub(crate) const G_GEOMETRIC_READ: SlotSpec = SlotSpec::new(
-    G_GEOMETRIC,
     SlotType::ColorTexture,
     Access::Read,
     Usage::Sampled,

@@ -1,10 +1,10 @@
 //! `ShadowRayCast`: one invocation per job, dispatched indirectly from the job count: an
 //! any-hit ray against the scene BVH from the pixel's position offset along its geometric
-//! normal; a hit sets the light's bit in the pixel's mask. Runs
+//! normal (from a G-buffer or a visibility buffer, as its jobs pass reads them:
+//! [`super::shadow_ray_jobs::SurfaceSource`]); a hit sets the light's bit in the pixel's mask. Runs
 //! `shaders/shadow/shadow_ray_cast.wgsl`.
 
-use super::g_buffer::{G_GEOMETRIC_READ, G_POSITION_READ};
-use super::shadow_ray_jobs::{SHADOW_JOBS, SHADOW_MASK};
+use super::shadow_ray_jobs::{check_surface_source, SHADOW_JOBS, SHADOW_MASK, SURFACE_SLOTS};
 use super::{Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 use crate::graph::model::SceneResource;
@@ -33,8 +33,11 @@ pub(crate) const BVH_TRIANGLES: &str = "bvh_triangles";
 pub(crate) const SLOTS: &[SlotSpec] = &[
     SlotSpec::new(SHADOW_JOBS, SlotType::Buffer, Access::Read, Usage::Bound)
         .needs(&[Contents::ShadowJobs]),
-    G_POSITION_READ,
-    G_GEOMETRIC_READ,
+    SURFACE_SLOTS[0],
+    SURFACE_SLOTS[1],
+    SURFACE_SLOTS[2],
+    SURFACE_SLOTS[3],
+    SURFACE_SLOTS[4],
     super::LIGHT_GEOMETRY_READ,
     SlotSpec::new(
         BVH_NODES,
@@ -58,6 +61,7 @@ pub(crate) fn check(p: &ShadowRayCast, ctx: &KindCtx, errors: &mut Vec<GraphErro
             p.normal_offset
         )));
     }
+    check_surface_source(ctx, errors);
 }
 
 impl KindRules for ShadowRayCast {

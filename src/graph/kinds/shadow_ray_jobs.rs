@@ -2,11 +2,20 @@
 //! and faces a pixel, walked from its light list; compacted per workgroup; writes the
 //! casting pass's indirect dispatch and clears each pixel's hit mask. Runs
 //! `shaders/shadow/shadow_ray_jobs.wgsl`.
+//!
+//! Both shadow passes take a pixel's surface from one of two sources, decided by their
+//! reads ([`SurfaceSource`]): a G-buffer's `g_position` and `g_geometric`, or a visibility
+//! buffer's `visibility` ids with the merged `vertices` and `triangles` (rebuilt as
+//! visibility shading rebuilds them, `shaders/shadow/surface_source.wgsl`).
 
-use super::g_buffer::{G_GEOMETRIC, G_GEOMETRIC_READ, G_POSITION, G_POSITION_READ};
+use super::g_buffer::{G_GEOMETRIC, G_POSITION};
+use super::visibility_buffer::VISIBILITY;
+use super::visibility_shading::{TRIANGLES, VERTICES};
 use super::{slot, Access, BufferLayout, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
+use crate::graph::model::{ResourceDesc, SceneResource, TextureFormat};
 use crate::graph::plan::FrameSize;
+use crate::graph::PassRoles;
 use serde::{Deserialize, Serialize};
 
 /// `ShadowRayJobs(jobs_per_pixel: 16.0)`.
@@ -46,9 +55,142 @@ pub(crate) fn job_buffer_bytes(capacity: u64) -> u64 {
     4 * (JOB_HEADER_WORDS + JOB_WORDS * capacity)
 }
 
+/// Where a shadow pass reads its pixels' surfaces from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SurfaceSource {
+    /// `g_position` and `g_geometric`: a G-buffer raster's world positions and geometric
+    /// normals.
+    GBuffer,
+    /// `visibility`, `vertices` and `triangles`: each pixel's triangle, its surface rebuilt
+    /// at the pixel centre (the triangle's normal facing the eye as geometric normal).
+    VisibilityBuffer,
+}
+
+/// The G-buffer source's slots.
+pub const G_BUFFER_SURFACE: [&str; 2] = [G_POSITION, G_GEOMETRIC];
+/// The visibility-buffer source's slots.
+pub const VISIBILITY_SURFACE: [&str; 3] = [VISIBILITY, VERTICES, TRIANGLES];
+
+/// The surface slots both shadow passes share, all optional: `check_surface_source`
+/// requires one whole source. The G-buffer's come first, so graphs that fill them by
+/// type order keep their meaning.
+pub const SURFACE_SLOTS: [SlotSpec; 5] = [
+    SlotSpec::new(G_POSITION, SlotType::ColorTexture, Access::Read, Usage::Sampled).optional(),
+    SlotSpec::new(G_GEOMETRIC, SlotType::ColorTexture, Access::Read, Usage::Sampled).optional(),
+    SlotSpec::new(VISIBILITY, SlotType::ColorTexture, Access::Read, Usage::Sampled).optional(),
+    SlotSpec::new(
+        VERTICES,
+        SlotType::Import(SceneResource::Vertices),
+        Access::Read,
+        Usage::Bound,
+    )
+    .optional(),
+    SlotSpec::new(
+        TRIANGLES,
+        SlotType::Import(SceneResource::Triangles),
+        Access::Read,
+        Usage::Bound,
+    )
+    .optional(),
+];
+
+/// The source a validated shadow pass reads (its reads decide; validation made sure
+/// they name one whole source).
+pub fn surface_source(roles: &PassRoles) -> SurfaceSource {
+    if roles.slot(VISIBILITY).is_some() {
+        SurfaceSource::VisibilityBuffer
+    } else {
+        SurfaceSource::GBuffer
+    }
+}
+
+/// A shadow pass reads one whole surface source: both G-buffer textures (single-sample
+/// Rgba32Float), or the ids (single-sample R32Uint) with both geometry imports.
+pub(crate) fn check_surface_source(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
+    let kind = ctx.pass.kind.label();
+    let filled = |slots: &[&'static str]| -> Vec<&'static str> {
+        slots.iter().copied().filter(|s| ctx.slot(s).is_some()).collect()
+    };
+    let (g, v) = (filled(&G_BUFFER_SURFACE), filled(&VISIBILITY_SURFACE));
+    let list = |slots: &[&str]| slots.join(", ");
+    // Ids not named after their slot fill the G-buffer's by type order.
+    for s in G_BUFFER_SURFACE {
+        if let Some(name) = ctx.slot(s).filter(|n| is_ids(ctx, n)) {
+            errors.push(ctx.mismatch(
+                name,
+                format!("an R32Uint texture of triangle ids fills slot 'visibility', not '{s}': read it as \"visibility={name}\" (with vertices and triangles)"),
+            ));
+            return;
+        }
+    }
+    if !g.is_empty() && !v.is_empty() {
+        let resource = ctx.slot(v[0]).unwrap_or_default();
+        errors.push(ctx.mismatch(
+            resource,
+            format!(
+                "{kind} reads surfaces from a G-buffer ({}) or from a visibility buffer ({}), not both: it reads '{}' as {} and '{resource}' as {}",
+                list(&G_BUFFER_SURFACE),
+                list(&VISIBILITY_SURFACE),
+                ctx.slot(g[0]).unwrap_or_default(),
+                g[0],
+                v[0],
+            ),
+        ));
+        return;
+    }
+    if g.is_empty() && v.is_empty() {
+        errors.push(ctx.bad(format!(
+            "{kind} needs the pixels' surfaces in reads: {} from a G-buffer, or {} from a visibility buffer",
+            list(&G_BUFFER_SURFACE),
+            list(&VISIBILITY_SURFACE)
+        )));
+        return;
+    }
+    let (all, got, source): (&[&str], _, _) = if v.is_empty() {
+        (&G_BUFFER_SURFACE, &g, "a G-buffer")
+    } else {
+        (&VISIBILITY_SURFACE, &v, "a visibility buffer")
+    };
+    let missing: Vec<&str> = all.iter().copied().filter(|s| !got.contains(s)).collect();
+    if !missing.is_empty() {
+        errors.push(ctx.bad(format!(
+            "{kind} reads surfaces from {source} ({}): {} missing from its reads",
+            list(got),
+            list(&missing)
+        )));
+        return;
+    }
+    if v.is_empty() {
+        for s in G_BUFFER_SURFACE {
+            let Some(name) = ctx.slot(s) else { continue };
+            if !ctx.is_single_rgba32f(name) {
+                errors.push(ctx.mismatch(
+                    name,
+                    "ray-cast shadows read world positions and geometric normals from single-sample Rgba32Float G-buffer textures (not the packed G-buffer)",
+                ));
+            }
+        }
+    } else {
+        super::visibility_buffer::check_ids(ctx, errors);
+    }
+}
+
+fn is_ids(ctx: &KindCtx, name: &str) -> bool {
+    matches!(
+        ctx.graph.resources.get(name),
+        Some(ResourceDesc::Texture {
+            format: TextureFormat::R32Uint,
+            ..
+        })
+    )
+}
+
 pub(crate) const SLOTS: &[SlotSpec] = &[
-    G_POSITION_READ,
-    G_GEOMETRIC_READ,
+    SURFACE_SLOTS[0],
+    SURFACE_SLOTS[1],
+    SURFACE_SLOTS[2],
+    SURFACE_SLOTS[3],
+    SURFACE_SLOTS[4],
     super::LIGHT_GEOMETRY_READ,
     super::LIGHT_PROPERTIES_READ,
     SlotSpec::new(
@@ -69,11 +211,7 @@ pub(crate) fn check(p: &ShadowRayJobs, ctx: &KindCtx, errors: &mut Vec<GraphErro
             p.jobs_per_pixel
         )));
     }
-    ctx.require_single_rgba32f(
-        &[G_POSITION, G_GEOMETRIC],
-        "ray-cast shadows read world positions and geometric normals from single-sample Rgba32Float G-buffer textures (not the packed G-buffer)",
-        errors,
-    );
+    check_surface_source(ctx, errors);
 }
 
 impl KindRules for ShadowRayJobs {

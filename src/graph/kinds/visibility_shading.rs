@@ -3,7 +3,9 @@
 //! range fetches the triangle, rebuilds its attributes at the pixel centre and runs the
 //! light loop. With `materials: Classified` and more than one material the frame is first
 //! classified: each workgroup-sized tile is listed under every material it holds, and each
-//! material's dispatch runs over its own tiles only. Runs
+//! material's dispatch runs over its own tiles only. With `shadow_mask` in its reads the
+//! light loop shadows each caster from a ray-cast mask (`ShadowRayJobs`,
+//! `ShadowRayCast`), numbered as forward and deferred shading number them. Runs
 //! `shaders/visibility/visibility_shading.wgsl` (and `classify_materials.wgsl`).
 
 use super::deferred_shading::HDR;
@@ -113,10 +115,10 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     super::LIGHT_PROPERTIES_READ,
     super::LIGHT_LISTS_READ,
     SlotSpec::new(HDR, SlotType::ColorTexture, Access::Write, Usage::Storage),
-    // Taken only to refuse them by name (see `check`).
     SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound)
         .optional()
         .needs(&[Contents::ShadowMask]),
+    // Taken only to refuse them by name (see `check`).
     super::SHADOW_ATLAS_READ,
     super::SHADOW_VIEWS_READ,
 ];
@@ -139,15 +141,15 @@ pub(crate) fn check(p: &VisibilityShading, ctx: &KindCtx, errors: &mut Vec<Graph
         "visibility shading stores into a single-sample Rgba32Float texture",
         errors,
     );
-    let shadows = [
-        SHADOW_MASK,
+    super::check_shadow_mask(ctx, errors);
+    let atlas = [
         super::shadow_atlas::SHADOW_ATLAS,
         super::shadow_atlas::SHADOW_VIEWS,
     ];
-    for name in shadows.iter().filter_map(|s| ctx.slot(s)) {
+    for name in atlas.iter().filter_map(|s| ctx.slot(s)) {
         errors.push(ctx.mismatch(
             name,
-            "visibility shading does not shadow its lights yet: use a G-buffer or forward graph for shadows",
+            "visibility shading shadows its lights from a ray-cast shadow_mask only, not from a shadow atlas: use a G-buffer or forward graph for the atlas",
         ));
     }
 }
@@ -242,7 +244,7 @@ mod tests {
     }
 
     #[test]
-    fn refuses_shadows_and_multisampled_ids() {
+    fn takes_a_mask_with_its_lists_refuses_the_atlas_and_multisampled_ids() {
         let e = errors(
             &format!(
                 r#"{VIS} {PREPASS} Pass(name: "s", kind: VisibilityShading(), reads: [{READS}, "shadow_mask=mask"], writes: ["hdr"])"#
@@ -250,7 +252,7 @@ mod tests {
             "hdr",
         );
         assert!(
-            e.contains("resource 'mask': visibility shading does not shadow its lights yet"),
+            e.contains("resource 'mask': the shadow mask numbers the lights of the culled lists"),
             "{e}"
         );
         let e = errors(

@@ -6,6 +6,7 @@ use super::{defines, PrepareCtx, PreparedPass, Timestamps};
 use crate::gpu::readback::read_buffer_range;
 use crate::graph::kinds::shadow_ray_cast::DEFAULT_NORMAL_OFFSET;
 use crate::graph::kinds::shadow_ray_jobs::{self as kind, SHADOW_JOBS, SHADOW_MASK};
+use crate::graph::kinds::shadow_ray_jobs::{surface_source, SurfaceSource};
 use crate::graph::Name;
 use crate::graph::{slot, ScheduledPass, ShadowRayJobs};
 use crate::render::pipelines::PipelineKey;
@@ -37,16 +38,18 @@ pub(super) fn prepare(
     let mut offered = cx.declared(sp)?;
     let params = cx.list_params(&sp.name, sp.required(slot::LIGHT_LISTS))?;
     offered.buffer("list_params", &params);
+    let mut d = vec![
+        ("LIGHT_LISTS", "1".into()),
+        (
+            "JOB_CAPACITY",
+            format!("{}u", capacity.min(u32::MAX as u64)),
+        ),
+        ("SHADOW_NORMAL_OFFSET", format!("{DEFAULT_NORMAL_OFFSET:?}")),
+    ];
+    d.extend(surface_define(&sp.roles));
     let key = |state: &str| PipelineKey {
         shader: "shadow/shadow_ray_jobs.wgsl".into(),
-        defines: defines(&[
-            ("LIGHT_LISTS", "1".into()),
-            (
-                "JOB_CAPACITY",
-                format!("{}u", capacity.min(u32::MAX as u64)),
-            ),
-            ("SHADOW_NORMAL_OFFSET", format!("{DEFAULT_NORMAL_OFFSET:?}")),
-        ]),
+        defines: defines(&d),
         virtual_code: BTreeMap::new(),
         state: state.to_string(),
     };
@@ -64,6 +67,15 @@ pub(super) fn prepare(
         mask_bytes: mask.size(),
         pixels,
     })
+}
+
+/// The define that makes the shadow shaders rebuild surfaces from visibility-buffer ids
+/// (shaders/shadow/surface_source.wgsl) instead of loading the G-buffer.
+pub(super) fn surface_define(roles: &crate::graph::PassRoles) -> Option<(&'static str, String)> {
+    match surface_source(roles) {
+        SurfaceSource::GBuffer => None,
+        SurfaceSource::VisibilityBuffer => Some(("VISIBILITY_IDS", "1".into())),
+    }
 }
 
 impl PreparedPass for ShadowRayJobsPass {

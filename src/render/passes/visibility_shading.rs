@@ -4,7 +4,8 @@
 //! and bind their textures in group 2. With `materials: Classified` and more than one
 //! material a classification dispatch first lists every tile under the materials it
 //! holds (shaders/visibility/classify_materials.wgsl) and each material's dispatch is
-//! indirect, over its own tiles; otherwise each covers the whole frame.
+//! indirect, over its own tiles; otherwise each covers the whole frame. A read
+//! `shadow_mask` shadows the casters (`SHADOWS`, `SHADOW_MASK`).
 
 use super::{defines, PrepareCtx, PreparedPass, ShadeLists, Timestamps};
 use crate::graph::kinds::visibility_shading::{LightLoop, MaterialDispatch};
@@ -50,6 +51,8 @@ pub(super) fn prepare(
 ) -> Result<VisibilityShadingPass, RenderError> {
     let mut offered = cx.declared(sp)?;
     let lists = cx.shading_lists(sp, p.lights, &mut offered)?;
+    // Validation lets only a ray-cast mask through.
+    let shadows = cx.shading_shadows(sp, &mut offered);
     let layout = tile_layout(cx, sp, lists);
     let side = p.workgroup_side();
     let light_loop = choose_light_loop(p.light_loop, layout, side);
@@ -98,6 +101,7 @@ pub(super) fn prepare(
         }
         d.extend(lists.define());
         d.extend(loop_define(light_loop));
+        d.extend(crate::render::draws::shadow_defines(shadows));
         // The shader's `@workgroup_size(SHADING_GROUP, SHADING_GROUP, 1)`.
         d.push(("SHADING_GROUP", format!("{side}u")));
         if light_loop == LightLoop::GroupList {
