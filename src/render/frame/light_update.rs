@@ -1,6 +1,7 @@
 //! Per-frame light updates: new light values written over the scene's light buffers,
 //! the frame's light count set, and the passes that keep per-light CPU state (shadow
-//! atlas allocation, per-light dispatches) told. No pipeline or bind group changes:
+//! atlas allocation, reflective shadow maps' views, VPL spawn parameters, per-light
+//! dispatches) told. No pipeline or bind group changes:
 //! culling and the light lists are rebuilt by the GPU every frame anyway.
 
 use super::PreparedFrame;
@@ -13,12 +14,17 @@ use std::sync::atomic::Ordering;
 /// Why a light update was refused; nothing was written.
 #[derive(Debug, thiserror::Error)]
 pub enum LightUpdateError {
+    /// More lights than the light buffers hold room for.
     #[error("light update of {count} lights is over the capacity of {capacity} set at upload (SceneGpu::upload_with_light_capacity)")]
     OverCapacity { count: usize, capacity: u32 },
+    /// A light fails the scene-file checks.
     #[error("light update: light {index}: {problem}")]
     BadLight { index: usize, problem: String },
+    /// A light needs a feature the graph was compiled without.
     #[error("light update: light {index} adds {feature}, which the scene had none of when the graph was compiled (passes for it were dropped or specialised away): compile and prepare again")]
     NewFeature { index: usize, feature: &'static str },
+    /// A pass cannot show the lights with the room it was prepared with (the VPL
+    /// candidates of more or larger indirect lights).
     #[error("light update: pass '{pass}' cannot follow moving lights: {problem}")]
     Pass { pass: String, problem: String },
 }
@@ -46,7 +52,7 @@ impl PreparedFrame {
         }
         check_features(&self.light_features, lights)?;
         for (name, pass) in &self.passes {
-            pass.can_follow_lights()
+            pass.can_follow_lights(lights)
                 .map_err(|problem| LightUpdateError::Pass {
                     pass: name.to_string(),
                     problem,
