@@ -487,7 +487,10 @@ fn a_moved_indirect_light_moves_its_maps_and_vpls_as_a_fresh_prepare_would() {
     // measured 0).
     let (d, px) = max_rel_diff(&moved.image, &fresh_image);
     assert!(d <= 6e-6, "moved vs fresh prepare: {d:e} at pixel {px}");
-    assert_eq!(moved.vpls[0].spawned, fresh.render(&r).unwrap().vpls[0].spawned);
+    assert_eq!(
+        moved.vpls[0].spawned,
+        fresh.render(&r).unwrap().vpls[0].spawned
+    );
     // The VPLs followed the light across the box: their flux sat on the left (red
     // wall) side, now on the right.
     let centre_b = vpl_centre_x(&r, &prepared, 1);
@@ -519,7 +522,10 @@ fn a_moved_indirect_light_moves_its_maps_and_vpls_as_a_fresh_prepare_would() {
     with_plain.lights = vec![b, plain];
     let (fresh, _) = prepare(&mut r, "indirect_vpl.ron", &with_plain, 0);
     let (d, px) = max_rel_diff(&two.image, &fresh.render(&r).unwrap().image);
-    assert!(d <= 6e-6, "two lights vs fresh prepare: {d:e} at pixel {px}");
+    assert!(
+        d <= 6e-6,
+        "two lights vs fresh prepare: {d:e} at pixel {px}"
+    );
     assert_eq!(two.vpls[0].scene_lights, 2);
     // VPL controls go by light index: as light 1 the indirect light gets the default
     // n = 8, four times the candidates the frame was prepared for. Refused, by pass.
@@ -528,8 +534,9 @@ fn a_moved_indirect_light_moves_its_maps_and_vpls_as_a_fresh_prepare_would() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("'vpl_spawn'") && e.contains("make 384 VPL candidates") && e.contains("prepared for 96"),
+        e.contains("'vpl_spawn'")
+            && e.contains("make 384 VPL candidates")
+            && e.contains("prepared for 96"),
         "{e}"
     );
 }
-

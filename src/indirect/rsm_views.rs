@@ -5,8 +5,8 @@
 //! of every light update (`PreparedFrame::update_lights`).
 
 use crate::scene::{Light, LightShape, Scene, VplControls};
-use std::collections::BTreeMap;
 use glam::{Mat4, Vec3};
+use std::collections::BTreeMap;
 
 /// One view of one light.
 #[derive(Clone, Copy, Debug, PartialEq)]
