@@ -300,6 +300,83 @@ fn render_time_is_reproducible_and_moves_the_lights() {
     assert!(first != later, "another --time gave the same image");
 }
 
+/// `watch --time` until its first frame is written; then stopped.
+fn watch_at(dir: &Path, scene: &Path, time: &str, out: &str) -> Vec<u8> {
+    use std::io::{BufRead, BufReader};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lightgraph"))
+        .current_dir(dir)
+        .args(["watch", "--scene", scene.to_str().unwrap()])
+        .args([
+            "--width", "64", "--height", "36", "--time", time, "--out", out,
+        ])
+        .env_remove("LIGHTGRAPH_ROOT")
+        .env_remove("XDG_RUNTIME_DIR")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    let stdout = BufReader::new(child.stdout.take().unwrap());
+    let mut seen = String::new();
+    for line in stdout.lines().map_while(Result::ok) {
+        seen.push_str(&line);
+        seen.push('\n');
+        if line.starts_with("watching; wrote") {
+            break;
+        }
+    }
+    child.kill().unwrap();
+    let status = child.wait().unwrap();
+    assert!(
+        seen.contains("watching; wrote"),
+        "watch ended ({status}) before its first frame:\n{seen}\n{}",
+        std::io::read_to_string(child.stderr.take().unwrap()).unwrap_or_default()
+    );
+    std::fs::read(dir.join(out)).unwrap()
+}
+
+#[test]
+fn watch_time_renders_what_render_time_renders() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("moving.ron");
+    std::fs::write(&scene, MOVING_SCENE).unwrap();
+    let watched = watch_at(dir.path(), &scene, "1.25", "w.exr");
+    assert!(watched.len() > 64 * 36 * 4, "an EXR of 64x36 pixels");
+    assert!(
+        watched == render_at(dir.path(), &scene, "1.25", "r.exr"),
+        "watch --time 1.25 and render --time 1.25 differ"
+    );
+    // Without --time both place the lights at 0 (the path light starts a whole offset
+    // away from where it is written, so unplaced lights would differ).
+    let watched_0 = watch_at(dir.path(), &scene, "0", "w0.exr");
+    assert!(watched_0 != watched, "another --time gave the same image");
+    let o = Command::new(env!("CARGO_BIN_EXE_lightgraph"))
+        .current_dir(dir.path())
+        .args(["render", "--scene", scene.to_str().unwrap()])
+        .args(["--width", "64", "--height", "36", "--out", "r0.exr"])
+        .env_remove("LIGHTGRAPH_ROOT")
+        .env_remove("XDG_RUNTIME_DIR")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        watched_0 == std::fs::read(dir.path().join("r0.exr")).unwrap(),
+        "watch --time 0 differs from render without --time"
+    );
+    let o = Command::new(env!("CARGO_BIN_EXE_lightgraph"))
+        .current_dir(dir.path())
+        .args(["watch", "--scene", scene.to_str().unwrap()])
+        .args(["--time", "inf", "--out", "x.exr"])
+        .env_remove("LIGHTGRAPH_ROOT")
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("--time must be a finite number"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
 #[test]
 fn scene_file_motion_is_a_pure_function_of_time() {
     let loaded = lightgraph::scene::scene_file::build_scene(

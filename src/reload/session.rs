@@ -28,6 +28,9 @@ use std::time::{Duration, Instant};
 /// Where the scene comes from: a file that is watched and reloaded, or a fixed scene.
 pub enum SceneSource {
     File(PathBuf),
+    /// A file watched and reloaded as with `File`, its moving lights placed at the given
+    /// seconds on every load (`Scene::place_lights_at`: a still frame, as `render --time`).
+    FileAt(PathBuf, f64),
     Fixed(Box<Scene>),
 }
 
@@ -142,6 +145,11 @@ fn load_scene(source: &SceneSource) -> Result<(Scene, Vec<PathBuf>), String> {
                 (l.scene, l.files)
             })
             .map_err(|e| e.to_string()),
+        SceneSource::FileAt(p, time) => {
+            let (mut scene, files) = load_scene(&SceneSource::File(p.clone()))?;
+            scene.place_lights_at(*time);
+            Ok((scene, files))
+        }
         SceneSource::Fixed(s) => Ok(((**s).clone(), Vec::new())),
     }
 }
