@@ -450,9 +450,24 @@ fn the_shadow_atlas_follows_moved_casters() {
     let mut start = scene.clone();
     start.lights = a.to_vec();
     let (prepared, gpu) = prepare(&mut r, "shadow_atlas.ron", &start, 0);
-    prepared.render(&r).unwrap();
+    let allocations = |f: &lightgraph::render::FrameResult| f.atlases[0].allocations;
+    assert_eq!(allocations(&prepared.render(&r).unwrap()), 1, "at prepare");
+    // A viewer's frame: the lights move, then the camera is set (to where it was):
+    // one allocation for both, made when the frame is recorded.
     prepared.update_lights(&r, &gpu, &b).unwrap();
-    let moved = prepared.render(&r).unwrap().image;
+    prepared.set_camera(&r, &start);
+    let moved = prepared.render(&r).unwrap();
+    assert_eq!(
+        allocations(&moved),
+        2,
+        "one more for the moved lights and camera"
+    );
+    assert_eq!(
+        allocations(&prepared.render(&r).unwrap()),
+        2,
+        "none for a frame where nothing moved"
+    );
+    let moved = moved.image;
     // The same graph prepared with the casters at B from the start: the same atlas
     // allocation and views, so the same image.
     assert_same(

@@ -233,6 +233,9 @@ pub struct AtlasReport {
     /// Draw calls and triangles over all views after culling chunks per view.
     pub draws: u64,
     pub triangles: u64,
+    /// Allocations made since prepare: one at prepare, then at most one a frame, before
+    /// a frame whose camera or lights changed.
+    pub allocations: u64,
 }
 
 impl AtlasReport {
