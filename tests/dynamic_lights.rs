@@ -510,6 +510,21 @@ fn an_animated_sweep_moves_the_lights_and_compares_them_where_they_started() {
     // left where the last timed frame moved them are off by the whole signal).
     let max_rel = rows[0].max_rel.expect("an error column");
     assert!(max_rel <= 1e-3, "max_rel {max_rel}");
+    // The CPU's share of a moving frame: evaluating 64 orbits and writing them. Well
+    // under a millisecond on any machine; not zero, and written to the CSV.
+    let update_ms = rows[0].light_update_cpu_ms.expect("a light update column");
+    eprintln!("light update: {update_ms} ms CPU a frame (64 lights)");
+    assert!(update_ms > 0.0 && update_ms < 50.0, "{update_ms} ms");
+    let csv = lightgraph::bench::report::to_csv(&rows);
+    let mut reader = csv::Reader::from_reader(csv.as_bytes());
+    let column = reader
+        .headers()
+        .unwrap()
+        .iter()
+        .position(|c| c == "light_update_cpu_ms")
+        .expect("the CSV column");
+    let record = reader.records().next().unwrap().unwrap();
+    assert_eq!(record[column].parse::<f64>().unwrap(), update_ms);
 
     let bad = ANIMATED_SWEEP.replace("animate: 0.25", "animate: 0");
     let e = Sweep::parse(&bad, Path::new("animated.ron"))
