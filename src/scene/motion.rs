@@ -147,11 +147,10 @@ impl Motion {
         let axis_name = ["x", "y", "z"];
         match &self.orbit {
             None => {
-                for k in 0..3 {
+                for (k, axis) in axis_name.iter().enumerate() {
                     if let Some(v) = [lo[k], hi[k]].into_iter().find(|&v| beyond(v)) {
                         return Err(format!(
-                            "path takes the light to {} = {v:e} m, beyond ±{MAX_COORDINATE:e} m",
-                            axis_name[k]
+                            "path takes the light to {axis} = {v:e} m, beyond ±{MAX_COORDINATE:e} m"
                         ));
                     }
                 }
@@ -170,12 +169,11 @@ impl Motion {
                         o.centre[k].abs() + far.length()
                     }
                 };
-                for k in 0..3 {
+                for (k, axis) in axis_name.iter().enumerate() {
                     let v = reach(k);
                     if beyond(v) {
                         return Err(format!(
-                            "orbit takes the light to |{}| = {v:e} m, beyond ±{MAX_COORDINATE:e} m",
-                            axis_name[k]
+                            "orbit takes the light to |{axis}| = {v:e} m, beyond ±{MAX_COORDINATE:e} m"
                         ));
                     }
                 }
