@@ -187,3 +187,28 @@ fn bad_edits_are_refused_and_leave_the_frame_as_it_was() {
         "after refusals",
     );
 }
+
+/// The build count the edits above assert to be zero does see builds: a material the
+/// scene holds but no mesh drew has no pipelines yet, and a mesh of it builds them.
+#[test]
+fn a_mesh_of_a_material_no_mesh_drew_builds_its_pipelines() {
+    let mut r = renderer();
+    let mut scene = room();
+    scene
+        .materials
+        .push(lambert("spare", Vec3::new(0.2, 0.6, 0.9)));
+    let (mut frame, mut gpu) = prepare(&mut r, "default.ron", &scene);
+    let mut mesh = block();
+    mesh.material = 2;
+    r.add_mesh(&mut frame, &mut scene, &mut gpu, mesh).unwrap();
+    assert!(
+        !frame.stats().pipelines_built.is_empty(),
+        "a new material's pipelines were not counted"
+    );
+    let image = frame.render(&r).unwrap().image;
+    assert_same(
+        &image,
+        &fresh(&mut r, "default.ron", &scene),
+        "spare material",
+    );
+}
