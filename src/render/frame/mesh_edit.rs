@@ -151,12 +151,9 @@ impl Renderer {
                 capacity: gpu.light_capacity,
             });
         }
-        // The frame starts from the upload's lights: make them the scene's.
-        gpu.write_lights(&self.ctx.queue, &scene.lights)
-            .map_err(|e| RenderError::Pass {
-                pass: "mesh edit".into(),
-                message: e.to_string(),
-            })?;
+        // The frame starts from the upload's light count and the passes from the scene's
+        // lights: the buffers get the scene's lights once the prepare succeeded (a
+        // refused edit leaves them as the last update wrote them).
         gpu.light_count = scene.lights.len() as u32;
         let light_stats = frame.stats.is_some();
         let rebound = self.prepare_reusing(
@@ -167,6 +164,11 @@ impl Renderer {
             light_stats,
             Some(frame),
         )?;
+        gpu.write_lights(&self.ctx.queue, &scene.lights)
+            .map_err(|e| RenderError::Pass {
+                pass: "mesh edit".into(),
+                message: e.to_string(),
+            })?;
         *frame = rebound;
         Ok(())
     }
