@@ -32,6 +32,18 @@ pub(crate) fn motion_for(scene: &Scene) -> Vec<LightMotion> {
     }]
 }
 
+/// What timing moving lights measured.
+pub struct MovingTimes {
+    /// The GPU's times, as for still lights.
+    pub times: PointTimes,
+    /// Per graph, the CPU milliseconds of every light update before a frame (warm-up
+    /// and timed): evaluating the motion (`animate_into`) and
+    /// `PreparedFrame::update_lights` (checks, the two buffer writes, the passes' light
+    /// state). The shadow atlas's reallocation runs when the frame is recorded and is not
+    /// in it.
+    pub update_cpu_ms: Vec<Vec<f64>>,
+}
+
 /// [`timing::time_point`] with the lights moved before every frame; afterwards every
 /// frame is given the scene's own lights back (what the reference images show).
 pub(crate) fn time_moving(
@@ -41,17 +53,24 @@ pub(crate) fn time_moving(
     renderer: &Renderer,
     method: &Method,
     step: f64,
-) -> Result<PointTimes, RenderError> {
+) -> Result<MovingTimes, RenderError> {
     let motion = motion_for(scene);
     let mut lights = Vec::with_capacity(scene.lights.len());
     let mut frame = 0u64;
+    let mut update_cpu_ms = vec![Vec::new(); frames.len()];
     let times = timing::time_point_with(frames, renderer, method, &mut |g| {
         frame += 1;
+        let start = std::time::Instant::now();
         animate_into(&scene.lights, &motion, frame as f64 * step, &mut lights);
-        Ok(frames[g].update_lights(renderer, gpu, &lights)?)
+        frames[g].update_lights(renderer, gpu, &lights)?;
+        update_cpu_ms[g].push(start.elapsed().as_secs_f64() * 1e3);
+        Ok(())
     })?;
     for f in frames {
         f.update_lights(renderer, gpu, &scene.lights)?;
     }
-    Ok(times)
+    Ok(MovingTimes {
+        times,
+        update_cpu_ms,
+    })
 }

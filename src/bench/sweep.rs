@@ -380,19 +380,29 @@ pub fn run(
                         .map(|g| prepare(g, &point, renderer))
                         .collect::<Result<Vec<_>, _>>()?;
                     let frames: Vec<&PreparedFrame> = prepared.iter().collect();
-                    let times = match sweep.animate {
-                        None => timing::time_point(&frames, renderer, &sweep.method())?,
-                        Some(step) => super::animate::time_moving(
-                            &frames,
-                            point.scene,
-                            &gpu,
-                            renderer,
-                            &sweep.method(),
-                            step,
-                        )?,
+                    let (times, update_cpu_ms) = match sweep.animate {
+                        None => (
+                            timing::time_point(&frames, renderer, &sweep.method())?,
+                            None,
+                        ),
+                        Some(step) => {
+                            let moving = super::animate::time_moving(
+                                &frames,
+                                point.scene,
+                                &gpu,
+                                renderer,
+                                &sweep.method(),
+                                step,
+                            )?;
+                            (moving.times, Some(moving.update_cpu_ms))
+                        }
                     };
-                    for ((g, frame), graph_times) in
-                        sweep.graphs.iter().zip(&prepared).zip(&times.graphs)
+                    for (i, ((g, frame), graph_times)) in sweep
+                        .graphs
+                        .iter()
+                        .zip(&prepared)
+                        .zip(&times.graphs)
+                        .enumerate()
                     {
                         let mut row = BenchRow {
                             scene: scene.name.clone(),
@@ -409,6 +419,10 @@ pub fn run(
                             ..Default::default()
                         };
                         set_timing_columns(&mut row, sweep, graph_times, &times, renderer);
+                        row.light_update_cpu_ms = update_cpu_ms
+                            .as_ref()
+                            .and_then(|ms| summarize(&ms[i]))
+                            .map(|t| t.median);
                         let reference_name = sweep.reference_for(g);
                         let reference = references.iter().find(|r| r.0 == reference_name);
                         row.reference = reference.map(|r| r.0.trim_end_matches(".ron").to_string());

@@ -13,8 +13,15 @@ pub fn watch(
     width: u32,
     height: u32,
     out: &Path,
+    time: Option<f64>,
 ) -> Result<()> {
     use lightgraph::reload::{ReloadSession, SceneSource};
+    if time.is_some_and(|t| !t.is_finite()) {
+        bail!("--time must be a finite number of seconds");
+    }
+    // Moving lights are placed where `render --time` places them (time 0 by default), on
+    // the first load and every reload.
+    let time = time.unwrap_or(0.0);
     let project = assets::project();
     if project.root.is_none() && graph.is_none() && scene.is_none() {
         bail!(
@@ -28,8 +35,12 @@ pub fn watch(
     println!("{}", watched_root(&project));
     let graph = graph.unwrap_or_else(|| project_path("graphs/default.ron"));
     let source = match scene {
-        Some(p) => SceneSource::File(p),
-        None => SceneSource::Fixed(Box::new(load_scene(None)?)),
+        Some(p) => SceneSource::FileAt(p, time),
+        None => {
+            let mut scene = load_scene(None)?;
+            scene.place_lights_at(time);
+            SceneSource::Fixed(Box::new(scene))
+        }
     };
     let renderer = Renderer::headless()?;
     let materials: Vec<PathBuf> = project.disk_folder("materials").into_iter().collect();

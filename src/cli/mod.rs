@@ -71,6 +71,10 @@ pub enum Command {
         /// Where every good frame is written: .png (tonemapped) or .exr (linear HDR).
         #[arg(long)]
         out: PathBuf,
+        /// Time in seconds at which moving lights are placed on every load of the scene
+        /// (scene `motion:`; default 0, as for `render`).
+        #[arg(long, value_name = "SECONDS")]
+        time: Option<f64>,
     },
     /// A window onto a hot-reloading graph: fly/orbit camera, per-pass GPU times, light
     /// statistics, reload errors and graph variants in an overlay.
@@ -313,7 +317,8 @@ pub fn run() -> Result<()> {
             width,
             height,
             out,
-        }) => live::watch(scene, graph, width, height, &out),
+            time,
+        }) => live::watch(scene, graph, width, height, &out, time),
         Some(Command::Bench { sweep, out }) => bench::run_bench(sweep.as_deref(), &out),
         Some(Command::View(args)) => live::view(args),
         Some(Command::ReloadBench(args)) => bench::reload_bench(&args),

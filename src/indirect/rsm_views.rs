@@ -1,10 +1,12 @@
 //! Where each indirect light's reflective-shadow-map views go: one tile for a spot light
 //! of at most 60° half-angle, six cube faces otherwise, in scene order on a grid of
 //! tiles over the atlas. The views do not depend on the camera, so both the map pass
-//! and the spawn pass compute the same layout from the scene.
+//! and the spawn pass compute the same layout from the scene, and again from the lights
+//! of every light update (`PreparedFrame::update_lights`).
 
 use crate::scene::{Light, LightShape, Scene, VplControls};
 use glam::{Mat4, Vec3};
+use std::collections::BTreeMap;
 
 /// One view of one light.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -94,14 +96,34 @@ pub(crate) fn layout(
     height: u32,
     max_lights: u32,
 ) -> RsmLayout {
+    layout_lights(
+        &scene.lights,
+        &scene.vpl_controls,
+        tile,
+        width,
+        height,
+        max_lights,
+    )
+}
+
+/// [`layout`] for `lights` with the VPL controls of each light index (`Scene::vpl_controls`;
+/// a light not in it gets the defaults, as in [`Scene::vpl`]).
+pub(crate) fn layout_lights(
+    lights: &[Light],
+    controls_of: &BTreeMap<u32, VplControls>,
+    tile: u32,
+    width: u32,
+    height: u32,
+    max_lights: u32,
+) -> RsmLayout {
     let cols = width / tile.max(1);
     let cells = cols * (height / tile.max(1));
     let mut out = RsmLayout::default();
-    for (i, l) in scene.lights.iter().enumerate() {
+    for (i, l) in lights.iter().enumerate() {
         if l.flags & crate::scene::light_flags::INDIRECT == 0 {
             continue;
         }
-        let controls = scene.vpl(i);
+        let controls = controls_of.get(&(i as u32)).copied().unwrap_or_default();
         let views = light_views(l);
         let drop = |reason: String| DroppedRsmLight {
             light: i as u32,

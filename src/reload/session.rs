@@ -29,6 +29,9 @@ use std::time::{Duration, Instant};
 pub enum SceneSource {
     /// A scene file (RON or glTF), reloaded when it or what it references changes.
     File(PathBuf),
+    /// A file watched and reloaded as with `File`, its moving lights placed at the given
+    /// seconds on every load (`Scene::place_lights_at`: a still frame, as `render --time`).
+    FileAt(PathBuf, f64),
     /// A scene given once, never reloaded.
     Fixed(Box<Scene>),
 }
@@ -150,6 +153,11 @@ fn load_scene(source: &SceneSource) -> Result<(Scene, Vec<PathBuf>), String> {
                 (l.scene, l.files)
             })
             .map_err(|e| e.to_string()),
+        SceneSource::FileAt(p, time) => {
+            let (mut scene, files) = load_scene(&SceneSource::File(p.clone()))?;
+            scene.place_lights_at(*time);
+            Ok((scene, files))
+        }
         SceneSource::Fixed(s) => Ok(((**s).clone(), Vec::new())),
     }
 }

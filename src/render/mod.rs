@@ -20,7 +20,7 @@ pub mod visibility_geometry;
 
 pub(crate) use bind::LayoutCache;
 pub use device_limits::supported_sample_counts;
-pub use frame::{LightUpdateError, PreparedFrame, RenderTimings};
+pub use frame::{LightUpdateError, MeshEditError, PreparedFrame, RenderTimings};
 pub use materials::MaterialProgram;
 pub use pipelines::{
     CacheCounters, GpuStateAtBuild, Pipeline, PipelineBuild, PipelineCache, PipelineKey,

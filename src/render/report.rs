@@ -257,6 +257,9 @@ pub struct AtlasReport {
     pub draws: u64,
     /// Triangles drawn over all views after culling chunks per view.
     pub triangles: u64,
+    /// Allocations made since prepare: one at prepare, then at most one a frame, before
+    /// a frame whose camera or lights changed.
+    pub allocations: u64,
 }
 
 impl AtlasReport {

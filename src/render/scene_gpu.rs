@@ -236,43 +236,7 @@ impl SceneGpu {
             .iter()
             .enumerate()
             .filter(|(_, m)| !m.indices.is_empty())
-            .map(|(scene_mesh, m)| {
-                let (shadow_indices, chunks) =
-                    crate::shadow::chunks::chunk_triangles(&m.positions, &m.indices);
-                let vertices = gpu_vertices(m);
-                GpuMesh {
-                    vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some(&m.name),
-                        contents: bytemuck::cast_slice(&vertices),
-                        usage: wgpu::BufferUsages::VERTEX,
-                    }),
-                    indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some(&m.name),
-                        contents: bytemuck::cast_slice(&m.indices),
-                        usage: wgpu::BufferUsages::INDEX,
-                    }),
-                    index_count: m.indices.len() as u32,
-                    material: m.material.min(materials.len() - 1),
-                    bounds: m.positions.iter().fold(
-                        [glam::Vec3::INFINITY, glam::Vec3::NEG_INFINITY],
-                        |[lo, hi], &p| [lo.min(p), hi.max(p)],
-                    ),
-                    shadow_indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some(&m.name),
-                        // Never empty: a mesh of only bad triangles binds one unused entry.
-                        contents: bytemuck::cast_slice(if shadow_indices.is_empty() {
-                            &[0u32; 3][..]
-                        } else {
-                            &shadow_indices[..]
-                        }),
-                        usage: wgpu::BufferUsages::INDEX,
-                    }),
-                    chunks: chunks.into(),
-                    scene_mesh,
-                    first_triangle: 0,
-                    blended_casts_shadow: m.blended_casts_shadow,
-                }
-            })
+            .map(|(scene_mesh, m)| upload_mesh(device, m, scene_mesh, materials.len()))
             .collect();
         let (mut geometry, mut properties) = light_buffers(&scene.lights);
         let light_capacity = capacity.max(scene.lights.len() as u32);
@@ -295,14 +259,63 @@ impl SceneGpu {
             bvh: Default::default(),
             visibility: Default::default(),
         };
-        // Visibility ids: opaque triangles numbered in draw order.
+        gpu.number_triangles();
+        gpu
+    }
+
+    /// Visibility ids: opaque triangles numbered in draw order.
+    fn number_triangles(&mut self) {
+        for m in &mut self.meshes {
+            m.first_triangle = 0;
+        }
         let mut next = 0u32;
-        for mesh in gpu.opaque_draws() {
-            let m = &mut gpu.meshes[mesh];
+        for mesh in self.opaque_draws() {
+            let m = &mut self.meshes[mesh];
             m.first_triangle = next;
             next = next.saturating_add(m.index_count / 3);
         }
-        gpu
+    }
+
+    /// Uploads `scene.meshes[index]`, a mesh just added to the scene this was uploaded
+    /// from (meshes after it in the scene shift up by one): its buffers alone are
+    /// created; the visibility ids are numbered again and the shadow BVH and the merged
+    /// visibility geometry are dropped, to be built for the new geometry when a pass
+    /// next binds them. Prepared frames need their passes bound again:
+    /// [`Renderer::add_mesh`](super::Renderer::add_mesh) does both.
+    pub fn add_mesh(&mut self, device: &wgpu::Device, scene: &Scene, index: usize) {
+        for m in &mut self.meshes {
+            if m.scene_mesh >= index {
+                m.scene_mesh += 1;
+            }
+        }
+        let mesh = &scene.meshes[index];
+        if !mesh.indices.is_empty() {
+            let at = self.meshes.partition_point(|m| m.scene_mesh < index);
+            let uploaded = upload_mesh(device, mesh, index, self.materials.len());
+            self.meshes.insert(at, uploaded);
+        }
+        self.geometry_changed();
+    }
+
+    /// Forgets the upload of scene mesh `index`, about to be removed from the scene
+    /// (meshes after it shift down by one); as [`add_mesh`](Self::add_mesh), the ids, the
+    /// BVH and the merged geometry follow.
+    pub fn remove_mesh(&mut self, index: usize) {
+        self.meshes.retain(|m| m.scene_mesh != index);
+        for m in &mut self.meshes {
+            if m.scene_mesh > index {
+                m.scene_mesh -= 1;
+            }
+        }
+        self.geometry_changed();
+    }
+
+    /// The meshes changed: number the ids again and drop what was built from the old
+    /// geometry (clones of this upload keep theirs).
+    fn geometry_changed(&mut self) {
+        self.number_triangles();
+        self.bvh = Default::default();
+        self.visibility = Default::default();
     }
 
     /// Mesh indices to draw for opaque and alpha-masked geometry, sorted by material so
@@ -340,6 +353,49 @@ impl SceneGpu {
     pub fn view_depth(&self, mesh: usize, view: &glam::Mat4) -> f32 {
         let [lo, hi] = self.meshes[mesh].bounds;
         -view.transform_point3((lo + hi) * 0.5).z
+    }
+}
+
+/// One mesh's vertex, index and chunked shadow index buffers.
+fn upload_mesh(
+    device: &wgpu::Device,
+    m: &crate::scene::Mesh,
+    scene_mesh: usize,
+    materials: usize,
+) -> GpuMesh {
+    let (shadow_indices, chunks) = crate::shadow::chunks::chunk_triangles(&m.positions, &m.indices);
+    let vertices = gpu_vertices(m);
+    GpuMesh {
+        vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(&m.name),
+            contents: bytemuck::cast_slice(&vertices),
+            usage: wgpu::BufferUsages::VERTEX,
+        }),
+        indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(&m.name),
+            contents: bytemuck::cast_slice(&m.indices),
+            usage: wgpu::BufferUsages::INDEX,
+        }),
+        index_count: m.indices.len() as u32,
+        material: m.material.min(materials - 1),
+        bounds: m.positions.iter().fold(
+            [glam::Vec3::INFINITY, glam::Vec3::NEG_INFINITY],
+            |[lo, hi], &p| [lo.min(p), hi.max(p)],
+        ),
+        shadow_indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(&m.name),
+            // Never empty: a mesh of only bad triangles binds one unused entry.
+            contents: bytemuck::cast_slice(if shadow_indices.is_empty() {
+                &[0u32; 3][..]
+            } else {
+                &shadow_indices[..]
+            }),
+            usage: wgpu::BufferUsages::INDEX,
+        }),
+        chunks: chunks.into(),
+        scene_mesh,
+        first_triangle: 0,
+        blended_casts_shadow: m.blended_casts_shadow,
     }
 }
 

@@ -2,6 +2,7 @@
 //! value is a pure function of (light, time), so a frame at time t is the same on every
 //! run; evaluating it allocates nothing (see [`animate_into`]).
 
+use super::ranges::{MAX_COORDINATE, MAX_LIGHT_POWER};
 use super::types::{Light, LightShape};
 use glam::{Quat, Vec3};
 use serde::{Deserialize, Serialize};
@@ -141,6 +142,66 @@ impl Motion {
         Ok(())
     }
 
+    /// Checks that `base` stays within the documented limits (`scene::ranges`) at every
+    /// time: its positions within ±[`MAX_COORDINATE`] m, its flickering power within
+    /// [`MAX_LIGHT_POWER`]. Call after [`check`](Self::check). The message names the
+    /// field. A path alone is bounded exactly (its points, and a Catmull–Rom segment's
+    /// extremes); an orbit alone by its circle; both together by the sphere about the
+    /// orbit's centre through the path's farthest place.
+    pub fn check_reach(&self, base: &Light) -> Result<(), String> {
+        let (lo, hi) = match &self.path {
+            Some(p) => p.bounds(),
+            None => (Vec3::ZERO, Vec3::ZERO),
+        };
+        let (lo, hi) = (base.position + lo, base.position + hi);
+        let beyond = |v: f32| !(v.is_finite() && v.abs() <= MAX_COORDINATE);
+        let axis_name = ["x", "y", "z"];
+        match &self.orbit {
+            None => {
+                for (k, axis) in axis_name.iter().enumerate() {
+                    if let Some(v) = [lo[k], hi[k]].into_iter().find(|&v| beyond(v)) {
+                        return Err(format!(
+                            "path takes the light to {axis} = {v:e} m, beyond ±{MAX_COORDINATE:e} m"
+                        ));
+                    }
+                }
+            }
+            Some(o) => {
+                let a = o.axis.normalize();
+                let reach = |k: usize| -> f32 {
+                    if self.path.is_none() {
+                        // The circle: its centre on the axis, its radius across it.
+                        let r = base.position - o.centre;
+                        let along = o.centre + a * r.dot(a);
+                        let radius = (r - a * r.dot(a)).length();
+                        along[k].abs() + radius * (1.0 - a[k] * a[k]).max(0.0).sqrt()
+                    } else {
+                        let far = (lo - o.centre).abs().max((hi - o.centre).abs());
+                        o.centre[k].abs() + far.length()
+                    }
+                };
+                for (k, axis) in axis_name.iter().enumerate() {
+                    let v = reach(k);
+                    if beyond(v) {
+                        return Err(format!(
+                            "orbit takes the light to |{axis}| = {v:e} m, beyond ±{MAX_COORDINATE:e} m"
+                        ));
+                    }
+                }
+            }
+        }
+        if let Some(f) = &self.flicker {
+            let power = base.intensity * base.color.max_element() * (1.0 + f.amplitude);
+            if !(power.is_finite() && power <= MAX_LIGHT_POWER) {
+                return Err(format!(
+                    "flicker amplitude {} raises the light to {power:e} cd, over the limit of {MAX_LIGHT_POWER:e}",
+                    f.amplitude
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// `base` at time `t` seconds; `index` is the light's place in its set (it seeds the
     /// flicker, so lights of one set flicker apart).
     pub fn apply(&self, base: &Light, index: u32, t: f64) -> Light {
@@ -168,6 +229,36 @@ impl Motion {
 }
 
 impl KeyframePath {
+    /// The smallest box holding every offset of the path: its points, and for a
+    /// Catmull–Rom path each segment's extremes (where a coordinate's cubic turns).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for &p in &self.points {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        let n = self.points.len();
+        if self.interpolation == Interpolation::CatmullRom && n >= 2 {
+            let at = |k: usize| self.points[k % n];
+            for i in 0..n {
+                let (p0, p1, p2, p3) = (at(i + n - 1), at(i), at(i + 1), at(i + 2));
+                // offset(s) = 0.5 (a + b s + c s² + d s³) per coordinate.
+                let b = p2 - p0;
+                let c = 2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3;
+                let d = 3.0 * p1 - p0 - 3.0 * p2 + p3;
+                for k in 0..3 {
+                    for s in turning_points(b[k], 2.0 * c[k], 3.0 * d[k]) {
+                        let v = 0.5 * (2.0 * p1[k] + b[k] * s + c[k] * s * s + d[k] * s * s * s);
+                        lo[k] = lo[k].min(v);
+                        hi[k] = hi[k].max(v);
+                    }
+                }
+            }
+        }
+        (lo, hi)
+    }
+
     /// The offset at time `t`: the path loops every `period` seconds.
     pub fn offset(&self, t: f64) -> Vec3 {
         let n = self.points.len();
@@ -207,6 +298,26 @@ impl Flicker {
         let k = k as i64;
         lattice(k) + (lattice(k.wrapping_add(1)) - lattice(k)) * s
     }
+}
+
+/// The roots in (0, 1) of `a + b s + c s²`.
+fn turning_points(a: f32, b: f32, c: f32) -> Vec<f32> {
+    let roots = if c.abs() < 1e-12 {
+        if b.abs() < 1e-12 {
+            vec![]
+        } else {
+            vec![-a / b]
+        }
+    } else {
+        let disc = b * b - 4.0 * c * a;
+        if disc < 0.0 {
+            vec![]
+        } else {
+            let q = disc.sqrt();
+            vec![(-b - q) / (2.0 * c), (-b + q) / (2.0 * c)]
+        }
+    };
+    roots.into_iter().filter(|s| *s > 0.0 && *s < 1.0).collect()
 }
 
 /// SplitMix64's finaliser: a fixed, platform-independent 64-bit hash.
@@ -280,6 +391,64 @@ mod tests {
             interpolation: Interpolation::Linear,
         };
         assert!((linear.offset(0.5) - Vec3::X * 0.5).length() < 1e-6);
+    }
+
+    #[test]
+    fn path_bounds_hold_every_offset_and_reach_names_the_field() {
+        // A Catmull–Rom path overshoots its points; the bounds hold what it reaches.
+        let p = KeyframePath {
+            points: vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 0.0, 1.0), Vec3::Z],
+            period: 4.0,
+            interpolation: Interpolation::CatmullRom,
+        };
+        let (lo, hi) = p.bounds();
+        let mut seen = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        for i in 0..4000 {
+            let o = p.offset(i as f64 * 1e-3);
+            seen = (seen.0.min(o), seen.1.max(o));
+        }
+        assert!(lo.cmple(seen.0 + 1e-5).all() && hi.cmpge(seen.1 - 1e-5).all());
+        assert!(
+            (lo - seen.0).abs().max_element() < 1e-3,
+            "{lo} vs {}",
+            seen.0
+        );
+        assert!(
+            (hi - seen.1).abs().max_element() < 1e-3,
+            "{hi} vs {}",
+            seen.1
+        );
+        assert!(hi.x > 1.0 + 1e-3, "overshoot past the points: {hi}");
+
+        let light = Light::point(Vec3::new(0.0, 1.0, 6e4), 3.0, Vec3::ONE, 1.0);
+        let orbit = |centre: Vec3| Motion {
+            orbit: Some(Orbit {
+                centre,
+                axis: Vec3::Y,
+                speed_deg: 10.0,
+            }),
+            ..Default::default()
+        };
+        assert!(orbit(Vec3::ZERO).check_reach(&light).is_ok());
+        let e = orbit(Vec3::new(5e4, 0.0, 0.0))
+            .check_reach(&light)
+            .unwrap_err();
+        assert!(e.starts_with("orbit takes the light to |x| = 1.28"), "{e}");
+        let flicker = Motion {
+            flicker: Some(Flicker {
+                amplitude: 0.5,
+                frequency: 1.0,
+                seed: 0,
+            }),
+            ..Default::default()
+        };
+        let mut bright = light;
+        bright.intensity = 8e14;
+        let e = flicker.check_reach(&bright).unwrap_err();
+        assert!(
+            e.contains("flicker amplitude 0.5 raises the light to 1.2e15"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -356,6 +356,33 @@ fn add_motion(
     Ok(())
 }
 
+/// When the lights just added have a motion (the scene's last), checks that each stays
+/// within the limits along it (`Motion::check_reach`); `set` is the count of a light
+/// set's lights, named by their place in it.
+fn check_reach(
+    scene: &Scene,
+    moving: bool,
+    set: Option<u64>,
+    file: &Path,
+    element: &str,
+) -> Result<(), SceneError> {
+    let Some(m) = scene.light_motion.last().filter(|_| moving) else {
+        return Ok(());
+    };
+    let first = m.first as usize;
+    let end = (first + m.count as usize).min(scene.lights.len());
+    for (i, light) in scene.lights[first..end].iter().enumerate() {
+        m.motion.check_reach(light).map_err(|e| {
+            let which = match set {
+                Some(n) => format!("light {i} of {n}: "),
+                None => String::new(),
+            };
+            SceneError::invalid(file, element, format!("motion: {which}{e}"))
+        })?;
+    }
+    Ok(())
+}
+
 /// Builds a scene from a parsed scene file; `file` is the RON file (relative paths resolve
 /// against its folder).
 pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> {
@@ -485,6 +512,7 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
         }
         add_motion(&mut scene, l.motion.as_ref(), 1, file, &element)?;
         scene.lights.push(light);
+        check_reach(&scene, l.motion.is_some(), None, file, &element)?;
     }
 
     // Procedural light sets (placed in the bounds of all geometry so far).
@@ -529,6 +557,7 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
                 scene.lights.extend(a.generate(b));
             }
         }
+        check_reach(&scene, motion.is_some(), Some(count), file, &element)?;
     }
 
     let bounds = scene.bounds();

@@ -35,6 +35,10 @@ pub struct BenchRow {
     pub round_ms_max: Option<f64>,
     /// Wall-clock seconds the point's warm-up took (all its graphs together).
     pub warmup_s: Option<f64>,
+    /// Moving lights (a sweep's `animate:`): CPU milliseconds of one frame's light update,
+    /// the median over the point's frames: evaluating the motion and
+    /// `PreparedFrame::update_lights` (see [`crate::bench::animate::MovingTimes`]).
+    pub light_update_cpu_ms: Option<f64>,
     /// The GPU's SM clock before the point's warm-up and after its last round, and its
     /// maximum, MHz (`nvidia-smi`; `None` elsewhere).
     pub sm_mhz_start: Option<u32>,

@@ -37,7 +37,7 @@ fn opt<T: ToString>(v: Option<T>) -> String {
 /// row (first-seen order): `pass_ms:<name>` (median), `pass_ms_p10:<name>`, `pass_ms_p90:<name>`,
 /// empty where a row lacks that pass. Time columns are empty, not 0, for untimed rows; the
 /// ray-cast shadow columns (`shadow_*`, `bvh_*`) are empty for graphs without those passes.
-pub const CSV_COLUMNS: [&str; 54] = [
+pub const CSV_COLUMNS: [&str; 55] = [
     "scene",
     "technique",
     "params",
@@ -52,6 +52,7 @@ pub const CSV_COLUMNS: [&str; 54] = [
     "round_ms_min",
     "round_ms_max",
     "warmup_s",
+    "light_update_cpu_ms",
     "sm_mhz_start",
     "sm_mhz_end",
     "sm_mhz_max",
@@ -124,6 +125,7 @@ pub fn to_csv(rows: &[BenchRow]) -> String {
             opt(r.round_ms_min),
             opt(r.round_ms_max),
             opt(r.warmup_s),
+            opt(r.light_update_cpu_ms),
             opt(r.sm_mhz_start),
             opt(r.sm_mhz_end),
             opt(r.sm_mhz_max),

@@ -1,6 +1,7 @@
 //! Per-frame light updates: new light values written over the scene's light buffers,
 //! the frame's light count set, and the passes that keep per-light CPU state (shadow
-//! atlas allocation, per-light dispatches) told. No pipeline or bind group changes:
+//! atlas allocation, reflective shadow maps' views, VPL spawn parameters, per-light
+//! dispatches) told. No pipeline or bind group changes:
 //! culling and the light lists are rebuilt by the GPU every frame anyway.
 
 use super::PreparedFrame;
@@ -38,7 +39,8 @@ pub enum LightUpdateError {
         /// The feature it adds.
         feature: &'static str,
     },
-    /// A pass's per-light state cannot take the new lights.
+    /// A pass cannot show the lights with the room it was prepared with (the VPL
+    /// candidates of more or larger indirect lights).
     #[error("light update: pass '{pass}' cannot follow moving lights: {problem}")]
     Pass {
         /// The pass's name.
@@ -71,7 +73,7 @@ impl PreparedFrame {
         }
         check_features(&self.light_features, lights)?;
         for (name, pass) in &self.passes {
-            pass.can_follow_lights()
+            pass.can_follow_lights(lights)
                 .map_err(|problem| LightUpdateError::Pass {
                     pass: name.to_string(),
                     problem,

@@ -4,10 +4,12 @@
 //! back. What each pass does lives in `passes/<kind>.rs`.
 
 mod light_update;
+mod mesh_edit;
 mod parallel_builds;
 mod readback;
 
 pub use light_update::LightUpdateError;
+pub use mesh_edit::MeshEditError;
 
 use parallel_builds::prebuild_in_parallel;
 

@@ -32,9 +32,9 @@ pub(super) trait PreparedPass {
     /// The camera moved without re-preparing: passes that depend on the view (the
     /// shadow atlas's allocation) update for the next frame.
     fn set_view(&self, _r: &Renderer, _camera: &crate::scene::Camera) {}
-    /// Why this pass cannot follow light updates, if it cannot (state laid out from the
-    /// lights at prepare that is too costly to redo per frame).
-    fn can_follow_lights(&self) -> Result<(), String> {
+    /// Why this pass cannot follow an update to `lights`, if it cannot (room prepared
+    /// for the lights at prepare that they outgrow).
+    fn can_follow_lights(&self, _lights: &[crate::scene::Light]) -> Result<(), String> {
         Ok(())
     }
     /// The scene's lights changed without re-preparing (`PreparedFrame::update_lights`):

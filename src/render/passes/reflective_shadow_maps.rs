@@ -1,7 +1,9 @@
 //! `ReflectiveShadowMaps`: lays out every indirect light's views (`indirect::rsm_views`),
 //! uploads the view table, and draws the scene into each view's tile in one render pass
 //! (normal, flux and position targets over depth; the view as the instance index). The
-//! layout depends only on the scene, so it is made once at prepare.
+//! layout depends only on the lights (not the camera): made at prepare, and again on the
+//! CPU for every light update, written into the same table (no pipeline or bind group
+//! changes).
 
 use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::reflective_shadow_maps::{
@@ -9,14 +11,42 @@ use crate::graph::kinds::reflective_shadow_maps::{
 };
 use crate::graph::Name;
 use crate::graph::ScheduledPass;
-use crate::indirect::rsm_views::{layout, view_table, RsmLayout};
+use crate::indirect::rsm_views::{layout, layout_lights, view_table, RsmLayout};
 use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws, MeshSet};
-use crate::render::RenderError;
+use crate::render::{RenderError, Renderer};
+use crate::scene::{Light, VplControls};
+use std::collections::BTreeMap;
+use std::sync::Mutex;
+
+/// What laying out the views again for new lights needs.
+#[derive(Clone)]
+pub(super) struct RsmLayoutRules {
+    pub params: ReflectiveShadowMaps,
+    pub width: u32,
+    pub height: u32,
+    /// The scene's VPL controls by light index.
+    pub controls: BTreeMap<u32, VplControls>,
+}
+
+impl RsmLayoutRules {
+    pub fn layout(&self, lights: &[Light]) -> RsmLayout {
+        layout_lights(
+            lights,
+            &self.controls,
+            self.params.tile,
+            self.width,
+            self.height,
+            self.params.max_lights,
+        )
+    }
+}
 
 pub(super) struct RsmPass {
     name: Name,
     tile: u32,
-    origins: Vec<(u32, u32)>,
+    rules: RsmLayoutRules,
+    /// Each view's tile origin, as the last layout placed them.
+    origins: Mutex<Vec<(u32, u32)>>,
     depth: wgpu::TextureView,
     targets: [wgpu::TextureView; 3],
     views: wgpu::Buffer,
@@ -42,6 +72,21 @@ pub(super) fn rsm_layout(
     let (w, h, _) = fixed_size(desc)
         .ok_or_else(|| pass_error(pass, format!("'{flux}' is not a fixed-size texture")))?;
     Ok((w, h, layout(cx.scene, p.tile, w, h, p.max_lights)))
+}
+
+/// [`rsm_layout`]'s inputs, kept to lay the views out again for new lights.
+pub(super) fn rsm_layout_rules(
+    cx: &PrepareCtx,
+    p: &ReflectiveShadowMaps,
+    width: u32,
+    height: u32,
+) -> RsmLayoutRules {
+    RsmLayoutRules {
+        params: *p,
+        width,
+        height,
+        controls: cx.scene.vpl_controls.clone(),
+    }
 }
 
 pub(super) fn prepare(
@@ -88,7 +133,8 @@ pub(super) fn prepare(
     Ok(RsmPass {
         name: sp.name.clone(),
         tile: p.tile,
-        origins: l.views.iter().map(|v| (v.x, v.y)).collect(),
+        rules: rsm_layout_rules(cx, p, w, h),
+        origins: Mutex::new(l.views.iter().map(|v| (v.x, v.y)).collect()),
         depth: target(RSM_DEPTH)?,
         targets: [
             target(RSM_NORMAL)?,
@@ -103,8 +149,20 @@ pub(super) fn prepare(
 }
 
 impl PreparedPass for RsmPass {
-    fn can_follow_lights(&self) -> Result<(), String> {
-        Err("its views are laid out from the indirect lights at prepare: prepare the frame again to move or change lights".into())
+    fn follow_lights(&self, r: &Renderer, lights: &[Light]) {
+        let l = self.rules.layout(lights);
+        let table = view_table(
+            &l,
+            self.tile,
+            self.rules.width,
+            self.rules.height,
+            self.rules.params.max_views(),
+        );
+        r.ctx
+            .queue
+            .write_buffer(&self.staging, 0, bytemuck::cast_slice(&table));
+        *self.origins.lock().unwrap_or_else(|e| e.into_inner()) =
+            l.views.iter().map(|v| (v.x, v.y)).collect();
     }
 
     fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
@@ -125,7 +183,8 @@ impl PreparedPass for RsmPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        self.draws.record_tiles(&mut pass, &self.origins, self.tile);
+        let origins = self.origins.lock().unwrap_or_else(|e| e.into_inner());
+        self.draws.record_tiles(&mut pass, &origins, self.tile);
     }
 }
 

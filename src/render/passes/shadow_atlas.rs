@@ -1,7 +1,8 @@
 //! `ShadowAtlas`: allocates the atlas for the current view on the CPU
 //! (`shadow::atlas::allocate`), uploads the view table, and draws every view's visible
 //! casters into its tile, all views in one render pass (a viewport each, the view as
-//! the instance index). The allocation is redone whenever the camera moves.
+//! the instance index). The allocation is redone once before the next frame whenever the
+//! camera or the lights moved (a viewer moving both between two frames pays for one).
 
 use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::shadow_atlas::{
@@ -16,6 +17,7 @@ use crate::render::{RenderError, Renderer};
 use crate::scene::{Camera, Light};
 use crate::shadow::atlas::{allocate, box_in_frustum, frustum_planes, Allocation, AtlasConfig};
 use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 pub(super) struct ShadowAtlasPass {
@@ -44,6 +46,13 @@ pub(super) struct ShadowAtlasPass {
     /// Writes the far depth over a tile (each view clears its own).
     clear: Arc<wgpu::RenderPipeline>,
     frame: Mutex<(Allocation, Vec<ViewDraw>)>,
+    /// The camera or the lights changed since the last allocation: allocate again before
+    /// the next frame is recorded or reported.
+    stale: AtomicBool,
+    /// Allocations made since prepare (reported: `AtlasReport::allocations`).
+    allocations: AtomicU64,
+    /// Writes the table the allocation makes.
+    queue: wgpu::Queue,
 }
 
 pub(super) fn prepare(
@@ -135,8 +144,11 @@ pub(super) fn prepare(
         draws,
         clear,
         frame: Mutex::new((Allocation::default(), Vec::new())),
+        stale: AtomicBool::new(false),
+        allocations: AtomicU64::new(0),
+        queue: cx.renderer.ctx.queue.clone(),
     };
-    pass.allocate(cx.renderer, &cx.scene.camera);
+    pass.allocate();
     Ok(pass)
 }
 
@@ -203,13 +215,22 @@ fn tile_clear_pipeline(
 }
 
 impl ShadowAtlasPass {
-    /// Allocates for `camera`, uploads the table and culls each view's casters.
-    fn allocate(&self, r: &Renderer, camera: &Camera) {
-        *self.camera.lock().unwrap_or_else(|e| e.into_inner()) = *camera;
+    /// Allocates again if the camera or the lights changed since the last allocation.
+    fn allocate_if_stale(&self) {
+        if self.stale.swap(false, Ordering::AcqRel) {
+            self.allocate();
+        }
+    }
+
+    /// Allocates for the kept camera and lights, uploads the table (written before the
+    /// next submission, so before the frame's copy of it) and culls each view's casters.
+    fn allocate(&self) {
+        self.allocations.fetch_add(1, Ordering::Relaxed);
+        let camera = *self.camera.lock().unwrap_or_else(|e| e.into_inner());
         let lights = self.lights.lock().unwrap_or_else(|e| e.into_inner());
         let a = allocate(
             &lights,
-            camera,
+            &camera,
             self.size.width,
             self.size.height,
             &self.config,
@@ -242,8 +263,7 @@ impl ShadowAtlasPass {
             let i = l.light as usize;
             table[light_table + i / 4][i % 4] = entry;
         }
-        r.ctx
-            .queue
+        self.queue
             .write_buffer(&self.staging, 0, bytemuck::cast_slice(&table));
         let draws = a
             .views
@@ -282,6 +302,7 @@ impl ShadowAtlasPass {
 
 impl PreparedPass for ShadowAtlasPass {
     fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
+        self.allocate_if_stale();
         encoder.copy_buffer_to_buffer(&self.staging, 0, &self.views, 0, self.table_bytes);
         let frame = self.frame.lock().unwrap_or_else(|e| e.into_inner());
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -301,6 +322,7 @@ impl PreparedPass for ShadowAtlasPass {
     }
 
     fn report(&self, _r: &Renderer) -> Result<Option<PassReport>, RenderError> {
+        self.allocate_if_stale();
         let frame = self.frame.lock().unwrap_or_else(|e| e.into_inner());
         let (a, draws) = &*frame;
         Ok(Some(PassReport::Atlas(AtlasReport {
@@ -319,21 +341,20 @@ impl PreparedPass for ShadowAtlasPass {
                 .iter()
                 .flat_map(|d| d.ranges.iter().map(|r| r.2 as u64 / 3))
                 .sum(),
+            allocations: self.allocations.load(Ordering::Relaxed),
         })))
     }
 
-    fn follow_lights(&self, r: &Renderer, lights: &[Light]) {
-        {
-            let mut kept = self.lights.lock().unwrap_or_else(|e| e.into_inner());
-            kept.clear();
-            kept.extend_from_slice(lights);
-        }
-        let camera = *self.camera.lock().unwrap_or_else(|e| e.into_inner());
-        self.allocate(r, &camera);
+    fn follow_lights(&self, _r: &Renderer, lights: &[Light]) {
+        let mut kept = self.lights.lock().unwrap_or_else(|e| e.into_inner());
+        kept.clear();
+        kept.extend_from_slice(lights);
+        self.stale.store(true, Ordering::Release);
     }
 
-    fn set_view(&self, r: &Renderer, camera: &Camera) {
-        self.allocate(r, camera);
+    fn set_view(&self, _r: &Renderer, camera: &Camera) {
+        *self.camera.lock().unwrap_or_else(|e| e.into_inner()) = *camera;
+        self.stale.store(true, Ordering::Release);
     }
 }
 

@@ -2,7 +2,9 @@
 //! candidate per block of each map view, select against the room, append), then the
 //! light counter is copied into the frame uniform's `light_count`, so every later pass
 //! of the frame loops over and culls the VPLs with no CPU round trip. Reports what it
-//! made, kept and dropped (read after the frame).
+//! made, kept and dropped (read after the frame). A light update lays the map views out
+//! again on the CPU (as the maps' pass does) and writes the spawn parameters and the
+//! dispatch sizes: the VPLs of the next frame come from the moved lights.
 
 use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::gpu::readback::read_buffer;
@@ -12,8 +14,11 @@ use crate::graph::{slot, PassKind, ScheduledPass, VplSpawn};
 use crate::render::pipelines::PipelineKey;
 use crate::render::report::{PassReport, VplReport};
 use crate::render::{RenderError, Renderer};
+use super::reflective_shadow_maps::{rsm_layout_rules, RsmLayoutRules};
+use crate::indirect::rsm_views::RsmLayout;
+use crate::scene::Light;
 use std::collections::BTreeMap;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use wgpu::util::DeviceExt;
 
 /// Bytes of one candidate (`Candidate` in vpl_spawn.wgsl).
@@ -25,10 +30,16 @@ pub(super) struct VplSpawnPass {
     name: Name,
     pipelines: [Arc<wgpu::ComputePipeline>; 4],
     bind: wgpu::BindGroup,
-    groups: [[u32; 3]; 4],
+    /// The maps' layout rules, to lay their views out again for new lights.
+    rules: RsmLayoutRules,
+    /// VPL candidates the candidate buffer holds room for (the prepared layout's).
+    candidate_room: u32,
+    room: u32,
+    params: wgpu::Buffer,
+    groups: Mutex<[[u32; 3]; 4]>,
     control: wgpu::Buffer,
     frame_uniform: wgpu::Buffer,
-    report: VplReport,
+    report: Mutex<VplReport>,
 }
 
 pub(super) fn prepare(
@@ -55,16 +66,19 @@ pub(super) fn prepare(
                 format!("no ReflectiveShadowMaps pass runs that writes '{views_name}'"),
             )
         })?;
-    let (_, _, layout) = super::reflective_shadow_maps::rsm_layout(cx, &sp.name, &rsm.0, &rsm.1)?;
+    let (w, h, layout) = super::reflective_shadow_maps::rsm_layout(cx, &sp.name, &rsm.0, &rsm.1)?;
+    let rules = rsm_layout_rules(cx, &rsm.0, w, h);
     let scene_lights = cx.gpu.light_count;
-    let need = (scene_lights as u64 + p.max_vpls as u64) * 32;
+    // Room for every light an update may write, then the VPLs.
+    let most_lights = cx.gpu.light_capacity;
+    let need = (most_lights as u64 + p.max_vpls as u64) * 32;
     for s in [slot::LIGHT_GEOMETRY, slot::LIGHT_PROPERTIES] {
         let b = cx.buffer(&sp.name, sp.required(s))?;
         if b.size() < need {
             return Err(pass_error(
                 &sp.name,
                 format!(
-                    "buffer '{}' holds {} bytes; {scene_lights} scene lights and room for {} VPLs need {need} (size: Auto)",
+                    "buffer '{}' holds {} bytes; {most_lights} scene lights and room for {} VPLs need {need} (size: Auto)",
                     sp.required(s),
                     b.size(),
                     p.max_vpls
@@ -89,11 +103,10 @@ pub(super) fn prepare(
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     });
-    let views = layout.views.len() as u32;
     let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("vpl spawn params"),
-        contents: bytemuck::cast_slice(&[scene_lights, views, layout.candidates, p.max_vpls]),
-        usage: wgpu::BufferUsages::UNIFORM,
+        contents: bytemuck::cast_slice(&spawn_params(scene_lights, &layout, p.max_vpls)),
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
     });
     let mut offered = cx.declared(sp)?;
     offered.buffer("params", &params);
@@ -112,38 +125,57 @@ pub(super) fn prepare(
     let (gather, _) = build("gather")?;
     let (select, _) = build("select_room")?;
     let (append, _) = build("append")?;
+    Ok(VplSpawnPass {
+        name: sp.name.clone(),
+        pipelines: [copy, gather, select, append],
+        bind,
+        rules,
+        candidate_room: layout.candidates,
+        room: p.max_vpls,
+        params,
+        groups: Mutex::new(dispatch_groups(scene_lights, &layout)),
+        control,
+        frame_uniform: cx.frame_uniform.clone(),
+        report: Mutex::new(layout_report(&sp.name, scene_lights, &layout, p.max_vpls)),
+    })
+}
+
+/// `SpawnParams` of vpl_spawn.wgsl.
+fn spawn_params(scene_lights: u32, layout: &RsmLayout, room: u32) -> [u32; 4] {
+    [scene_lights, layout.views.len() as u32, layout.candidates, room]
+}
+
+/// The four dispatches' sizes: copy the scene's lights, gather each view's blocks,
+/// select, append every candidate.
+fn dispatch_groups(scene_lights: u32, layout: &RsmLayout) -> [[u32; 3]; 4] {
     let most_blocks = layout
         .views
         .iter()
         .map(|v| v.controls.n * v.controls.n)
         .max()
         .unwrap_or(0);
-    let groups = [
+    [
         [scene_lights.div_ceil(64), 1, 1],
-        [most_blocks.div_ceil(64), views, 1],
+        [most_blocks.div_ceil(64), layout.views.len() as u32, 1],
         [1, 1, 1],
         [layout.candidates.div_ceil(64), 1, 1],
-    ];
-    Ok(VplSpawnPass {
-        name: sp.name.clone(),
-        pipelines: [copy, gather, select, append],
-        bind,
-        groups,
-        control,
-        frame_uniform: cx.frame_uniform.clone(),
-        report: VplReport {
-            pass: sp.name.to_string(),
-            lights: layout.lights,
-            views,
-            dropped_lights: layout.dropped.clone(),
-            candidates: layout.candidates,
-            with_flux: 0,
-            spawned: 0,
-            dropped: 0,
-            room: p.max_vpls,
-            scene_lights,
-        },
-    })
+    ]
+}
+
+/// What the layout says before the GPU counts anything.
+fn layout_report(pass: &str, scene_lights: u32, layout: &RsmLayout, room: u32) -> VplReport {
+    VplReport {
+        pass: pass.to_string(),
+        lights: layout.lights,
+        views: layout.views.len() as u32,
+        dropped_lights: layout.dropped.clone(),
+        candidates: layout.candidates,
+        with_flux: 0,
+        spawned: 0,
+        dropped: 0,
+        room,
+        scene_lights,
+    }
 }
 
 /// Where the frame uniform keeps the light count.
@@ -151,8 +183,29 @@ const LIGHT_COUNT_OFFSET: u64 =
     std::mem::offset_of!(crate::gpu::structs::GpuFrame, light_count) as u64;
 
 impl PreparedPass for VplSpawnPass {
-    fn can_follow_lights(&self) -> Result<(), String> {
-        Err("it appends VPLs after the scene's light count fixed at prepare: prepare the frame again to move or change lights".into())
+    fn can_follow_lights(&self, lights: &[Light]) -> Result<(), String> {
+        let candidates = self.rules.layout(lights).candidates;
+        if candidates > self.candidate_room {
+            return Err(format!(
+                "the lights' map views make {candidates} VPL candidates; the candidate buffer was prepared for {}: prepare the frame again for more or larger indirect lights",
+                self.candidate_room
+            ));
+        }
+        Ok(())
+    }
+
+    fn follow_lights(&self, r: &Renderer, lights: &[Light]) {
+        let layout = self.rules.layout(lights);
+        let scene_lights = lights.len() as u32;
+        r.ctx.queue.write_buffer(
+            &self.params,
+            0,
+            bytemuck::cast_slice(&spawn_params(scene_lights, &layout, self.room)),
+        );
+        *self.groups.lock().unwrap_or_else(|e| e.into_inner()) =
+            dispatch_groups(scene_lights, &layout);
+        *self.report.lock().unwrap_or_else(|e| e.into_inner()) =
+            layout_report(&self.name, scene_lights, &layout, self.room);
     }
 
     fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
@@ -162,7 +215,8 @@ impl PreparedPass for VplSpawnPass {
                 timestamp_writes: ts.compute(),
             });
             pass.set_bind_group(0, &self.bind, &[]);
-            for (pipeline, [x, y, z]) in self.pipelines.iter().zip(self.groups) {
+            let groups = *self.groups.lock().unwrap_or_else(|e| e.into_inner());
+            for (pipeline, [x, y, z]) in self.pipelines.iter().zip(groups) {
                 if x * y * z == 0 {
                     continue;
                 }
@@ -176,7 +230,7 @@ impl PreparedPass for VplSpawnPass {
     fn report(&self, r: &Renderer) -> Result<Option<PassReport>, RenderError> {
         let bytes = read_buffer(&r.ctx.device, &r.ctx.queue, &self.control)?;
         let w: &[u32] = bytemuck::cast_slice(&bytes);
-        let mut report = self.report.clone();
+        let mut report = self.report.lock().unwrap_or_else(|e| e.into_inner()).clone();
         report.spawned = w[0].saturating_sub(report.scene_lights);
         report.dropped = w[1];
         report.with_flux = w[5];
