@@ -400,4 +400,30 @@ fn without_blended_meshes_the_default_graph_is_the_compute_first_frame() {
         a.image.iter().any(|p| p[0] > 0.0),
         "a dark frame tests nothing"
     );
+    // Not only the same passes and image: the same shaders. default.ron's shading reads
+    // the shadow mask and its glass the BVH; without casters neither may switch on the
+    // shadowed light loop (it costs shading time for nothing), so every pipeline of
+    // default.ron is one the plain frame already put in the cache.
+    // A renderer of its own: the shared one's cache already holds default.ron's pipelines.
+    let mut fresh = lightgraph::render::Renderer::headless().expect("a wgpu adapter");
+    let read = |g: &str| std::fs::read_to_string(graph_path(g)).unwrap();
+    let plain = prepare_text(
+        &mut fresh,
+        &read("visibility_compute_raster.ron"),
+        &scene,
+        W,
+        H,
+        false,
+    )
+    .unwrap();
+    assert!(
+        !plain.stats().pipelines_built.is_empty(),
+        "a fresh cache builds"
+    );
+    let default = prepare_text(&mut fresh, &read("default.ron"), &scene, W, H, false).unwrap();
+    assert!(
+        default.stats().pipelines_built.is_empty(),
+        "default.ron without glass or casters built {:?}",
+        default.stats().pipelines_built
+    );
 }

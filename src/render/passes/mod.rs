@@ -268,6 +268,14 @@ impl PrepareCtx<'_> {
         offered: &mut BindingSet,
     ) -> crate::graph::kinds::forward_shading::Shadows {
         use crate::graph::kinds::forward_shading::{shadows, Shadows};
+        // A scene without casting lights shades as the graph without shadows: the passes
+        // that fill the mask were culled (`when: ShadowCasters`), there is nothing to
+        // trace, and a light update cannot add a caster to a frame prepared without.
+        // The shadowed light loop would cost its extra work for nothing (about 3% of
+        // harada's shading in default.ron).
+        if !self.scene.features().has_shadow_casters {
+            return Shadows::None;
+        }
         let s = shadows(&sp.roles, &self.graph.plan);
         if let Shadows::Atlas(_) = s {
             offered.offer("shadow_sampler", comparison_sampler(&self.device()));
