@@ -8,7 +8,8 @@
 //!   rebuilt on the CPU in f64 from the pixel's triangle, except rays near an edge;
 //! - the shaded image equals Forward+'s with shadows within visibility shading's own
 //!   difference from forward shading, and every light loop and the classified dispatch
-//!   give the same image to the bit;
+//!   give the same image to the bit; the same for graphs/visibility_shadow_atlas.ron against
+//!   Forward+ with the shadow atlas (graphs/shadow_atlas.ron);
 //! - default.ron on a scene with casters renders exactly visibility_raycast_shadows.ron;
 //! - a textured glTF scene (the gallery's models, glass left out) shadows through
 //!   default.ron as Forward+ does.
