@@ -8,7 +8,8 @@
 //!   rebuilt on the CPU in f64 from the pixel's triangle, except rays near an edge;
 //! - the shaded image equals Forward+'s with shadows within visibility shading's own
 //!   difference from forward shading, and every light loop and the classified dispatch
-//!   give the same image to the bit;
+//!   give the same image to the bit; the same for graphs/visibility_shadow_atlas.ron against
+//!   Forward+ with the shadow atlas (graphs/shadow_atlas.ron);
 //! - default.ron on a scene with casters renders exactly visibility_raycast_shadows.ron;
 //! - a textured glTF scene (the gallery's models, glass left out) shadows through
 //!   default.ron as Forward+ does.
@@ -480,11 +481,34 @@ fn differing(a: &[[f32; 4]], b: &[[f32; 4]], rel: f32) -> Vec<usize> {
 
 #[test]
 fn shaded_image_equals_forward_plus_and_every_light_loop_agrees() {
+    shaded_image_equals_forward_plus(
+        "visibility_raycast_shadows.ron",
+        "raycast_shadows.ron",
+        COMPUTE_RASTER_EDGE_PIXELS,
+    );
+}
+
+#[test]
+fn atlas_image_equals_forward_plus_and_every_light_loop_agrees() {
+    // Both frames sample the same atlas (drawn by the same ShadowAtlas pass from the same
+    // camera) at points a few ulps apart, through the same filter and light loop.
+    shaded_image_equals_forward_plus(
+        "visibility_shadow_atlas.ron",
+        "shadow_atlas.ron",
+        COMPUTE_RASTER_EDGE_PIXELS,
+    );
+}
+
+/// The compute-first shadow graph `vis_graph` against Forward+ with the same shadows
+/// (`fwd_graph`): beyond the unshadowed frames' own differences at most `max_extra`
+/// pixels differ, and every light loop and the classified dispatch give the same image
+/// to the bit.
+fn shaded_image_equals_forward_plus(vis_graph: &str, fwd_graph: &str, max_extra: usize) {
     let mut r = renderer();
     let scene = shadow_scene(36, 11);
-    let vis_text = graph_text("visibility_raycast_shadows.ron");
+    let vis_text = graph_text(vis_graph);
     let (_, vis) = run(&mut r, &vis_text, &scene);
-    let (_, fwd) = run(&mut r, &graph_text("raycast_shadows.ron"), &scene);
+    let (_, fwd) = run(&mut r, &graph_text(fwd_graph), &scene);
     let (_, vis_plain) = run(&mut r, &graph_text("visibility_compute_raster.ron"), &scene);
     let (_, fwd_plain) = run(&mut r, &graph_text("forward_plus.ron"), &scene);
     // Visibility shading differs from forward shading in the last bits of the rebuilt
@@ -501,16 +525,15 @@ fn shaded_image_equals_forward_plus_and_every_light_loop_agrees() {
         .filter(|(s, u)| s[0] < u[0] * 0.99)
         .count();
     eprintln!(
-        "{} pixels differ from Forward+ with shadows, {} without; {darker} darkened by shadows",
+        "{vis_graph}: {} pixels differ from {fwd_graph}, {} without shadows; {darker} darkened by shadows",
         shadowed.len(),
         unshadowed.len()
     );
     assert!(darker > 500, "shadows darkened only {darker} pixels");
-    // Beyond the unshadowed frames' own differences, only pixels where the rasterizers
-    // pick different surfaces (COMPUTE_RASTER_EDGE_PIXELS) may differ.
+    // Beyond the unshadowed frames' own differences, only `max_extra` pixels may differ.
     let extra = shadowed.iter().filter(|i| !unshadowed.contains(i)).count();
     assert!(
-        extra <= COMPUTE_RASTER_EDGE_PIXELS,
+        extra <= max_extra,
         "{extra} pixels differ only with shadows"
     );
 

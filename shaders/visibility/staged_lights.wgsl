@@ -25,10 +25,10 @@ var<private> shadow_pixel: u32;
 var<private> shadow_caster: u32;
 #endif
 
-// Light (g, props) at reach r added to `color`, when the material takes it and it
-// gives radiance (and, with SHADOWS, its caster bit says it is not hidden), as
-// shade_surface adds it.
-fn add_reached(color: vec3<f32>, g: LightGeometry, props: LightProperties, r: LightReach, m: MaterialSample) -> vec3<f32> {
+// Light `i` (g, props) at reach r added to `color`, when the material takes it and it
+// gives radiance (and, with SHADOWS, scaled by the fraction of it that reaches p: its
+// caster bit or its atlas taps), as shade_surface adds it.
+fn add_reached(color: vec3<f32>, i: u32, g: LightGeometry, props: LightProperties, r: LightReach, p: ShadingPoint, m: MaterialSample) -> vec3<f32> {
 #if SHADOWS
     if ((props.flags & LIGHT_CASTS_SHADOW) != 0u) {
         let inc = incident_reached(g, props, r);
@@ -37,11 +37,14 @@ fn add_reached(color: vec3<f32>, g: LightGeometry, props: LightProperties, r: Li
         }
         let caster = shadow_caster;
         shadow_caster += 1u;
-        // The mask reads neither position.
-        if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u || !shadow_visible(shadow_pixel, caster, g.position, g.position)) {
+        if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
             return color;
         }
-        return color + inc.radiance * material_eval(m, inc.dir);
+        let visibility = shadow_visibility(shadow_pixel, caster, i, g.position, p);
+        if (visibility <= 0.0) {
+            return color;
+        }
+        return color + (visibility * inc.radiance) * material_eval(m, inc.dir);
     }
 #endif
     if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
@@ -76,7 +79,7 @@ fn add_in_range(color: vec3<f32>, q: vec4<f32>, i: u32, p: ShadingPoint, m: Mate
     if (r.window <= 0.0) {
         return color;
     }
-    return add_reached(color, light_geometry[i], light_properties[i], r, m);
+    return add_reached(color, i, light_geometry[i], light_properties[i], r, p, m);
 }
 
 // What the range test reads of a light: its position and range (16 bytes).
@@ -137,22 +140,26 @@ fn group_list(group: vec2<u32>) -> LightRange {
 
 #if STAGED_LIGHTS
 // One light per invocation of the 8×8 workgroup, two batches (the one shaded, the one
-// stored): 2 × 64 × 80 bytes of workgroup memory.
+// stored): 2 × 64 × 80 bytes of workgroup memory (84 with SHADOWS).
 const STAGE_BATCH: u32 = 64u;
 // xyz: the light's position; w: a squared distance past which it surely adds nothing
 // here (`reject_beyond`), -1 when this material does not take it.
 var<workgroup> staged_reach: array<vec4<f32>, 128>;
 var<workgroup> staged_geometry: array<LightGeometry, 128>;
 var<workgroup> staged_properties: array<LightProperties, 128>;
-
+#if SHADOWS
+// The lights' indices: the atlas finds a caster's views by its index.
+var<workgroup> staged_index: array<u32, 128>;
+#endif
 
 struct ListedLight {
+    index: u32,
     g: LightGeometry,
     props: LightProperties,
 };
 
 fn listed_light(i: u32) -> ListedLight {
-    return ListedLight(light_geometry[i], light_properties[i]);
+    return ListedLight(i, light_geometry[i], light_properties[i]);
 }
 
 fn stage(slot: u32, l: ListedLight) {
@@ -170,6 +177,9 @@ fn stage(slot: u32, l: ListedLight) {
     staged_reach[slot] = vec4<f32>(l.g.position, beyond);
     staged_geometry[slot] = l.g;
     staged_properties[slot] = l.props;
+#if SHADOWS
+    staged_index[slot] = l.index;
+#endif
 }
 
 // `list` is workgroup-uniform (from the workgroup id), so every invocation runs the same
@@ -218,7 +228,12 @@ fn staged_lights(unlit: vec3<f32>, shades: bool, p: ShadingPoint, m: MaterialSam
                 if (r.window <= 0.0) {
                     continue;
                 }
-                color = add_reached(color, g, staged_properties[j], r, m);
+#if SHADOWS
+                let index = staged_index[j];
+#else
+                let index = 0u; // read only by the shadow lookup
+#endif
+                color = add_reached(color, index, g, staged_properties[j], r, p, m);
             }
         }
     }

@@ -17,7 +17,9 @@
 // from the workgroup id, so the compiler sees the walk as uniform), or neither
 // (common/light_loop.wgsl's shade_surface, as forward shading runs it). SHADOWS with
 // SHADOW_MASK: each shadow-casting light is looked up in a ray-cast mask
-// (shadow/shadow_ray_cast.wgsl), casters numbered as job creation numbers them.
+// (shadow/shadow_ray_cast.wgsl), casters numbered as job creation numbers them; or with
+// SHADOW_ATLAS (and SHADOW_PCF5): sampled from a ShadowAtlas pass's maps, filtered as
+// forward shading filters them (common/shadows.wgsl).
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"
@@ -40,6 +42,11 @@
 @group(0) @binding(9) var hdr: texture_storage_2d<rgba32float, write>;
 #if SHADOW_MASK
 @group(0) @binding(10) var<storage, read> shadow_mask: array<u32>;
+#endif
+#if SHADOW_ATLAS
+@group(0) @binding(13) var<storage, read> shadow_views: array<vec4<f32>>;
+@group(0) @binding(14) var shadow_atlas: texture_depth_2d;
+@group(0) @binding(15) var shadow_sampler: sampler_comparison;
 #endif
 #if CLASSIFIED
 @group(0) @binding(11) var<storage, read> material_tiles: array<u32>;

@@ -5,7 +5,8 @@
 //! classified: each workgroup-sized tile is listed under every material it holds, and each
 //! material's dispatch runs over its own tiles only. With `shadow_mask` in its reads the
 //! light loop shadows each caster from a ray-cast mask (`ShadowRayJobs`,
-//! `ShadowRayCast`), numbered as forward and deferred shading number them. Runs
+//! `ShadowRayCast`), numbered as forward and deferred shading number them; with
+//! `shadow_atlas` and `shadow_views` it samples a `ShadowAtlas` pass's maps as they do. Runs
 //! `shaders/visibility/visibility_shading.wgsl` (and `classify_materials.wgsl`).
 
 use super::deferred_shading::HDR;
@@ -118,7 +119,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Read, Usage::Bound)
         .optional()
         .needs(&[Contents::ShadowMask]),
-    // Taken only to refuse them by name (see `check`).
+    // Shadow maps: a ShadowAtlas pass's atlas and view table.
     super::SHADOW_ATLAS_READ,
     super::SHADOW_VIEWS_READ,
 ];
@@ -142,16 +143,7 @@ pub(crate) fn check(p: &VisibilityShading, ctx: &KindCtx, errors: &mut Vec<Graph
         errors,
     );
     super::check_shadow_mask(ctx, errors);
-    let atlas = [
-        super::shadow_atlas::SHADOW_ATLAS,
-        super::shadow_atlas::SHADOW_VIEWS,
-    ];
-    for name in atlas.iter().filter_map(|s| ctx.slot(s)) {
-        errors.push(ctx.mismatch(
-            name,
-            "visibility shading shadows its lights from a ray-cast shadow_mask only, not from a shadow atlas: use a G-buffer or forward graph for the atlas",
-        ));
-    }
+    super::check_shadow_atlas(ctx, errors);
 }
 
 impl KindRules for VisibilityShading {
@@ -244,7 +236,31 @@ mod tests {
     }
 
     #[test]
-    fn takes_a_mask_with_its_lists_refuses_the_atlas_and_multisampled_ids() {
+    fn takes_an_atlas_with_its_views_and_one_shadow_source() {
+        const ATLAS: &str = r#"Pass(name: "a", kind: ShadowAtlas(), reads: ["geometry"], writes: ["atlas", "views"]),"#;
+        let pass = |reads: &str| {
+            format!(
+                r#"{VIS} {ATLAS} Pass(name: "s", kind: VisibilityShading(), reads: [{READS}, {reads}], writes: ["hdr"])"#
+            )
+        };
+        validate(&pass(r#""atlas", "shadow_views=views""#), "hdr").unwrap();
+        let e = errors(&pass(r#""atlas""#), "hdr");
+        assert!(
+            e.contains("pass 's', resource 'atlas': a shadow atlas is sampled through its view table"),
+            "{e}"
+        );
+        let e = errors(
+            &pass(r#""atlas", "shadow_views=views", "shadow_mask=mask""#),
+            "hdr",
+        );
+        assert!(
+            e.contains("resource 'mask': a pass shadows its lights one way"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn takes_a_mask_with_its_lists_and_refuses_multisampled_ids() {
         let e = errors(
             &format!(
                 r#"{VIS} {PREPASS} Pass(name: "s", kind: VisibilityShading(), reads: [{READS}, "shadow_mask=mask"], writes: ["hdr"])"#

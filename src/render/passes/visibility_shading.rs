@@ -5,7 +5,8 @@
 //! material a classification dispatch first lists every tile under the materials it
 //! holds (shaders/visibility/classify_materials.wgsl) and each material's dispatch is
 //! indirect, over its own tiles; otherwise each covers the whole frame. A read
-//! `shadow_mask` shadows the casters (`SHADOWS`, `SHADOW_MASK`).
+//! `shadow_mask` shadows the casters (`SHADOWS`, `SHADOW_MASK`), a read `shadow_atlas`
+//! with its `shadow_views` samples their maps (`SHADOW_ATLAS`, as forward shading).
 
 use super::{defines, PrepareCtx, PreparedPass, ShadeLists, Timestamps};
 use crate::graph::kinds::visibility_shading::{LightLoop, MaterialDispatch};
@@ -51,7 +52,8 @@ pub(super) fn prepare(
 ) -> Result<VisibilityShadingPass, RenderError> {
     let mut offered = cx.declared(sp)?;
     let lists = cx.shading_lists(sp, p.lights, &mut offered)?;
-    // Validation lets only a ray-cast mask through.
+    // A ray-cast mask or an atlas (validation refuses both at once); an atlas's
+    // comparison sampler is offered here.
     let shadows = cx.shading_shadows(sp, &mut offered);
     let layout = tile_layout(cx, sp, lists);
     let side = p.workgroup_side();
