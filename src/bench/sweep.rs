@@ -609,7 +609,7 @@ mod tests {
     fn the_shadow_sweep_parses() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/sweeps/raycast_shadows.ron");
         let s = Sweep::load(&path).unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!(s.point_count(), 8);
+        assert_eq!(s.point_count(), 10);
         assert_eq!(s.reference_for("forward_plus.ron"), "brute_force.ron");
     }
 }
