@@ -205,17 +205,29 @@ impl Motion {
     /// `base` at time `t` seconds; `index` is the light's place in its set (it seeds the
     /// flicker, so lights of one set flicker apart).
     pub fn apply(&self, base: &Light, index: u32, t: f64) -> Light {
+        self.apply_turned(base, index, t, self.orbit_turn(t))
+    }
+
+    /// The orbit's rotation at time `t`: the same for every light of the set, so
+    /// [`animate_into`] takes it once per set, not once per light.
+    fn orbit_turn(&self, t: f64) -> Option<Quat> {
+        self.orbit.as_ref().map(|o| {
+            // The angle is reduced in f64 so that long runs keep their precision.
+            let angle = (o.speed_deg as f64).to_radians() * t;
+            Quat::from_axis_angle(
+                o.axis.normalize(),
+                angle.rem_euclid(std::f64::consts::TAU) as f32,
+            )
+        })
+    }
+
+    /// [`Self::apply`] with the orbit's rotation at `t` already taken.
+    fn apply_turned(&self, base: &Light, index: u32, t: f64, turn: Option<Quat>) -> Light {
         let mut l = *base;
         if let Some(p) = &self.path {
             l.position += p.offset(t);
         }
-        if let Some(o) = &self.orbit {
-            // The angle is reduced in f64 so that long runs keep their precision.
-            let angle = (o.speed_deg as f64).to_radians() * t;
-            let q = Quat::from_axis_angle(
-                o.axis.normalize(),
-                angle.rem_euclid(std::f64::consts::TAU) as f32,
-            );
+        if let (Some(o), Some(q)) = (&self.orbit, turn) {
             l.position = o.centre + q * (l.position - o.centre);
             if let LightShape::Spot { direction, .. } = &mut l.shape {
                 *direction = q * *direction;
@@ -337,8 +349,9 @@ pub fn animate_into(base: &[Light], motions: &[LightMotion], t: f64, out: &mut V
     for m in motions {
         let first = (m.first as usize).min(out.len());
         let end = first.saturating_add(m.count as usize).min(out.len());
+        let turn = m.motion.orbit_turn(t);
         for (i, l) in out[first..end].iter_mut().enumerate() {
-            *l = m.motion.apply(l, i as u32, t);
+            *l = m.motion.apply_turned(l, i as u32, t, turn);
         }
     }
 }
@@ -463,6 +476,55 @@ mod tests {
         assert!(values.iter().any(|&v| (v - values[0]).abs() > 0.1));
         assert_eq!(f.noise(3, 1.234), f.noise(3, 1.234));
         assert_ne!(f.noise(3, 1.234), f.noise(4, 1.234));
+    }
+
+    #[test]
+    fn animate_into_equals_each_lights_own_motion_bit_for_bit() {
+        // animate_into takes an orbit's rotation once per set; every light must still
+        // come out exactly as `apply` moves it alone, at every time.
+        let m = LightMotion {
+            first: 0,
+            count: 3,
+            motion: Motion {
+                orbit: Some(Orbit {
+                    centre: Vec3::new(1.0, 0.0, -2.0),
+                    axis: Vec3::new(0.2, 1.0, 0.1),
+                    speed_deg: 37.0,
+                }),
+                flicker: Some(Flicker {
+                    amplitude: 0.5,
+                    frequency: 3.0,
+                    seed: 7,
+                }),
+                ..Default::default()
+            },
+        };
+        let base = [
+            point(),
+            Light::point(Vec3::new(-4.0, 2.0, 3.0), 2.0, Vec3::X, 5.0),
+            point(),
+        ];
+        let mut out = Vec::new();
+        for t in [0.0, 0.25, 1.7, 1234.5] {
+            animate_into(&base, std::slice::from_ref(&m), t, &mut out);
+            for (i, l) in base.iter().enumerate() {
+                let alone = m.motion.apply(l, i as u32, t);
+                assert_eq!(
+                    out[i].position.to_array(),
+                    alone.position.to_array(),
+                    "t {t}"
+                );
+                assert_eq!(
+                    out[i].intensity.to_bits(),
+                    alone.intensity.to_bits(),
+                    "t {t}"
+                );
+            }
+            assert!(
+                t == 0.0 || out[1].position != base[1].position,
+                "t {t}: the orbit moved nothing"
+            );
+        }
     }
 
     #[test]
