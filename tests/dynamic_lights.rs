@@ -30,21 +30,7 @@ fn prepare(
     scene: &Scene,
     capacity: u32,
 ) -> (PreparedFrame, SceneGpu) {
-    let text = std::fs::read_to_string(graph_path(graph_file)).unwrap();
-    let checked = graph::check_text(Path::new(graph_file), &text, &ShaderLibrary::builtin())
-        .expect("valid graph");
-    let gpu = SceneGpu::upload_with_light_capacity(&r.ctx.device, &r.ctx.queue, scene, capacity)
-        .expect("materials");
-    let size = FrameSize {
-        width: W,
-        height: H,
-        lights: gpu.light_capacity,
-    };
-    let compiled = graph::compile(checked, &scene.features(), size);
-    let prepared = r
-        .prepare(compiled, scene, &gpu, size, false)
-        .expect("prepare");
-    (prepared, gpu)
+    prepare_file_with_gpu(r, graph_file, scene, W, H, capacity)
 }
 
 /// A still render of `scene` with `lights` placed in it from the start.

@@ -8,11 +8,8 @@ mod common;
 use common::*;
 
 use glam::Vec3;
-use lightgraph::graph::{self, FrameSize};
 use lightgraph::render::{MeshEditError, PreparedFrame, Renderer, SceneGpu};
 use lightgraph::scene::{light_flags, Scene};
-use lightgraph::shader::ShaderLibrary;
-use std::path::Path;
 
 const W: u32 = 80;
 const H: u32 = 48;
@@ -23,20 +20,7 @@ const H: u32 = 48;
 const SAME_SCENE: f32 = 2e-6;
 
 fn prepare(r: &mut Renderer, graph_file: &str, scene: &Scene) -> (PreparedFrame, SceneGpu) {
-    let text = std::fs::read_to_string(graph_path(graph_file)).unwrap();
-    let checked = graph::check_text(Path::new(graph_file), &text, &ShaderLibrary::builtin())
-        .expect("valid graph");
-    let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, scene).expect("materials");
-    let size = FrameSize {
-        width: W,
-        height: H,
-        lights: gpu.light_capacity,
-    };
-    let compiled = graph::compile(checked, &scene.features(), size);
-    let prepared = r
-        .prepare(compiled, scene, &gpu, size, false)
-        .expect("prepare");
-    (prepared, gpu)
+    prepare_file_with_gpu(r, graph_file, scene, W, H, 0)
 }
 
 fn fresh(r: &mut Renderer, graph_file: &str, scene: &Scene) -> Vec<[f32; 4]> {

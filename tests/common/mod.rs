@@ -282,6 +282,34 @@ pub fn prepare_text(
     r.prepare(compiled, scene, &gpu, size, stats)
 }
 
+/// `graph_file` (under graphs/) prepared for `scene`, uploaded with light buffers holding
+/// room for `capacity` lights (at least the scene's); with the scene's buffers, which light
+/// updates and mesh edits take.
+pub fn prepare_file_with_gpu(
+    r: &mut Renderer,
+    graph_file: &str,
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    capacity: u32,
+) -> (PreparedFrame, SceneGpu) {
+    let text = std::fs::read_to_string(graph_path(graph_file)).unwrap();
+    let checked = graph::check_text(Path::new(graph_file), &text, &ShaderLibrary::builtin())
+        .expect("valid graph");
+    let gpu = SceneGpu::upload_with_light_capacity(&r.ctx.device, &r.ctx.queue, scene, capacity)
+        .expect("materials");
+    let size = FrameSize {
+        width,
+        height,
+        lights: gpu.light_capacity,
+    };
+    let compiled = graph::compile(checked, &scene.features(), size);
+    let prepared = r
+        .prepare(compiled, scene, &gpu, size, false)
+        .expect("prepare");
+    (prepared, gpu)
+}
+
 pub fn render_file(
     r: &mut Renderer,
     graph: &str,
