@@ -12,7 +12,7 @@
 
 mod common;
 
-use common::{cuboid, lambert, renderer, Rng};
+use common::{lambert, renderer, shadow_room, Rng};
 use glam::{DVec3, Vec3};
 use lightgraph::graph::{self, FrameSize};
 use lightgraph::render::{FrameResult, PreparedFrame, Renderer, SceneGpu};
@@ -79,28 +79,7 @@ fn run(r: &mut Renderer, text: &str, scene: &Scene) -> (PreparedFrame, FrameResu
 /// Floor, boxes, a floating slab and a standing cylinder under shadow-casting lights.
 fn shadow_scene(lights: usize, seed: u64) -> Scene {
     let mut rng = Rng(seed);
-    let mut meshes = vec![cuboid(
-        "floor",
-        Vec3::new(-8.0, -1.0, -12.0),
-        Vec3::new(8.0, 0.0, 4.0),
-        0,
-        false,
-    )];
-    for i in 0..5 {
-        let p = rng.vec3(Vec3::new(-5.0, 0.0, -9.0), Vec3::new(5.0, 0.0, 0.0));
-        let s = rng.vec3(Vec3::new(0.4, 0.5, 0.4), Vec3::new(1.2, 2.5, 1.2));
-        meshes.push(cuboid(&format!("box{i}"), p, p + s, 1, false));
-    }
-    meshes.push(cuboid(
-        "slab",
-        Vec3::new(-2.0, 2.5, -5.0),
-        Vec3::new(1.0, 2.7, -3.0),
-        1,
-        false,
-    ));
-    let mut cyl = MeshBuilder::new("column", 1);
-    cyl.cylinder(Vec3::new(2.5, 0.0, -2.0), 0.6, 3.0, 24, 4);
-    meshes.push(cyl.build());
+    let meshes = shadow_room(&mut rng);
     // Every third light a spot pointing down and about, so the reach test covers cones.
     let lights = (0..lights)
         .map(|i| {

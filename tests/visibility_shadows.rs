@@ -16,7 +16,7 @@
 
 mod common;
 
-use common::{cuboid, lambert, prepare_text, renderer, Rng};
+use common::{lambert, prepare_text, renderer, shadow_room, Rng};
 use glam::{DMat4, DVec3, DVec4, Vec3};
 use lightgraph::render::{FrameResult, PreparedFrame, Renderer, SceneGpu};
 use lightgraph::scene::geometry::MeshBuilder;
@@ -92,28 +92,7 @@ fn run(r: &mut Renderer, text: &str, scene: &Scene) -> (PreparedFrame, FrameResu
 /// lights no material, yet a caster among them still takes its number.
 fn shadow_scene(lights: usize, seed: u64) -> Scene {
     let mut rng = Rng(seed);
-    let mut meshes = vec![cuboid(
-        "floor",
-        Vec3::new(-8.0, -1.0, -12.0),
-        Vec3::new(8.0, 0.0, 4.0),
-        0,
-        false,
-    )];
-    for i in 0..5 {
-        let p = rng.vec3(Vec3::new(-5.0, 0.0, -9.0), Vec3::new(5.0, 0.0, 0.0));
-        let s = rng.vec3(Vec3::new(0.4, 0.5, 0.4), Vec3::new(1.2, 2.5, 1.2));
-        meshes.push(cuboid(&format!("box{i}"), p, p + s, 1, false));
-    }
-    meshes.push(cuboid(
-        "slab",
-        Vec3::new(-2.0, 2.5, -5.0),
-        Vec3::new(1.0, 2.7, -3.0),
-        1,
-        false,
-    ));
-    let mut cyl = MeshBuilder::new("column", 1);
-    cyl.cylinder(Vec3::new(2.5, 0.0, -2.0), 0.6, 3.0, 24, 4);
-    meshes.push(cyl.build());
+    let mut meshes = shadow_room(&mut rng);
     // A double-sided wall seen from its back: its geometric normal must be turned to the
     // eye for the lights in front to reach it.
     let mut wall = MeshBuilder::new("back wall", 2);

@@ -8,6 +8,7 @@ pub mod textured;
 use glam::{Vec2, Vec3, Vec4};
 use lightgraph::graph::{self, FrameSize};
 use lightgraph::render::{FrameResult, PreparedFrame, RenderError, Renderer, SceneGpu};
+use lightgraph::scene::geometry::MeshBuilder;
 use lightgraph::scene::{Camera, Light, LightShape, Mesh, Scene, SurfaceMaterial};
 use lightgraph::shader::ShaderLibrary;
 use std::path::Path;
@@ -44,6 +45,34 @@ impl Rng {
             self.range(lo.z, hi.z),
         )
     }
+}
+
+/// The ray-cast shadow tests' room: a floor, five boxes of random size and place (from
+/// `rng`), a floating slab and a standing column; floor material 0, the rest 1.
+pub fn shadow_room(rng: &mut Rng) -> Vec<Mesh> {
+    let mut meshes = vec![cuboid(
+        "floor",
+        Vec3::new(-8.0, -1.0, -12.0),
+        Vec3::new(8.0, 0.0, 4.0),
+        0,
+        false,
+    )];
+    for i in 0..5 {
+        let p = rng.vec3(Vec3::new(-5.0, 0.0, -9.0), Vec3::new(5.0, 0.0, 0.0));
+        let s = rng.vec3(Vec3::new(0.4, 0.5, 0.4), Vec3::new(1.2, 2.5, 1.2));
+        meshes.push(cuboid(&format!("box{i}"), p, p + s, 1, false));
+    }
+    meshes.push(cuboid(
+        "slab",
+        Vec3::new(-2.0, 2.5, -5.0),
+        Vec3::new(1.0, 2.7, -3.0),
+        1,
+        false,
+    ));
+    let mut cyl = MeshBuilder::new("column", 1);
+    cyl.cylinder(Vec3::new(2.5, 0.0, -2.0), 0.6, 3.0, 24, 4);
+    meshes.push(cyl.build());
+    meshes
 }
 
 /// An axis-aligned box as 12 triangles with outward normals (or inward when `inside`).
