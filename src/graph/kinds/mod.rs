@@ -1,19 +1,19 @@
-//! Built-in pass kinds, one file each: its parameters, its slot table and its checks
-//! (a `KindRules` impl). This file holds the registry of kinds (`built_in_kinds!`),
-//! which generates `PassKind` and every dispatch over it, and the rows and checks
-//! several kinds share; `matching.rs` holds the slot matcher they all use and
-//! `contracts.rs` the checks of read buffers against their writers. Generic kinds
+//! The graph side of the built-in pass kinds. A kind is one folder, `src/kinds/<kind>/`,
+//! whose `rules.rs` build.rs mounts here as `graph::kinds::<kind>`: its parameters, its
+//! slot table and its checks (a `KindRules` impl). This file holds the registry of kinds
+//! (`built_in_kinds!`), which generates `PassKind` and every dispatch over it, and the
+//! rows and checks several kinds share; `matching.rs` holds the slot matcher they all use
+//! and `contracts.rs` the checks of read buffers against their writers. Generic kinds
 //! (Compute, Fullscreen) bind by reflected shader binding names instead (see `roles.rs`).
 
 /// The built-in pass kinds: one line each, in the order graph files list them. A line
 /// names the variant graph files spell, its parameters (a kind without any names
-/// none) and its module, the same name under `graph/kinds/` (parameters, slot table,
-/// checks: [`KindRules`]) and `render/passes/` (prepare and record: `PrepareKind`).
+/// none) and its module, the name of its folder `src/kinds/<module>/`: `rules.rs`
+/// (parameters, slot table, checks: [`KindRules`]) and `prepare.rs` (prepare and record).
 /// `$then` is the macro that makes something of the list: the `PassKind` enum and the
 /// graph's dispatch here, the prepare dispatch in `render/passes/`. Each is generated
-/// from this one list, so none can miss a kind; a line without its module file, or a
-/// module without its `KindRules` or `PrepareKind` impl, does not compile, and a module
-/// file without its line fails `every_kind_file_is_registered`.
+/// from this one list, so none can miss a kind; a line without its folder's files, or a
+/// module without its `KindRules` or `PrepareKind` impl, does not compile.
 macro_rules! built_in_kinds {
     ($then:ident) => {
         $then! {
@@ -74,8 +74,6 @@ pub(crate) use kind_value;
 /// kinds after the built-in ones, its label, and the kind's rules.
 macro_rules! graph_side {
     ($( $(#[$doc:meta])* $kind:ident $( ($params:ident : $ty:ident) )? => $module:ident, )*) => {
-        $( pub mod $module; )*
-
         /// Each built-in kind's module name, in registry order.
         pub const KIND_MODULES: &[&str] = &[$( stringify!($module) ),*];
 
@@ -146,6 +144,9 @@ macro_rules! graph_side {
 }
 
 built_in_kinds!(graph_side);
+
+// Each kind folder's `rules.rs` as `graph::kinds::<kind>` (build.rs).
+include!(concat!(env!("OUT_DIR"), "/kind_rules.rs"));
 
 pub(crate) mod contracts;
 mod layout;
@@ -391,44 +392,29 @@ pub(crate) fn plain_u32<S: serde::Serializer>(v: &Option<u32>, s: S) -> Result<S
 
 #[cfg(test)]
 mod registry_tests {
-    use super::KIND_MODULES;
-
-    /// Every module file beside the registered kinds is named here as shared support, so
-    /// a kind whose registry line was dropped cannot linger uncompiled.
+    /// A kind is its folder under src/kinds/ (build.rs mounts it): the places kinds had
+    /// files before hold only shared support, so a kind file left there (a merge of a
+    /// branch from before the folders) is refused instead of lingering uncompiled.
     #[test]
-    fn every_kind_file_is_registered() {
+    fn kind_files_live_in_their_folders() {
         let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
         let support: [(&str, &[&str]); 2] = [
             (
                 "graph/kinds",
                 &["mod", "matching", "contracts", "slots", "layout"],
             ),
-            (
-                "render/passes",
-                &[
-                    "mod",
-                    "compute",
-                    "fullscreen",
-                    "compute_raster_fallback",
-                    "compute_raster_resolve",
-                ],
-            ),
+            ("render/passes", &["mod"]),
         ];
         for (dir, shared) in support {
-            let mut kinds = 0;
             for entry in std::fs::read_dir(src.join(dir)).unwrap() {
                 let path = entry.unwrap().path();
                 let stem = path.file_stem().unwrap().to_str().unwrap().to_string();
-                if KIND_MODULES.contains(&stem.as_str()) {
-                    kinds += 1;
-                } else {
-                    assert!(
-                        shared.contains(&stem.as_str()),
-                        "{dir}/{stem}.rs is neither a registered kind nor shared support"
-                    );
-                }
+                assert!(
+                    shared.contains(&stem.as_str()),
+                    "src/{dir}/{stem}: a kind's files belong in its folder src/kinds/<kind>/ \
+                     (docs/adding_a_pass_kind.md); only shared support stays here"
+                );
             }
-            assert_eq!(kinds, KIND_MODULES.len(), "{dir}");
         }
     }
 }

@@ -1,12 +1,13 @@
-//! Built-in and generic passes, one file per kind (named as in `graph/kinds/`): each
-//! prepares its pipelines and bind groups from a scheduled pass and records itself.
+//! The render side of the pass kinds, built-in and generic: each kind folder's
+//! `prepare.rs` (`src/kinds/<kind>/`), which build.rs mounts here as
+//! `render::passes::<kind>`, prepares its pipelines and bind groups from a scheduled pass
+//! and records itself.
 //! This file holds the prepare dispatch, generated from the registry of kinds
 //! (`graph::kinds::built_in_kinds!`), and what preparing any pass needs.
 
-mod compute;
-mod compute_raster_fallback;
-mod compute_raster_resolve;
-mod fullscreen;
+// Each kind folder's `prepare.rs` as `render::passes::<kind>`, its other files as
+// `<kind>_<file>` (build.rs).
+include!(concat!(env!("OUT_DIR"), "/kind_prepare.rs"));
 
 use super::bind::{BindingSet, Bound};
 use super::pipelines::{Pipeline, PipelineKey};
@@ -43,8 +44,8 @@ pub(super) trait PreparedPass {
     fn follow_lights(&self, _r: &Renderer, _lights: &[crate::scene::Light]) {}
 }
 
-/// How a built-in kind prepares its pass; implemented in `render/passes/<kind>.rs` by the
-/// type `graph/kinds/<kind>.rs` implements `KindRules` on.
+/// How a built-in kind prepares its pass; implemented in its `prepare.rs` by the type its
+/// `rules.rs` implements `KindRules` on.
 pub(super) trait PrepareKind {
     fn prepare(
         &self,
@@ -57,8 +58,6 @@ pub(super) trait PrepareKind {
 /// and the prepare dispatch, with the two generic kinds after the built-in ones.
 macro_rules! render_side {
     ($( $(#[$doc:meta])* $kind:ident $( ($params:ident : $ty:ident) )? => $module:ident, )*) => {
-        $( mod $module; )*
-
         /// Prepares one scheduled pass.
         pub(super) fn prepare(
             cx: &mut PrepareCtx<'_>,
