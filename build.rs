@@ -3,7 +3,9 @@
 //!
 //! For a folder `src/kinds/<kind>/` it declares `rules.rs` as `graph::kinds::<kind>` and,
 //! on the render side, `prepare.rs` as `render::passes::<kind>` and any other `<file>.rs`
-//! as `render::passes::<kind>_<file>`.
+//! as `render::passes::<kind>_<file>`. It also asserts, at compile time, that the folder
+//! has its registry line; the registry names each kind's modules, so a line without its
+//! folder does not compile either.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -49,6 +51,11 @@ fn main() {
             }
             .expect("writing to a String");
         }
+        writeln!(
+            rules,
+            "const _: () = assert!(\n    registered({kind:?}),\n    \"src/kinds/{kind}/ is a kind folder without its line in the registry (built_in_kinds!, src/graph/kinds/mod.rs)\"\n);"
+        )
+        .expect("writing to a String");
     }
     let out = Path::new(&out);
     write(&out.join("kind_rules.rs"), &rules);

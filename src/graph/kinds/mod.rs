@@ -12,8 +12,9 @@
 /// (parameters, slot table, checks: [`KindRules`]) and `prepare.rs` (prepare and record).
 /// `$then` is the macro that makes something of the list: the `PassKind` enum and the
 /// graph's dispatch here, the prepare dispatch in `render/passes/`. Each is generated
-/// from this one list, so none can miss a kind; a line without its folder's files, or a
-/// module without its `KindRules` or `PrepareKind` impl, does not compile.
+/// from this one list, so none can miss a kind; a line without its folder's files, a
+/// module without its `KindRules` or `PrepareKind` impl, or a folder without its line
+/// (build.rs asserts `registered` of each) does not compile.
 macro_rules! built_in_kinds {
     ($then:ident) => {
         $then! {
@@ -145,8 +146,43 @@ macro_rules! graph_side {
 
 built_in_kinds!(graph_side);
 
-// Each kind folder's `rules.rs` as `graph::kinds::<kind>` (build.rs).
+// Each kind folder's `rules.rs` as `graph::kinds::<kind>`, and a check that the folder
+// has its registry line (build.rs).
 include!(concat!(env!("OUT_DIR"), "/kind_rules.rs"));
+
+/// The generic kinds' modules: their folders hold only a `prepare.rs`; `PassKind` and
+/// the prepare dispatch name their variants by hand.
+const GENERIC_KIND_MODULES: &[&str] = &["compute", "fullscreen"];
+
+/// Whether `module` is a registered kind's, built-in or generic: what build.rs asserts
+/// of every folder under `src/kinds/`.
+const fn registered(module: &str) -> bool {
+    // Byte by byte: `==` on strings is not callable in constants.
+    const fn same(a: &[u8], b: &[u8]) -> bool {
+        if a.len() != b.len() {
+            return false;
+        }
+        let mut i = 0;
+        while i < a.len() {
+            if a[i] != b[i] {
+                return false;
+            }
+            i += 1;
+        }
+        true
+    }
+    const fn contains(list: &[&str], module: &str) -> bool {
+        let mut i = 0;
+        while i < list.len() {
+            if same(list[i].as_bytes(), module.as_bytes()) {
+                return true;
+            }
+            i += 1;
+        }
+        false
+    }
+    contains(KIND_MODULES, module) || contains(GENERIC_KIND_MODULES, module)
+}
 
 pub(crate) mod contracts;
 mod layout;
