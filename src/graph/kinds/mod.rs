@@ -13,8 +13,8 @@
 /// `$then` is the macro that makes something of the list: the `PassKind` enum and the
 /// graph's dispatch here, the prepare dispatch in `render/passes/`. Each is generated
 /// from this one list, so none can miss a kind; a line without its folder's files, a
-/// module without its `KindRules` or `PrepareKind` impl, or a folder without its line
-/// (build.rs asserts `registered` of each) does not compile.
+/// `rules.rs` without its `KindRules` impl, a `prepare.rs` without its `prepare`, or a
+/// folder without its line (build.rs asserts `registered` of each) does not compile.
 macro_rules! built_in_kinds {
     ($then:ident) => {
         $then! {
@@ -69,7 +69,6 @@ macro_rules! kind_value {
         &$unit
     };
 }
-pub(crate) use kind_value;
 
 /// The graph side of the registry: the kinds' modules, `PassKind` with the two generic
 /// kinds after the built-in ones, its label, and the kind's rules.

@@ -32,7 +32,7 @@ pub(super) fn prepare(
 ) -> Result<Box<dyn PreparedPass>, RenderError> {
     let missing = FEATURES - cx.device().features();
     if missing.is_empty() {
-        return Ok(Box::new(compute_raster::prepare(cx, sp)?));
+        return Ok(Box::new(compute_raster::prepare_compute(cx, sp)?));
     }
     Ok(Box::new(HardwareRaster::prepare(cx, sp, missing)?))
 }

@@ -182,9 +182,13 @@ impl TestLimits {
     }
 }
 
+/// The registry's entry point: the compute rasterizer, or its hardware fallback on an
+/// adapter without [`FEATURES`].
+pub(super) use super::compute_raster_fallback::prepare;
+
 /// The compute path, for a device with [`FEATURES`]: `compute_raster_fallback::prepare`
 /// picks the hardware path on any other.
-pub(super) fn prepare(
+pub(super) fn prepare_compute(
     cx: &mut PrepareCtx,
     sp: &ScheduledPass,
 ) -> Result<ComputeRasterPass, RenderError> {
@@ -507,18 +511,6 @@ impl PreparedPass for ComputeRasterPass {
 
     fn report(&self, r: &Renderer) -> Result<Option<PassReport>, RenderError> {
         Ok(Some(PassReport::Raster(self.raster_report(r)?)))
-    }
-}
-
-impl super::PrepareKind for crate::graph::kinds::compute_raster::ComputeRaster {
-    /// The compute rasterizer, or its hardware fallback on an adapter without its
-    /// 64-bit atomics.
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
-        super::compute_raster_fallback::prepare(cx, sp)
     }
 }
 

@@ -143,13 +143,3 @@ impl PreparedPass for DeferredShadingPass {
         }
     }
 }
-
-impl super::PrepareKind for crate::graph::kinds::deferred_shading::DeferredShading {
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
-        Ok(Box::new(prepare(cx, sp, self)?))
-    }
-}

@@ -57,13 +57,3 @@ impl PreparedPass for DepthPrepass {
         self.draws.record(&mut pass);
     }
 }
-
-impl super::PrepareKind for crate::graph::kinds::depth_prepass::DepthPrepass {
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
-        Ok(Box::new(prepare(cx, sp)?))
-    }
-}

@@ -62,13 +62,3 @@ impl PreparedPass for ForwardShadingPass {
         self.draws.record(&mut pass);
     }
 }
-
-impl super::PrepareKind for crate::graph::kinds::forward_shading::ForwardShading {
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
-        Ok(Box::new(prepare(cx, sp, self)?))
-    }
-}

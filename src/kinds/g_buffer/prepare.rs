@@ -115,16 +115,6 @@ impl PreparedPass for GBuffer {
     }
 }
 
-impl super::PrepareKind for crate::graph::kinds::g_buffer::GBuffer {
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
-        Ok(Box::new(prepare(cx, sp)?))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::attachment_problem;

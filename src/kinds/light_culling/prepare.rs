@@ -353,13 +353,3 @@ impl PreparedPass for LightCullingPass {
         })))
     }
 }
-
-impl super::PrepareKind for crate::graph::kinds::light_culling::LightCulling {
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
-        Ok(Box::new(prepare(cx, sp, self)?))
-    }
-}

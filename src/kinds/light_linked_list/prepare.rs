@@ -108,13 +108,3 @@ impl PreparedPass for LightLinkedListPass {
         })))
     }
 }
-
-impl super::PrepareKind for crate::graph::kinds::light_linked_list::LightLinkedList {
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
-        Ok(Box::new(prepare(cx, sp, self)?))
-    }
-}

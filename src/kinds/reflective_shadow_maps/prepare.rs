@@ -187,13 +187,3 @@ impl PreparedPass for RsmPass {
         self.draws.record_tiles(&mut pass, &origins, self.tile);
     }
 }
-
-impl super::PrepareKind for crate::graph::kinds::reflective_shadow_maps::ReflectiveShadowMaps {
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
-        Ok(Box::new(prepare(cx, sp, self)?))
-    }
-}

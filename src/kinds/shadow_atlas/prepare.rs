@@ -357,13 +357,3 @@ impl PreparedPass for ShadowAtlasPass {
         self.stale.store(true, Ordering::Release);
     }
 }
-
-impl super::PrepareKind for crate::graph::kinds::shadow_atlas::ShadowAtlas {
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
-        Ok(Box::new(prepare(cx, sp, self)?))
-    }
-}

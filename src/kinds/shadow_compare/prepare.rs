@@ -86,13 +86,3 @@ impl PreparedPass for ShadowComparePass {
         })))
     }
 }
-
-impl super::PrepareKind for crate::graph::kinds::shadow_compare::ShadowCompare {
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
-        Ok(Box::new(prepare(cx, sp)?))
-    }
-}

@@ -75,13 +75,3 @@ impl PreparedPass for ShadowRayCastPass {
         pass.dispatch_workgroups_indirect(&self.jobs, DISPATCH_OFFSET);
     }
 }
-
-impl super::PrepareKind for crate::graph::kinds::shadow_ray_cast::ShadowRayCast {
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
-        Ok(Box::new(prepare(cx, sp, self)?))
-    }
-}

@@ -109,13 +109,3 @@ impl PreparedPass for ShadowRayJobsPass {
         })))
     }
 }
-
-impl super::PrepareKind for crate::graph::kinds::shadow_ray_jobs::ShadowRayJobs {
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
-        Ok(Box::new(prepare(cx, sp, self)?))
-    }
-}

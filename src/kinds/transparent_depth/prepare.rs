@@ -14,13 +14,3 @@ pub(super) fn prepare(
 ) -> Result<DepthPrepass, RenderError> {
     depth_prepass::prepare_meshes(cx, sp, MeshSet::Transparent)
 }
-
-impl super::PrepareKind for crate::graph::kinds::transparent_depth::TransparentDepth {
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
-        Ok(Box::new(prepare(cx, sp)?))
-    }
-}

@@ -99,13 +99,3 @@ impl PreparedPass for TransparentShadingPass {
         *self.order.lock().unwrap_or_else(|e| e.into_inner()) = order;
     }
 }
-
-impl super::PrepareKind for crate::graph::kinds::transparent_shading::TransparentShading {
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
-        Ok(Box::new(prepare(cx, sp, self)?))
-    }
-}

@@ -128,16 +128,6 @@ impl PreparedPass for VisibilityBuffer {
     }
 }
 
-impl super::PrepareKind for crate::graph::kinds::visibility_buffer::VisibilityBuffer {
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
-        Ok(Box::new(prepare(cx, sp)?))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     #[test]

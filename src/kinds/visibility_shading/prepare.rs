@@ -282,16 +282,6 @@ impl PreparedPass for VisibilityShadingPass {
     }
 }
 
-impl super::PrepareKind for crate::graph::kinds::visibility_shading::VisibilityShading {
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
-        Ok(Box::new(prepare(cx, sp, self)?))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::choose_light_loop;

@@ -237,13 +237,3 @@ impl PreparedPass for VplSpawnPass {
         Ok(Some(PassReport::Vpl(report)))
     }
 }
-
-impl super::PrepareKind for crate::graph::kinds::vpl_spawn::VplSpawn {
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
-        Ok(Box::new(prepare(cx, sp, self)?))
-    }
-}

@@ -16,7 +16,7 @@ use super::resources::FrameResources;
 use super::scene_gpu::SceneGpu;
 use super::{RenderError, Renderer};
 use crate::gpu::structs::{GpuLinkParams, GpuListParams};
-use crate::graph::kinds::{built_in_kinds, kind_value};
+use crate::graph::kinds::built_in_kinds;
 use crate::graph::{
     CompiledGraph, FrameSize, PassKind, ResourceDesc, SceneResource, ScheduledPass,
 };
@@ -44,18 +44,27 @@ pub(super) trait PreparedPass {
     fn follow_lights(&self, _r: &Renderer, _lights: &[crate::scene::Light]) {}
 }
 
-/// How a built-in kind prepares its pass; implemented in its `prepare.rs` by the type its
-/// `rules.rs` implements `KindRules` on.
-pub(super) trait PrepareKind {
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn PreparedPass>, RenderError>;
+/// What a kind's `prepare` returns, boxed: its pass, or a pass it boxed itself because
+/// it picks one of several (ComputeRaster's hardware fallback).
+trait IntoPrepared {
+    fn into_prepared(self) -> Box<dyn PreparedPass>;
 }
 
-/// The render side of the registry (`graph::kinds::built_in_kinds`): the kinds' modules
-/// and the prepare dispatch, with the two generic kinds after the built-in ones.
+impl<P: PreparedPass + 'static> IntoPrepared for P {
+    fn into_prepared(self) -> Box<dyn PreparedPass> {
+        Box::new(self)
+    }
+}
+
+impl IntoPrepared for Box<dyn PreparedPass> {
+    fn into_prepared(self) -> Box<dyn PreparedPass> {
+        self
+    }
+}
+
+/// The render side of the registry (`graph::kinds::built_in_kinds`): the prepare
+/// dispatch, calling each kind module's `prepare(cx, sp)` (with `&params` for a kind that
+/// has them), and the two generic kinds after the built-in ones.
 macro_rules! render_side {
     ($( $(#[$doc:meta])* $kind:ident $( ($params:ident : $ty:ident) )? => $module:ident, )*) => {
         /// Prepares one scheduled pass.
@@ -63,20 +72,19 @@ macro_rules! render_side {
             cx: &mut PrepareCtx<'_>,
             sp: &ScheduledPass,
         ) -> Result<Box<dyn PreparedPass>, RenderError> {
-            let built_in: &dyn PrepareKind = match &sp.kind {
+            Ok(match &sp.kind {
                 $( PassKind::$kind $( ($params) )? => {
-                    kind_value!($($params)? ; crate::graph::kinds::$module::$kind)
+                    $module::prepare(cx, sp $(, $params)?)?.into_prepared()
                 } )*
                 PassKind::Compute {
                     shader,
                     entry,
                     dispatch,
-                } => return Ok(Box::new(compute::prepare(cx, sp, shader, entry, *dispatch)?)),
+                } => compute::prepare(cx, sp, shader, entry, *dispatch)?.into_prepared(),
                 PassKind::Fullscreen { shader, entry } => {
-                    return Ok(Box::new(fullscreen::prepare(cx, sp, shader, entry)?))
+                    fullscreen::prepare(cx, sp, shader, entry)?.into_prepared()
                 }
-            };
-            built_in.prepare(cx, sp)
+            })
         }
     };
 }
