@@ -75,7 +75,7 @@ fn shadow_visible(pixel_index: u32, caster: u32, light_pos: vec3<f32>, p: vec3<f
 #endif
 
 #if SHADOW_ATLAS
-// The view table (src/graph/kinds/shadow_atlas.rs): a header (views, atlas side, lights,
+// The view table (src/kinds/shadow_atlas/rules.rs): a header (views, atlas side, lights,
 // room for views), per view its view-projection, its tile in atlas UV (min, max) and
 // (texel size at unit distance, normal offset in texels); then per light its first
 // view + 1 (0: no shadow map this frame), bit 31 set for six cube faces.

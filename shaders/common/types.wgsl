@@ -51,7 +51,7 @@ struct ListParams {
 };
 
 // How a LightLinkedList pass laid out its links (see LinkLayout in
-// src/graph/kinds/light_linked_list.rs).
+// src/kinds/light_linked_list/rules.rs).
 struct LinkParams {
     // Output pixels per list-pixel side.
     scale: u32,

@@ -1,4 +1,4 @@
-// The shadow atlas against ray-cast shadows (src/graph/kinds/shadow_compare.rs): per
+// The shadow atlas against ray-cast shadows (src/kinds/shadow_compare/rules.rs): per
 // pixel, every shadow-casting light its list visits that reaches it, numbered as the
 // light loop numbers casters, counted where it is in front of the shading normal (the
 // pairs the image shows); the ray's answer is the mask bit, the atlas's the filtered

@@ -9,7 +9,7 @@
 // are hidden without a ray: their mask bit is set here, which also clears every pixel's
 // mask for the frame. `finalize` then writes the casting pass's indirect dispatch.
 //
-// Job buffer (src/graph/kinds/shadow_ray_jobs.rs, ShadowJobLayout): words 0..4 jobs wanted,
+// Job buffer (src/kinds/shadow_ray_jobs/rules.rs, ShadowJobLayout): words 0..4 jobs wanted,
 // jobs dropped (buffer full), pixels with more than 128 casters, unused; 4..8 the
 // indirect dispatch (x, y, z, unused); then two words a job.
 // Surfaces come from the G-buffer (g_position, g_geometric) or, with VISIBILITY_IDS, from

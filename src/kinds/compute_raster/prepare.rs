@@ -5,7 +5,7 @@
 //! of a tile, appends the tile's 8×8-pixel blocks the triangle may cover; `raster`
 //! (indirect), a thread per pixel of a block. A resolve then writes the buffer into the
 //! depth texture and the R32Uint visibility texture (a draw or a dispatch, by the depth's
-//! format: `compute_raster_resolve.rs`). Alpha-masked materials: setup, bin and raster
+//! format: `resolve.rs`). Alpha-masked materials: setup, bin and raster
 //! run again per masked material, with its material code testing alpha per pixel; the
 //! first run draws the opaque triangles.
 //! See `shaders/visibility/compute_raster.wgsl`.

@@ -1,7 +1,7 @@
 //! A compiled graph made ready for one scene and output size, executed as often as
 //! needed (benchmarks run it many times), with readback of the output and statistics.
 //! The loops live here: prepare every pass, record every pass between timestamps, read
-//! back. What each pass does lives in `passes/<kind>.rs`.
+//! back. What each pass does lives in its kind's folder (`src/kinds/<kind>/prepare.rs`).
 
 mod light_update;
 mod mesh_edit;
