@@ -37,6 +37,10 @@ fn main() {
             .filter(|path| path.extension().is_some_and(|x| x == "rs"))
             .collect();
         files.sort();
+        // A folder without sources is no kind (what a branch switch can leave behind).
+        if files.is_empty() {
+            continue;
+        }
         for file in &files {
             let stem = file_name(&file.with_extension(""));
             assert!(
@@ -62,6 +66,7 @@ fn main() {
     write(&out.join("kind_prepare.rs"), &prepare);
 }
 
+/// The last component of `path`.
 fn file_name(path: &Path) -> String {
     path.file_name()
         .and_then(|n| n.to_str())
@@ -69,11 +74,15 @@ fn file_name(path: &Path) -> String {
         .to_string()
 }
 
+/// Whether `name` is usable as a module name as it stands (and so as a kind's name).
 fn is_module_name(name: &str) -> bool {
     name.starts_with(|c: char| c.is_ascii_lowercase())
-        && name.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
+        && name
+            .chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
 }
 
+/// Writes a generated file into OUT_DIR.
 fn write(path: &Path, text: &str) {
     std::fs::write(path, text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
 }
