@@ -102,7 +102,6 @@ fn watch_survives_every_bad_save() {
         check(&mut s, scene, &bad);
     }
     save(&mut s, scene, &project.good_scene).expect("the good scene recovers");
-    drop(check);
 
     // Materials: `// expect:` is the message, `// at:` its place in the saved file.
     for bad in ron_files(&root().join("tests/bad/materials")) {
