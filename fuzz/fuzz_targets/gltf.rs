@@ -7,7 +7,9 @@ use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {
     let base = Path::new("/nonexistent-lightgraph-fuzz");
-    if let Ok(loaded) = import_gltf_slice(data, base, Path::new("fuzz.glb"), &ImportLimits::default()) {
+    if let Ok(loaded) =
+        import_gltf_slice(data, base, Path::new("fuzz.glb"), &ImportLimits::default())
+    {
         let _ = loaded.scene.check_gpu_ranges(Path::new("fuzz.glb"));
     }
 });

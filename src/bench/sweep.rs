@@ -98,6 +98,10 @@ fn default_reference() -> String {
 pub const MAX_FRAMES: u32 = 100_000;
 /// Most warm-up frames per graph and point (warming up by time is what reaches the clocks).
 pub const MAX_WARMUP_FRAMES: u32 = 100_000;
+/// Most points one sweep runs (scenes × cases × light counts × resolutions × graphs):
+/// every point renders and times each of its graphs, so 100,000 already take days; the
+/// product of five long lists would also overflow the count.
+pub const MAX_POINTS: u64 = 100_000;
 /// Most rounds per point: each round keeps a median; more rounds than timed frames do not
 /// run anyway (one frame a round at least).
 pub const MAX_ROUNDS: u32 = 10_000;
@@ -221,6 +225,16 @@ impl Sweep {
                 )));
             }
         }
+        match sweep.points() {
+            Some(n) if n <= MAX_POINTS => {}
+            n => {
+                let line = line_of("Sweep");
+                let n = n.map_or("over 2^64".to_string(), |n| n.to_string());
+                return Err(error(format!(
+                    "{line}the sweep has {n} points (scenes × cases × light counts × resolutions × graphs), over the limit of {MAX_POINTS}"
+                )));
+            }
+        }
         if let Some(g) = sweep.references.keys().find(|g| !sweep.graphs.contains(g)) {
             let line = line_of("references");
             return Err(error(format!(
@@ -245,13 +259,23 @@ impl Sweep {
         }
     }
 
-    /// Number of points the sweep runs.
+    /// Number of points the sweep runs (at most [`MAX_POINTS`] once parsed).
     pub fn point_count(&self) -> usize {
-        self.scenes.len()
-            * self.cases.len().max(1)
-            * self.lights.len().max(1)
-            * self.resolutions.len()
-            * self.graphs.len()
+        self.points()
+            .map_or(usize::MAX, |n| n.min(usize::MAX as u64) as usize)
+    }
+
+    /// scenes × cases × light counts × resolutions × graphs; `None` past u64.
+    fn points(&self) -> Option<u64> {
+        [
+            self.scenes.len(),
+            self.cases.len().max(1),
+            self.lights.len().max(1),
+            self.resolutions.len(),
+            self.graphs.len(),
+        ]
+        .iter()
+        .try_fold(1u64, |product, &n| product.checked_mul(n as u64))
     }
 }
 
@@ -579,6 +603,35 @@ fn check_graph(name: &str, renderer: &Renderer) -> Result<graph::CheckedGraph, S
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// 8,000 entries in each of the five lists: 3.3e19 points, past u64 (the count
+    /// wrapped in release builds and panicked with overflow checks; the sweep fuzz
+    /// target's binary found it), refused at the `Sweep(` line.
+    #[test]
+    fn too_many_points_are_refused_even_past_u64() {
+        let list = |item: &str| vec![item; 8000].join(", ");
+        let text = format!(
+            "Sweep(\n scenes: [{}],\n graphs: [{}],\n lights: [{}],\n resolutions: [{}],\n cases: [{}],\n)",
+            list("\"builtin:harada\""),
+            list("\"a.ron\""),
+            list("1"),
+            list("(1, 1)"),
+            list("(name: \"c\")"),
+        );
+        let e = Sweep::parse(&text, "big.ron".as_ref())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("big.ron: 1: the sweep has over 2^64 points")
+                && e.contains("limit of 100000"),
+            "{e}"
+        );
+        let fewer = text.replace(&list("1"), "1");
+        let e = Sweep::parse(&fewer, "big.ron".as_ref())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("has 4096000000000000 points"), "{e}");
+    }
 
     const SWEEP: &str = r#"Sweep(
         scenes: ["builtin:chairs"],

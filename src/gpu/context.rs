@@ -72,6 +72,9 @@ pub struct GpuContext {
     /// ([`ContextOptions::disabled_features`]) or by the caller who made the device
     /// ([`Self::from_device`]): passes that fall back say so.
     pub disabled_features: wgpu::Features,
+    /// What the adapter's driver cannot do beyond wgpu's limits (a loop's iterations),
+    /// from its adapter info; passes check against this, never the adapter's name.
+    pub driver_limits: super::DriverLimits,
 }
 
 impl GpuContext {
@@ -107,6 +110,7 @@ impl GpuContext {
         let disabled_features = (adapter.features() & Self::wanted_features()) - device.features();
         Self {
             has_timestamps: device.features().contains(TIMESTAMPS),
+            driver_limits: super::DriverLimits::of(&adapter.get_info()),
             adapter,
             device,
             queue,
@@ -194,6 +198,7 @@ impl GpuContext {
             .and_then(|dir| DiskPipelineCache::open(&device, &adapter.get_info(), &dir))
             .map(Arc::new);
         Ok(Self {
+            driver_limits: super::DriverLimits::of(&adapter.get_info()),
             adapter,
             device,
             queue,

@@ -167,29 +167,21 @@ pub fn create_internal_buffer(
     Ok(device.create_buffer(desc))
 }
 
-/// The most iterations one shader loop may run on this adapter, where it is known to end
-/// longer loops early and silently: llvmpipe (lavapipe) leaves any loop after 65,535
-/// iterations (gallivm's `LP_MAX_TGSI_LOOP_ITERATIONS`), so a light loop past it drops
-/// every later light without an error. None where no such limit is known.
-pub fn loop_iteration_limit(info: &wgpu::AdapterInfo) -> Option<u64> {
-    let llvmpipe = info.name.contains("llvmpipe") || info.driver.contains("llvmpipe");
-    llvmpipe.then_some(65_535)
-}
-
-/// A shading pass's light loop of up to `most` lights at one pixel, against the
-/// adapter's loop limit; `what` says where the bound comes from.
+/// A shading pass's light loop of up to `most` lights at one pixel, against the most
+/// iterations the adapter's driver lets one loop run (`GpuContext::driver_limits`, see
+/// `gpu::driver_limits`); `what` says where the bound comes from, `adapter` names it.
 pub fn check_light_loop(
-    info: &wgpu::AdapterInfo,
+    driver: &crate::gpu::DriverLimits,
+    adapter: &str,
     pass: &str,
     most: u64,
     what: &str,
 ) -> Result<(), RenderError> {
-    match loop_iteration_limit(info) {
+    match driver.loop_iterations {
         Some(limit) if most > limit => Err(RenderError::Pass {
             pass: pass.to_string(),
             message: format!(
-                "its light loop may visit {most} lights at one pixel ({what}), over this adapter's limit of {limit} iterations a loop ({} ends longer loops silently, losing the lights past it)",
-                info.name
+                "its light loop may visit {most} lights at one pixel ({what}), over this adapter's limit of {limit} iterations a loop ({adapter} ends longer loops silently, losing the lights past it)"
             ),
         }),
         _ => Ok(()),

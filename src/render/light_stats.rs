@@ -40,7 +40,8 @@ impl LightStatsPass {
         let device = r.ctx.device.clone();
         // The exact count walks every light at every pixel.
         super::device_limits::check_light_loop(
-            &r.ctx.adapter.get_info(),
+            &r.ctx.driver_limits,
+            &r.ctx.adapter.get_info().name,
             PASS,
             gpu.light_capacity as u64,
             "its exact count walks every light",

@@ -77,13 +77,12 @@ impl MaterialProgram {
             for (i, slot) in slots.iter().enumerate() {
                 let image = slot.source.load()?;
                 let max = device.limits().max_texture_dimension_2d;
-                let fitted = super::texture_fit::fit_to_device(&image, max).map_err(|message| {
-                    MaterialError::TextureDecode {
+                let fitted = super::texture_fit::fit_to_device(&image, max, material.path())
+                    .map_err(|message| MaterialError::TextureDecode {
                         name: image.name.clone(),
                         path: material.path().to_path_buf(),
                         message,
-                    }
-                })?;
+                    })?;
                 let image = fitted.as_ref().unwrap_or(&image);
                 let chain = super::texture_mips::mip_chain(
                     image.width,

@@ -319,9 +319,11 @@ impl PrepareCtx<'_> {
             .map_or(self.gpu.light_count as u64, |b| {
                 b / std::mem::size_of::<crate::gpu::structs::GpuLightGeometry>() as u64
             });
-        let info = self.renderer.ctx.adapter.get_info();
+        let ctx = &self.renderer.ctx;
+        let adapter = ctx.adapter.get_info().name;
         let loop_check = |most: u64, what: &str| {
-            crate::render::device_limits::check_light_loop(&info, &sp.name, most, what)
+            let limits = &ctx.driver_limits;
+            crate::render::device_limits::check_light_loop(limits, &adapter, &sp.name, most, what)
         };
         if lights == crate::graph::LightSource::AllLights {
             loop_check(lights_bound, "lights: AllLights")?;
