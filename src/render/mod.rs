@@ -5,6 +5,7 @@ mod bind;
 mod device_limits;
 mod draws;
 mod frame;
+mod light_motion;
 mod light_stats;
 pub mod materials;
 mod passes;

@@ -244,9 +244,11 @@ impl SceneGpu {
         // read (every pass loops to the frame's light count).
         geometry.resize(light_capacity as usize, bytemuck::Zeroable::zeroed());
         properties.resize(light_capacity as usize, bytemuck::Zeroable::zeroed());
-        // A scene without lights binds one unused entry.
+        // A scene without lights binds one unused entry. Written by light updates, read
+        // back by whoever checks what they hold.
         let storage = |label: &str, bytes: &[u8]| {
-            storage_buffer(device, label, bytes, wgpu::BufferUsages::COPY_DST)
+            let usage = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
+            storage_buffer(device, label, bytes, usage)
         };
         let mut gpu = Self {
             meshes,

@@ -101,6 +101,9 @@ pub struct PreparedFrame {
     light_capacity: u32,
     /// The light features the graph was compiled and its pipelines specialised for.
     light_features: crate::scene::SceneFeatures,
+    /// Scene-file light motion evaluated on the GPU before the passes, when set
+    /// ([`set_light_motion`](Self::set_light_motion)).
+    motion: std::sync::Mutex<Option<super::light_motion::LightMotionStep>>,
 }
 
 impl Renderer {
@@ -272,6 +275,7 @@ impl Renderer {
             light_count: gpu.light_count.into(),
             light_capacity: gpu.light_capacity,
             light_features: scene.features(),
+            motion: Default::default(),
         })
     }
 }
@@ -352,6 +356,18 @@ impl PreparedFrame {
                 }
             }
         }
+        // Moving lights first: every pass reads the light buffers it writes. Timed in the
+        // query pair after the passes'.
+        let moving = self.motion.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(step) = moving.as_ref() {
+            let n = self.passes.len() as u32;
+            step.record(
+                encoder,
+                Timestamps(self.queries.as_ref().map(|(q, _)| (q, n))),
+            );
+        }
+        let timed = self.passes.len() as u32 + moving.is_some() as u32;
+        drop(moving);
         for (i, (_, pass)) in self.passes.iter().enumerate() {
             let ts = Timestamps(self.queries.as_ref().map(|(q, _)| (q, i as u32)));
             pass.record(encoder, ts);
@@ -360,7 +376,7 @@ impl PreparedFrame {
             }
         }
         if let Some((q, buf)) = &self.queries {
-            encoder.resolve_query_set(q, 0..2 * self.passes.len() as u32, buf, 0);
+            encoder.resolve_query_set(q, 0..2 * timed, buf, 0);
         }
     }
 
@@ -385,15 +401,16 @@ impl PreparedFrame {
         let bytes = read_buffer(device, &r.ctx.queue, buf)?;
         let ticks: &[u64] = bytemuck::cast_slice(&bytes);
         let period = r.ctx.queue.get_timestamp_period() as f64;
-        let pass_ms: Vec<(String, f64)> = self
+        let ms = |i: usize| ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period / 1e6;
+        let mut pass_ms: Vec<(String, f64)> = self
             .passes
             .iter()
             .enumerate()
-            .map(|(i, (n, _))| {
-                let dt = ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period;
-                (n.to_string(), dt / 1e6)
-            })
+            .map(|(i, (n, _))| (n.to_string(), ms(i)))
             .collect();
+        if self.has_light_motion() {
+            pass_ms.push((super::light_motion::STEP.to_string(), ms(self.passes.len())));
+        }
         timings.gpu_frame_ms = Some(pass_ms.iter().map(|(_, ms)| ms).sum());
         timings.timestamps_read = gpu_done.elapsed();
         Ok((Some(pass_ms), timings))
