@@ -677,6 +677,19 @@ fn four_motions(mut scene: Scene) -> Scene {
     scene
 }
 
+/// `lights` as the GPU should hold them.
+fn gpu_lights(
+    lights: &[Light],
+) -> (
+    Vec<lightgraph::gpu::structs::GpuLightGeometry>,
+    Vec<lightgraph::gpu::structs::GpuLightProperties>,
+) {
+    lights
+        .iter()
+        .map(lightgraph::gpu::structs::gpu_light)
+        .unzip()
+}
+
 /// The light buffers as the GPU holds them: (geometry, properties) as f32 words, 8 a light.
 fn light_buffers_on_gpu(r: &Renderer, gpu: &SceneGpu) -> (Vec<f32>, Vec<f32>) {
     let read = |b| {
@@ -694,7 +707,7 @@ fn gpu_motion_writes_what_the_cpu_motion_evaluates() {
     prepared
         .set_light_motion(&r, &gpu, &scene.lights, &scene.light_motion)
         .unwrap();
-    let placed = lightgraph::gpu::structs::light_buffers(&scene.lights);
+    let placed = gpu_lights(&scene.lights);
     let mut cpu = Vec::new();
     // A long run too: the phases are taken in f64, so it stays as tight as time 0.
     for t in [0.0, 0.37, 2.5, 7.9, 1234.5] {
@@ -703,7 +716,7 @@ fn gpu_motion_writes_what_the_cpu_motion_evaluates() {
         let (g, p) = light_buffers_on_gpu(&r, &gpu);
         assert!(g.len() >= 8 * 160 && p.len() >= 8 * 160);
         scene.lights_at(t, &mut cpu);
-        let (want_g, want_p) = lightgraph::gpu::structs::light_buffers(&cpu);
+        let (want_g, want_p) = gpu_lights(&cpu);
         let mut moved = 0;
         for i in 0..160 {
             let (wg, wp) = (want_g[i], want_p[i]);

@@ -199,13 +199,9 @@ impl GpuLinkParams {
     }
 }
 
-/// Splits lights into the two GPU arrays.
-pub fn light_buffers(lights: &[Light]) -> (Vec<GpuLightGeometry>, Vec<GpuLightProperties>) {
-    lights.iter().map(gpu_light).unzip()
-}
-
-/// One light as culling and shading read it (what [`light_buffers`] writes per light).
-pub(crate) fn gpu_light(l: &Light) -> (GpuLightGeometry, GpuLightProperties) {
+/// One light as culling and shading read it: the one conversion from [`Light`], which
+/// every upload and update of the light buffers writes out.
+pub fn gpu_light(l: &Light) -> (GpuLightGeometry, GpuLightProperties) {
     let (direction, cos_outer, cos_inner) = match l.shape {
         LightShape::Point => (Vec3::ZERO, -1.0, -1.0),
         LightShape::Spot {

@@ -12,7 +12,6 @@
 
 use super::scene_gpu::SceneGpu;
 use super::{RenderError, Renderer};
-use crate::gpu::structs::light_buffers;
 use crate::scene::motion::{LightMotion, MotionPhase};
 use crate::scene::{light_flags, Light};
 use bytemuck::{Pod, Zeroable};
@@ -144,15 +143,18 @@ impl LightMotionStep {
             super::scene_gpu::storage_buffer(device, label, bytes, extra)
         };
         let none = wgpu::BufferUsages::empty();
-        let (geometry, properties) = light_buffers(lights);
         let motion_of_light = storage(
             "motion of light",
             bytemuck::cast_slice(&motion_of_light),
             none,
         );
-        let placed_geometry = storage("placed geometry", bytemuck::cast_slice(&geometry), none);
-        let placed_properties =
-            storage("placed properties", bytemuck::cast_slice(&properties), none);
+        let [placed_geometry, placed_properties] = super::scene_gpu::light_storage(
+            device,
+            ["placed geometry", "placed properties"],
+            lights,
+            0,
+            none,
+        );
         let params = storage("motions", bytemuck::cast_slice(&params), none);
         let points = storage("path points", bytemuck::cast_slice(&points), none);
         let gpu_phases = vec![GpuPhase::zeroed(); motions.len()];

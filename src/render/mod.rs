@@ -21,6 +21,7 @@ pub mod visibility_geometry;
 
 pub(crate) use bind::LayoutCache;
 pub use device_limits::supported_sample_counts;
+pub(crate) use frame::LightCount;
 pub use frame::{LightUpdateError, MeshEditError, PreparedFrame, RenderTimings};
 pub use materials::MaterialProgram;
 pub use pipelines::{

@@ -160,7 +160,7 @@ impl PreparedFrame {
     /// The light count and the passes' per-light state follow `lights`.
     fn lights_changed(&self, r: &Renderer, lights: &[Light]) {
         let count = lights.len() as u32;
-        self.light_count.store(count, Ordering::Relaxed);
+        self.light_count.set(count);
         r.ctx.queue.write_buffer(
             &self.frame_uniform,
             LIGHT_COUNT_OFFSET,
@@ -173,12 +173,32 @@ impl PreparedFrame {
 
     /// The light count the passes read: the upload's, or the last update's.
     pub fn light_count(&self) -> u32 {
-        self.light_count.load(Ordering::Relaxed)
+        self.light_count.get()
     }
 
     /// The most lights [`update_lights`](Self::update_lights) takes.
     pub fn light_capacity(&self) -> u32 {
         self.light_capacity
+    }
+}
+
+/// The light count of a prepared frame: the one number the CPU side reads it from (the
+/// frame uniform's `light_count`, which the GPU reads, is written from it). Shared with
+/// the passes that size work by it at record (a `Compute` pass dispatched `PerLight`).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct LightCount(std::sync::Arc<std::sync::atomic::AtomicU32>);
+
+impl LightCount {
+    /// A count starting at `n`.
+    pub fn new(n: u32) -> Self {
+        Self(std::sync::Arc::new(n.into()))
+    }
+    /// The lights passes loop over now.
+    pub fn get(&self) -> u32 {
+        self.0.load(Ordering::Relaxed)
+    }
+    fn set(&self, n: u32) {
+        self.0.store(n, Ordering::Relaxed)
     }
 }
 

@@ -8,6 +8,7 @@ mod mesh_edit;
 mod parallel_builds;
 mod readback;
 
+pub(crate) use light_update::LightCount;
 pub use light_update::LightUpdateError;
 pub use mesh_edit::MeshEditError;
 
@@ -96,7 +97,7 @@ pub struct PreparedFrame {
     prepare_stats: PrepareStats,
     /// The light count every pass reads (the frame uniform's): the upload's, then what
     /// the last [`update_lights`](Self::update_lights) wrote.
-    light_count: std::sync::atomic::AtomicU32,
+    light_count: LightCount,
     /// Room in the scene's light buffers.
     light_capacity: u32,
     /// The light features the graph was compiled and its pipelines specialised for.
@@ -202,8 +203,9 @@ impl Renderer {
             scene.ambient,
             size.width,
             size.height,
-            gpu.light_count,
+            scene.lights.len() as u32,
         );
+        let light_count = LightCount::new(gpu_frame.light_count);
         let frame_uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("frame"),
             contents: bytemuck::bytes_of(&gpu_frame),
@@ -217,6 +219,7 @@ impl Renderer {
             frame_uniform: &frame_uniform,
             size,
             scene,
+            light_count: &light_count,
         };
         prebuild_in_parallel(&mut cx);
         let mut prepared = Vec::with_capacity(graph.passes.len());
@@ -272,7 +275,7 @@ impl Renderer {
             queries,
             stats,
             prepare_stats: PrepareStats::default(),
-            light_count: gpu.light_count.into(),
+            light_count,
             light_capacity: gpu.light_capacity,
             light_features: scene.features(),
             motion: Default::default(),
