@@ -782,12 +782,29 @@ fn gpu_motion_writes_what_the_cpu_motion_evaluates() {
             "t {t}: only {moved} of 120 lights moved"
         );
     }
-    // The caller takes over again: what it writes is what the buffers hold.
+    // The caller takes over again: what it writes is what the buffers hold (its spot
+    // directions normalised on the way).
     prepared.update_lights(&r, &gpu, &scene.lights).unwrap();
     assert!(!prepared.has_light_motion());
     prepared.execute(&r).unwrap();
     let (g, _) = light_buffers_on_gpu(&r, &gpu);
-    assert_eq!(&g[..8 * 160], bytemuck::cast_slice::<_, f32>(&placed.0));
+    let unit: Vec<Light> = scene
+        .lights
+        .iter()
+        .map(|l| {
+            let mut l = *l;
+            if let lightgraph::scene::LightShape::Spot { direction, .. } = &mut l.shape {
+                *direction = direction.normalize();
+            }
+            l
+        })
+        .collect();
+    let (written, _) = gpu_lights(&unit);
+    let written: &[f32] = bytemuck::cast_slice(&written);
+    assert!(
+        g[..8 * 160] == *written,
+        "the caller's lights are not what the buffer holds"
+    );
 }
 
 #[test]

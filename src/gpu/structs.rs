@@ -200,7 +200,8 @@ impl GpuLinkParams {
 }
 
 /// One light as culling and shading read it: the one conversion from [`Light`], which
-/// every upload and update of the light buffers writes out.
+/// every upload and update of the light buffers writes out. Spot directions are taken as
+/// they are: unit length, as `LightShape::Spot` says (normalised where lights come in).
 pub fn gpu_light(l: &Light) -> (GpuLightGeometry, GpuLightProperties) {
     let (direction, cos_outer, cos_inner) = match l.shape {
         LightShape::Point => (Vec3::ZERO, -1.0, -1.0),
@@ -209,7 +210,7 @@ pub fn gpu_light(l: &Light) -> (GpuLightGeometry, GpuLightProperties) {
             inner_angle,
             outer_angle,
         } => (
-            direction.normalize_or_zero(),
+            direction,
             outer_angle.cos(),
             inner_angle.min(outer_angle).cos(),
         ),

@@ -165,7 +165,15 @@ impl SceneGpu {
             queue.write_buffer_with(&self.light_geometry, 0, bytes),
             queue.write_buffer_with(&self.light_properties, 0, bytes),
         ) {
-            write_light_bytes(lights, g.slice(..), p.slice(..));
+            // The caller's lights are checked (above) and normalised once, here.
+            let unit = lights.iter().map(|l| {
+                let mut l = *l;
+                if let crate::scene::LightShape::Spot { direction, .. } = &mut l.shape {
+                    *direction = direction.normalize();
+                }
+                l
+            });
+            write_light_bytes(unit, g.slice(..), p.slice(..));
         }
         Ok(())
     }
@@ -428,7 +436,7 @@ pub(super) fn light_storage(
         // Mapped whole at creation: mapping the whole range again cannot fail.
         let mapped = |b: &wgpu::Buffer| b.get_mapped_range_mut(..).expect("mapped at creation");
         let (mut gv, mut pv) = (mapped(&g), mapped(&p));
-        write_light_bytes(lights, gv.slice(..), pv.slice(..));
+        write_light_bytes(lights.iter().copied(), gv.slice(..), pv.slice(..));
     }
     g.unmap();
     p.unmap();
@@ -438,14 +446,14 @@ pub(super) fn light_storage(
 /// The one place lights are written out as the bytes culling and shading read: each
 /// light's [`gpu_light`] (32 bytes into each array), in order from the start.
 fn write_light_bytes(
-    lights: &[Light],
+    lights: impl Iterator<Item = Light>,
     geometry: wgpu::WriteOnly<[u8]>,
     properties: wgpu::WriteOnly<[u8]>,
 ) {
     let (geometry, _) = geometry.into_chunks::<LIGHT_BYTES>();
     let (properties, _) = properties.into_chunks::<LIGHT_BYTES>();
-    for ((l, g), p) in lights.iter().zip(geometry).zip(properties) {
-        let (lg, lp) = gpu_light(l);
+    for ((l, g), p) in lights.zip(geometry).zip(properties) {
+        let (lg, lp) = gpu_light(&l);
         g.write(bytemuck::cast(lg));
         p.write(bytemuck::cast(lp));
     }
