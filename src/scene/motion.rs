@@ -143,8 +143,8 @@ impl Motion {
     }
 
     /// Checks that `base` stays within the documented limits (`scene::ranges`) at every
-    /// time: its positions within ±[`MAX_COORDINATE`] m, its flickering power within
-    /// [`MAX_LIGHT_POWER`]. Call after [`check`](Self::check). The message names the
+    /// time: its positions within ±`MAX_COORDINATE` m, its flickering power within
+    /// `MAX_LIGHT_POWER`. Call after the parameters' own check. The message names the
     /// field. A path alone is bounded exactly (its points, and a Catmull–Rom segment's
     /// extremes); an orbit alone by its circle; both together by the sphere about the
     /// orbit's centre through the path's farthest place.
