@@ -852,3 +852,42 @@ fn gpu_motion_moves_shadow_casters_the_atlas_follows() {
         "vs placed",
     );
 }
+
+#[test]
+fn gpu_motion_moves_an_indirect_light_its_maps_and_vpls_follow() {
+    let mut r = renderer();
+    let mut scene = cornell_indirect();
+    // From the left of the box (red wall) to the right (green wall) and back.
+    scene.lights[0].position = Vec3::new(-0.55, 0.6, 0.1);
+    scene.light_motion = vec![LightMotion {
+        first: 0,
+        count: 1,
+        motion: motion("(path: (points: [(0, 0, 0), (1.1, 0, 0)], period: 2))"),
+    }];
+    let (prepared, gpu) = prepare(&mut r, "indirect_vpl.ron", &scene, 0);
+    prepared
+        .set_light_motion(&r, &gpu, &scene.lights, &scene.light_motion)
+        .unwrap();
+    let centre_placed = vpl_centre_x(&r, &prepared, 1);
+    prepared.move_lights_to(&r, 1.0).unwrap();
+    let moved = prepared.render(&r).unwrap();
+    let mut fresh_scene = scene.clone();
+    scene.lights_at(1.0, &mut fresh_scene.lights);
+    fresh_scene.light_motion.clear();
+    assert!((fresh_scene.lights[0].position.x - 0.55).abs() < 1e-6);
+    let (fresh, _) = prepare(&mut r, "indirect_vpl.ron", &fresh_scene, 0);
+    let fresh = fresh.render(&r).unwrap();
+    assert_eq!(moved.image.len(), (W * H) as usize);
+    // The bound of the update_lights test above: the same VPLs, summed in another order.
+    let (d, px) = max_rel_diff(&moved.image, &fresh.image);
+    assert!(
+        d <= 6e-6,
+        "moved on the GPU vs fresh prepare: {d:e} at pixel {px}"
+    );
+    assert_eq!(moved.vpls[0].spawned, fresh.vpls[0].spawned);
+    let centre_moved = vpl_centre_x(&r, &prepared, 1);
+    assert!(
+        centre_placed < -0.2 && centre_moved > 0.2,
+        "VPL centre x {centre_placed} placed, {centre_moved} moved"
+    );
+}

@@ -236,6 +236,7 @@ impl Renderer {
             .map(|r| r.name.clone())
             .collect();
         let queries = self.ctx.has_timestamps.then(|| {
+            // A pair per pass, and one for the light-motion step (`set_light_motion`).
             let count = 2 * (prepared.len() as u32 + 1);
             (
                 device.create_query_set(&wgpu::QuerySetDescriptor {
