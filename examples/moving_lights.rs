@@ -1,7 +1,8 @@
-//! Lights that move, through the library: the scene's motion evaluated on the CPU each
-//! frame and written into the prepared frame (`update_lights`: one queue write per light
-//! buffer, no pipeline or bind group rebuilt), then the frame run; the last one is
-//! written as a PNG.
+//! Lights that move, through the library: the scene's motion uploaded once
+//! (`set_light_motion`) and evaluated on the GPU before each frame's passes; each frame
+//! the CPU only sets the time (`move_lights_to`: a few bytes per motion, no pipeline or
+//! bind group rebuilt), then the frame runs; the last one is written as a PNG. A caller
+//! that places lights itself writes them with `update_lights` instead.
 //!
 //!     cargo run --release --example moving_lights -- [SCENE] [FRAMES] [OUT.png]
 use lightgraph::bench::image_io::write_png_tonemapped;
@@ -40,11 +41,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let compiled = graph::compile(checked, &scene.features(), size);
     let frame = renderer.prepare(compiled, &scene, &gpu, size, false)?;
 
-    let mut lights = Vec::new();
+    frame.set_light_motion(&renderer, &gpu, &scene.lights, &scene.light_motion)?;
     for i in 0..frames {
-        let t = f64::from(i) / 60.0;
-        scene.lights_at(t, &mut lights);
-        frame.update_lights(&renderer, &gpu, &lights)?;
+        frame.move_lights_to(&renderer, f64::from(i) / 60.0)?;
         frame.execute(&renderer)?;
     }
     let result = frame.render(&renderer)?;
@@ -58,7 +57,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "wrote {} after {frames} frames of {} moving lights",
         out.display(),
-        lights.len()
+        scene.lights.len()
     );
     Ok(())
 }

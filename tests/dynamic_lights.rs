@@ -633,3 +633,261 @@ fn a_moved_indirect_light_moves_its_maps_and_vpls_as_a_fresh_prepare_would() {
         "{e}"
     );
 }
+
+/// A motion written as in a scene file (paths can only be made so).
+fn motion(ron_text: &str) -> Motion {
+    ron::Options::default()
+        .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
+        .from_str(ron_text)
+        .expect("a motion")
+}
+
+/// `scene`'s 160 lights in four runs: orbiting (tilted axis) and flickering, on a
+/// Catmull–Rom path while orbiting, on a straight path while flickering, and still.
+fn four_motions(mut scene: Scene) -> Scene {
+    let run = |first: u32, motion: Motion| LightMotion {
+        first,
+        count: 40,
+        motion,
+    };
+    scene.light_motion = vec![
+        run(
+            0,
+            motion(
+                "(orbit: (centre: (1, 2, -17), axis: (0.3, 1, -0.2), speed_deg: 47),
+                  flicker: (amplitude: 0.9, frequency: 5, seed: 12345678901))",
+            ),
+        ),
+        run(
+            40,
+            motion(
+                "(orbit: (centre: (-2, 0, -12), speed_deg: -30),
+                  path: (points: [(-3, 0, 0), (3, 1, 0), (0, 2, 4), (1, -1, 1)], period: 2.7,
+                         interpolation: CatmullRom))",
+            ),
+        ),
+        run(
+            80,
+            motion(
+                "(path: (points: [(0, 0, 0), (4, 0, -3), (-2, 3, 1)], period: 1.3),
+                  flicker: (amplitude: 0.5, frequency: 11, seed: 3))",
+            ),
+        ),
+    ];
+    scene
+}
+
+/// `lights` as the GPU should hold them.
+fn gpu_lights(
+    lights: &[Light],
+) -> (
+    Vec<lightgraph::gpu::structs::GpuLightGeometry>,
+    Vec<lightgraph::gpu::structs::GpuLightProperties>,
+) {
+    lights
+        .iter()
+        .map(lightgraph::gpu::structs::gpu_light)
+        .unzip()
+}
+
+/// The light buffers as the GPU holds them: (geometry, properties) as f32 words, 8 a light.
+fn light_buffers_on_gpu(r: &Renderer, gpu: &SceneGpu) -> (Vec<f32>, Vec<f32>) {
+    let read = |b| {
+        let bytes = lightgraph::gpu::readback::read_buffer(&r.ctx.device, &r.ctx.queue, b).unwrap();
+        bytemuck::cast_slice::<u8, f32>(&bytes).to_vec()
+    };
+    (read(&gpu.light_geometry), read(&gpu.light_properties))
+}
+
+#[test]
+fn gpu_motion_writes_what_the_cpu_motion_evaluates() {
+    let mut r = renderer();
+    let scene = four_motions(random_scene(160, 8));
+    let (prepared, gpu) = prepare(&mut r, "forward_plus.ron", &scene, 0);
+    prepared
+        .set_light_motion(&r, &gpu, &scene.lights, &scene.light_motion)
+        .unwrap();
+    let placed = gpu_lights(&scene.lights);
+    let mut cpu = Vec::new();
+    // A long run too: the phases are taken in f64, so it stays as tight as time 0.
+    for t in [0.0, 0.37, 2.5, 7.9, 1234.5] {
+        prepared.move_lights_to(&r, t).unwrap();
+        prepared.execute(&r).unwrap();
+        let (g, p) = light_buffers_on_gpu(&r, &gpu);
+        assert!(g.len() >= 8 * 160 && p.len() >= 8 * 160);
+        scene.lights_at(t, &mut cpu);
+        let (want_g, want_p) = gpu_lights(&cpu);
+        let mut moved = 0;
+        for i in 0..160 {
+            let (wg, wp) = (want_g[i], want_p[i]);
+            let at = |k: usize| -> &[f32] { &g[8 * i + k..8 * i + k + 3] };
+            let position = Vec3::from_slice(at(0));
+            let direction = Vec3::from_slice(at(4));
+            let color = Vec3::from_slice(&p[8 * i..8 * i + 3]);
+            // The same f32 operations on both sides (phases from the CPU, no sines on the
+            // GPU), but the GPU may fuse a multiply and add or sum a dot product in
+            // another order: each a rounding of at most 2^-24 of the magnitude, and about
+            // ten of them stand between a light's place and its coordinates (tens of
+            // metres). 16 roundings of it bound that (lavapipe: 0; the spot directions,
+            // normalised again on the CPU, 4).
+            let scale = Vec3::from(wg.position).abs().max_element().max(20.0);
+            let d = (position - Vec3::from(wg.position)).abs().max_element();
+            assert!(
+                d <= scale * 2f32.powi(-20),
+                "t {t} light {i}: position {position} vs {:?}",
+                wg.position
+            );
+            // Unit vectors: the same bound at magnitude 1.
+            let d = (direction - Vec3::from(wg.direction)).abs().max_element();
+            assert!(
+                d <= 2f32.powi(-20),
+                "t {t} light {i}: direction {direction} vs {:?}",
+                wg.direction
+            );
+            // Colour × intensity × (1 + amplitude × noise): the noise's lattice values are
+            // exact integers on both sides; three roundings of the product, at most 2×
+            // the placed colour (amplitude ≤ 1).
+            let peak = Vec3::from(placed.1[i].color).max_element() * 2.0;
+            let d = (color - Vec3::from(wp.color)).abs().max_element();
+            assert!(
+                d <= peak * 2f32.powi(-21),
+                "t {t} light {i}: colour {color} vs {:?}",
+                wp.color
+            );
+            // The rest is copied: bit for bit.
+            assert_eq!(g[8 * i + 3].to_bits(), wg.range.to_bits());
+            assert_eq!(g[8 * i + 7].to_bits(), wg.cos_outer.to_bits());
+            assert_eq!(p[8 * i + 3].to_bits(), wp.cos_inner.to_bits());
+            assert_eq!(
+                [p[8 * i + 4].to_bits(), p[8 * i + 5].to_bits()],
+                [wp.flags, wp.material_mask]
+            );
+            if i >= 120 {
+                assert_eq!(
+                    position.to_array(),
+                    placed.0[i].position,
+                    "light {i} stands still"
+                );
+                assert_eq!(
+                    color.to_array(),
+                    placed.1[i].color,
+                    "light {i} stands still"
+                );
+            } else if (position - Vec3::from(placed.0[i].position)).length() > 0.1 {
+                moved += 1;
+            }
+        }
+        assert!(
+            t == 0.0 || moved > 100,
+            "t {t}: only {moved} of 120 lights moved"
+        );
+    }
+    // The caller takes over again: what it writes is what the buffers hold (its spot
+    // directions normalised on the way).
+    prepared.update_lights(&r, &gpu, &scene.lights).unwrap();
+    assert!(!prepared.has_light_motion());
+    prepared.execute(&r).unwrap();
+    let (g, _) = light_buffers_on_gpu(&r, &gpu);
+    let unit: Vec<Light> = scene
+        .lights
+        .iter()
+        .map(|l| {
+            let mut l = *l;
+            if let lightgraph::scene::LightShape::Spot { direction, .. } = &mut l.shape {
+                *direction = direction.normalize();
+            }
+            l
+        })
+        .collect();
+    let (written, _) = gpu_lights(&unit);
+    let written: &[f32] = bytemuck::cast_slice(&written);
+    assert!(
+        g[..8 * 160] == *written,
+        "the caller's lights are not what the buffer holds"
+    );
+}
+
+#[test]
+fn gpu_motion_moves_shadow_casters_the_atlas_follows() {
+    let mut r = renderer();
+    let mut scene = random_scene(0, 4);
+    let caster = |p: Vec3| {
+        let mut l = Light::point(p, 10.0, Vec3::ONE, 20.0);
+        l.flags = lightgraph::scene::light_flags::CASTS_SHADOW;
+        l
+    };
+    scene.lights = vec![
+        caster(Vec3::new(-4.0, 2.0, -8.0)),
+        caster(Vec3::new(3.0, 5.0, -20.0)),
+    ];
+    scene.light_motion = vec![LightMotion {
+        first: 0,
+        count: 2,
+        motion: motion(
+            "(orbit: (centre: (0, 0, -14), speed_deg: 20),
+              path: (points: [(0, 0, 0), (1, 0.5, 0)], period: 4))",
+        ),
+    }];
+    let (prepared, gpu) = prepare(&mut r, "shadow_atlas.ron", &scene, 0);
+    prepared
+        .set_light_motion(&r, &gpu, &scene.lights, &scene.light_motion)
+        .unwrap();
+    let t = 3.0;
+    prepared.move_lights_to(&r, t).unwrap();
+    let moved = prepared.render(&r).unwrap().image;
+    // The casters at t placed from the start: the same atlas allocation and views (the
+    // CPU evaluated the casters), the same places on the GPU, so the same image.
+    let mut at_t = Vec::new();
+    scene.lights_at(t, &mut at_t);
+    let mut still_scene = scene.clone();
+    still_scene.light_motion.clear();
+    assert_same(
+        &moved,
+        &still(&mut r, "shadow_atlas.ron", &still_scene, &at_t),
+        "atlas at t",
+    );
+    assert_differs(
+        &moved,
+        &still(&mut r, "shadow_atlas.ron", &still_scene, &scene.lights),
+        "vs placed",
+    );
+}
+
+#[test]
+fn gpu_motion_moves_an_indirect_light_its_maps_and_vpls_follow() {
+    let mut r = renderer();
+    let mut scene = cornell_indirect();
+    // From the left of the box (red wall) to the right (green wall) and back.
+    scene.lights[0].position = Vec3::new(-0.55, 0.6, 0.1);
+    scene.light_motion = vec![LightMotion {
+        first: 0,
+        count: 1,
+        motion: motion("(path: (points: [(0, 0, 0), (1.1, 0, 0)], period: 2))"),
+    }];
+    let (prepared, gpu) = prepare(&mut r, "indirect_vpl.ron", &scene, 0);
+    prepared
+        .set_light_motion(&r, &gpu, &scene.lights, &scene.light_motion)
+        .unwrap();
+    let centre_placed = vpl_centre_x(&r, &prepared, 1);
+    prepared.move_lights_to(&r, 1.0).unwrap();
+    let moved = prepared.render(&r).unwrap();
+    let mut fresh_scene = scene.clone();
+    scene.lights_at(1.0, &mut fresh_scene.lights);
+    fresh_scene.light_motion.clear();
+    assert!((fresh_scene.lights[0].position.x - 0.55).abs() < 1e-6);
+    let (fresh, _) = prepare(&mut r, "indirect_vpl.ron", &fresh_scene, 0);
+    let fresh = fresh.render(&r).unwrap();
+    assert_eq!(moved.image.len(), (W * H) as usize);
+    // The bound of the update_lights test above: the same VPLs, summed in another order.
+    let (d, px) = max_rel_diff(&moved.image, &fresh.image);
+    assert!(
+        d <= 6e-6,
+        "moved on the GPU vs fresh prepare: {d:e} at pixel {px}"
+    );
+    assert_eq!(moved.vpls[0].spawned, fresh.vpls[0].spawned);
+    let centre_moved = vpl_centre_x(&r, &prepared, 1);
+    assert!(
+        centre_placed < -0.2 && centre_moved > 0.2,
+        "VPL centre x {centre_placed} placed, {centre_moved} moved"
+    );
+}

@@ -1,12 +1,13 @@
 //! Timing moving lights (a sweep's `animate:`): before every frame the lights move on by
-//! `animate` seconds and are written with `PreparedFrame::update_lights`, so each frame
-//! culls, lists and (with an atlas) allocates shadows for lights that moved. Scenes whose
+//! `animate` seconds on the GPU (`PreparedFrame::set_light_motion` once, then
+//! `move_lights_to`), so each frame culls, lists and (with an atlas) allocates shadows
+//! for lights that moved. Scenes whose
 //! lights have no motion of their own (and every light count a sweep generates) orbit the
 //! centre of the scene's bounds about +Y at [`ORBIT_DEG_PER_S`].
 
 use super::timing::{self, Method, PointTimes};
 use crate::render::{PreparedFrame, RenderError, Renderer, SceneGpu};
-use crate::scene::motion::{animate_into, LightMotion, Motion, Orbit};
+use crate::scene::motion::{LightMotion, Motion, Orbit};
 use crate::scene::Scene;
 
 /// Degrees per second of the orbit given to lights without motion.
@@ -37,10 +38,10 @@ pub struct MovingTimes {
     /// The GPU's times, as for still lights.
     pub times: PointTimes,
     /// Per graph, the CPU milliseconds of every light update before a frame (warm-up
-    /// and timed): evaluating the motion (`animate_into`) and
-    /// `PreparedFrame::update_lights` (checks, the two buffer writes, the passes' light
-    /// state). The shadow atlas's reallocation runs when the frame is recorded and is not
-    /// in it.
+    /// and timed): `PreparedFrame::move_lights_to` (each motion's phase and its write,
+    /// the moving casters' and indirect lights' evaluation, the passes' light state).
+    /// The shadow atlas's reallocation runs when the frame is recorded and is not in it;
+    /// the GPU's evaluation is the `light_motion` entry of the pass times.
     pub update_cpu_ms: Vec<Vec<f64>>,
 }
 
@@ -55,14 +56,15 @@ pub(crate) fn time_moving(
     step: f64,
 ) -> Result<MovingTimes, RenderError> {
     let motion = motion_for(scene);
-    let mut lights = Vec::with_capacity(scene.lights.len());
+    for f in frames {
+        f.set_light_motion(renderer, gpu, &scene.lights, &motion)?;
+    }
     let mut frame = 0u64;
     let mut update_cpu_ms = vec![Vec::new(); frames.len()];
     let times = timing::time_point_with(frames, renderer, method, &mut |g| {
         frame += 1;
         let start = std::time::Instant::now();
-        animate_into(&scene.lights, &motion, frame as f64 * step, &mut lights);
-        frames[g].update_lights(renderer, gpu, &lights)?;
+        frames[g].move_lights_to(renderer, frame as f64 * step)?;
         update_cpu_ms[g].push(start.elapsed().as_secs_f64() * 1e3);
         Ok(())
     })?;

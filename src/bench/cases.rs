@@ -14,7 +14,6 @@
 //! ]
 //! ```
 
-use crate::scene::lights::check_light;
 use crate::scene::scene_file::{LightSetSpec, LightSpec};
 use crate::scene::{Light, Scene};
 use serde::Deserialize;
@@ -75,7 +74,7 @@ impl SceneCase {
             }
         }
         for (i, l) in self.lights.iter().flatten().enumerate() {
-            check_light(&l.to_light()).map_err(|m| format!("lights[{i}]: {m}"))?;
+            l.to_light().map_err(|m| format!("lights[{i}]: {m}"))?;
         }
         Ok(())
     }
@@ -99,7 +98,9 @@ impl SceneCase {
                     },
                 }
             }
-            lights.extend(self.lights.iter().flatten().map(LightSpec::to_light));
+            for (i, l) in self.lights.iter().flatten().enumerate() {
+                lights.push(l.to_light().map_err(|m| format!("lights[{i}]: {m}"))?);
+            }
             s.lights = lights;
             // Replaced lights do not move as the scene file said (sweeps' `animate`
             // orbits them instead).

@@ -199,13 +199,10 @@ impl GpuLinkParams {
     }
 }
 
-/// Splits lights into the two GPU arrays.
-pub fn light_buffers(lights: &[Light]) -> (Vec<GpuLightGeometry>, Vec<GpuLightProperties>) {
-    lights.iter().map(gpu_light).unzip()
-}
-
-/// One light as culling and shading read it (what [`light_buffers`] writes per light).
-pub(crate) fn gpu_light(l: &Light) -> (GpuLightGeometry, GpuLightProperties) {
+/// One light as culling and shading read it: the one conversion from [`Light`], which
+/// every upload and update of the light buffers writes out. Spot directions are taken as
+/// they are: unit length, as `LightShape::Spot` says (normalised where lights come in).
+pub fn gpu_light(l: &Light) -> (GpuLightGeometry, GpuLightProperties) {
     let (direction, cos_outer, cos_inner) = match l.shape {
         LightShape::Point => (Vec3::ZERO, -1.0, -1.0),
         LightShape::Spot {
@@ -213,7 +210,7 @@ pub(crate) fn gpu_light(l: &Light) -> (GpuLightGeometry, GpuLightProperties) {
             inner_angle,
             outer_angle,
         } => (
-            direction.normalize_or_zero(),
+            direction,
             outer_angle.cos(),
             inner_angle.min(outer_angle).cos(),
         ),

@@ -5,6 +5,7 @@ mod bind;
 mod device_limits;
 mod draws;
 mod frame;
+mod light_motion;
 mod light_stats;
 pub mod materials;
 mod passes;
@@ -20,6 +21,7 @@ pub mod visibility_geometry;
 
 pub(crate) use bind::LayoutCache;
 pub use device_limits::supported_sample_counts;
+pub(crate) use frame::LightCount;
 pub use frame::{LightUpdateError, MeshEditError, PreparedFrame, RenderTimings};
 pub use materials::MaterialProgram;
 pub use pipelines::{

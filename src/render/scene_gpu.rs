@@ -3,9 +3,7 @@
 
 use super::materials::MaterialProgram;
 use super::visibility_geometry::VisibilityGeometry;
-use crate::gpu::structs::{
-    gpu_light, light_buffers, GpuLightGeometry, GpuLightProperties, GpuVertex,
-};
+use crate::gpu::structs::{gpu_light, GpuLightGeometry, GpuLightProperties, GpuVertex};
 use crate::scene::{AlphaMode, Light, Scene};
 use wgpu::util::DeviceExt;
 
@@ -55,11 +53,9 @@ pub struct SceneGpu {
     /// The `light_properties` storage buffer ([`crate::gpu::structs::GpuLightProperties`]
     /// per light).
     pub light_properties: wgpu::Buffer,
-    /// Lights at upload. After [`SceneGpu::write_lights`] a prepared frame's count is the
-    /// one passes read (`PreparedFrame::update_lights`).
-    pub light_count: u32,
-    /// Lights the two light buffers hold room for (at least `light_count`): the most a
-    /// light update may write.
+    /// Lights the two light buffers hold room for (at least the scene's): the most a
+    /// light update may write. The count passes read is the prepared frame's
+    /// (`PreparedFrame::light_count`).
     pub light_capacity: u32,
     /// The shadow BVH, built the first time a pass binds it (see [`SceneGpu::bvh`]);
     /// shared by clones of this upload.
@@ -165,14 +161,19 @@ impl SceneGpu {
         else {
             return Ok(());
         };
-        // The staging views are write-only: each light goes in as its 32 bytes.
-        if let Some(mut g) = queue.write_buffer_with(&self.light_geometry, 0, bytes) {
-            let (slots, _) = g.slice(..).into_chunks::<LIGHT_BYTES>();
-            slots.write_iter(lights.iter().map(|l| bytemuck::cast(gpu_light(l).0)));
-        }
-        if let Some(mut p) = queue.write_buffer_with(&self.light_properties, 0, bytes) {
-            let (slots, _) = p.slice(..).into_chunks::<LIGHT_BYTES>();
-            slots.write_iter(lights.iter().map(|l| bytemuck::cast(gpu_light(l).1)));
+        if let (Some(mut g), Some(mut p)) = (
+            queue.write_buffer_with(&self.light_geometry, 0, bytes),
+            queue.write_buffer_with(&self.light_properties, 0, bytes),
+        ) {
+            // The caller's lights are checked (above) and normalised once, here.
+            let unit = lights.iter().map(|l| {
+                let mut l = *l;
+                if let crate::scene::LightShape::Spot { direction, .. } = &mut l.shape {
+                    *direction = direction.normalize();
+                }
+                l
+            });
+            write_light_bytes(unit, g.slice(..), p.slice(..));
         }
         Ok(())
     }
@@ -238,22 +239,22 @@ impl SceneGpu {
             .filter(|(_, m)| !m.indices.is_empty())
             .map(|(scene_mesh, m)| upload_mesh(device, m, scene_mesh, materials.len()))
             .collect();
-        let (mut geometry, mut properties) = light_buffers(&scene.lights);
         let light_capacity = capacity.max(scene.lights.len() as u32);
         // Room for the lights an update may add: zeroed entries past the count are never
-        // read (every pass loops to the frame's light count).
-        geometry.resize(light_capacity as usize, bytemuck::Zeroable::zeroed());
-        properties.resize(light_capacity as usize, bytemuck::Zeroable::zeroed());
-        // A scene without lights binds one unused entry.
-        let storage = |label: &str, bytes: &[u8]| {
-            storage_buffer(device, label, bytes, wgpu::BufferUsages::COPY_DST)
-        };
+        // read (every pass loops to the frame's light count). Written by light updates,
+        // read back by whoever checks what they hold.
+        let [light_geometry, light_properties] = light_storage(
+            device,
+            ["light geometry", "light properties"],
+            &scene.lights,
+            light_capacity,
+            wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+        );
         let mut gpu = Self {
             meshes,
             materials,
-            light_geometry: storage("light geometry", bytemuck::cast_slice(&geometry)),
-            light_properties: storage("light properties", bytemuck::cast_slice(&properties)),
-            light_count: scene.lights.len() as u32,
+            light_geometry,
+            light_properties,
             light_capacity,
             // A new upload (hot reload of geometry) builds its own when first bound.
             bvh: Default::default(),
@@ -410,6 +411,52 @@ pub(super) fn gpu_vertices(m: &crate::scene::Mesh) -> Vec<GpuVertex> {
             tangent: m.tangents.get(i).copied().unwrap_or_default().into(),
         })
         .collect()
+}
+
+/// The two light storage buffers (geometry, properties) with room for `capacity` lights
+/// (one when 0: storage bindings may not be empty), holding `lights` and zeros after.
+pub(super) fn light_storage(
+    device: &wgpu::Device,
+    labels: [&str; 2],
+    lights: &[Light],
+    capacity: u32,
+    extra: wgpu::BufferUsages,
+) -> [wgpu::Buffer; 2] {
+    let size = capacity.max(lights.len() as u32).max(1) as u64 * LIGHT_BYTES as u64;
+    let [g, p] = labels.map(|label| {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size,
+            usage: wgpu::BufferUsages::STORAGE | extra,
+            // Mapped memory starts zeroed.
+            mapped_at_creation: true,
+        })
+    });
+    {
+        // Mapped whole at creation: mapping the whole range again cannot fail.
+        let mapped = |b: &wgpu::Buffer| b.get_mapped_range_mut(..).expect("mapped at creation");
+        let (mut gv, mut pv) = (mapped(&g), mapped(&p));
+        write_light_bytes(lights.iter().copied(), gv.slice(..), pv.slice(..));
+    }
+    g.unmap();
+    p.unmap();
+    [g, p]
+}
+
+/// The one place lights are written out as the bytes culling and shading read: each
+/// light's [`gpu_light`] (32 bytes into each array), in order from the start.
+fn write_light_bytes(
+    lights: impl Iterator<Item = Light>,
+    geometry: wgpu::WriteOnly<[u8]>,
+    properties: wgpu::WriteOnly<[u8]>,
+) {
+    let (geometry, _) = geometry.into_chunks::<LIGHT_BYTES>();
+    let (properties, _) = properties.into_chunks::<LIGHT_BYTES>();
+    for ((l, g), p) in lights.zip(geometry).zip(properties) {
+        let (lg, lp) = gpu_light(&l);
+        g.write(bytemuck::cast(lg));
+        p.write(bytemuck::cast(lp));
+    }
 }
 
 /// A storage buffer holding `bytes`, padded to 32 bytes when empty: storage bindings may

@@ -143,8 +143,8 @@ impl Motion {
     }
 
     /// Checks that `base` stays within the documented limits (`scene::ranges`) at every
-    /// time: its positions within ±[`MAX_COORDINATE`] m, its flickering power within
-    /// [`MAX_LIGHT_POWER`]. Call after [`check`](Self::check). The message names the
+    /// time: its positions within ±`MAX_COORDINATE` m, its flickering power within
+    /// `MAX_LIGHT_POWER`. Call after the parameters' own check. The message names the
     /// field. A path alone is bounded exactly (its points, and a Catmull–Rom segment's
     /// extremes); an orbit alone by its circle; both together by the sphere about the
     /// orbit's centre through the path's farthest place.
@@ -205,38 +205,76 @@ impl Motion {
     /// `base` at time `t` seconds; `index` is the light's place in its set (it seeds the
     /// flicker, so lights of one set flicker apart).
     pub fn apply(&self, base: &Light, index: u32, t: f64) -> Light {
-        self.apply_turned(base, index, t, self.orbit_turn(t))
+        self.apply_phase(base, index, &self.phase(t))
     }
 
-    /// The orbit's rotation at time `t`: the same for every light of the set, so
-    /// [`animate_into`] takes it once per set, not once per light.
-    fn orbit_turn(&self, t: f64) -> Option<Quat> {
-        self.orbit.as_ref().map(|o| {
-            // The angle is reduced in f64 so that long runs keep their precision.
+    /// The part of the motion at time `t` that every light of the set shares: the
+    /// orbit's rotation, the path's segment, the flicker's lattice cell. Taken once per
+    /// set and time, in f64 (long runs keep their precision); what is left per light is
+    /// f32 arithmetic without sines ([`apply_phase`](Self::apply_phase)), which the GPU
+    /// repeats (`shaders/scene/light_motion.wgsl`).
+    pub fn phase(&self, t: f64) -> MotionPhase {
+        let mut phase = MotionPhase::default();
+        if let Some(o) = &self.orbit {
             let angle = (o.speed_deg as f64).to_radians() * t;
-            Quat::from_axis_angle(
+            phase.turn = Quat::from_axis_angle(
                 o.axis.normalize(),
                 angle.rem_euclid(std::f64::consts::TAU) as f32,
-            )
-        })
+            );
+        }
+        if let Some(p) = &self.path {
+            (phase.segment, phase.along) = p.segment(t);
+        }
+        if let Some(f) = &self.flicker {
+            (phase.cell, phase.blend) = f.cell(t);
+        }
+        phase
     }
 
-    /// [`Self::apply`] with the orbit's rotation at `t` already taken.
-    fn apply_turned(&self, base: &Light, index: u32, t: f64, turn: Option<Quat>) -> Light {
+    /// `base` moved by the motion's `phase` (from [`phase`](Self::phase)); `index` is the
+    /// light's place in its set.
+    pub fn apply_phase(&self, base: &Light, index: u32, phase: &MotionPhase) -> Light {
         let mut l = *base;
         if let Some(p) = &self.path {
-            l.position += p.offset(t);
+            l.position += p.offset_at(phase.segment, phase.along);
         }
-        if let (Some(o), Some(q)) = (&self.orbit, turn) {
-            l.position = o.centre + q * (l.position - o.centre);
+        if let Some(o) = &self.orbit {
+            l.position = o.centre + phase.turn * (l.position - o.centre);
             if let LightShape::Spot { direction, .. } = &mut l.shape {
-                *direction = q * *direction;
+                *direction = phase.turn * *direction;
             }
         }
         if let Some(f) = &self.flicker {
-            l.intensity *= (1.0 + f.amplitude * f.noise(index, t)).max(0.0);
+            l.intensity *= f.factor(index, phase);
         }
         l
+    }
+}
+
+/// A motion at one time, shared by all its lights (see [`Motion::phase`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MotionPhase {
+    /// The orbit's rotation (identity without an orbit).
+    pub turn: Quat,
+    /// The path's segment: it runs from point `segment` to the next.
+    pub segment: u32,
+    /// How far along the segment, 0..1.
+    pub along: f32,
+    /// The flicker's lattice cell (`floor(t × frequency)`).
+    pub cell: i64,
+    /// The smoothstep weight between the cell's lattice value and the next one.
+    pub blend: f32,
+}
+
+impl Default for MotionPhase {
+    fn default() -> Self {
+        Self {
+            turn: Quat::IDENTITY,
+            segment: 0,
+            along: 0.0,
+            cell: 0,
+            blend: 0.0,
+        }
     }
 }
 
@@ -273,13 +311,28 @@ impl KeyframePath {
 
     /// The offset at time `t`: the path loops every `period` seconds.
     pub fn offset(&self, t: f64) -> Vec3 {
+        let (segment, along) = self.segment(t);
+        self.offset_at(segment, along)
+    }
+
+    /// The segment the path is on at time `t` and how far along it (0..1).
+    pub fn segment(&self, t: f64) -> (u32, f32) {
+        let n = self.points.len();
+        if n < 2 {
+            return (0, 0.0);
+        }
+        let u = (t / self.period as f64).rem_euclid(1.0) * n as f64;
+        let i = (u.floor() as usize).min(n - 1);
+        (i as u32, (u - i as f64) as f32)
+    }
+
+    /// The offset `along` segment `segment` (see [`segment`](Self::segment)).
+    pub fn offset_at(&self, segment: u32, along: f32) -> Vec3 {
         let n = self.points.len();
         if n < 2 {
             return self.points.first().copied().unwrap_or(Vec3::ZERO);
         }
-        let u = (t / self.period as f64).rem_euclid(1.0) * n as f64;
-        let i = (u.floor() as usize).min(n - 1);
-        let s = (u - i as f64) as f32;
+        let (i, s) = (segment as usize, along);
         let at = |k: usize| self.points[k % n];
         match self.interpolation {
             Interpolation::Linear => at(i).lerp(at(i + 1), s),
@@ -293,22 +346,46 @@ impl KeyframePath {
             }
         }
     }
+
+    /// The keyframes (offsets from the light's position).
+    pub fn points(&self) -> &[Vec3] {
+        &self.points
+    }
+
+    /// Whether segments are Catmull–Rom splines (else straight).
+    pub fn is_catmull_rom(&self) -> bool {
+        self.interpolation == Interpolation::CatmullRom
+    }
 }
 
 impl Flicker {
     /// Value noise in [−1, 1]: hashed lattice values at integer `t × frequency`,
     /// blended with smoothstep.
     pub fn noise(&self, index: u32, t: f64) -> f32 {
+        let (cell, blend) = self.cell(t);
+        self.noise_at(index, cell, blend)
+    }
+
+    /// The lattice cell at time `t` and the smoothstep weight towards the next one.
+    pub fn cell(&self, t: f64) -> (i64, f32) {
         let x = t * self.frequency as f64;
         let k = x.floor();
         let f = (x - k) as f32;
-        let s = f * f * (3.0 - 2.0 * f);
+        (k as i64, f * f * (3.0 - 2.0 * f))
+    }
+
+    /// The noise of light `index` in lattice cell `cell`, `blend` of the way to the next.
+    pub fn noise_at(&self, index: u32, cell: i64, blend: f32) -> f32 {
         let lattice = |k: i64| {
             let h = mix64(self.seed ^ mix64(((index as u64) << 32) ^ k as u64));
             (h >> 40) as f32 * (2.0 / 16_777_216.0) - 1.0
         };
-        let k = k as i64;
-        lattice(k) + (lattice(k.wrapping_add(1)) - lattice(k)) * s
+        lattice(cell) + (lattice(cell.wrapping_add(1)) - lattice(cell)) * blend
+    }
+
+    /// What the intensity of light `index` is multiplied by at `phase` (≥ 0).
+    pub fn factor(&self, index: u32, phase: &MotionPhase) -> f32 {
+        (1.0 + self.amplitude * self.noise_at(index, phase.cell, phase.blend)).max(0.0)
     }
 }
 
@@ -349,9 +426,9 @@ pub fn animate_into(base: &[Light], motions: &[LightMotion], t: f64, out: &mut V
     for m in motions {
         let first = (m.first as usize).min(out.len());
         let end = first.saturating_add(m.count as usize).min(out.len());
-        let turn = m.motion.orbit_turn(t);
+        let phase = m.motion.phase(t);
         for (i, l) in out[first..end].iter_mut().enumerate() {
-            *l = m.motion.apply_turned(l, i as u32, t, turn);
+            *l = m.motion.apply_phase(l, i as u32, &phase);
         }
     }
 }

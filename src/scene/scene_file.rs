@@ -239,7 +239,10 @@ pub(crate) struct SpotSpec {
 }
 
 impl LightSpec {
-    pub(crate) fn to_light(&self) -> Light {
+    /// The light this entry describes: checked once (`check_light`, the values as
+    /// written in its messages) and its spot direction normalised once. Nothing later
+    /// on the way to the GPU checks or normalises it again.
+    pub(crate) fn to_light(&self) -> Result<Light, String> {
         let mut flags = 0;
         if self.casts_shadow {
             flags |= light_flags::CASTS_SHADOW;
@@ -247,7 +250,7 @@ impl LightSpec {
         if self.indirect {
             flags |= light_flags::INDIRECT;
         }
-        Light {
+        let mut light = Light {
             position: self.position,
             range: self.range,
             color: self.color,
@@ -255,14 +258,19 @@ impl LightSpec {
             shape: match &self.spot {
                 None => LightShape::Point,
                 Some(s) => LightShape::Spot {
-                    direction: s.direction.normalize_or_zero(),
+                    direction: s.direction,
                     inner_angle: s.inner_deg.to_radians(),
                     outer_angle: s.outer_deg.to_radians(),
                 },
             },
             flags,
             material_mask: self.material_mask,
+        };
+        check_light(&light)?;
+        if let LightShape::Spot { direction, .. } = &mut light.shape {
+            *direction = direction.normalize();
         }
+        Ok(light)
     }
 }
 
@@ -484,20 +492,9 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
             Some(n) => format!("lights[{i}] (\"{n}\")"),
             None => format!("lights[{i}]"),
         };
-        if let Some(s) = &l.spot {
-            if !s.direction.is_finite() || s.direction.length_squared() < 1e-12 {
-                return Err(SceneError::invalid(
-                    file,
-                    element,
-                    format!(
-                        "spot direction {} is not a finite non-zero vector",
-                        s.direction
-                    ),
-                ));
-            }
-        }
-        let light = l.to_light();
-        check_light(&light).map_err(|m| SceneError::invalid(file, &element, m))?;
+        let light = l
+            .to_light()
+            .map_err(|m| SceneError::invalid(file, &element, m))?;
         if let Some(vpl) = &l.vpl {
             if !l.indirect {
                 return Err(SceneError::invalid(

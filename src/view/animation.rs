@@ -1,16 +1,14 @@
 //! The viewer's clock for moving lights: advances with the frames unless paused (Space)
-//! and writes the scene's lights at that time through `PreparedFrame::update_lights`.
+//! and moves the scene's lights to that time on the GPU (`PreparedFrame::move_lights_to`,
+//! after `set_light_motion` on each newly prepared frame).
 
 use crate::reload::ReloadSession;
-use crate::scene::Light;
 
 #[derive(Default)]
 pub(crate) struct LightClock {
     /// Seconds of light motion shown.
     pub(crate) time: f64,
     pub(crate) paused: bool,
-    /// The lights at `time`, kept so that a frame allocates nothing.
-    lights: Vec<Light>,
 }
 
 impl LightClock {
@@ -25,9 +23,14 @@ impl LightClock {
         let Some(prepared) = session.prepared() else {
             return Ok(());
         };
-        scene.lights_at(self.time, &mut self.lights);
+        let r = &session.renderer;
+        if !prepared.has_light_motion() {
+            prepared
+                .set_light_motion(r, session.gpu(), &scene.lights, &scene.light_motion)
+                .map_err(|e| e.to_string())?;
+        }
         prepared
-            .update_lights(&session.renderer, session.gpu(), &self.lights)
+            .move_lights_to(r, self.time)
             .map_err(|e| e.to_string())
     }
 }

@@ -36,8 +36,9 @@ pub struct BenchRow {
     /// Wall-clock seconds the point's warm-up took (all its graphs together).
     pub warmup_s: Option<f64>,
     /// Moving lights (a sweep's `animate:`): CPU milliseconds of one frame's light update,
-    /// the median over the point's frames: evaluating the motion and
-    /// `PreparedFrame::update_lights` (see [`crate::bench::animate::MovingTimes`]).
+    /// the median over the point's frames: `PreparedFrame::move_lights_to` (the motions'
+    /// phases, the moving casters and indirect lights, the passes' light state; the GPU
+    /// evaluates the rest, in the `light_motion` pass time).
     pub light_update_cpu_ms: Option<f64>,
     /// The GPU's SM clock before the point's warm-up and after its last round, and its
     /// maximum, MHz (`nvidia-smi`; `None` elsewhere).

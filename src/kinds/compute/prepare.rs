@@ -8,7 +8,6 @@ use crate::render::bind::Bound;
 use crate::render::pipelines::{Pipeline, PipelineKey};
 use crate::render::RenderError;
 use std::collections::BTreeMap;
-use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::Arc;
 
 pub(super) struct ComputePass {
@@ -18,7 +17,7 @@ pub(super) struct ComputePass {
     groups: [u32; 3],
     /// For `PerLight` dispatches: the workgroup size and the light count it is run for
     /// now (light updates change it; the dispatch limit was checked at the capacity).
-    per_light: Option<(u32, AtomicU32)>,
+    per_light: Option<(u32, crate::render::LightCount)>,
 }
 
 pub(super) fn prepare(
@@ -73,9 +72,7 @@ pub(super) fn prepare(
     };
     crate::render::device_limits::check_dispatch(cx.graph, &sp.name, groups, &device.limits())?;
     let per_light = match d {
-        Dispatch::PerLight { workgroup } => {
-            Some((workgroup.max(1), AtomicU32::new(cx.gpu.light_count)))
-        }
+        Dispatch::PerLight { workgroup } => Some((workgroup.max(1), cx.light_count.clone())),
         _ => None,
     };
     Ok(ComputePass {
@@ -123,15 +120,9 @@ impl PreparedPass for ComputePass {
             &self.pipeline,
             &self.bind,
             match &self.per_light {
-                Some((w, lights)) => [lights.load(Ordering::Relaxed).div_ceil(*w).max(1), 1, 1],
+                Some((w, lights)) => [lights.get().div_ceil(*w).max(1), 1, 1],
                 None => self.groups,
             },
         );
-    }
-
-    fn follow_lights(&self, _r: &crate::render::Renderer, lights: &[crate::scene::Light]) {
-        if let Some((_, count)) = &self.per_light {
-            count.store(lights.len() as u32, Ordering::Relaxed);
-        }
     }
 }

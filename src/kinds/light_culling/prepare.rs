@@ -98,7 +98,7 @@ pub(super) fn prepare(
     // add lights to the scene's).
     let light_capacity = offered
         .buffer_size("light_geometry")
-        .map_or(cx.gpu.light_count as u64, |b| b / LIGHT_GEOMETRY_BYTES)
+        .map_or(cx.gpu.light_capacity as u64, |b| b / LIGHT_GEOMETRY_BYTES)
         .max(1);
     let light_bounds = create_internal_buffer(
         &device,

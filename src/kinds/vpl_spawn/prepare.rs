@@ -68,7 +68,7 @@ pub(super) fn prepare(
         })?;
     let (w, h, layout) = super::reflective_shadow_maps::rsm_layout(cx, &sp.name, &rsm.0, &rsm.1)?;
     let rules = rsm_layout_rules(cx, &rsm.0, w, h);
-    let scene_lights = cx.gpu.light_count;
+    let scene_lights = cx.light_count.get();
     // Room for every light an update may write, then the VPLs.
     let most_lights = cx.gpu.light_capacity;
     let need = (most_lights as u64 + p.max_vpls as u64) * 32;

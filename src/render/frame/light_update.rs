@@ -6,8 +6,10 @@
 
 use super::PreparedFrame;
 use crate::gpu::structs::GpuFrame;
+use crate::render::light_motion::{LightMotionStep, StepError};
 use crate::render::scene_gpu::SceneGpu;
 use crate::render::Renderer;
+use crate::scene::motion::LightMotion;
 use crate::scene::{light_flags, Light, LightShape, SceneFeatures};
 use std::sync::atomic::Ordering;
 
@@ -39,6 +41,20 @@ pub enum LightUpdateError {
         /// The feature it adds.
         feature: &'static str,
     },
+    /// Two motions move one light: the GPU evaluates one motion per light.
+    #[error(
+        "light motion: light {index} is in the runs of two motions; give each light one motion"
+    )]
+    OverlappingMotion {
+        /// The light's index in the scene.
+        index: usize,
+    },
+    /// The motion step could not be built (its shader, or a device limit).
+    #[error("light motion: {0}")]
+    MotionStep(String),
+    /// [`PreparedFrame::move_lights_to`] without a motion set.
+    #[error("light motion: no motion is set on this frame (PreparedFrame::set_light_motion)")]
+    NoMotion,
     /// A pass cannot show the lights with the room it was prepared with (the VPL
     /// candidates of more or larger indirect lights).
     #[error("light update: pass '{pass}' cannot follow moving lights: {problem}")]
@@ -65,6 +81,65 @@ impl PreparedFrame {
         gpu: &SceneGpu,
         lights: &[Light],
     ) -> Result<(), LightUpdateError> {
+        self.check_update(lights)?;
+        gpu.write_lights(&r.ctx.queue, lights)?;
+        // The caller places the lights from now on.
+        *self.motion.lock().unwrap_or_else(|e| e.into_inner()) = None;
+        self.lights_changed(r, lights);
+        Ok(())
+    }
+
+    /// Makes scene-file motion move the lights on the GPU: uploads `lights` (as placed,
+    /// the scene's `lights`) and their `motion` (the scene's `light_motion`) once, and
+    /// from the next frame on a dispatch before the passes writes every light moved to
+    /// the time of the last [`move_lights_to`](Self::move_lights_to) (0 until then) over
+    /// `gpu`'s light buffers. The CPU evaluates only the moving lights whose places it
+    /// needs (shadow casters, indirect lights). Refused as
+    /// [`update_lights`](Self::update_lights) refuses `lights`, and for two motions over
+    /// one light. [`update_lights`](Self::update_lights) ends it.
+    pub fn set_light_motion(
+        &self,
+        r: &Renderer,
+        gpu: &SceneGpu,
+        lights: &[Light],
+        motion: &[LightMotion],
+    ) -> Result<(), LightUpdateError> {
+        self.check_update(lights)?;
+        let mut step = LightMotionStep::new(r, gpu, lights, motion).map_err(|e| match e {
+            StepError::Overlap(index) => LightUpdateError::OverlappingMotion { index },
+            StepError::Render(e) => LightUpdateError::MotionStep(e.to_string()),
+        })?;
+        let at_0 = step.move_to(&r.ctx.queue, 0.0);
+        self.lights_changed(r, at_0.unwrap_or(lights));
+        *self.motion.lock().unwrap_or_else(|e| e.into_inner()) = Some(step);
+        Ok(())
+    }
+
+    /// Moves the lights of [`set_light_motion`](Self::set_light_motion) to time `t`
+    /// seconds for the next frame: writes each motion's phase (a few bytes per motion,
+    /// whatever the light count) and evaluates on the CPU the moving shadow casters and
+    /// indirect lights, which the passes that keep per-light state then follow.
+    pub fn move_lights_to(&self, r: &Renderer, t: f64) -> Result<(), LightUpdateError> {
+        let mut motion = self.motion.lock().unwrap_or_else(|e| e.into_inner());
+        let step = motion.as_mut().ok_or(LightUpdateError::NoMotion)?;
+        if let Some(lights) = step.move_to(&r.ctx.queue, t) {
+            for (_, pass) in &self.passes {
+                pass.follow_lights(r, lights);
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether the lights move on the GPU ([`set_light_motion`](Self::set_light_motion)).
+    pub fn has_light_motion(&self) -> bool {
+        self.motion
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .is_some()
+    }
+
+    /// What every light update checks: room, the compiled features, the passes' room.
+    fn check_update(&self, lights: &[Light]) -> Result<(), LightUpdateError> {
         if lights.len() > self.light_capacity as usize {
             return Err(LightUpdateError::OverCapacity {
                 count: lights.len(),
@@ -79,9 +154,13 @@ impl PreparedFrame {
                     problem,
                 })?;
         }
-        gpu.write_lights(&r.ctx.queue, lights)?;
+        Ok(())
+    }
+
+    /// The light count and the passes' per-light state follow `lights`.
+    fn lights_changed(&self, r: &Renderer, lights: &[Light]) {
         let count = lights.len() as u32;
-        self.light_count.store(count, Ordering::Relaxed);
+        self.light_count.set(count);
         r.ctx.queue.write_buffer(
             &self.frame_uniform,
             LIGHT_COUNT_OFFSET,
@@ -90,17 +169,36 @@ impl PreparedFrame {
         for (_, pass) in &self.passes {
             pass.follow_lights(r, lights);
         }
-        Ok(())
     }
 
     /// The light count the passes read: the upload's, or the last update's.
     pub fn light_count(&self) -> u32 {
-        self.light_count.load(Ordering::Relaxed)
+        self.light_count.get()
     }
 
     /// The most lights [`update_lights`](Self::update_lights) takes.
     pub fn light_capacity(&self) -> u32 {
         self.light_capacity
+    }
+}
+
+/// The light count of a prepared frame: the one number the CPU side reads it from (the
+/// frame uniform's `light_count`, which the GPU reads, is written from it). Shared with
+/// the passes that size work by it at record (a `Compute` pass dispatched `PerLight`).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct LightCount(std::sync::Arc<std::sync::atomic::AtomicU32>);
+
+impl LightCount {
+    /// A count starting at `n`.
+    pub fn new(n: u32) -> Self {
+        Self(std::sync::Arc::new(n.into()))
+    }
+    /// The lights passes loop over now.
+    pub fn get(&self) -> u32 {
+        self.0.load(Ordering::Relaxed)
+    }
+    fn set(&self, n: u32) {
+        self.0.store(n, Ordering::Relaxed)
     }
 }
 

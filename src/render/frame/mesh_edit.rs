@@ -151,10 +151,9 @@ impl Renderer {
                 capacity: gpu.light_capacity,
             });
         }
-        // The frame starts from the upload's light count and the passes from the scene's
-        // lights: the buffers get the scene's lights once the prepare succeeded (a
+        // The frame's light count and the passes start from the scene's lights: the
+        // buffers get the scene's lights once the prepare succeeded (a
         // refused edit leaves them as the last update wrote them).
-        gpu.light_count = scene.lights.len() as u32;
         let light_stats = frame.stats.is_some();
         let rebound = self.prepare_reusing(
             frame.graph.clone(),

@@ -8,6 +8,7 @@ mod mesh_edit;
 mod parallel_builds;
 mod readback;
 
+pub(crate) use light_update::LightCount;
 pub use light_update::LightUpdateError;
 pub use mesh_edit::MeshEditError;
 
@@ -96,11 +97,14 @@ pub struct PreparedFrame {
     prepare_stats: PrepareStats,
     /// The light count every pass reads (the frame uniform's): the upload's, then what
     /// the last [`update_lights`](Self::update_lights) wrote.
-    light_count: std::sync::atomic::AtomicU32,
+    light_count: LightCount,
     /// Room in the scene's light buffers.
     light_capacity: u32,
     /// The light features the graph was compiled and its pipelines specialised for.
     light_features: crate::scene::SceneFeatures,
+    /// Scene-file light motion evaluated on the GPU before the passes, when set
+    /// ([`set_light_motion`](Self::set_light_motion)).
+    motion: std::sync::Mutex<Option<super::light_motion::LightMotionStep>>,
 }
 
 impl Renderer {
@@ -199,8 +203,9 @@ impl Renderer {
             scene.ambient,
             size.width,
             size.height,
-            gpu.light_count,
+            scene.lights.len() as u32,
         );
+        let light_count = LightCount::new(gpu_frame.light_count);
         let frame_uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("frame"),
             contents: bytemuck::bytes_of(&gpu_frame),
@@ -214,6 +219,7 @@ impl Renderer {
             frame_uniform: &frame_uniform,
             size,
             scene,
+            light_count: &light_count,
         };
         prebuild_in_parallel(&mut cx);
         let mut prepared = Vec::with_capacity(graph.passes.len());
@@ -230,6 +236,7 @@ impl Renderer {
             .map(|r| r.name.clone())
             .collect();
         let queries = self.ctx.has_timestamps.then(|| {
+            // A pair per pass, and one for the light-motion step (`set_light_motion`).
             let count = 2 * (prepared.len() as u32 + 1);
             (
                 device.create_query_set(&wgpu::QuerySetDescriptor {
@@ -269,9 +276,10 @@ impl Renderer {
             queries,
             stats,
             prepare_stats: PrepareStats::default(),
-            light_count: gpu.light_count.into(),
+            light_count,
             light_capacity: gpu.light_capacity,
             light_features: scene.features(),
+            motion: Default::default(),
         })
     }
 }
@@ -352,6 +360,18 @@ impl PreparedFrame {
                 }
             }
         }
+        // Moving lights first: every pass reads the light buffers it writes. Timed in the
+        // query pair after the passes'.
+        let moving = self.motion.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(step) = moving.as_ref() {
+            let n = self.passes.len() as u32;
+            step.record(
+                encoder,
+                Timestamps(self.queries.as_ref().map(|(q, _)| (q, n))),
+            );
+        }
+        let timed = self.passes.len() as u32 + moving.is_some() as u32;
+        drop(moving);
         for (i, (_, pass)) in self.passes.iter().enumerate() {
             let ts = Timestamps(self.queries.as_ref().map(|(q, _)| (q, i as u32)));
             pass.record(encoder, ts);
@@ -360,7 +380,7 @@ impl PreparedFrame {
             }
         }
         if let Some((q, buf)) = &self.queries {
-            encoder.resolve_query_set(q, 0..2 * self.passes.len() as u32, buf, 0);
+            encoder.resolve_query_set(q, 0..2 * timed, buf, 0);
         }
     }
 
@@ -385,15 +405,16 @@ impl PreparedFrame {
         let bytes = read_buffer(device, &r.ctx.queue, buf)?;
         let ticks: &[u64] = bytemuck::cast_slice(&bytes);
         let period = r.ctx.queue.get_timestamp_period() as f64;
-        let pass_ms: Vec<(String, f64)> = self
+        let ms = |i: usize| ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period / 1e6;
+        let mut pass_ms: Vec<(String, f64)> = self
             .passes
             .iter()
             .enumerate()
-            .map(|(i, (n, _))| {
-                let dt = ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period;
-                (n.to_string(), dt / 1e6)
-            })
+            .map(|(i, (n, _))| (n.to_string(), ms(i)))
             .collect();
+        if self.has_light_motion() {
+            pass_ms.push((super::light_motion::STEP.to_string(), ms(self.passes.len())));
+        }
         timings.gpu_frame_ms = Some(pass_ms.iter().map(|(_, ms)| ms).sum());
         timings.timestamps_read = gpu_done.elapsed();
         Ok((Some(pass_ms), timings))

@@ -72,6 +72,7 @@ pub(super) fn prebuild_in_parallel(cx: &mut PrepareCtx<'_>) {
                             frame_uniform,
                             size,
                             scene,
+                            light_count: &Default::default(),
                         },
                         sp,
                     )

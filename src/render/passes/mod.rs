@@ -143,6 +143,8 @@ pub(super) struct PrepareCtx<'a> {
     pub frame_uniform: &'a wgpu::Buffer,
     pub size: FrameSize,
     pub scene: &'a crate::scene::Scene,
+    /// The frame's light count (starts at the scene's).
+    pub light_count: &'a crate::render::LightCount,
 }
 
 impl PrepareCtx<'_> {
@@ -316,7 +318,7 @@ impl PrepareCtx<'_> {
         // (passes before it, VplSpawn, may add lights).
         let lights_bound = offered
             .buffer_size("light_geometry")
-            .map_or(self.gpu.light_count as u64, |b| {
+            .map_or(self.gpu.light_capacity as u64, |b| {
                 b / std::mem::size_of::<crate::gpu::structs::GpuLightGeometry>() as u64
             });
         let ctx = &self.renderer.ctx;
