@@ -16,6 +16,8 @@
 // The light loop asks `shadow_visibility` for the fraction of light that reaches p:
 // 0 or 1 from the mask and the tracer, filtered from the atlas.
 
+#include "common/shading_point.wgsl"
+
 const LIGHT_CASTS_SHADOW: u32 = 1u;
 const SHADOW_MAX_CASTERS: u32 = 128u;
 const SHADOW_MASK_WORDS: u32 = 4u;

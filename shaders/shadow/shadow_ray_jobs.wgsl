@@ -21,10 +21,8 @@
 #include "common/lighting.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
-@group(0) @binding(2) var<storage, read> light_properties: array<LightProperties>;
-@group(0) @binding(3) var<storage, read> light_lists: array<u32>;
-@group(0) @binding(4) var<uniform> list_params: ListParams;
+// LIGHT_LISTS is always set: tile lists.
+#include "common/light_inputs.wgsl"
 #if VISIBILITY_IDS
 @group(0) @binding(5) var visibility: texture_2d<u32>;
 @group(0) @binding(6) var<storage, read> vertices: array<f32>;
@@ -36,7 +34,6 @@
 @group(0) @binding(7) var<storage, read_write> shadow_jobs: array<atomic<u32>>;
 @group(0) @binding(8) var<storage, read_write> shadow_mask: array<u32>;
 
-#include "common/light_lists.wgsl"
 #include "common/shadows.wgsl"
 #include "shadow/surface_source.wgsl"
 
