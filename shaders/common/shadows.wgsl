@@ -21,6 +21,10 @@
 const LIGHT_CASTS_SHADOW: u32 = 1u;
 const SHADOW_MAX_CASTERS: u32 = 128u;
 const SHADOW_MASK_WORDS: u32 = 4u;
+// The job buffer (src/graph/kinds/shadow_ray_jobs.rs): header words before the jobs, and
+// words a job (pixel index, then light index | caster number << 24).
+const JOB_HEADER_WORDS: u32 = 8u;
+const JOB_WORDS: u32 = 2u;
 // Jobs a workgroup of the casting pass (its dispatch is written by job creation).
 const SHADOW_CAST_GROUP: u32 = 64u;
 

@@ -37,7 +37,6 @@
 #include "common/shadows.wgsl"
 #include "shadow/surface_source.wgsl"
 
-const JOB_HEADER_WORDS: u32 = 8u;
 const GROUP_SIZE: u32 = 256u;
 // Workgroups a dispatch dimension may have (WebGPU's limit).
 const MAX_GROUPS_X: u32 = 65535u;
@@ -97,8 +96,8 @@ fn walk(px: Pixel, emit: bool) {
                 if (emit) {
                     let slot = group_base + atomicAdd(&bucket_next[bucket], 1u);
                     if (slot < JOB_CAPACITY) {
-                        atomicStore(&shadow_jobs[JOB_HEADER_WORDS + 2u * slot], px.index);
-                        atomicStore(&shadow_jobs[JOB_HEADER_WORDS + 2u * slot + 1u], i | (caster << 24u));
+                        atomicStore(&shadow_jobs[JOB_HEADER_WORDS + JOB_WORDS * slot], px.index);
+                        atomicStore(&shadow_jobs[JOB_HEADER_WORDS + JOB_WORDS * slot + 1u], i | (caster << 24u));
                     }
                 } else {
                     atomicAdd(&bucket_count[bucket], 1u);

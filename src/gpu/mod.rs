@@ -4,5 +4,7 @@ mod context;
 pub mod pipeline_cache;
 pub mod readback;
 pub mod structs;
+#[cfg(test)]
+mod wgsl_constants;
 
 pub use context::{ContextOptions, GpuContext, GpuError};

@@ -310,7 +310,7 @@ impl PrepareCtx<'_> {
         let lights_bound = offered
             .buffer_size("light_geometry")
             .map_or(self.gpu.light_count as u64, |b| {
-                b / std::mem::size_of::<crate::gpu::structs::GpuLightGeometry>() as u64
+                b / crate::gpu::structs::LIGHT_BYTES
             });
         let info = self.renderer.ctx.adapter.get_info();
         let loop_check = |most: u64, what: &str| {
