@@ -97,3 +97,70 @@ fn link_params_match() {
         [scale, width, height, pool_offset, pool, _pad0, _pad1, _pad2]
     );
 }
+
+/// The array stride naga's layouter gives WGSL struct `name` (its size rounded up to its
+/// alignment): how far apart elements of a storage array of it lie.
+fn wgsl_stride(module: &naga::Module, name: &str) -> u32 {
+    let (handle, _) = module
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no struct {name}"));
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).unwrap();
+    layouter[handle].to_stride()
+}
+
+fn types_module() -> naga::Module {
+    ShaderLibrary::builtin()
+        .compose("common/types.wgsl", &BTreeMap::new(), &BTreeMap::new())
+        .unwrap()
+        .validate()
+        .unwrap()
+}
+
+#[test]
+fn light_arrays_are_strided_as_light_bytes() {
+    let module = types_module();
+    // Both light arrays are indexed by light and sized LIGHT_BYTES a light on the CPU.
+    assert_eq!(wgsl_stride(&module, "LightGeometry") as u64, LIGHT_BYTES);
+    assert_eq!(wgsl_stride(&module, "LightProperties") as u64, LIGHT_BYTES);
+    assert_eq!(size_of::<GpuLightGeometry>() as u64, LIGHT_BYTES);
+    assert_eq!(size_of::<GpuLightProperties>() as u64, LIGHT_BYTES);
+}
+
+/// The u32 value of WGSL constant `name`.
+fn wgsl_const(module: &naga::Module, name: &str) -> u32 {
+    let (_, c) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no constant {name}"));
+    match module.global_expressions[c.init] {
+        naga::Expression::Literal(naga::Literal::U32(v)) => v,
+        ref e => panic!("{name} is not a u32 literal: {e:?}"),
+    }
+}
+
+#[test]
+fn merged_vertices_are_strided_as_gpu_vertex() {
+    use lightgraph::render::visibility_geometry::VERTEX_FLOATS;
+    // visibility/surface.wgsl fetches vertices from a float array, VERTEX_FLOATS apart;
+    // composed after the types and the bindings it reads.
+    let lib = ShaderLibrary::builtin();
+    let none = BTreeMap::new();
+    let types = lib.compose("common/types.wgsl", &none, &none).unwrap();
+    let surface = lib
+        .compose("visibility/surface.wgsl", &none, &none)
+        .unwrap();
+    let text = format!(
+        "{}\n\
+         @group(0) @binding(0) var<uniform> frame: Frame;\n\
+         @group(0) @binding(1) var<storage, read> vertices: array<f32>;\n\
+         @group(0) @binding(2) var<storage, read> triangles: array<u32>;\n{}",
+        types.text, surface.text
+    );
+    let module = naga::front::wgsl::parse_str(&text).unwrap();
+    assert_eq!(wgsl_const(&module, "VERTEX_FLOATS"), VERTEX_FLOATS);
+    assert_eq!(VERTEX_FLOATS as usize * 4, size_of::<GpuVertex>());
+}

@@ -1,9 +1,12 @@
-// The light loop's building block: which lights to visit for a pixel. Tile-list readers
-// call `light_range` once, then `light_at` for k in 0..count, the same for every
-// culling variant (and for all lights when LIGHT_LISTS is off). The light loop walks a
-// cursor instead (`light_first`, `light_valid`, `light_next`, then `light_in_span` and
-// `light_index`), which also walks a light linked list (LINKED_LISTS) in link order,
-// skipping links whose depth span misses the surface.
+// The walk over a pixel's lights, one for every reader: the light loop (common/light_loop.wgsl),
+// visibility shading's faster loops, light statistics and the shadow passes.
+// A cursor visits the pixel's lights in list order:
+//     for (var c = light_first(pixel, view_z); light_valid(c); c = light_next(c, view_z)) {
+//         let i = light_index(c);
+// the same for every culling variant, a light linked list (LINKED_LISTS: links whose
+// depth span misses the surface are skipped here, so no caller tests spans) and all
+// lights (neither LINKED_LISTS nor LIGHT_LISTS). Tile-list readers that need the list
+// itself call `light_range` once, then `light_at` for k in 0..count.
 
 struct LightRange {
     offset: u32,
@@ -19,18 +22,12 @@ struct LightCursor {
     left: u32,
 };
 
-// `pixel` in framebuffer coordinates.
-fn light_first(pixel: vec2<f32>, view_z: f32) -> LightCursor {
-    let p = min(vec2<u32>(pixel) / link_params.scale, vec2<u32>(link_params.width, link_params.height) - 1u);
-    return LightCursor(light_lists[LINK_HEADER_WORDS + p.y * link_params.width + p.x], light_lists[3]);
-}
-
 fn light_valid(c: LightCursor) -> bool {
     return c.link != LINK_END && c.left > 0u;
 }
 
-// One load, no loop: the advance runs in loops' continuing blocks.
-fn light_next(c: LightCursor) -> LightCursor {
+// The link after `c`, whatever its span.
+fn light_link_after(c: LightCursor) -> LightCursor {
     return LightCursor(light_lists[link_params.pool_offset + LINK_WORDS * c.link + 2u], c.left - 1u);
 }
 
@@ -38,6 +35,26 @@ fn light_next(c: LightCursor) -> LightCursor {
 fn light_in_span(c: LightCursor, view_z: f32) -> bool {
     let span = unpack2x16float(light_lists[link_params.pool_offset + LINK_WORDS * c.link]);
     return view_z >= span.x && view_z <= span.y;
+}
+
+// `c` or the first link after it whose span holds `view_z` (or the end).
+fn light_skip_to_span(c: LightCursor, view_z: f32) -> LightCursor {
+    var s = c;
+    while (light_valid(s) && !light_in_span(s, view_z)) {
+        s = light_link_after(s);
+    }
+    return s;
+}
+
+// `pixel` in framebuffer coordinates.
+fn light_first(pixel: vec2<f32>, view_z: f32) -> LightCursor {
+    let p = min(vec2<u32>(pixel) / link_params.scale, vec2<u32>(link_params.width, link_params.height) - 1u);
+    let head = LightCursor(light_lists[LINK_HEADER_WORDS + p.y * link_params.width + p.x], light_lists[3]);
+    return light_skip_to_span(head, view_z);
+}
+
+fn light_next(c: LightCursor, view_z: f32) -> LightCursor {
+    return light_skip_to_span(light_link_after(c), view_z);
 }
 
 fn light_index(c: LightCursor) -> u32 {
@@ -98,13 +115,9 @@ fn light_valid(c: LightCursor) -> bool {
     return c.k < c.range.count;
 }
 
-fn light_next(c: LightCursor) -> LightCursor {
+// Tile lists bound no depth span per light: every entry is visited.
+fn light_next(c: LightCursor, view_z: f32) -> LightCursor {
     return LightCursor(c.range, c.k + 1u);
-}
-
-// Tile lists bound no depth span per light.
-fn light_in_span(c: LightCursor, view_z: f32) -> bool {
-    return true;
 }
 
 fn light_index(c: LightCursor) -> u32 {

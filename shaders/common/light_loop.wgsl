@@ -2,6 +2,9 @@
 // (or all lights) names. Included after the material code by the forward fragment
 // shader and by the deferred compute shader, so both shade with the same code.
 // `pixel` is the framebuffer position, `view_z` the positive view-space depth.
+
+#include "common/shading_point.wgsl"
+
 fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f32) -> vec3<f32> {
     var color = material_emission(m) + frame.ambient.rgb * material_eval(m, p.normal);
 #if SHADOWS
@@ -9,10 +12,7 @@ fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f
     var caster = 0u;
     let pixel_index = u32(pixel.y) * frame.size.x + u32(pixel.x);
 #endif
-    for (var c = light_first(pixel, view_z); light_valid(c); c = light_next(c)) {
-        if (!light_in_span(c, view_z)) {
-            continue;
-        }
+    for (var c = light_first(pixel, view_z); light_valid(c); c = light_next(c, view_z)) {
         let i = light_index(c);
         let props = light_properties[i];
 #if SHADOWS

@@ -16,9 +16,15 @@
 // The light loop asks `shadow_visibility` for the fraction of light that reaches p:
 // 0 or 1 from the mask and the tracer, filtered from the atlas.
 
+#include "common/shading_point.wgsl"
+
 const LIGHT_CASTS_SHADOW: u32 = 1u;
 const SHADOW_MAX_CASTERS: u32 = 128u;
 const SHADOW_MASK_WORDS: u32 = 4u;
+// The job buffer (src/graph/kinds/shadow_ray_jobs.rs): header words before the jobs, and
+// words a job (pixel index, then light index | caster number << 24).
+const JOB_HEADER_WORDS: u32 = 8u;
+const JOB_WORDS: u32 = 2u;
 // Jobs a workgroup of the casting pass (its dispatch is written by job creation).
 const SHADOW_CAST_GROUP: u32 = 64u;
 

@@ -16,16 +16,7 @@
 #include "common/lighting.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
-@group(0) @binding(2) var<storage, read> light_properties: array<LightProperties>;
-#if LIGHT_LISTS
-@group(0) @binding(3) var<storage, read> light_lists: array<u32>;
-@group(0) @binding(4) var<uniform> list_params: ListParams;
-#endif
-#if LINKED_LISTS
-@group(0) @binding(3) var<storage, read> light_lists: array<u32>;
-@group(0) @binding(4) var<uniform> link_params: LinkParams;
-#endif
+#include "common/light_inputs.wgsl"
 #if G_SAMPLES
 // A multisampled G-buffer (see deferred/deferred_msaa.wgsl): `hdr` holds partial sums
 // between the materials' dispatches.
@@ -50,7 +41,6 @@
 #endif
 #endif
 
-#include "common/light_lists.wgsl"
 #if SHADOW_MASK
 @group(0) @binding(8) var<storage, read> shadow_mask: array<u32>;
 #endif
@@ -63,13 +53,7 @@
 #include "common/shadows.wgsl"
 #endif
 
-struct ShadingPoint {
-    position: vec3<f32>,
-    normal: vec3<f32>,
-    tangent: vec4<f32>,
-    uv: vec2<f32>,
-    view: vec3<f32>,
-};
+#include "common/shading_point.wgsl"
 
 #include <material>
 #include "common/light_loop.wgsl"

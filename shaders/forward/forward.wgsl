@@ -18,18 +18,8 @@ enable primitive_index;
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 #if SHADE
-@group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
-@group(0) @binding(2) var<storage, read> light_properties: array<LightProperties>;
-#if LIGHT_LISTS
-@group(0) @binding(3) var<storage, read> light_lists: array<u32>;
-@group(0) @binding(4) var<uniform> list_params: ListParams;
-#endif
-#if LINKED_LISTS
-@group(0) @binding(3) var<storage, read> light_lists: array<u32>;
-@group(0) @binding(4) var<uniform> link_params: LinkParams;
-#endif
+#include "common/light_inputs.wgsl"
 
-#include "common/light_lists.wgsl"
 #if SHADOW_MASK
 @group(0) @binding(5) var<storage, read> shadow_mask: array<u32>;
 #endif
@@ -56,19 +46,12 @@ enable primitive_index;
 #endif
 #if RSM
 // A ReflectiveShadowMaps pass: the instance index is the view (src/indirect/rsm_views.rs).
-@group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
-@group(0) @binding(2) var<storage, read> light_properties: array<LightProperties>;
+#include "common/light_inputs.wgsl"
 @group(0) @binding(11) var<storage, read> rsm_views: array<vec4<f32>>;
 const RSM_VIEW_VEC4S: u32 = 8u;
 #endif
 
-struct ShadingPoint {
-    position: vec3<f32>,
-    normal: vec3<f32>,
-    tangent: vec4<f32>,
-    uv: vec2<f32>,
-    view: vec3<f32>,
-};
+#include "common/shading_point.wgsl"
 
 #include <material>
 #if SHADE

@@ -8,10 +8,8 @@
 #include "common/lighting.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
-@group(0) @binding(2) var<storage, read> light_properties: array<LightProperties>;
-@group(0) @binding(3) var<storage, read> light_lists: array<u32>;
-@group(0) @binding(4) var<uniform> list_params: ListParams;
+// LIGHT_LISTS is always set: tile lists.
+#include "common/light_inputs.wgsl"
 @group(0) @binding(5) var g_position: texture_2d<f32>;
 @group(0) @binding(6) var g_normal: texture_2d<f32>;
 @group(0) @binding(7) var<storage, read> shadow_mask: array<u32>;
@@ -20,16 +18,7 @@
 @group(0) @binding(10) var shadow_sampler: sampler_comparison;
 @group(0) @binding(11) var<storage, read_write> shadow_errors: array<atomic<u32>>;
 
-#include "common/light_lists.wgsl"
 #include "common/shadows.wgsl"
-
-struct ShadingPoint {
-    position: vec3<f32>,
-    normal: vec3<f32>,
-    tangent: vec4<f32>,
-    uv: vec2<f32>,
-    view: vec3<f32>,
-};
 
 var<workgroup> counts: array<atomic<u32>, 4>;
 
@@ -44,11 +33,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_
         let position = g.xyz;
         let normal = textureLoad(g_normal, id.xy, 0).xyz;
         let view_z = -(frame.view * vec4<f32>(position, 1.0)).z;
-        let range = light_range(vec2<f32>(id.xy) + 0.5, view_z);
+        let pixel = vec2<f32>(id.xy) + 0.5;
         let pixel_index = id.y * frame.size.x + id.x;
         var caster = 0u;
-        for (var k = 0u; k < range.count; k++) {
-            let i = light_at(range, k);
+        for (var c = light_first(pixel, view_z); light_valid(c); c = light_next(c, view_z)) {
+            let i = light_index(c);
             let props = light_properties[i];
             let lg = light_geometry[i];
             let inc = incident_light(lg, props, position);

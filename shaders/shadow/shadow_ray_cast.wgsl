@@ -26,8 +26,6 @@
 #include "common/shadows.wgsl"
 #include "shadow/surface_source.wgsl"
 
-const JOB_HEADER_WORDS: u32 = 8u;
-
 @compute @workgroup_size(SHADOW_CAST_GROUP, 1, 1)
 fn main(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -38,8 +36,8 @@ fn main(
     if (job >= min(shadow_jobs[0], JOB_CAPACITY)) {
         return;
     }
-    let pixel = shadow_jobs[JOB_HEADER_WORDS + 2u * job];
-    let packed = shadow_jobs[JOB_HEADER_WORDS + 2u * job + 1u];
+    let pixel = shadow_jobs[JOB_HEADER_WORDS + JOB_WORDS * job];
+    let packed = shadow_jobs[JOB_HEADER_WORDS + JOB_WORDS * job + 1u];
     let light = packed & 0xffffffu;
     let caster = packed >> 24u;
     let xy = vec2<u32>(pixel % frame.size.x, pixel / frame.size.x);

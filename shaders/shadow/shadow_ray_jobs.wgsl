@@ -21,10 +21,8 @@
 #include "common/lighting.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
-@group(0) @binding(2) var<storage, read> light_properties: array<LightProperties>;
-@group(0) @binding(3) var<storage, read> light_lists: array<u32>;
-@group(0) @binding(4) var<uniform> list_params: ListParams;
+// LIGHT_LISTS is always set: tile lists.
+#include "common/light_inputs.wgsl"
 #if VISIBILITY_IDS
 @group(0) @binding(5) var visibility: texture_2d<u32>;
 @group(0) @binding(6) var<storage, read> vertices: array<f32>;
@@ -36,11 +34,9 @@
 @group(0) @binding(7) var<storage, read_write> shadow_jobs: array<atomic<u32>>;
 @group(0) @binding(8) var<storage, read_write> shadow_mask: array<u32>;
 
-#include "common/light_lists.wgsl"
 #include "common/shadows.wgsl"
 #include "shadow/surface_source.wgsl"
 
-const JOB_HEADER_WORDS: u32 = 8u;
 const GROUP_SIZE: u32 = 256u;
 // Workgroups a dispatch dimension may have (WebGPU's limit).
 const MAX_GROUPS_X: u32 = 65535u;
@@ -100,8 +96,8 @@ fn walk(px: Pixel, emit: bool) {
                 if (emit) {
                     let slot = group_base + atomicAdd(&bucket_next[bucket], 1u);
                     if (slot < JOB_CAPACITY) {
-                        atomicStore(&shadow_jobs[JOB_HEADER_WORDS + 2u * slot], px.index);
-                        atomicStore(&shadow_jobs[JOB_HEADER_WORDS + 2u * slot + 1u], i | (caster << 24u));
+                        atomicStore(&shadow_jobs[JOB_HEADER_WORDS + JOB_WORDS * slot], px.index);
+                        atomicStore(&shadow_jobs[JOB_HEADER_WORDS + JOB_WORDS * slot + 1u], i | (caster << 24u));
                     }
                 } else {
                     atomicAdd(&bucket_count[bucket], 1u);

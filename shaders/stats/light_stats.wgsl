@@ -45,10 +45,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let world = h.xyz / h.w;
     let view_z = -(frame.view * vec4<f32>(world, 1.0)).z;
     var listed = 0u;
-    for (var c = light_first(pixel, view_z); light_valid(c); c = light_next(c)) {
-        if (!light_in_span(c, view_z)) {
-            continue;
-        }
+    for (var c = light_first(pixel, view_z); light_valid(c); c = light_next(c, view_z)) {
         listed += 1u;
     }
     var exact = 0u;

@@ -90,11 +90,9 @@ fn light_reach_of(i: u32) -> vec4<f32> {
 #if LINKED_LISTS
 fn shade_range_first(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f32) -> vec3<f32> {
     var color = surface_unlit(p, m);
-    for (var c = light_first(pixel, view_z); light_valid(c); c = light_next(c)) {
-        if (light_in_span(c, view_z)) {
-            let i = light_index(c);
-            color = add_in_range(color, light_reach_of(i), i, p, m);
-        }
+    for (var c = light_first(pixel, view_z); light_valid(c); c = light_next(c, view_z)) {
+        let i = light_index(c);
+        color = add_in_range(color, light_reach_of(i), i, p, m);
     }
     return color;
 }

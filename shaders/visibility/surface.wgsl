@@ -6,13 +6,7 @@
 // `vertices` and `triangles` bound, and with MATERIAL_TEXTURED the material code (which
 // declares material_uv_ddx and material_uv_ddy) in the module.
 
-struct ShadingPoint {
-    position: vec3<f32>,
-    normal: vec3<f32>,
-    tangent: vec4<f32>,
-    uv: vec2<f32>,
-    view: vec3<f32>,
-};
+#include "common/shading_point.wgsl"
 
 const VERTEX_FLOATS: u32 = 12u;
 

@@ -25,16 +25,7 @@
 #include "common/lighting.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
-@group(0) @binding(2) var<storage, read> light_properties: array<LightProperties>;
-#if LIGHT_LISTS
-@group(0) @binding(3) var<storage, read> light_lists: array<u32>;
-@group(0) @binding(4) var<uniform> list_params: ListParams;
-#endif
-#if LINKED_LISTS
-@group(0) @binding(3) var<storage, read> light_lists: array<u32>;
-@group(0) @binding(4) var<uniform> link_params: LinkParams;
-#endif
+#include "common/light_inputs.wgsl"
 @group(0) @binding(5) var visibility: texture_2d<u32>;
 @group(0) @binding(6) var<storage, read> vertices: array<f32>;
 @group(0) @binding(7) var<storage, read> triangles: array<u32>;
@@ -52,8 +43,6 @@
 @group(0) @binding(11) var<storage, read> material_tiles: array<u32>;
 @group(0) @binding(12) var<storage, read> material_tile_counts: array<u32>;
 #endif
-
-#include "common/light_lists.wgsl"
 
 #include "visibility/surface.wgsl"
 #if SHADOWS

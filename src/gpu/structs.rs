@@ -93,6 +93,12 @@ pub struct GpuLightProperties {
     pub _pad: [u32; 2],
 }
 
+/// Bytes of one light in either light array (`light_geometry`, `light_properties`): the
+/// one definition every buffer size and stride of a light array takes.
+pub const LIGHT_BYTES: u64 = std::mem::size_of::<GpuLightGeometry>() as u64;
+// Both arrays are indexed alike, so their elements must be the same size.
+const _: () = assert!(std::mem::size_of::<GpuLightProperties>() as u64 == LIGHT_BYTES);
+
 /// How a culling pass laid out its lists; see [`crate::graph::ListLayout`].
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]

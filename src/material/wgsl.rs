@@ -16,15 +16,9 @@ pub const LOBE_LIBRARY: &str = include_str!("../../shaders/material/lobes.wgsl")
 /// `WgslOptions::include_library`.
 pub(crate) const LOBE_LIBRARY_INCLUDE: &str = "#include \"material/lobes.wgsl\"";
 
-/// What the forward shader declares before including a material (the contract).
-pub const SHADING_POINT_WGSL: &str = "struct ShadingPoint {
-    position: vec3<f32>,
-    normal: vec3<f32>,
-    tangent: vec4<f32>,
-    uv: vec2<f32>,
-    view: vec3<f32>,
-};
-";
+/// What every shading pass declares before including a material (the contract):
+/// `shaders/common/shading_point.wgsl`, the shaders' one declaration of `ShadingPoint`.
+pub const SHADING_POINT_WGSL: &str = include_str!("../../shaders/common/shading_point.wgsl");
 
 /// How [`Material::wgsl_with`](super::Material::wgsl_with) generates a material's WGSL; the
 /// default suits the forward and deferred fragment shaders.

@@ -8,9 +8,7 @@ use crate::scene::{AlphaMode, Light, Scene};
 use wgpu::util::DeviceExt;
 
 /// Bytes of one light in either light buffer.
-const LIGHT_BYTES: usize = 32;
-const _: () = assert!(std::mem::size_of::<GpuLightGeometry>() == LIGHT_BYTES);
-const _: () = assert!(std::mem::size_of::<GpuLightProperties>() == LIGHT_BYTES);
+const LIGHT_BYTES: usize = crate::gpu::structs::LIGHT_BYTES as usize;
 
 /// One uploaded mesh: its vertex and index buffers, material and shadow-culling data.
 #[derive(Clone)]

@@ -5,6 +5,7 @@
 
 use super::{defines, PrepareCtx, PreparedPass, Timestamps};
 use crate::gpu::readback::read_buffer;
+use crate::gpu::structs::LIGHT_BYTES;
 use crate::graph::Name;
 use crate::graph::{slot, LightCulling, ListLayout, ListStorage, ScheduledPass};
 use crate::render::device_limits::create_internal_buffer;
@@ -19,8 +20,6 @@ use std::sync::Arc;
 const COARSE_CAPACITY: u64 = 8192;
 /// `light_bounds` in `light_culling.wgsl`: four vec4s a light.
 const LIGHT_BOUNDS_BYTES: u64 = 64;
-/// `LightGeometry` in `types.wgsl`.
-const LIGHT_GEOMETRY_BYTES: u64 = 32;
 /// The bounds dispatch's workgroup size (`bounds` in the shader).
 const BOUNDS_GROUP: u32 = 64;
 
@@ -98,7 +97,7 @@ pub(super) fn prepare(
     // add lights to the scene's).
     let light_capacity = offered
         .buffer_size("light_geometry")
-        .map_or(cx.gpu.light_capacity as u64, |b| b / LIGHT_GEOMETRY_BYTES)
+        .map_or(cx.gpu.light_capacity as u64, |b| b / LIGHT_BYTES)
         .max(1);
     let light_bounds = create_internal_buffer(
         &device,

@@ -71,7 +71,7 @@ pub(super) fn prepare(
     let scene_lights = cx.light_count.get();
     // Room for every light an update may write, then the VPLs.
     let most_lights = cx.gpu.light_capacity;
-    let need = (most_lights as u64 + p.max_vpls as u64) * 32;
+    let need = (most_lights as u64 + p.max_vpls as u64) * crate::gpu::structs::LIGHT_BYTES;
     for s in [slot::LIGHT_GEOMETRY, slot::LIGHT_PROPERTIES] {
         let b = cx.buffer(&sp.name, sp.required(s))?;
         if b.size() < need {

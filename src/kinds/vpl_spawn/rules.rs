@@ -103,7 +103,7 @@ impl KindRules for VplSpawn {
         (slot == slot::LIGHT_GEOMETRY || slot == slot::LIGHT_PROPERTIES).then(|| {
             BufferLayout::Lights {
                 lights: frame.lights as u64 + self.max_vpls as u64,
-                stride: 32,
+                stride: crate::gpu::structs::LIGHT_BYTES,
             }
         })
     }

@@ -319,7 +319,7 @@ impl PrepareCtx<'_> {
         let lights_bound = offered
             .buffer_size("light_geometry")
             .map_or(self.gpu.light_capacity as u64, |b| {
-                b / std::mem::size_of::<crate::gpu::structs::GpuLightGeometry>() as u64
+                b / crate::gpu::structs::LIGHT_BYTES
             });
         let ctx = &self.renderer.ctx;
         let adapter = ctx.adapter.get_info().name;
