@@ -49,6 +49,10 @@ enable primitive_index;
 #if FLOAT_DEPTH
 @group(0) @binding(12) var depth: texture_2d<f32>;
 #endif
+#if VPL_VISIBILITY
+@group(0) @binding(13) var<storage, read> vpl_visibility: array<u32>;
+#include "indirect/vpl_lookup.wgsl"
+#endif
 #endif
 #if ATLAS_DEPTH
 // A ShadowAtlas pass: the instance index is the view (see common/shadows.wgsl).

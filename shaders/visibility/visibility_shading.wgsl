@@ -48,6 +48,10 @@
 @group(0) @binding(14) var shadow_atlas: texture_depth_2d;
 @group(0) @binding(15) var shadow_sampler: sampler_comparison;
 #endif
+#if VPL_VISIBILITY
+@group(0) @binding(16) var<storage, read> vpl_visibility: array<u32>;
+#include "indirect/vpl_lookup.wgsl"
+#endif
 #if CLASSIFIED
 @group(0) @binding(11) var<storage, read> material_tiles: array<u32>;
 @group(0) @binding(12) var<storage, read> material_tile_counts: array<u32>;
@@ -158,6 +162,9 @@ fn main(
 #if SHADOWS
     shadow_pixel = id.y * frame.size.x + id.x;
 #endif
+#if VPL_VISIBILITY
+    vpl_pixel = id.xy;
+#endif
     let s = rebuild(id.xy, select(range.x, tri, shades));
     let color = staged_lights(surface_unlit(s.p, s.m), shades, s.p, s.m, lane, group_list(tile));
     if (shades) {
@@ -197,6 +204,9 @@ fn main(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group
     }
 #if SHADOWS
     shadow_pixel = id.y * frame.size.x + id.x;
+#endif
+#if VPL_VISIBILITY
+    vpl_pixel = id.xy;
 #endif
     let s = rebuild(id.xy, tri);
 #if RANGE_FIRST
