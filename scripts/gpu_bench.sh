@@ -4,7 +4,7 @@
 #   frames    every frame kind on harada, AMD's atrium and the Cornell box glTF
 #             (frame_kinds_*.ron), Forward+'s tile tests (forward_plus_culling.ron), and
 #             visibility shading's material classification (material_classification.ron);
-#   features  ray-cast shadows, the shadow atlas, transparency, MSAA, VPL indirect light
+#   features  ray-cast shadows, the shadow atlas, transparency, MSAA, VPL indirect light, VPL visibility
 #             and the light linked list (their sweeps);
 #   extras    the VPL bounce against its path-traced reference (vpl-error) and hot-reload
 #             latency (reload-bench).
@@ -26,7 +26,7 @@ if [[ $stages == *" frames "* ]]; then
     run_sweep material_classification material_classification 200
 fi
 if [[ $stages == *" features "* ]]; then
-    for s in raycast_shadows shadow_atlas transparency msaa indirect_vpl light_linked_list; do
+    for s in raycast_shadows shadow_atlas transparency msaa indirect_vpl vpl_visibility light_linked_list; do
         run_sweep $s $s 150
     done
 fi
