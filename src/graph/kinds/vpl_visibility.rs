@@ -85,7 +85,7 @@ pub(crate) fn check(p: &VplVisibility, ctx: &KindCtx, errors: &mut Vec<GraphErro
             p.block
         )));
     }
-    if p.max_vpls == 0 || p.max_vpls % 32 != 0 || p.max_vpls > 16384 {
+    if p.max_vpls == 0 || !p.max_vpls.is_multiple_of(32) || p.max_vpls > 16384 {
         errors.push(ctx.bad(format!(
             "max_vpls {} must be a multiple of 32 in 32..=16384",
             p.max_vpls
