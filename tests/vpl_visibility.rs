@@ -1,6 +1,7 @@
 //! VPL visibility (`VplVisibility`): a VPL lights a pixel only where its block's ray to
 //! the VPL is not blocked. The compute-first frame (graphs/default.ron,
-//! graphs/visibility_indirect_vpl.ron) and Forward+ (graphs/indirect_vpl_visibility.ron).
+//! graphs/visibility_indirect_vpl.ron), Forward+ (graphs/indirect_vpl_visibility.ron) and
+//! tiled deferred (graphs/tiled_deferred_indirect_vpl_visibility.ron).
 //! On lavapipe, at small sizes.
 
 mod common;
@@ -87,24 +88,20 @@ fn a_vpl_behind_a_full_wall_adds_nothing_to_the_other_room() {
     let s = two_rooms();
     assert!(s.features().has_indirect_lights);
     let mut r = common::renderer();
-    let direct = render_text(
-        &mut r,
-        &graph_text("visibility_compute_raster.ron"),
-        &s,
-        w,
-        h,
-    );
-    for graph in ["default.ron", "indirect_vpl_visibility.ron"] {
+    for (graph, direct) in [
+        ("default.ron", "visibility_compute_raster.ron"),
+        ("indirect_vpl_visibility.ron", "forward_plus.ron"),
+        (
+            "tiled_deferred_indirect_vpl_visibility.ron",
+            "tiled_deferred.ron",
+        ),
+    ] {
         let text = graph_text(graph);
         let with = render_text(&mut r, &text, &s, w, h);
         assert_eq!(with.image.len(), (w * h) as usize, "{graph}");
         assert!(with.vpls[0].spawned > 32, "{graph}: {:?}", with.vpls);
         // Every pixel is the second room's: its indirect light is exactly zero.
-        let base = if graph == "default.ron" {
-            direct.image.clone()
-        } else {
-            render_text(&mut r, &graph_text("forward_plus.ron"), &s, w, h).image
-        };
+        let base = render_text(&mut r, &graph_text(direct), &s, w, h).image;
         let bounce = indirect_part(&with.image, &base);
         let lit = bounce.iter().filter(|p| p.max_element() != 0.0).count();
         assert_eq!(
@@ -231,6 +228,20 @@ fn the_compute_first_bounce_equals_the_forward_plus_bounce() {
         assert!(
             d < 1e-4,
             "{name}: compute-first and Forward+ VPL frames differ by {d} at {at}"
+        );
+        // Tiled deferred's G-buffer holds the same interpolated surfaces as Forward+'s
+        // (tiled_deferred_with_vpls_agrees_with_forward_plus: 1e-4 without visibility).
+        let deferred = render_text(
+            &mut r,
+            &graph_text("tiled_deferred_indirect_vpl_visibility.ron"),
+            &s,
+            w,
+            h,
+        );
+        let (d, at) = common::max_rel_diff(&deferred.image, &forward.image);
+        assert!(
+            d < 1e-4,
+            "{name}: tiled deferred and Forward+ VPL frames differ by {d} at {at}"
         );
         // And visibility changed the image: a frame without it differs by far more.
         let leaky = render_text(

@@ -77,10 +77,10 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
         let g = light_geometry[first + v];
         let d = g.position - s.position;
         var visible = dot(d, d) >= g.range * g.range;
-        // The ray ends off the VPL's surface, along its normal, by the distance clamp (the
-        // size of patch the VPL stands for): a VPL averaged over a block of map texels
-        // that folds round a convex edge lies inside the solid, and a ray to its centre
-        // would be hidden by the surface it stands for.
+        // The ray ends off the VPL's surface, along its normal, by VPL_TARGET_OFFSET times
+        // its distance clamp (about the size of patch it stands for): a VPL averaged over
+        // a block of map texels that folds round a convex edge lies inside the solid, and
+        // a ray to its centre would be hidden by the surface it stands for.
         let aim = g.position + g.direction * (VPL_TARGET_OFFSET * light_properties[first + v].cos_inner);
         if (!visible && shadow_faces(s.position, s.ng, aim)) {
             visible = !bvh_occluded(origin, aim - origin, shadow_t_max(origin, aim));

@@ -19,7 +19,9 @@
 // SHADOW_MASK: each shadow-casting light is looked up in a ray-cast mask
 // (shadow/shadow_ray_cast.wgsl), casters numbered as job creation numbers them; or with
 // SHADOW_ATLAS (and SHADOW_PCF5): sampled from a ShadowAtlas pass's maps, filtered as
-// forward shading filters them (common/shadows.wgsl).
+// forward shading filters them (common/shadows.wgsl). VPL_VISIBILITY (with VPL_BLOCK,
+// VPL_WORDS): VPLs hidden from the pixel's block by a VplVisibility pass add nothing
+// (indirect/vpl_lookup.wgsl).
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"
