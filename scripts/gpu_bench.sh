@@ -4,7 +4,7 @@
 #   frames    every frame kind on harada, AMD's atrium and the Cornell box glTF
 #             (frame_kinds_*.ron), Forward+'s tile tests (forward_plus_culling.ron), and
 #             visibility shading's material classification (material_classification.ron);
-#   features  ray-cast shadows, the shadow atlas, transparency, MSAA, VPL indirect light
+#   features  ray-cast shadows, the shadow atlas, transparency, MSAA, VPL indirect light, VPL visibility
 #             and the light linked list (their sweeps);
 #   extras    the VPL bounce against its path-traced reference (vpl-error) and hot-reload
 #             latency (reload-bench).
@@ -26,7 +26,7 @@ if [[ $stages == *" frames "* ]]; then
     run_sweep material_classification material_classification 200
 fi
 if [[ $stages == *" features "* ]]; then
-    for s in raycast_shadows shadow_atlas transparency msaa indirect_vpl light_linked_list; do
+    for s in raycast_shadows shadow_atlas transparency msaa indirect_vpl vpl_visibility light_linked_list; do
         run_sweep $s $s 150
     done
 fi
@@ -34,6 +34,12 @@ if [[ $stages == *" extras "* ]]; then
     timeout 330 $lg vpl-error --scene scenes/cornell_indirect.ron scenes/atrium_indirect.ron \
         --width 1920 --height 1080 --samples 256 --frames 10 --out "$out/vpl_error" > "$out/vpl_error.log" 2>&1
     echo "== vpl_error (rc $?)"; cat "$out/vpl_error/results.md" 2>/dev/null | head -20
+    # The same bounce in the compute-first frame, with VPL visibility (8×8-pixel blocks).
+    timeout 330 $lg vpl-error --scene scenes/cornell_indirect.ron scenes/atrium_indirect.ron \
+        --width 1920 --height 1080 --samples 256 --frames 10 --graph graphs/visibility_indirect_vpl.ron \
+        --error-graph benches/graphs/visibility_indirect_vpl_all_lights.ron \
+        --direct graphs/visibility_compute_raster.ron --out "$out/vpl_error_visibility" > "$out/vpl_error_visibility.log" 2>&1
+    echo "== vpl_error_visibility (rc $?)"; cat "$out/vpl_error_visibility/results.md" 2>/dev/null | head -20
     timeout 150 $lg reload-bench --out "$out/reload_latency" --width 1920 --height 1080 \
         --lights 3072 --repeats 20 > "$out/reload_latency.log" 2>&1
     echo "== reload_latency (rc $?)"; cat "$out/reload_latency/reload_latency.md" 2>/dev/null | head -20

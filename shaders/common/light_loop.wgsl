@@ -7,6 +7,9 @@
 
 fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f32) -> vec3<f32> {
     var color = material_emission(m) + frame.ambient.rgb * material_eval(m, p.normal);
+#if VPL_VISIBILITY
+    vpl_pixel = vec2<u32>(pixel);
+#endif
 #if SHADOWS
     // Casters are numbered before the material mask is applied, as job creation does.
     var caster = 0u;
@@ -15,6 +18,13 @@ fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f
     for (var c = light_first(pixel, view_z); light_valid(c); c = light_next(c, view_z)) {
         let i = light_index(c);
         let props = light_properties[i];
+#if VPL_VISIBILITY
+        // A VPL hidden from this pixel's block (VplVisibility) adds nothing; VPLs cast no
+        // shadow, so skipping one changes no caster number.
+        if (!vpl_visible(props)) {
+            continue;
+        }
+#endif
 #if SHADOWS
         let g = light_geometry[i];
         let inc = incident_light(g, props, p.position);

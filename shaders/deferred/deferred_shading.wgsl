@@ -10,7 +10,8 @@
 // Defines: MATERIAL_INDEX, LIGHT_LISTS (tile lists) or LINKED_LISTS (a light linked
 // list), G_PACKED, G_SAMPLES (a multisampled G-buffer of that many samples: the main of
 // deferred/deferred_msaa.wgsl), SHADOWS with SHADOW_MASK (ray-cast shadows from
-// shadow/shadow_ray_cast.wgsl) or SHADOW_ATLAS (a ShadowAtlas pass's maps).
+// shadow/shadow_ray_cast.wgsl) or SHADOW_ATLAS (a ShadowAtlas pass's maps),
+// VPL_VISIBILITY (VPLs hidden from the pixel's block add nothing: indirect/vpl_lookup.wgsl).
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"
@@ -51,6 +52,10 @@
 #endif
 #if SHADOWS
 #include "common/shadows.wgsl"
+#endif
+#if VPL_VISIBILITY
+@group(0) @binding(14) var<storage, read> vpl_visibility: array<u32>;
+#include "indirect/vpl_lookup.wgsl"
 #endif
 
 #include "common/shading_point.wgsl"

@@ -6,6 +6,8 @@
 // sample. The material's generated code is included as <material>; ALPHA_MASK
 // discards below the cutoff. Only SHADE binds lights: a pass binds what it declares.
 // VISIBILITY writes each fragment's triangle id (the visibility buffer).
+// VPL_VISIBILITY (SHADE): VPLs hidden from the pixel's block by a VplVisibility pass add
+// nothing (indirect/vpl_lookup.wgsl).
 // FLOAT_DEPTH (SHADE, single-sample): the depth to test against is an R32Float texture (a
 // compute resolve's) instead of a depth attachment; each fragment loads it at its pixel
 // and is discarded where the attachment's LessEqual test would fail.
@@ -38,6 +40,10 @@ enable primitive_index;
 #endif
 #if FLOAT_DEPTH
 @group(0) @binding(12) var depth: texture_2d<f32>;
+#endif
+#if VPL_VISIBILITY
+@group(0) @binding(13) var<storage, read> vpl_visibility: array<u32>;
+#include "indirect/vpl_lookup.wgsl"
 #endif
 #endif
 #if ATLAS_DEPTH

@@ -199,5 +199,6 @@ fn append(@builtin(global_invocation_id) id: vec3<u32>) {
     let mask = bitcast<u32>(rsm_views[vb + 6u].w);
     // A Lambertian emitter of the block's flux: intensity Φ/π along its normal.
     light_geometry[i] = LightGeometry(c.position, art.z, c.normal, 0.0);
-    light_properties[i] = LightProperties(c.flux * (art.y / PI), art.w, LIGHT_VPL, mask, 0u, 0u);
+    // _pad0: the VPL's number among the VPLs, its bit in a VplVisibility pass's masks.
+    light_properties[i] = LightProperties(c.flux * (art.y / PI), art.w, LIGHT_VPL, mask, i - params.scene_lights, 0u);
 }

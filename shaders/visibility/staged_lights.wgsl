@@ -29,6 +29,12 @@ var<private> shadow_caster: u32;
 // gives radiance (and, with SHADOWS, scaled by the fraction of it that reaches p: its
 // caster bit or its atlas taps), as shade_surface adds it.
 fn add_reached(color: vec3<f32>, i: u32, g: LightGeometry, props: LightProperties, r: LightReach, p: ShadingPoint, m: MaterialSample) -> vec3<f32> {
+#if VPL_VISIBILITY
+    // As shade_surface: a hidden VPL adds nothing and numbers no caster.
+    if (!vpl_visible(props)) {
+        return color;
+    }
+#endif
 #if SHADOWS
     if ((props.flags & LIGHT_CASTS_SHADOW) != 0u) {
         let inc = incident_reached(g, props, r);

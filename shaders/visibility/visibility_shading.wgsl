@@ -19,7 +19,9 @@
 // SHADOW_MASK: each shadow-casting light is looked up in a ray-cast mask
 // (shadow/shadow_ray_cast.wgsl), casters numbered as job creation numbers them; or with
 // SHADOW_ATLAS (and SHADOW_PCF5): sampled from a ShadowAtlas pass's maps, filtered as
-// forward shading filters them (common/shadows.wgsl).
+// forward shading filters them (common/shadows.wgsl). VPL_VISIBILITY (with VPL_BLOCK,
+// VPL_WORDS): VPLs hidden from the pixel's block by a VplVisibility pass add nothing
+// (indirect/vpl_lookup.wgsl).
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"
@@ -38,6 +40,10 @@
 @group(0) @binding(13) var<storage, read> shadow_views: array<vec4<f32>>;
 @group(0) @binding(14) var shadow_atlas: texture_depth_2d;
 @group(0) @binding(15) var shadow_sampler: sampler_comparison;
+#endif
+#if VPL_VISIBILITY
+@group(0) @binding(16) var<storage, read> vpl_visibility: array<u32>;
+#include "indirect/vpl_lookup.wgsl"
 #endif
 #if CLASSIFIED
 @group(0) @binding(11) var<storage, read> material_tiles: array<u32>;
@@ -147,6 +153,9 @@ fn main(
 #if SHADOWS
     shadow_pixel = id.y * frame.size.x + id.x;
 #endif
+#if VPL_VISIBILITY
+    vpl_pixel = id.xy;
+#endif
     let s = rebuild(id.xy, select(range.x, tri, shades));
     let color = staged_lights(surface_unlit(s.p, s.m), shades, s.p, s.m, lane, group_list(tile));
     if (shades) {
@@ -186,6 +195,9 @@ fn main(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group
     }
 #if SHADOWS
     shadow_pixel = id.y * frame.size.x + id.x;
+#endif
+#if VPL_VISIBILITY
+    vpl_pixel = id.xy;
 #endif
     let s = rebuild(id.xy, tri);
 #if RANGE_FIRST

@@ -37,6 +37,8 @@ pub(super) enum DrawMode {
         /// attachment: the fragment shader loads it and discards what the attachment's
         /// LessEqual test would have failed; the pipeline has no depth state.
         float_depth: bool,
+        /// VPLs hidden from a pixel add nothing (`VPL_VISIBILITY`): the bits' layout.
+        vpl_visibility: Option<super::passes::VplLookup>,
     },
     /// A shadow atlas's views: depth only, the view from the instance index, both faces,
     /// biased.
@@ -217,9 +219,11 @@ impl Renderer {
                     lists,
                     shadows,
                     float_depth,
+                    vpl_visibility,
                     ..
                 } => {
                     d.push(("SHADE", "1".into()));
+                    d.extend(super::passes::VplLookup::defines(vpl_visibility));
                     d.extend(lists.define());
                     d.extend(shadow_defines(shadows));
                     if float_depth {

@@ -182,7 +182,9 @@ impl SceneGpu {
     pub fn bvh(&self, device: &wgpu::Device, scene: &Scene) -> Result<&GpuBvh, String> {
         self.bvh
             .get_or_init(|| {
-                GpuBvh::build(device, scene, scene.features().has_shadow_casters)
+                // VPL visibility (VplVisibility) traces against it too.
+                let f = scene.features();
+                GpuBvh::build(device, scene, f.has_shadow_casters || f.has_indirect_lights)
                     .map_err(|e| format!("the scene's shadow BVH could not be built: {e}"))
             })
             .as_ref()

@@ -30,6 +30,7 @@ impl Contents {
             Contents::Lights => "the lights of a VplSpawn pass",
             Contents::RsmViews => "the view table of a ReflectiveShadowMaps pass",
             Contents::ShadowViews => "the view table of a ShadowAtlas pass",
+            Contents::VplVisibility => "the visibility bits of a VplVisibility pass",
         }
     }
 }

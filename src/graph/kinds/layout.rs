@@ -43,6 +43,15 @@ pub enum BufferLayout {
         /// How shading samples the atlas.
         filter: shadow_atlas::ShadowFilter,
     },
+    /// A `VplVisibility` pass's bits: `words` a block of `block`×`block` pixels.
+    VplVisibility {
+        /// Pixels per side of a block.
+        block: u32,
+        /// Words of bits a block (32 VPLs a word).
+        words: u32,
+        /// Blocks of the frame.
+        blocks: u64,
+    },
 }
 
 /// What a laid-out buffer holds: a [`BufferLayout`] without its sizes, for contracts
@@ -63,6 +72,8 @@ pub enum Contents {
     RsmViews,
     /// A `ShadowAtlas` pass's view table.
     ShadowViews,
+    /// A `VplVisibility` pass's visibility bits.
+    VplVisibility,
 }
 
 impl Contents {
@@ -75,6 +86,7 @@ impl Contents {
             Contents::Lights => "VplSpawn",
             Contents::RsmViews => "ReflectiveShadowMaps",
             Contents::ShadowViews => "ShadowAtlas",
+            Contents::VplVisibility => "VplVisibility",
         }
     }
 }
@@ -90,6 +102,7 @@ impl BufferLayout {
             BufferLayout::Lights { .. } => Contents::Lights,
             BufferLayout::RsmViews { .. } => Contents::RsmViews,
             BufferLayout::ShadowViews { .. } => Contents::ShadowViews,
+            BufferLayout::VplVisibility { .. } => Contents::VplVisibility,
         }
     }
     /// The buffer's size in bytes.
@@ -106,6 +119,7 @@ impl BufferLayout {
             BufferLayout::ShadowViews {
                 lights, max_views, ..
             } => shadow_atlas::view_table_bytes(*lights, *max_views),
+            BufferLayout::VplVisibility { words, blocks, .. } => 4 * u64::from(*words) * blocks,
         }
     }
 }

@@ -47,6 +47,8 @@ macro_rules! built_in_kinds {
             ReflectiveShadowMaps(params: ReflectiveShadowMaps) => reflective_shadow_maps,
             /// Virtual point lights from the reflective shadow maps, appended to the lights.
             VplSpawn(params: VplSpawn) => vpl_spawn,
+            /// Which VPLs each block of pixels sees: a ray per block and VPL against the shadow BVH.
+            VplVisibility(params: VplVisibility) => vpl_visibility,
             /// Depth and a 32-bit triangle id per pixel (R32Uint) for every opaque mesh.
             VisibilityBuffer => visibility_buffer,
             /// Every material shaded in compute from the visibility buffer's triangle ids.

@@ -226,3 +226,14 @@ pub(crate) const BVH_TRIANGLES_READ: SlotSpec = SlotSpec::new(
     Usage::Bound,
 )
 .optional();
+
+/// Row of the shading passes that hide VPLs from the pixels they cannot see: a
+/// `VplVisibility` pass's bits.
+pub(crate) const VPL_VISIBILITY_READ: SlotSpec = SlotSpec::new(
+    super::vpl_visibility::VPL_VISIBILITY,
+    SlotType::Buffer,
+    Access::Read,
+    Usage::Bound,
+)
+.optional()
+.needs(&[Contents::VplVisibility]);

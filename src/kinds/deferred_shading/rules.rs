@@ -49,6 +49,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     // Textured and anisotropic materials: the surface the material samples.
     super::g_buffer::G_SURFACE_READ,
     super::g_buffer::G_UV_GRAD_READ,
+    super::VPL_VISIBILITY_READ,
 ];
 
 pub(crate) fn check(p: &DeferredShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {

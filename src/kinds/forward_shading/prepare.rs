@@ -30,6 +30,7 @@ pub(super) fn prepare(
         blend: false,
         shadows,
         float_depth: false,
+        vpl_visibility: super::VplLookup::of(cx, sp),
     };
     let draws = cx.renderer.mesh_draws(
         cx.gpu,

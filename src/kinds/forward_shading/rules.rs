@@ -45,6 +45,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     // Shadow maps: a ShadowAtlas pass's atlas and view table.
     super::SHADOW_ATLAS_READ,
     super::SHADOW_VIEWS_READ,
+    super::VPL_VISIBILITY_READ,
 ];
 
 /// How a shading pass shadows its lights, from the slots it filled.

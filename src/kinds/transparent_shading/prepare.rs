@@ -54,6 +54,7 @@ pub(super) fn prepare(
         blend: true,
         shadows,
         float_depth,
+        vpl_visibility: None,
     };
     let draws = cx.renderer.mesh_draws(
         cx.gpu,

@@ -55,6 +55,7 @@ pub(super) fn prepare(
     // A ray-cast mask or an atlas (validation refuses both at once); an atlas's
     // comparison sampler is offered here.
     let shadows = cx.shading_shadows(sp, &mut offered);
+    let vpl = super::VplLookup::of(cx, sp);
     let layout = tile_layout(cx, sp, lists);
     let side = p.workgroup_side();
     let light_loop = choose_light_loop(p.light_loop, layout, side);
@@ -104,6 +105,7 @@ pub(super) fn prepare(
         d.extend(lists.define());
         d.extend(loop_define(light_loop));
         d.extend(crate::render::draws::shadow_defines(shadows));
+        d.extend(super::VplLookup::defines(vpl));
         // The shader's `@workgroup_size(SHADING_GROUP, SHADING_GROUP, 1)`.
         d.push(("SHADING_GROUP", format!("{side}u")));
         if light_loop == LightLoop::GroupList {

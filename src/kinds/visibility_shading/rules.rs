@@ -122,6 +122,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     // Shadow maps: a ShadowAtlas pass's atlas and view table.
     super::SHADOW_ATLAS_READ,
     super::SHADOW_VIEWS_READ,
+    super::VPL_VISIBILITY_READ,
 ];
 
 pub(crate) fn check(p: &VisibilityShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {

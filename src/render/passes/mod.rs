@@ -22,6 +22,7 @@ use crate::graph::{
 };
 use std::collections::BTreeMap;
 use std::sync::Arc;
+pub(crate) use vpl_visibility::VplLookup;
 
 /// A pass ready to record, as often as frames run.
 pub(super) trait PreparedPass {
