@@ -3,7 +3,7 @@
 
 use super::materials::MaterialProgram;
 use super::visibility_geometry::VisibilityGeometry;
-use crate::gpu::structs::{gpu_light, GpuLightGeometry, GpuLightProperties, GpuVertex};
+use crate::gpu::structs::{gpu_light, GpuVertex};
 use crate::scene::{AlphaMode, Light, Scene};
 use wgpu::util::DeviceExt;
 

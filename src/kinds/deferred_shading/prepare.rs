@@ -107,13 +107,8 @@ pub(super) fn prepare(
             state: String::new(),
         };
         let label = format!("{} (material '{}')", sp.name, m.name);
-        let (pipeline, bind, textures) = cx.compute_pipeline_with_material(
-            &label,
-            key,
-            "main",
-            &offered,
-            m.textures.as_ref(),
-        )?;
+        let (pipeline, bind, textures) =
+            cx.compute_pipeline_with_material(&label, key, "main", &offered, m.textures.as_ref())?;
         dispatches.push(ShadeDispatch {
             pipeline,
             bind,

@@ -3,7 +3,9 @@
 
 use super::shadow_ray_cast::BVH_NODES;
 use super::shadow_ray_jobs::SHADOW_MASK;
-use super::{check_light_source, slot, Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
+use super::{
+    check_light_source, slot, Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage,
+};
 use crate::graph::error::GraphError;
 use crate::graph::model::LightSource;
 use serde::{Deserialize, Serialize};

@@ -17,9 +17,9 @@
 
 use super::{slot, Access, BufferLayout, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
-use crate::graph::roles::PassRoles;
-use crate::graph::plan::FrameSize;
 use crate::graph::model::CullVariant;
+use crate::graph::plan::FrameSize;
+use crate::graph::roles::PassRoles;
 use serde::{Deserialize, Serialize};
 
 /// `LightCulling(tile: 16, variant: Frustum, capacity: 256, coarse: 4)` or
@@ -473,7 +473,10 @@ mod tests {
             .expect("an R32Float opaque depth with a Depth32Float transparent depth is valid");
         // The transparent depth itself stays a depth texture.
         let e = errors(
-            &FLOAT_FRAME.replace(r#""transparent_depth=depth""#, r#""transparent_depth=fdepth4""#),
+            &FLOAT_FRAME.replace(
+                r#""transparent_depth=depth""#,
+                r#""transparent_depth=fdepth4""#,
+            ),
             "hdr",
         );
         assert!(e.contains("pass 'c', resource 'fdepth4'"), "{e}");

@@ -140,9 +140,10 @@ impl KindRules for LightLinkedList {
     }
     /// The candidates come from one list a tile, whose tiles a list pixel does not straddle.
     fn check_inputs(&self, ctx: &InputsCtx, errors: &mut Vec<GraphError>) {
-        let (Some(lists), Some(BufferLayout::LightLists(tiles))) =
-            (ctx.slot(slot::LIGHT_LISTS), ctx.published(slot::LIGHT_LISTS))
-        else {
+        let (Some(lists), Some(BufferLayout::LightLists(tiles))) = (
+            ctx.slot(slot::LIGHT_LISTS),
+            ctx.published(slot::LIGHT_LISTS),
+        ) else {
             return;
         };
         if tiles.lists_per_tile != 1 {

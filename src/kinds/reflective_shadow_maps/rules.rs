@@ -6,8 +6,8 @@
 
 use super::{Access, BufferLayout, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
-use crate::graph::plan::FrameSize;
 use crate::graph::model::{ResourceDesc, TextureFormat, TextureSize};
+use crate::graph::plan::FrameSize;
 use serde::{Deserialize, Serialize};
 
 /// `ReflectiveShadowMaps(tile: 32, max_lights: 64)`.

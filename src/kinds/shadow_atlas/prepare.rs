@@ -110,9 +110,9 @@ pub(super) fn prepare(
         depth_bias: p.depth_bias as i32,
         slope_bias_bits: p.slope_bias.to_bits(),
     };
-    let draws = cx
-        .renderer
-        .mesh_draws(cx.gpu, mode, MeshSet::ShadowCasters, 1, &sp.name, &offered)?;
+    let draws =
+        cx.renderer
+            .mesh_draws(cx.gpu, mode, MeshSet::ShadowCasters, 1, &sp.name, &offered)?;
     let clear = tile_clear_pipeline(cx, &sp.name, format)?;
     let meshes = draws
         .meshes()

@@ -6,8 +6,8 @@
 
 use super::{Access, BufferLayout, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
-use crate::graph::plan::FrameSize;
 use crate::graph::model::{ResourceDesc, TextureSize};
+use crate::graph::plan::FrameSize;
 use serde::{Deserialize, Serialize};
 
 /// `ShadowAtlas(filter: Pcf5x5, min_tile: 16, max_tile: 1024, importance: 1.0, ...)`.

@@ -75,9 +75,27 @@ pub const VISIBILITY_SURFACE: [&str; 3] = [VISIBILITY, VERTICES, TRIANGLES];
 /// requires one whole source. The G-buffer's come first, so graphs that fill them by
 /// type order keep their meaning.
 pub const SURFACE_SLOTS: [SlotSpec; 5] = [
-    SlotSpec::new(G_POSITION, SlotType::ColorTexture, Access::Read, Usage::Sampled).optional(),
-    SlotSpec::new(G_GEOMETRIC, SlotType::ColorTexture, Access::Read, Usage::Sampled).optional(),
-    SlotSpec::new(VISIBILITY, SlotType::ColorTexture, Access::Read, Usage::Sampled).optional(),
+    SlotSpec::new(
+        G_POSITION,
+        SlotType::ColorTexture,
+        Access::Read,
+        Usage::Sampled,
+    )
+    .optional(),
+    SlotSpec::new(
+        G_GEOMETRIC,
+        SlotType::ColorTexture,
+        Access::Read,
+        Usage::Sampled,
+    )
+    .optional(),
+    SlotSpec::new(
+        VISIBILITY,
+        SlotType::ColorTexture,
+        Access::Read,
+        Usage::Sampled,
+    )
+    .optional(),
     SlotSpec::new(
         VERTICES,
         SlotType::Import(SceneResource::Vertices),
@@ -109,7 +127,11 @@ pub fn surface_source(roles: &PassRoles) -> SurfaceSource {
 pub(crate) fn check_surface_source(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     let kind = ctx.pass.kind.label();
     let filled = |slots: &[&'static str]| -> Vec<&'static str> {
-        slots.iter().copied().filter(|s| ctx.slot(s).is_some()).collect()
+        slots
+            .iter()
+            .copied()
+            .filter(|s| ctx.slot(s).is_some())
+            .collect()
     };
     let (g, v) = (filled(&G_BUFFER_SURFACE), filled(&VISIBILITY_SURFACE));
     let list = |slots: &[&str]| slots.join(", ");

@@ -178,12 +178,21 @@ mod tests {
         );
         // Shadow maps instead: the atlas with its view table, and one source only.
         let atlas = r#"Pass(name: "a", kind: ShadowAtlas(), reads: ["geometry"], writes: ["atlas", "shadow_views"]),"#;
-        validate(&format!("{atlas} {}", glass(r#""atlas", "shadow_views""#)), "hdr")
-            .expect("glass sampling the atlas is valid");
+        validate(
+            &format!("{atlas} {}", glass(r#""atlas", "shadow_views""#)),
+            "hdr",
+        )
+        .expect("glass sampling the atlas is valid");
         let e = errors(&format!("{atlas} {}", glass(r#""atlas""#)), "hdr");
-        assert!(e.contains("read the ShadowAtlas pass's shadow_views buffer too"), "{e}");
+        assert!(
+            e.contains("read the ShadowAtlas pass's shadow_views buffer too"),
+            "{e}"
+        );
         let e = errors(
-            &format!("{atlas} {}", glass(r#""atlas", "shadow_views", "bn", "bt""#)),
+            &format!(
+                "{atlas} {}",
+                glass(r#""atlas", "shadow_views", "bn", "bt""#)
+            ),
             "hdr",
         );
         assert!(e.contains("a pass shadows its lights one way"), "{e}");

@@ -247,7 +247,9 @@ mod tests {
         validate(&pass(r#""atlas", "shadow_views=views""#), "hdr").unwrap();
         let e = errors(&pass(r#""atlas""#), "hdr");
         assert!(
-            e.contains("pass 's', resource 'atlas': a shadow atlas is sampled through its view table"),
+            e.contains(
+                "pass 's', resource 'atlas': a shadow atlas is sampled through its view table"
+            ),
             "{e}"
         );
         let e = errors(

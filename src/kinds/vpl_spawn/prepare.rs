@@ -6,16 +6,16 @@
 //! again on the CPU (as the maps' pass does) and writes the spawn parameters and the
 //! dispatch sizes: the VPLs of the next frame come from the moved lights.
 
+use super::reflective_shadow_maps::{rsm_layout_rules, RsmLayoutRules};
 use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::gpu::readback::read_buffer;
 use crate::graph::kinds::reflective_shadow_maps::{RSM_FLUX, RSM_VIEWS};
 use crate::graph::Name;
 use crate::graph::{slot, PassKind, ScheduledPass, VplSpawn};
+use crate::indirect::rsm_views::RsmLayout;
 use crate::render::pipelines::PipelineKey;
 use crate::render::report::{PassReport, VplReport};
 use crate::render::{RenderError, Renderer};
-use super::reflective_shadow_maps::{rsm_layout_rules, RsmLayoutRules};
-use crate::indirect::rsm_views::RsmLayout;
 use crate::scene::Light;
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
@@ -142,7 +142,12 @@ pub(super) fn prepare(
 
 /// `SpawnParams` of vpl_spawn.wgsl.
 fn spawn_params(scene_lights: u32, layout: &RsmLayout, room: u32) -> [u32; 4] {
-    [scene_lights, layout.views.len() as u32, layout.candidates, room]
+    [
+        scene_lights,
+        layout.views.len() as u32,
+        layout.candidates,
+        room,
+    ]
 }
 
 /// The four dispatches' sizes: copy the scene's lights, gather each view's blocks,
@@ -230,7 +235,11 @@ impl PreparedPass for VplSpawnPass {
     fn report(&self, r: &Renderer) -> Result<Option<PassReport>, RenderError> {
         let bytes = read_buffer(&r.ctx.device, &r.ctx.queue, &self.control)?;
         let w: &[u32] = bytemuck::cast_slice(&bytes);
-        let mut report = self.report.lock().unwrap_or_else(|e| e.into_inner()).clone();
+        let mut report = self
+            .report
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone();
         report.spawned = w[0].saturating_sub(report.scene_lights);
         report.dropped = w[1];
         report.with_flux = w[5];

@@ -9,8 +9,8 @@
 use super::reflective_shadow_maps::{RSM_FLUX, RSM_NORMAL, RSM_POSITION, RSM_VIEWS};
 use super::{slot, Access, BufferLayout, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
-use crate::graph::plan::FrameSize;
 use crate::graph::model::SceneResource;
+use crate::graph::plan::FrameSize;
 use serde::{Deserialize, Serialize};
 
 /// `VplSpawn(max_vpls: 16384)`.

@@ -31,34 +31,32 @@ impl PreparedPass for VplVisibilityPass {
     }
 }
 
-impl super::PrepareKind for VplVisibility {
-    fn prepare(
-        &self,
-        cx: &mut PrepareCtx<'_>,
-        sp: &ScheduledPass,
-    ) -> Result<Box<dyn super::PreparedPass>, RenderError> {
-        let offered = cx.declared(sp)?;
-        let mut d = vec![
-            ("VPL_BLOCK", format!("{}u", self.block)),
-            ("VPL_WORDS", format!("{}u", self.words())),
-            ("SHADOW_NORMAL_OFFSET", format!("{DEFAULT_NORMAL_OFFSET:?}")),
-        ];
-        d.extend(super::shadow_ray_jobs::surface_define(&sp.roles));
-        let key = PipelineKey {
-            shader: "indirect/vpl_visibility.wgsl".into(),
-            defines: defines(&d),
-            virtual_code: BTreeMap::new(),
-            state: String::new(),
-        };
-        let (pipeline, bind) = cx.compute_pipeline(&sp.name, key, "main", &offered)?;
-        let (x, y) = self.blocks(cx.size.width, cx.size.height);
-        Ok(Box::new(VplVisibilityPass {
-            name: sp.name.clone(),
-            pipeline,
-            bind,
-            groups: [x, y],
-        }))
-    }
+pub(super) fn prepare(
+    cx: &mut PrepareCtx<'_>,
+    sp: &ScheduledPass,
+    p: &VplVisibility,
+) -> Result<VplVisibilityPass, RenderError> {
+    let offered = cx.declared(sp)?;
+    let mut d = vec![
+        ("VPL_BLOCK", format!("{}u", p.block)),
+        ("VPL_WORDS", format!("{}u", p.words())),
+        ("SHADOW_NORMAL_OFFSET", format!("{DEFAULT_NORMAL_OFFSET:?}")),
+    ];
+    d.extend(super::shadow_ray_jobs::surface_define(&sp.roles));
+    let key = PipelineKey {
+        shader: "indirect/vpl_visibility.wgsl".into(),
+        defines: defines(&d),
+        virtual_code: BTreeMap::new(),
+        state: String::new(),
+    };
+    let (pipeline, bind) = cx.compute_pipeline(&sp.name, key, "main", &offered)?;
+    let (x, y) = p.blocks(cx.size.width, cx.size.height);
+    Ok(VplVisibilityPass {
+        name: sp.name.clone(),
+        pipeline,
+        bind,
+        groups: [x, y],
+    })
 }
 
 /// How a shading pass looks VPL visibility up: the bits' layout as the `VplVisibility`

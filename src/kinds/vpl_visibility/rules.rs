@@ -75,7 +75,12 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
         Access::Read,
         Usage::Bound,
     ),
-    SlotSpec::new(VPL_VISIBILITY, SlotType::Buffer, Access::Write, Usage::Bound),
+    SlotSpec::new(
+        VPL_VISIBILITY,
+        SlotType::Buffer,
+        Access::Write,
+        Usage::Bound,
+    ),
 ];
 
 pub(crate) fn check(p: &VplVisibility, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
@@ -129,6 +134,9 @@ mod tests {
             r#"Pass(name: "v", kind: VplVisibility(), reads: ["lg", "lp", "bn", "bt"], writes: ["mask"])"#,
             "hdr",
         );
-        assert!(e.contains("VplVisibility needs the pixels' surfaces"), "{e}");
+        assert!(
+            e.contains("VplVisibility needs the pixels' surfaces"),
+            "{e}"
+        );
     }
 }
