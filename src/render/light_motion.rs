@@ -313,7 +313,8 @@ fn pipeline(r: &Renderer) -> Result<wgpu::ComputePipeline, RenderError> {
             module: &module,
             entry_point: Some("main"),
             compilation_options: Default::default(),
-            cache: None,
+            // The driver's cache on disk, as every pipeline the renderer builds.
+            cache: r.ctx.pipeline_cache.as_deref().map(|c| c.cache()),
         }),
     )
 }
