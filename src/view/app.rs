@@ -3,7 +3,6 @@
 use super::camera::{CameraController, CameraMode, Movement};
 use super::overlay::{FrameInfo, Overlay, OverlayAction};
 use super::{ViewError, ViewOptions};
-use crate::bench::image_io::write_png_rgb8;
 use crate::gpu::readback::read_texture;
 use crate::gpu::GpuContext;
 use crate::reload::ReloadSession;
@@ -533,7 +532,15 @@ impl Viewer {
                 }
             })
             .collect();
-        write_png_rgb8(path, rgb, texture.width(), texture.height())
+        // The image crate directly, not bench::image_io: the viewer builds without `bench`.
+        let (w, h) = (texture.width(), texture.height());
+        let image = image::RgbImage::from_raw(w, h, rgb)
+            .ok_or_else(|| err(format!("{w}×{h} pixels read back short")))?;
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|e| err(e.to_string()))?;
+        }
+        image
+            .save_with_format(path, image::ImageFormat::Png)
             .map_err(|e| err(e.to_string()))?;
         eprintln!(
             "screenshot after {} frames: {} ({}×{}, {:?})",
