@@ -141,7 +141,7 @@ pub struct VplErrorArgs {
     /// Bounce rays a pixel of the reference.
     #[arg(long, default_value_t = 256)]
     pub samples: u32,
-    /// Timed frames for each n (after as many warm-up frames); medians are reported.
+    /// Timed frames for each n, after as many warm-up frames and at least 1 s of them; medians are reported.
     #[arg(long, default_value_t = 10)]
     pub frames: u32,
     /// Folder for results.csv, results.md and time_vs_error.png.

@@ -16,6 +16,10 @@ use lightgraph::scene::{light_flags, Scene};
 use lightgraph::shader::{assets, ShaderLibrary};
 use std::fmt::Write as _;
 use std::path::Path;
+use std::time::{Duration, Instant};
+
+/// Least warm-up before a graph's timed frames (the sweeps' `warmup_seconds` default).
+const WARMUP: Duration = Duration::from_secs(1);
 
 /// Passes whose GPU time the table reports, each by the names the shipped VPL graphs use
 /// (shading: Forward+'s or the compute-first frame's; visibility: `VplVisibility`'s).
@@ -68,8 +72,14 @@ fn frame(
     let compiled = graph::compile(checked, &scene.features(), size);
     let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, scene)?;
     let prepared = r.prepare(compiled, scene, &gpu, size, false)?;
-    for _ in 0..frames {
+    // Warm up by time as the benchmark does (docs/benchmarks.md): from idle the GPU's
+    // clocks take about a second to ramp, and `frames` frames alone left the first n's
+    // maps at 2.3–2.8 ms against 0.49 ms after. Each frame waits for its timestamps.
+    let start = Instant::now();
+    let mut warmed = 0;
+    while warmed < frames || start.elapsed() < WARMUP {
         prepared.execute(r)?;
+        warmed += 1;
     }
     let mut times = Vec::new();
     for _ in 0..frames {
@@ -104,7 +114,7 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
     let mut md = String::from("# VPL one-bounce error against a path-traced bounce\n\n");
     let _ = writeln!(
         md,
-        "Adapter: {}. {w}×{h}, reference {} bounce rays a pixel. Relative MSE = Σ(vpl − ref)² / Σ ref² of the indirect part (VPL frame minus the frame without VPLs); the worst pixel is the one with the largest (vpl − ref)², with its share of Σ(vpl − ref)²; times are GPU medians of {} frames.\n",
+        "Adapter: {}. {w}×{h}, reference {} bounce rays a pixel. Relative MSE = Σ(vpl − ref)² / Σ ref² of the indirect part (VPL frame minus the frame without VPLs); the worst pixel is the one with the largest (vpl − ref)², with its share of Σ(vpl − ref)²; times are GPU medians of {} frames after at least 1 s of warm-up.\n",
         renderer.ctx.adapter_name(),
         args.samples,
         args.frames
