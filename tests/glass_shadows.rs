@@ -6,7 +6,8 @@
 //! - glass receives the shadow of an opaque box between a casting light and the pane: a
 //!   pane pixel is black exactly where an f64 ray from it to the light hits the box, and
 //!   elsewhere keeps the light of the scene without the box (glass tracing rays, and
-//!   glass sampling the atlas beyond its blur); a pane that casts too is unchanged;
+//!   glass sampling the atlas beyond its blur; over Forward+, tiled deferred and the
+//!   compute-first frame); a pane that casts too is unchanged;
 //! - the BVH leaves a glTF model's blended meshes out unless its model opts in, and every
 //!   triangle it keeps names its own scene triangle.
 
@@ -318,8 +319,10 @@ fn glass_shows_the_shadow_of_a_box() {
     assert_eq!(box_tris.len(), 12);
     let graphs = [
         "transparent_raycast_shadows.ron",
+        "tiled_deferred_raycast_shadows.ron",
         "default.ron",
         "transparent_shadow_atlas.ron",
+        "tiled_deferred_shadow_atlas.ron",
     ];
     for graph in graphs {
         let frame = render_result(&mut r, graph, &scene);
