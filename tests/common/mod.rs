@@ -2,6 +2,7 @@
 //! file on the real adapter (lavapipe on CI).
 #![allow(dead_code)]
 
+pub mod cornell;
 pub mod msaa;
 pub mod textured;
 
