@@ -10,14 +10,6 @@
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> light_geometry: array<LightGeometry>;
 @group(0) @binding(2) var<storage, read> shadow_jobs: array<u32>;
-#if VISIBILITY_IDS
-@group(0) @binding(3) var visibility: texture_2d<u32>;
-@group(0) @binding(4) var<storage, read> vertices: array<f32>;
-@group(0) @binding(8) var<storage, read> triangles: array<u32>;
-#else
-@group(0) @binding(3) var g_position: texture_2d<f32>;
-@group(0) @binding(4) var g_geometric: texture_2d<f32>;
-#endif
 @group(0) @binding(5) var<storage, read> bvh_nodes: array<BvhNode>;
 @group(0) @binding(6) var<storage, read> bvh_triangles: array<BvhTriangle>;
 @group(0) @binding(7) var<storage, read_write> shadow_mask: array<atomic<u32>>;

@@ -23,14 +23,6 @@
 @group(0) @binding(0) var<uniform> frame: Frame;
 // LIGHT_LISTS is always set: tile lists.
 #include "common/light_inputs.wgsl"
-#if VISIBILITY_IDS
-@group(0) @binding(5) var visibility: texture_2d<u32>;
-@group(0) @binding(6) var<storage, read> vertices: array<f32>;
-@group(0) @binding(9) var<storage, read> triangles: array<u32>;
-#else
-@group(0) @binding(5) var g_position: texture_2d<f32>;
-@group(0) @binding(6) var g_geometric: texture_2d<f32>;
-#endif
 @group(0) @binding(7) var<storage, read_write> shadow_jobs: array<atomic<u32>>;
 @group(0) @binding(8) var<storage, read_write> shadow_mask: array<u32>;
 

@@ -4,6 +4,17 @@
 // exactly as visibility shading rebuilds the point it shades (the triangle's normal,
 // facing the eye, is the geometric normal). Job creation and casting read it alike.
 
+// The surface's bindings, declared here for every pass that includes this file (bound by
+// name; numbers clear of the including shaders' own).
+#if VISIBILITY_IDS
+@group(0) @binding(14) var visibility: texture_2d<u32>;
+@group(0) @binding(15) var<storage, read> vertices: array<f32>;
+@group(0) @binding(16) var<storage, read> triangles: array<u32>;
+#else
+@group(0) @binding(14) var g_position: texture_2d<f32>;
+@group(0) @binding(15) var g_geometric: texture_2d<f32>;
+#endif
+
 struct ShadowSurface {
     valid: bool,
     position: vec3<f32>,
