@@ -138,6 +138,48 @@ fn max_abs_diff(a: &[[f32; 4]], b: &[[f32; 4]]) -> (f32, usize) {
     worst
 }
 
+/// Renders `[graph, opaque]` (glass over a frame, and that frame's graph without glass)
+/// and `[reference, opaque_reference]` likewise, and checks that the glass shows (it
+/// changes over a tenth of the frame's pixels) and adds no error of its own: the
+/// composite differs from the reference by at most the opaque layers' difference plus
+/// TOL of the reference's peak. Returns the frame, the opaque layers' difference and the
+/// peak.
+fn glass_adds_no_error(
+    r: &mut lightgraph::render::Renderer,
+    scene: &Scene,
+    [graph, opaque]: [&str; 2],
+    [reference, opaque_reference]: [&str; 2],
+) -> (lightgraph::render::FrameResult, f32, f32) {
+    let reference_frame = render_file(r, reference, scene, W, H);
+    let frame = render_file(r, graph, scene, W, H);
+    assert_eq!(frame.image.len(), (W * H) as usize);
+    let opaque_reference = render_file(r, opaque_reference, scene, W, H);
+    let opaque_frame = render_file(r, opaque, scene, W, H);
+    let (opaque_err, _) = max_abs_diff(&opaque_frame.image, &opaque_reference.image);
+    let peak = reference_frame
+        .image
+        .iter()
+        .flat_map(|p| p[..3].iter().copied())
+        .fold(0.0f32, f32::max);
+    assert!(peak > 0.0, "a dark frame tests nothing");
+    let changed = differing(&frame.image, &opaque_frame.image);
+    assert!(
+        changed > (W * H / 10) as usize,
+        "only {changed} pixels show glass in {graph}"
+    );
+    let (err, at) = max_abs_diff(&frame.image, &reference_frame.image);
+    eprintln!("{graph}: opaque {opaque_err:e}, with glass {err:e}, peak {peak}");
+    assert!(
+        err <= opaque_err + TOL * peak,
+        "{graph}: error {err:e} (opaque layers alone {opaque_err:e}) at pixel ({}, {}): {:?} vs {:?}",
+        at as u32 % W,
+        at as u32 / W,
+        frame.image[at],
+        reference_frame.image[at]
+    );
+    (frame, opaque_err, peak)
+}
+
 /// Glass over the compute-first frame (graphs/default.ron: compute rasterizer, compute
 /// shading, then the transparency passes on its depth) against forward brute force with
 /// the same blending order.
@@ -155,38 +197,16 @@ fn max_abs_diff(a: &[[f32; 4]], b: &[[f32; 4]]) -> (f32, usize) {
 fn glass_over_the_compute_first_frame_equals_brute_force() {
     let scene = glass();
     let mut r = renderer();
-    let reference = render_file(&mut r, "transparent_brute_force.ron", &scene, W, H);
-    let frame = render_file(&mut r, "default.ron", &scene, W, H);
-    assert_eq!(frame.image.len(), (W * H) as usize);
     // The opaque layers alone: these graphs have no transparency pass and skip the glass.
-    let opaque_reference = render_file(&mut r, "brute_force.ron", &scene, W, H);
-    let opaque = render_file(&mut r, "visibility_compute_raster.ron", &scene, W, H);
-    let (opaque_err, _) = max_abs_diff(&opaque.image, &opaque_reference.image);
-    let peak = reference
-        .image
-        .iter()
-        .flat_map(|p| p[..3].iter().copied())
-        .fold(0.0f32, f32::max);
-    assert!(peak > 0.0, "a dark frame tests nothing");
+    let (frame, opaque_err, peak) = glass_adds_no_error(
+        &mut r,
+        &scene,
+        ["default.ron", "visibility_compute_raster.ron"],
+        ["transparent_brute_force.ron", "brute_force.ron"],
+    );
     assert!(
         opaque_err <= 1e-4 * peak,
         "the opaque compute-first frame differs from brute force by {opaque_err:e} (peak {peak})"
-    );
-    // The glass shows: it changes a large share of the compute-first frame's pixels.
-    let changed = differing(&frame.image, &opaque.image);
-    assert!(
-        changed > (W * H / 10) as usize,
-        "only {changed} pixels show glass over the compute-first frame"
-    );
-    let (err, at) = max_abs_diff(&frame.image, &reference.image);
-    eprintln!("opaque {opaque_err:e}, with glass {err:e}, peak {peak}");
-    assert!(
-        err <= opaque_err + TOL * peak,
-        "error {err:e} (opaque layer alone {opaque_err:e}) at pixel ({}, {}): {:?} vs {:?}",
-        at as u32 % W,
-        at as u32 / W,
-        frame.image[at],
-        reference.image[at]
     );
     // The glass was culled into its own lists, on the compute rasterizer's depth.
     let t = frame
@@ -212,33 +232,14 @@ fn glass_over_the_compute_first_frame_equals_brute_force() {
 fn glass_over_tiled_deferred_equals_glass_over_forward_plus() {
     let scene = glass();
     let mut r = renderer();
-    let forward = render_file(&mut r, "transparent.ron", &scene, W, H);
-    let deferred = render_file(&mut r, "tiled_deferred_transparent.ron", &scene, W, H);
-    assert_eq!(deferred.image.len(), (W * H) as usize);
-    assert_eq!(forward.image.len(), deferred.image.len());
-    let opaque_forward = render_file(&mut r, "forward_plus.ron", &scene, W, H);
-    let opaque_deferred = render_file(&mut r, "tiled_deferred_prepass.ron", &scene, W, H);
-    let (opaque_err, _) = max_abs_diff(&opaque_deferred.image, &opaque_forward.image);
-    let peak = forward
-        .image
-        .iter()
-        .flat_map(|p| p[..3].iter().copied())
-        .fold(0.0f32, f32::max);
-    assert!(peak > 0.0, "a dark frame tests nothing");
-    let changed = differing(&deferred.image, &opaque_deferred.image);
-    assert!(
-        changed > (W * H / 10) as usize,
-        "only {changed} pixels show glass over tiled deferred"
-    );
-    let (err, at) = max_abs_diff(&deferred.image, &forward.image);
-    eprintln!("opaque {opaque_err:e}, with glass {err:e}, peak {peak}");
-    assert!(
-        err <= opaque_err + TOL * peak,
-        "error {err:e} (opaque layers alone {opaque_err:e}) at pixel ({}, {}): {:?} vs {:?}",
-        at as u32 % W,
-        at as u32 / W,
-        deferred.image[at],
-        forward.image[at]
+    glass_adds_no_error(
+        &mut r,
+        &scene,
+        [
+            "tiled_deferred_transparent.ron",
+            "tiled_deferred_prepass.ron",
+        ],
+        ["transparent.ron", "forward_plus.ron"],
     );
 }
 
