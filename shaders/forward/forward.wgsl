@@ -1,4 +1,4 @@
-// Mesh draws of one material (src/render/draws.rs): the depth prepass and the
+// Mesh draws of one material (src/render/draws/): the depth prepass and the
 // transparent one (DEPTH_ONLY), the G-buffer (GBUFFER, GBUFFER_PACKED), forward shading
 // of opaque and blended meshes (SHADE, with LIGHT_LISTS for tile lists or LINKED_LISTS for
 // a light linked list; blended ones return the material's alpha, blending is pipeline
