@@ -30,6 +30,17 @@ const PAIRS: &[(&str, &str)] = &[
     ("tiled_deferred_raycast_shadows.ron", "raycast_shadows.ron"),
     ("tiled_deferred_shadow_atlas.ron", "shadow_atlas.ron"),
     ("tiled_deferred_indirect_vpl.ron", "indirect_vpl.ron"),
+    (
+        "tiled_deferred_indirect_vpl_visibility.ron",
+        "indirect_vpl_visibility.ron",
+    ),
+    ("tiled_deferred_transparent.ron", "transparent.ron"),
+    (
+        "tiled_deferred_msaa_transparent.ron",
+        "transparent_msaa.ron",
+    ),
+    // No forward glass at 8× to set it beside; these scenes have no glass.
+    ("tiled_deferred_msaa_8x_transparent.ron", "msaa_8x.ron"),
 ];
 
 /// FLIP mean of a deferred image against forward's. Measured on lavapipe at 160×96

@@ -365,6 +365,7 @@ fn mirrored_pair(tangents: bool, normal_map: bool) -> Loaded {
             normals: Some(w.add_vec3(&[Vec3::Z; 4])),
             uvs: Some(w.add_vec2(&uv)),
             tangents: tangents.then(|| w.add_vec4(&[tangent; 4])),
+            colors: None,
             indices: Some(w.add_indices(&[0, 1, 2, 0, 2, 3])),
             material: Some(m),
             mode: None,

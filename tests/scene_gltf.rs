@@ -464,3 +464,44 @@ fn a_far_plane_past_depth_precision_is_pulled_in_to_the_scene() {
         loaded.warnings
     );
 }
+
+/// Vertex colours (COLOR_0) are not drawn: the import says so, naming the primitive,
+/// rather than dropping them without a word (the mesh still loads).
+#[test]
+fn vertex_colours_are_refused_with_a_warning() {
+    let (p, n, uv, idx) = quad();
+    let mut w = GltfWriter::new();
+    let positions = w.add_positions(&p);
+    let normals = w.add_vec3(&n);
+    let uvs = w.add_vec2(&uv);
+    let colors = w.add_vec4(&[Vec4::new(1.0, 0.0, 0.0, 1.0); 4]);
+    let indices = w.add_indices(&idx);
+    let mesh = w.add_mesh(
+        "coloured",
+        &[PrimitiveDesc {
+            positions,
+            normals: Some(normals),
+            uvs: Some(uvs),
+            colors: Some(colors),
+            indices: Some(indices),
+            ..Default::default()
+        }],
+    );
+    let node = w.add_node(&NodeDesc {
+        mesh: Some(mesh),
+        ..Default::default()
+    });
+    w.add_root(node);
+    let path = tmp("vertex_colours").join("coloured.glb");
+    w.write_glb(&path).unwrap();
+    let loaded = scene::load(&path).unwrap();
+    assert_eq!(loaded.scene.triangle_count(), 2);
+    assert!(
+        loaded
+            .warnings
+            .iter()
+            .any(|w| w.contains("primitive 0") && w.contains("COLOR_0")),
+        "{:?}",
+        loaded.warnings
+    );
+}

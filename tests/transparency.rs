@@ -14,6 +14,7 @@
 //! 6e-8, per term over a few dozen terms per pixel and two blended layers).
 
 mod common;
+use common::glass::{check_glass_layers, differing, GlassLayers};
 use common::*;
 use glam::{Vec2, Vec3, Vec4};
 use lightgraph::graph::{self, CullReason, FrameSize};
@@ -32,12 +33,6 @@ fn graph_file(name: &str) -> String {
 
 fn glass() -> Scene {
     builtin::by_name("glass").expect("the built-in glass scene")
-}
-
-/// Pixels that differ between two images of one size.
-fn differing(a: &[[f32; 4]], b: &[[f32; 4]]) -> usize {
-    assert_eq!(a.len(), b.len(), "images of different sizes");
-    a.iter().zip(b).filter(|(x, y)| x != y).count()
 }
 
 #[test]
@@ -123,21 +118,6 @@ fn opaque_lists_for_glass_differ_from_brute_force() {
     );
 }
 
-/// The largest absolute difference of two images of one size, over colour channels.
-fn max_abs_diff(a: &[[f32; 4]], b: &[[f32; 4]]) -> (f32, usize) {
-    assert_eq!(a.len(), b.len(), "images of different sizes");
-    let mut worst = (0.0f32, 0);
-    for (i, (x, y)) in a.iter().zip(b).enumerate() {
-        for c in 0..3 {
-            let d = (x[c] - y[c]).abs();
-            if d > worst.0 || d.is_nan() {
-                worst = (d, i);
-            }
-        }
-    }
-    worst
-}
-
 /// Renders `[graph, opaque]` (glass over a frame, and that frame's graph without glass)
 /// and `[reference, opaque_reference]` likewise, and checks that the glass shows (it
 /// changes over a tenth of the frame's pixels) and adds no error of its own: the
@@ -155,28 +135,13 @@ fn glass_adds_no_error(
     assert_eq!(frame.image.len(), (W * H) as usize);
     let opaque_reference = render_file(r, opaque_reference, scene, W, H);
     let opaque_frame = render_file(r, opaque, scene, W, H);
-    let (opaque_err, _) = max_abs_diff(&opaque_frame.image, &opaque_reference.image);
-    let peak = reference_frame
-        .image
-        .iter()
-        .flat_map(|p| p[..3].iter().copied())
-        .fold(0.0f32, f32::max);
-    assert!(peak > 0.0, "a dark frame tests nothing");
-    let changed = differing(&frame.image, &opaque_frame.image);
-    assert!(
-        changed > (W * H / 10) as usize,
-        "only {changed} pixels show glass in {graph}"
-    );
-    let (err, at) = max_abs_diff(&frame.image, &reference_frame.image);
-    eprintln!("{graph}: opaque {opaque_err:e}, with glass {err:e}, peak {peak}");
-    assert!(
-        err <= opaque_err + TOL * peak,
-        "{graph}: error {err:e} (opaque layers alone {opaque_err:e}) at pixel ({}, {}): {:?} vs {:?}",
-        at as u32 % W,
-        at as u32 / W,
-        frame.image[at],
-        reference_frame.image[at]
-    );
+    let layers = GlassLayers {
+        frame: &frame.image,
+        opaque: &opaque_frame.image,
+        reference: &reference_frame.image,
+        opaque_reference: &opaque_reference.image,
+    };
+    let (opaque_err, peak) = check_glass_layers(graph, W, TOL, &layers);
     (frame, opaque_err, peak)
 }
 

@@ -17,7 +17,7 @@ pub fn undrawn(graph: &CompiledGraph, features: &SceneFeatures) -> Vec<String> {
         .any(|p| matches!(p.kind, PassKind::TransparentShading(_)));
     if features.has_transparent && !draws_blended {
         out.push(format!(
-            "graph '{}' has no TransparentShading pass: the scene's blended (transparent) meshes are not drawn (graphs/default.ron, transparent*.ron, tiled_deferred_transparent.ron and the tiled deferred shadow graphs draw them)",
+            "graph '{}' has no TransparentShading pass: the scene's blended (transparent) meshes are not drawn (graphs/default.ron, transparent*.ron, tiled_deferred_transparent.ron and the packed, linked-list, VPL and shadow deferred graphs draw them)",
             graph.name()
         ));
     }

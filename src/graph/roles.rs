@@ -97,12 +97,9 @@ impl RoleCtx<'_> {
                 })
                 .collect();
             match targets.as_slice() {
-                [one] => {
-                    if self.color_texture(one) != Some(1) {
-                        errors.push(self.mismatch(pass, one, "a Fullscreen pass renders into a single-sample target; this one is multisampled"));
-                    }
-                    roles.target = Some((*one).clone());
-                }
+                // A multisampled target takes the shader's colour in every sample it
+                // covers (once per pixel, unless the shader reads its sample index).
+                [one] => roles.target = Some((*one).clone()),
                 [] => errors.push(self.bad(pass, "a Fullscreen pass needs one colour texture in writes that is not a shader binding (its render target)")),
                 many => errors.push(self.bad(pass, format!("a Fullscreen pass has one render target, found {}", many.len()))),
             }

@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod cornell;
+pub mod glass;
 pub mod msaa;
 pub mod textured;
 

@@ -30,14 +30,19 @@ pub(super) fn prepare(
         .target
         .clone()
         .ok_or_else(|| pass_error(&sp.name, "no render target was resolved".into()))?;
-    let format = cx
+    let (format, samples) = cx
         .graph
         .checked
         .desc
         .resources
         .iter()
         .find_map(|r| match r {
-            ResourceDesc::Texture { name, format, .. } if *name == target => Some(format.to_wgpu()),
+            ResourceDesc::Texture {
+                name,
+                format,
+                samples,
+                ..
+            } if *name == target => Some((format.to_wgpu(), *samples)),
             _ => None,
         })
         .ok_or_else(|| pass_error(&sp.name, format!("'{target}' is not a texture")))?;
@@ -46,7 +51,7 @@ pub(super) fn prepare(
         shader: shader.to_string(),
         defines: BTreeMap::new(),
         virtual_code: BTreeMap::new(),
-        state: format!("fullscreen entry={entry} format={format:?}"),
+        state: format!("fullscreen entry={entry} format={format:?} samples={samples}"),
     };
     // The user's fragment shader, with the built-in full-screen triangle appended.
     let vs_text = cx
@@ -71,7 +76,10 @@ pub(super) fn prepare(
                 },
                 primitive: Default::default(),
                 depth_stencil: None,
-                multisample: Default::default(),
+                multisample: wgpu::MultisampleState {
+                    count: samples,
+                    ..Default::default()
+                },
                 fragment: Some(wgpu::FragmentState {
                     module: &module,
                     entry_point: Some(entry),

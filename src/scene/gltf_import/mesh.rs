@@ -36,6 +36,13 @@ impl Importer {
                 self.warn(format!("{pel}: no POSITION attribute; skipped"));
                 continue;
             };
+            // Vertex colours would multiply the base colour (glTF 2.0, 3.7.2.1); no
+            // vertex layout carries them, so the material's colour stands alone.
+            if prim.get(&gltf::Semantic::Colors(0)).is_some() {
+                self.warn(format!(
+                    "{pel}: COLOR_0 (vertex colours) is not supported; the material's base colour is used alone"
+                ));
+            }
             let el =
                 |sem: &str, acc: &gltf::Accessor| format!("{pel} {sem} accessor {}", acc.index());
             let pe = el("POSITION", &pos_acc);

@@ -34,6 +34,8 @@ pub struct PrimitiveDesc {
     pub uvs: Option<usize>,
     /// Accessor of the tangents (`TANGENT`, xyz and handedness w).
     pub tangents: Option<usize>,
+    /// Accessor of the vertex colours (`COLOR_0`, VEC3 or VEC4).
+    pub colors: Option<usize>,
     /// Accessor of the indices (from
     /// [`GltfWriter::add_indices`](super::GltfWriter::add_indices)); `None` for a
     /// non-indexed primitive.

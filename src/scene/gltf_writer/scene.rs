@@ -25,6 +25,7 @@ impl GltfWriter {
                     (Semantic::Normals, p.normals),
                     (Semantic::TexCoords(0), p.uvs),
                     (Semantic::Tangents, p.tangents),
+                    (Semantic::Colors(0), p.colors),
                 ] {
                     if let Some(a) = accessor {
                         attributes.insert(Valid(semantic), index(a));
@@ -65,6 +66,7 @@ impl GltfWriter {
             normals: normals.map(|n| self.add_vec3(n)),
             uvs: uvs.map(|u| self.add_vec2(u)),
             tangents: None,
+            colors: None,
             indices: indices.map(|i| self.add_indices(i)),
             material,
             mode: None,

@@ -1,0 +1,62 @@
+//! Glass over an opaque frame against a reference with the same blending order: the glass
+//! must show, and add no error beyond the opaque layers' own difference.
+
+/// Pixels that differ between two images of one size.
+pub fn differing(a: &[[f32; 4]], b: &[[f32; 4]]) -> usize {
+    assert_eq!(a.len(), b.len(), "images of different sizes");
+    a.iter().zip(b).filter(|(x, y)| x != y).count()
+}
+
+/// The largest absolute difference of two images of one size, over colour channels.
+pub fn max_abs_diff(a: &[[f32; 4]], b: &[[f32; 4]]) -> (f32, usize) {
+    assert_eq!(a.len(), b.len(), "images of different sizes");
+    let mut worst = (0.0f32, 0);
+    for (i, (x, y)) in a.iter().zip(b).enumerate() {
+        for c in 0..3 {
+            let d = (x[c] - y[c]).abs();
+            if d > worst.0 || d.is_nan() {
+                worst = (d, i);
+            }
+        }
+    }
+    worst
+}
+
+/// A frame with glass and the same frame without it, and their references.
+pub struct GlassLayers<'a> {
+    pub frame: &'a [[f32; 4]],
+    pub opaque: &'a [[f32; 4]],
+    pub reference: &'a [[f32; 4]],
+    pub opaque_reference: &'a [[f32; 4]],
+}
+
+/// Checks that the glass shows (it changes over a tenth of the `width`-wide frame's
+/// pixels) and adds no error of its own: the composite differs from the reference by at
+/// most the opaque layers' difference plus `tol` of the reference's peak (glass blends
+/// over the opaque colour with weight 1 − α ≤ 1). Returns the opaque layers' difference
+/// and the peak.
+pub fn check_glass_layers(graph: &str, width: u32, tol: f32, l: &GlassLayers) -> (f32, f32) {
+    let (opaque_err, _) = max_abs_diff(l.opaque, l.opaque_reference);
+    let peak = l
+        .reference
+        .iter()
+        .flat_map(|p| p[..3].iter().copied())
+        .fold(0.0f32, f32::max);
+    assert!(peak > 0.0, "a dark frame tests nothing");
+    let changed = differing(l.frame, l.opaque);
+    assert!(
+        changed > l.frame.len() / 10,
+        "only {changed} pixels show glass in {graph}"
+    );
+    let (err, at) = max_abs_diff(l.frame, l.reference);
+    eprintln!("{graph}: opaque {opaque_err:e}, with glass {err:e}, peak {peak}");
+    assert!(
+        err <= opaque_err + tol * peak,
+        "{graph}: error {err:e} (opaque layers alone {opaque_err:e}) at pixel ({}, {}): {:?} vs {:?}",
+        at as u32 % width,
+        at as u32 / width,
+        l.frame[at],
+        l.reference[at]
+    );
+    (opaque_err, peak)
+}
