@@ -24,12 +24,14 @@ struct SpawnParams {
     merge: u32,
     merge_cos: f32,
     min_flux: f32,
-    // bit 0: redistribute the negligible flux; bit 1: the disc falloff
+    // bit 0: redistribute the negligible flux; bit 1: the disc falloff; bit 2: the disc's
+    // radius as the least clamp
     flags: u32,
 };
 
 const REDISTRIBUTE: u32 = 1u;
 const DISC: u32 = 2u;
+const AREA_CLAMP: u32 = 4u;
 
 struct Candidate {
     position: vec3<f32>,
@@ -360,8 +362,12 @@ fn append(@builtin(global_invocation_id) id: vec3<u32>) {
     // _pad0: the VPL's number among the VPLs, its bit in a VplVisibility pass's masks.
     let scale = bitcast<f32>(atomicLoad(&control[10]));
     var disc_sq = 0.0;
+    var clamp = art.w;
     if ((params.flags & DISC) != 0u) {
         disc_sq = c.area / PI;
     }
-    light_properties[i] = LightProperties(c.flux * (scale * art.y / PI), art.w, LIGHT_VPL, mask, i - params.scene_lights, disc_sq);
+    if ((params.flags & AREA_CLAMP) != 0u) {
+        clamp = max(clamp, sqrt(c.area / PI));
+    }
+    light_properties[i] = LightProperties(c.flux * (scale * art.y / PI), clamp, LIGHT_VPL, mask, i - params.scene_lights, disc_sq);
 }

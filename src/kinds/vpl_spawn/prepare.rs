@@ -145,8 +145,12 @@ pub(super) fn prepare(
 
 /// `SpawnParams` of vpl_spawn.wgsl.
 fn spawn_params(scene_lights: u32, layout: &RsmLayout, p: &VplSpawn) -> [u32; 8] {
-    let flags = u32::from(p.redistribute)
-        | if p.falloff == VplFalloff::Disc { 2 } else { 0 };
+    let falloff = match p.falloff {
+        VplFalloff::Clamp => 0,
+        VplFalloff::Disc => 2,
+        VplFalloff::AreaClamp => 4,
+    };
+    let flags = u32::from(p.redistribute) | falloff;
     [
         scene_lights,
         layout.views.len() as u32,
@@ -174,7 +178,11 @@ fn dispatch_groups(scene_lights: u32, layout: &RsmLayout, merge: u32) -> [[u32; 
         .map(|v| (v.controls.n / merge.min(v.controls.n)).pow(2))
         .max()
         .unwrap_or(0);
-    let merge_groups = if merge > 1 { most_groups.div_ceil(64) } else { 0 };
+    let merge_groups = if merge > 1 {
+        most_groups.div_ceil(64)
+    } else {
+        0
+    };
     [
         [scene_lights.div_ceil(64), 1, 1],
         [most_blocks.div_ceil(64), layout.views.len() as u32, 1],

@@ -53,6 +53,8 @@ pub enum VplFalloff {
     /// over π. On its axis this is exactly the irradiance of a Lambertian disc of that
     /// area.
     Disc,
+    /// `1 / max(d², clamp², r²)`: the clamp grows to the disc's radius r.
+    AreaClamp,
 }
 
 fn default_max_vpls() -> u32 {
