@@ -123,6 +123,18 @@ fn negligible_vpls_are_dropped_counted_and_change_the_image_within_their_flux_bo
     );
     let kept = sorted(vpls(&r, &fd, &s, vd).iter().map(|v| luma(v.0)).collect());
     assert_eq!(kept, over);
+    // With a full room as well, the room's selection runs over the rest: the brightest
+    // `room` of those over the floor stay, the others count as dropped for room.
+    let room = 40;
+    let text = graph(&format!("min_flux: {min_flux}"))
+        .replace("max_vpls: 16384", &format!("max_vpls: {room}"));
+    let (ff, full) = render(&mut r, &text, &s, w, h);
+    let vf = &full.vpls[0];
+    assert!(over.len() > room, "{}", over.len());
+    assert_eq!(vf.negligible as usize, small.len());
+    assert_eq!(vf.dropped as usize, over.len() - room, "{vf:?}");
+    let brightest = sorted(vpls(&r, &ff, &s, vf).iter().map(|v| luma(v.0)).collect());
+    assert_eq!(brightest, over[over.len() - room..].to_vec());
     let lost: f64 = small.iter().sum();
     assert!(
         ((vd.negligible_flux as f64 - lost) / lost).abs() < 1e-4,
