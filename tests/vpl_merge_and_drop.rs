@@ -182,11 +182,24 @@ fn negligible_vpls_are_dropped_counted_and_change_the_image_within_their_flux_bo
 
 /// A floor and one indirect spot light straight above it whose whole map lands on it.
 fn spot_over_floor(height: f32, outer: f32) -> Scene {
+    spot_over_step(height, outer, 0.0)
+}
+
+/// `spot_over_floor` with the floor's x > 0 half `step` lower: the step runs under the
+/// light, along the map's middle column.
+fn spot_over_step(height: f32, outer: f32, step: f32) -> Scene {
     use lightgraph::scene::{light_flags, Camera, Light, LightShape, VplControls};
-    let floor = common::cuboid(
-        "floor",
+    let upper = common::cuboid(
+        "upper",
         Vec3::new(-20.0, -1.0, -20.0),
-        Vec3::new(20.0, 0.0, 20.0),
+        Vec3::new(0.0, 0.0, 20.0),
+        0,
+        false,
+    );
+    let lower = common::cuboid(
+        "lower",
+        Vec3::new(0.0, -1.0 - step, -20.0),
+        Vec3::new(20.0, -step, 20.0),
         0,
         false,
     );
@@ -198,8 +211,8 @@ fn spot_over_floor(height: f32, outer: f32) -> Scene {
     };
     spot.flags = light_flags::INDIRECT;
     let mut s = Scene {
-        name: "spot_over_floor".into(),
-        meshes: vec![floor],
+        name: "spot_over_step".into(),
+        meshes: vec![upper, lower],
         materials: vec![common::lambert("white", Vec3::splat(0.8))],
         lights: vec![spot],
         camera: Camera {
@@ -272,4 +285,24 @@ fn a_disc_vpl_covers_the_floor_area_its_map_texels_see() {
     // Clamp (the default) leaves every VPL a point.
     let (f, res) = render(&mut r, &graph("falloff: Clamp"), &s, 32, 24);
     assert!(vpls(&r, &f, &s, &res.vpls[0]).iter().all(|x| x.1 == 0.0));
+}
+
+#[test]
+fn parallel_surfaces_at_different_depths_do_not_merge() {
+    let (height, outer) = (2.5f32, 40f32.to_radians());
+    let mut r = renderer();
+    // n = 2 and merge: 2: each view's four VPLs form one group, two on either side of
+    // the step. With merge_cos 0.99 the plane bound is the group's disc radius (about
+    // 2.5 m here) × tan(acos 0.99) = 0.14: about 0.36 m.
+    let merged = |r: &mut Renderer, step: f32| {
+        let mut s = spot_over_step(height, outer, step);
+        s.vpl_controls.get_mut(&0).unwrap().n = 2;
+        let (_, res) = render(r, &graph("merge: 2, merge_cos: 0.99"), &s, 32, 24);
+        res.vpls[0].clone()
+    };
+    let flat = merged(&mut r, 0.0);
+    assert_eq!((flat.spawned, flat.merged), (1, 3), "{flat:?}");
+    // A 1 m step puts each member 0.5 m off the group's plane: nothing merges.
+    let stepped = merged(&mut r, 1.0);
+    assert_eq!((stepped.spawned, stepped.merged), (4, 0), "{stepped:?}");
 }

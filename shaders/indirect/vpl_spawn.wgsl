@@ -4,8 +4,9 @@
 //   gather: one candidate per n×n block of each view: the block's summed flux at its
 //           flux-weighted position and normal, and the surface area its texels cover;
 //   merge:  (merge > 1) per group of merge×merge neighbouring candidates of a view: when
-//           every member faces within merge_cos of the group's flux-weighted normal,
-//           the group becomes one candidate carrying the members' summed flux and area;
+//           every member faces within merge_cos of the group's flux-weighted normal and
+//           lies near its plane, the group becomes one candidate carrying the members'
+//           summed flux and area;
 //   select: one workgroup: the total flux; candidates under min_flux of it are
 //           negligible; when more of the rest than there is room, the exact flux
 //           threshold (a radix select over the luminance's float bits, which order like
@@ -186,10 +187,16 @@ fn merge(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let mean = normalize(normal);
+    let centre = position / weight;
+    // Members must also lie near the group's plane: within the group's disc radius times
+    // the tangent of the normals' bound, so parallel surfaces at different depths (a
+    // floor seen past a ledge) do not merge into a point between them.
+    let cos_bound = max(params.merge_cos, 0.01);
+    let depth_bound = sqrt(area / PI) * sqrt(max(1.0 - cos_bound * cos_bound, 0.0)) / cos_bound;
     for (var y = 0u; y < g; y++) {
         for (var x = 0u; x < g; x++) {
             let c = candidates[origin + y * n + x];
-            if (c.key != 0u && dot(c.normal, mean) < params.merge_cos) {
+            if (c.key != 0u && (dot(c.normal, mean) < params.merge_cos || abs(dot(c.position - centre, mean)) > depth_bound)) {
                 return;
             }
         }
@@ -204,7 +211,7 @@ fn merge(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     candidates[leader].flux = flux;
-    candidates[leader].position = position / weight;
+    candidates[leader].position = centre;
     candidates[leader].normal = mean;
     candidates[leader].area = area;
     candidates[leader].key = bitcast<u32>(dot(flux, LUMA));
