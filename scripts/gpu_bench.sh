@@ -6,7 +6,8 @@
 #             visibility shading's material classification (material_classification.ron);
 #   features  ray-cast shadows, the shadow atlas, transparency, MSAA, VPL indirect light, VPL visibility
 #             and the light linked list (their sweeps);
-#   extras    the VPL bounce against its path-traced reference (vpl-error) and hot-reload
+#   extras    the VPL bounce against its path-traced reference (vpl-error; the variants run
+#             puts with and without visibility and the cheaper VPLs on one plot) and hot-reload
 #             latency (reload-bench).
 # Each sweep's CSV, Markdown and plots go to $OUT/r/<sweep>/ (or results/r/), packed into
 # results.tar.gz after every sweep, so a cut-off run still brings back what it finished.
@@ -26,7 +27,7 @@ if [[ $stages == *" frames "* ]]; then
     run_sweep material_classification material_classification 200
 fi
 if [[ $stages == *" features "* ]]; then
-    for s in raycast_shadows shadow_atlas transparency msaa indirect_vpl vpl_visibility light_linked_list; do
+    for s in raycast_shadows shadow_atlas transparency msaa indirect_vpl vpl_visibility vpl_cheaper light_linked_list; do
         run_sweep $s $s 150
     done
 fi
@@ -40,6 +41,19 @@ if [[ $stages == *" extras "* ]]; then
         --error-graph benches/graphs/visibility_indirect_vpl_all_lights.ron \
         --direct graphs/visibility_compute_raster.ron --out "$out/vpl_error_visibility" > "$out/vpl_error_visibility.log" 2>&1
     echo "== vpl_error_visibility (rc $?)"; cat "$out/vpl_error_visibility/results.md" 2>/dev/null | head -20
+    # One time-vs-error plot: without and with visibility, and the cheaper VPLs
+    # (docs/indirect_light.md, "Cheaper VPLs"); one reference a scene for all of them.
+    vis="graph=graphs/visibility_indirect_vpl.ron;error_graph=benches/graphs/visibility_indirect_vpl_all_lights.ron;direct=graphs/visibility_compute_raster.ron"
+    timeout 600 $lg vpl-error --scene scenes/cornell_indirect.ron scenes/atrium_indirect.ron \
+        --width 1920 --height 1080 --samples 256 --frames 10 --n 4,8,16 \
+        --variant "label=no visibility;graph=benches/graphs/visibility_indirect_vpl_no_visibility.ron" \
+        --variant "label=visibility;$vis" \
+        --variant "label=visibility disc;$vis;spawn=falloff: Disc" \
+        --variant "label=visibility min_flux 1e-4;$vis;spawn=min_flux: 0.0001" \
+        --variant "label=visibility merge 2;$vis;spawn=merge: 2" \
+        --variant "label=default;$vis;spawn=min_flux: 0.0001, falloff: Disc" \
+        --out "$out/vpl_error_variants" > "$out/vpl_error_variants.log" 2>&1
+    echo "== vpl_error_variants (rc $?)"; cat "$out/vpl_error_variants/results.md" 2>/dev/null | head -40
     timeout 150 $lg reload-bench --out "$out/reload_latency" --width 1920 --height 1080 \
         --lights 3072 --repeats 20 > "$out/reload_latency.log" 2>&1
     echo "== reload_latency (rc $?)"; cat "$out/reload_latency/reload_latency.md" 2>/dev/null | head -20

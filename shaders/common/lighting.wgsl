@@ -51,7 +51,7 @@ fn incident_reached(g: LightGeometry, p: LightProperties, r: LightReach) -> Inci
     }
     if ((p.flags & LIGHT_VPL) != 0u) {
         let lobe = max(dot(g.direction, -out.dir), 0.0);
-        out.radiance = p.color * (lobe * r.window / max(r.dist_sq, p.cos_inner * p.cos_inner));
+        out.radiance = p.color * (lobe * r.window / max(r.dist_sq + p.disc_sq, p.cos_inner * p.cos_inner));
         return out;
     }
     let falloff = r.window / max(r.dist_sq, MIN_DISTANCE_SQ);
@@ -65,5 +65,7 @@ fn incident_light(g: LightGeometry, p: LightProperties, pos: vec3<f32>) -> Incid
 
 // A virtual point light (VplSpawn): a cosine-weighted hemisphere about `direction`
 // (the surface it sits on emits like a Lambertian patch); `cos_inner` holds its distance
-// clamp, below which 1/d² stops growing; culled as a 90° spot light.
+// clamp, below which 1/d² stops growing, and `disc_sq` the squared radius of the disc it
+// stands for (1/d² becomes 1/(d² + r²), a disc's on-axis falloff); culled as a 90° spot
+// light.
 const LIGHT_VPL: u32 = 4u;

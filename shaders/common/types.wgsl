@@ -32,7 +32,8 @@ struct LightProperties {
     flags: u32,
     material_mask: u32,
     _pad0: u32,
-    _pad1: u32,
+    // A VPL's disc radius squared (VplSpawn's `falloff: Disc`); 0 for any other light.
+    disc_sq: f32,
 };
 
 // How a culling pass laid out its light lists (see ListLayout in src/graph/plan.rs).

@@ -5,6 +5,7 @@ pub mod bench;
 pub mod live;
 pub mod render;
 pub mod vpl_error;
+pub mod vpl_variants;
 
 use anyhow::{bail, Result};
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
@@ -144,6 +145,12 @@ pub struct VplErrorArgs {
     /// Timed frames for each n, after as many warm-up frames and at least 1 s of them; medians are reported.
     #[arg(long, default_value_t = 10)]
     pub frames: u32,
+    /// Frames to measure against the same reference, each
+    /// `label=L;graph=G;error_graph=E;direct=D;spawn=P` (keys but `label` optional: the
+    /// graphs default to --graph, --error-graph, --direct; `spawn` adds VplSpawn
+    /// parameters such as `merge: 2, falloff: Disc`). None: one frame, labelled `vpl`.
+    #[arg(long)]
+    pub variant: Vec<String>,
     /// Folder for results.csv, results.md and time_vs_error.png.
     #[arg(long)]
     pub out: PathBuf,

@@ -5,6 +5,7 @@
 //! cost in the culled graph (maps, spawn, culling, shading) over `frames` frames, with
 //! its list overflows. Writes results.csv, results.md, time_vs_error.png.
 
+use super::vpl_variants::{self, Variant};
 use super::{render::load_scene, VplErrorArgs};
 use anyhow::{bail, Context, Result};
 use lightgraph::graph::{self, FrameSize};
@@ -13,7 +14,6 @@ use lightgraph::indirect::reference::{
 };
 use lightgraph::render::{Renderer, SceneGpu};
 use lightgraph::scene::{light_flags, Scene};
-use lightgraph::shader::{assets, ShaderLibrary};
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -33,6 +33,7 @@ const PASSES: [&[&str]; 5] = [
 
 struct Row {
     scene: String,
+    variant: String,
     n: u32,
     vpls: u32,
     dropped: u32,
@@ -58,12 +59,13 @@ fn median(mut v: Vec<f64>) -> Option<f64> {
 fn frame(
     r: &mut Renderer,
     graph_path: &Path,
+    spawn: Option<&str>,
     scene: &Scene,
     w: u32,
     h: u32,
     frames: u32,
 ) -> Result<(lightgraph::render::FrameResult, Vec<PassTimes>)> {
-    let checked = assets::check_graph(graph_path, &ShaderLibrary::builtin())?;
+    let checked = vpl_variants::check(graph_path, spawn)?;
     let size = FrameSize {
         width: w,
         height: h,
@@ -90,6 +92,14 @@ fn frame(
     Ok((prepared.render(r)?, times))
 }
 
+/// A label as a file name's part: letters and digits, anything else `_`.
+fn file_label(label: &str) -> String {
+    label
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect()
+}
+
 pub fn run(args: &VplErrorArgs) -> Result<()> {
     let graph_path = args
         .graph
@@ -106,6 +116,21 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
     if args.n.is_empty() || args.frames == 0 || args.samples == 0 {
         bail!("--n, --frames and --samples need at least one");
     }
+    let base = Variant {
+        label: "vpl".into(),
+        graph: graph_path,
+        error_graph: error_path,
+        direct: direct_path,
+        spawn: None,
+    };
+    let variants = if args.variant.is_empty() {
+        vec![base]
+    } else {
+        args.variant
+            .iter()
+            .map(|t| vpl_variants::parse(t, &base))
+            .collect::<Result<Vec<_>>>()?
+    };
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let mut renderer = Renderer::headless()?;
@@ -141,7 +166,6 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
             "{}: reference ({} samples) in {reference_s:.1} s, its noise {noise:.4} (relative MSE)",
             base.name, args.samples
         );
-        let (direct, _) = frame(&mut renderer, &direct_path, &base, w, h, 1)?;
         let to_rgb = |v: &[glam::Vec3]| {
             v.iter()
                 .map(|p| p.max(glam::Vec3::ZERO).to_array())
@@ -158,68 +182,86 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
         )?;
         let _ = writeln!(
             md,
-            "## {} ({} indirect lights; reference {reference_s:.1} s on the CPU; its own noise: relative MSE {noise:.4})\n\n| n | VPLs | dropped | lists overflowed (timed graph) | rel. MSE | Σvpl/Σref | worst pixel: share of the squared error (VPL / reference luminance) | VPL passes (ms) | rsm | spawn | culling | shading | visibility |\n|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|",
+            "## {} ({} indirect lights; reference {reference_s:.1} s on the CPU; its own noise: relative MSE {noise:.4})\n\n| variant | n | VPLs | dropped | lists overflowed (timed graph) | rel. MSE | Σvpl/Σref | worst pixel: share of the squared error (VPL / reference luminance) | VPL passes (ms) | rsm | spawn | culling | shading | visibility |\n|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|",
             base.name,
             indirect.len()
         );
-        for &n in &args.n {
-            let mut scene = base.clone();
-            for &i in &indirect {
-                let mut c = scene.vpl(i);
-                c.n = n;
-                c.check().map_err(|m| anyhow::anyhow!("--n {n}: {m}"))?;
-                scene.vpl_controls.insert(i as u32, c);
-            }
-            let (result, times) = frame(&mut renderer, &graph_path, &scene, w, h, args.frames)?;
-            let v = result
-                .vpls
-                .first()
-                .with_context(|| format!("{} ran no VplSpawn pass", graph_path.display()))?;
-            let (measured, _) = frame(&mut renderer, &error_path, &scene, w, h, 0)?;
-            let vpl_image = indirect_part(&measured.image, &direct.image);
-            let e = relative_mse(&vpl_image, &reference);
-            let worst = worst_pixel(&vpl_image, &reference);
-            let (wx, wy) = (worst.index as u32 % w, worst.index as u32 / w);
-            let luma = |c: glam::Vec3| c.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722));
-            lightgraph::bench::write_png_tonemapped(
-                args.out.join(format!("{}_vpl_n{n}.png", base.name)),
-                &to_rgb(&vpl_image),
-                w,
-                h,
-                &tonemap,
-            )?;
-            // Total indirect light of the VPL image over the reference's: bias, apart from noise.
-            let total = |v: &[glam::Vec3]| v.iter().map(|p| (p.x + p.y + p.z) as f64).sum::<f64>();
-            let energy = total(&vpl_image) / total(&reference).max(1e-30);
-            let overflowed_lists: u32 = result.culling.iter().map(|c| c.overflowed_lists).sum();
-            let pass_ms: Vec<Option<f64>> = PASSES
-                .iter()
-                .map(|p| {
-                    median(
-                        times
-                            .iter()
-                            .filter_map(|t| {
-                                t.iter().find(|(n, _)| p.contains(&n.as_str())).map(|x| x.1)
-                            })
-                            .collect(),
-                    )
-                })
-                .collect();
-            let frame_ms = median(
-                times
+        for variant in &variants {
+            let spawn = variant.spawn.as_deref();
+            let (direct, _) = frame(&mut renderer, &variant.direct, None, &base, w, h, 1)?;
+            for &n in &args.n {
+                let mut scene = base.clone();
+                for &i in &indirect {
+                    let mut c = scene.vpl(i);
+                    c.n = n;
+                    c.check().map_err(|m| anyhow::anyhow!("--n {n}: {m}"))?;
+                    scene.vpl_controls.insert(i as u32, c);
+                }
+                let (result, times) = frame(
+                    &mut renderer,
+                    &variant.graph,
+                    spawn,
+                    &scene,
+                    w,
+                    h,
+                    args.frames,
+                )?;
+                let v = result
+                    .vpls
+                    .first()
+                    .with_context(|| format!("{} ran no VplSpawn pass", variant.graph.display()))?;
+                let (measured, _) =
+                    frame(&mut renderer, &variant.error_graph, spawn, &scene, w, h, 0)?;
+                let vpl_image = indirect_part(&measured.image, &direct.image);
+                let e = relative_mse(&vpl_image, &reference);
+                let worst = worst_pixel(&vpl_image, &reference);
+                let (wx, wy) = (worst.index as u32 % w, worst.index as u32 / w);
+                let luma = |c: glam::Vec3| c.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722));
+                lightgraph::bench::write_png_tonemapped(
+                    args.out.join(format!(
+                        "{}_{}_n{n}.png",
+                        base.name,
+                        file_label(&variant.label)
+                    )),
+                    &to_rgb(&vpl_image),
+                    w,
+                    h,
+                    &tonemap,
+                )?;
+                // Total indirect light of the VPL image over the reference's: bias, apart from noise.
+                let total =
+                    |v: &[glam::Vec3]| v.iter().map(|p| (p.x + p.y + p.z) as f64).sum::<f64>();
+                let energy = total(&vpl_image) / total(&reference).max(1e-30);
+                let overflowed_lists: u32 = result.culling.iter().map(|c| c.overflowed_lists).sum();
+                let pass_ms: Vec<Option<f64>> = PASSES
                     .iter()
-                    .map(|t| {
-                        t.iter()
-                            .filter(|(n, _)| PASSES.iter().any(|p| p.contains(&n.as_str())))
-                            .map(|x| x.1)
-                            .sum()
+                    .map(|p| {
+                        median(
+                            times
+                                .iter()
+                                .filter_map(|t| {
+                                    t.iter().find(|(n, _)| p.contains(&n.as_str())).map(|x| x.1)
+                                })
+                                .collect(),
+                        )
                     })
-                    .collect(),
-            );
-            let ms = |x: Option<f64>| x.map_or("–".to_string(), |x| format!("{x:.3}"));
-            let _ = writeln!(
+                    .collect();
+                let frame_ms = median(
+                    times
+                        .iter()
+                        .map(|t| {
+                            t.iter()
+                                .filter(|(n, _)| PASSES.iter().any(|p| p.contains(&n.as_str())))
+                                .map(|x| x.1)
+                                .sum()
+                        })
+                        .collect(),
+                );
+                let ms = |x: Option<f64>| x.map_or("–".to_string(), |x| format!("{x:.3}"));
+                let _ = writeln!(
                 md,
-                "| {n} | {} | {} | {overflowed_lists} | {e:.4} | {energy:.3} | {:.1}% at ({wx}, {wy}) ({:.3} / {:.3}){} | {} | {} | {} | {} | {} | {} |",
+                "| {} | {n} | {} | {} | {overflowed_lists} | {e:.4} | {energy:.3} | {:.1}% at ({wx}, {wy}) ({:.3} / {:.3}){} | {} | {} | {} | {} | {} | {} |",
+                variant.label,
                 v.spawned,
                 v.dropped,
                 100.0 * worst.share,
@@ -237,9 +279,10 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
                 ms(pass_ms[3]),
                 ms(pass_ms[4])
             );
-            println!(
-                "{} n={n}: {} VPLs ({} dropped, {overflowed_lists} lists overflowed), relative MSE {e:.4}, energy {energy:.3} of the reference's, worst pixel ({wx}, {wy}) {:.1}% of the squared error (VPL {:.3}, reference {:.3}), {} non-finite pixels, VPL passes {} ms",
+                println!(
+                "{} {} n={n}: {} VPLs ({} dropped, {overflowed_lists} lists overflowed), relative MSE {e:.4}, energy {energy:.3} of the reference's, worst pixel ({wx}, {wy}) {:.1}% of the squared error (VPL {:.3}, reference {:.3}), {} non-finite pixels, VPL passes {} ms",
                 base.name,
+                variant.label,
                 v.spawned,
                 v.dropped,
                 100.0 * worst.share,
@@ -248,30 +291,36 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
                 worst.non_finite,
                 ms(frame_ms)
             );
-            rows.push(Row {
-                scene: base.name.clone(),
-                n,
-                vpls: v.spawned,
-                dropped: v.dropped,
-                overflowed_lists,
-                rel_mse: e,
-                energy,
-                worst,
-                frame_ms,
-                pass_ms,
-            });
+                for line in v.lines().iter().skip(1) {
+                    println!("  {line}");
+                }
+                rows.push(Row {
+                    scene: base.name.clone(),
+                    variant: variant.label.clone(),
+                    n,
+                    vpls: v.spawned,
+                    dropped: v.dropped,
+                    overflowed_lists,
+                    rel_mse: e,
+                    energy,
+                    worst,
+                    frame_ms,
+                    pass_ms,
+                });
+            }
         }
         md.push('\n');
     }
     let mut csv = String::from(
-        "scene,n,vpls,dropped,overflowed_lists,rel_mse,energy_ratio,worst_pixel,worst_share,non_finite,vpl_passes_ms,rsm_ms,spawn_ms,culling_ms,shading_ms,visibility_ms\n",
+        "scene,variant,n,vpls,dropped,overflowed_lists,rel_mse,energy_ratio,worst_pixel,worst_share,non_finite,vpl_passes_ms,rsm_ms,spawn_ms,culling_ms,shading_ms,visibility_ms\n",
     );
     let opt = |x: Option<f64>| x.map_or(String::new(), |x| format!("{x:.4}"));
     for r in &rows {
         let _ = writeln!(
             csv,
-            "{},{},{},{},{},{:.6},{:.4},{},{:.6},{},{},{}",
+            "{},{},{},{},{},{},{:.6},{:.4},{},{:.6},{},{},{}",
             r.scene,
+            r.variant,
             r.n,
             r.vpls,
             r.dropped,
@@ -293,12 +342,16 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
     std::fs::write(args.out.join("results.md"), &md)?;
     let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
     for r in rows.iter().filter(|r| r.frame_ms.is_some()) {
-        match series.iter_mut().find(|(s, _)| *s == r.scene) {
-            Some((_, pts)) => pts.push((r.rel_mse, r.frame_ms.unwrap_or(0.0))),
-            None => series.push((
-                r.scene.clone(),
-                vec![(r.rel_mse, r.frame_ms.unwrap_or(0.0))],
-            )),
+        // One series a scene and variant (the variant's n values along it).
+        let name = if variants.len() > 1 {
+            format!("{}: {}", r.scene, r.variant)
+        } else {
+            r.scene.clone()
+        };
+        let point = (r.rel_mse, r.frame_ms.unwrap_or(0.0));
+        match series.iter_mut().find(|(s, _)| *s == name) {
+            Some((_, pts)) => pts.push(point),
+            None => series.push((name, vec![point])),
         }
     }
     if series.is_empty() {

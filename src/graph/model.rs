@@ -10,7 +10,7 @@ pub use super::kinds::shadow_ray_cast::ShadowRayCast;
 pub use super::kinds::shadow_ray_jobs::ShadowRayJobs;
 pub use super::kinds::transparent_shading::TransparentShading;
 pub use super::kinds::visibility_shading::VisibilityShading;
-pub use super::kinds::vpl_spawn::VplSpawn;
+pub use super::kinds::vpl_spawn::{VplFalloff, VplSpawn};
 pub use super::name::Name;
 use serde::{Deserialize, Serialize};
 

@@ -321,6 +321,20 @@ pub struct VplReport {
     pub spawned: u32,
     /// VPLs dropped for want of room (lowest flux first).
     pub dropped: u32,
+    /// Candidates merged into a neighbour (`merge`): the merged VPL carries their flux.
+    pub merged: u32,
+    /// Candidates dropped as negligible: flux (luminance) at most `min_flux` of the total.
+    pub negligible: u32,
+    /// Their summed luminance, in the maps' flux units (before the lights' VPL
+    /// `intensity`).
+    pub negligible_flux: f32,
+    /// Every candidate's summed luminance (after merging), in the same units.
+    pub total_flux: f32,
+    /// The pass's `min_flux`.
+    pub min_flux: f32,
+    /// Whether the kept VPLs were scaled to carry the negligible ones' flux
+    /// (`redistribute`).
+    pub redistributed: bool,
     /// Room for VPLs (the graph's max_vpls).
     pub room: u32,
     /// The scene's lights, before the VPLs.
@@ -329,6 +343,15 @@ pub struct VplReport {
 
 /// The report's lines for `render` (a full room or a dropped light is a warning).
 impl VplReport {
+    /// The share of the flux the negligible VPLs carried (0 when there was none).
+    pub fn negligible_fraction(&self) -> f32 {
+        if self.total_flux > 0.0 {
+            self.negligible_flux / self.total_flux
+        } else {
+            0.0
+        }
+    }
+
     /// One summary line, then a warning line for a full room and for each light that
     /// spawned nothing.
     pub fn lines(&self) -> Vec<String> {
@@ -337,6 +360,26 @@ impl VplReport {
         "{}: {} indirect lights, {} map views, {} VPLs spawned of {} candidates with flux ({} blocks); room {}",
         v.pass, v.lights, v.views, v.spawned, v.with_flux, v.candidates, v.room
     )];
+        if v.merged > 0 {
+            lines.push(format!(
+                "{}: {} VPLs merged into their neighbours (flux kept)",
+                v.pass, v.merged
+            ));
+        }
+        if v.min_flux > 0.0 {
+            lines.push(format!(
+                "{}: {} VPLs under min_flux {} dropped: {:.3}% of the flux{}",
+                v.pass,
+                v.negligible,
+                v.min_flux,
+                100.0 * v.negligible_fraction(),
+                if v.redistributed {
+                    ", redistributed over the rest"
+                } else {
+                    ", lost"
+                }
+            ));
+        }
         if v.dropped > 0 {
             lines.push(format!(
                 "warning: {}: {} VPLs dropped (lowest flux first): max_vpls {} is full",

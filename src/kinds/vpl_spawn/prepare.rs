@@ -11,7 +11,7 @@ use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::gpu::readback::read_buffer;
 use crate::graph::kinds::reflective_shadow_maps::{RSM_FLUX, RSM_VIEWS};
 use crate::graph::Name;
-use crate::graph::{slot, PassKind, ScheduledPass, VplSpawn};
+use crate::graph::{slot, PassKind, ScheduledPass, VplFalloff, VplSpawn};
 use crate::indirect::rsm_views::RsmLayout;
 use crate::render::pipelines::PipelineKey;
 use crate::render::report::{PassReport, VplReport};
@@ -22,21 +22,23 @@ use std::sync::{Arc, Mutex};
 use wgpu::util::DeviceExt;
 
 /// Bytes of one candidate (`Candidate` in vpl_spawn.wgsl).
-const CANDIDATE_BYTES: u64 = 48;
+const CANDIDATE_BYTES: u64 = 64;
 /// Words of the control buffer (`control` in vpl_spawn.wgsl).
-const CONTROL_WORDS: u64 = 8;
+const CONTROL_WORDS: u64 = 12;
+/// The dispatches, in order: copy, gather, merge, select, append.
+const DISPATCHES: usize = 5;
 
 pub(super) struct VplSpawnPass {
     name: Name,
-    pipelines: [Arc<wgpu::ComputePipeline>; 4],
+    pipelines: [Arc<wgpu::ComputePipeline>; DISPATCHES],
     bind: wgpu::BindGroup,
     /// The maps' layout rules, to lay their views out again for new lights.
     rules: RsmLayoutRules,
     /// VPL candidates the candidate buffer holds room for (the prepared layout's).
     candidate_room: u32,
-    room: u32,
+    spawn: VplSpawn,
     params: wgpu::Buffer,
-    groups: Mutex<[[u32; 3]; 4]>,
+    groups: Mutex<[[u32; 3]; DISPATCHES]>,
     control: wgpu::Buffer,
     frame_uniform: wgpu::Buffer,
     report: Mutex<VplReport>,
@@ -105,7 +107,7 @@ pub(super) fn prepare(
     });
     let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("vpl spawn params"),
-        contents: bytemuck::cast_slice(&spawn_params(scene_lights, &layout, p.max_vpls)),
+        contents: bytemuck::cast_slice(&spawn_params(scene_lights, &layout, p)),
         usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
     });
     let mut offered = cx.declared(sp)?;
@@ -123,52 +125,75 @@ pub(super) fn prepare(
     };
     let (copy, bind) = build("copy")?;
     let (gather, _) = build("gather")?;
+    let (merge, _) = build("merge")?;
     let (select, _) = build("select_room")?;
     let (append, _) = build("append")?;
     Ok(VplSpawnPass {
         name: sp.name.clone(),
-        pipelines: [copy, gather, select, append],
+        pipelines: [copy, gather, merge, select, append],
         bind,
         rules,
         candidate_room: layout.candidates,
-        room: p.max_vpls,
+        spawn: *p,
         params,
-        groups: Mutex::new(dispatch_groups(scene_lights, &layout)),
+        groups: Mutex::new(dispatch_groups(scene_lights, &layout, p.merge)),
         control,
         frame_uniform: cx.frame_uniform.clone(),
-        report: Mutex::new(layout_report(&sp.name, scene_lights, &layout, p.max_vpls)),
+        report: Mutex::new(layout_report(&sp.name, scene_lights, &layout, p)),
     })
 }
 
 /// `SpawnParams` of vpl_spawn.wgsl.
-fn spawn_params(scene_lights: u32, layout: &RsmLayout, room: u32) -> [u32; 4] {
+fn spawn_params(scene_lights: u32, layout: &RsmLayout, p: &VplSpawn) -> [u32; 8] {
+    let falloff = match p.falloff {
+        VplFalloff::Clamp => 0,
+        VplFalloff::Disc => 2,
+        VplFalloff::AreaClamp => 4,
+    };
+    let flags = u32::from(p.redistribute) | falloff;
     [
         scene_lights,
         layout.views.len() as u32,
         layout.candidates,
-        room,
+        p.max_vpls,
+        p.merge,
+        p.merge_cos.to_bits(),
+        p.min_flux.to_bits(),
+        flags,
     ]
 }
 
-/// The four dispatches' sizes: copy the scene's lights, gather each view's blocks,
-/// select, append every candidate.
-fn dispatch_groups(scene_lights: u32, layout: &RsmLayout) -> [[u32; 3]; 4] {
+/// The dispatches' sizes: copy the scene's lights, gather each view's blocks, merge
+/// each view's groups (none when `merge` is 1), select, append every candidate.
+fn dispatch_groups(scene_lights: u32, layout: &RsmLayout, merge: u32) -> [[u32; 3]; DISPATCHES] {
     let most_blocks = layout
         .views
         .iter()
         .map(|v| v.controls.n * v.controls.n)
         .max()
         .unwrap_or(0);
+    let most_groups = layout
+        .views
+        .iter()
+        .map(|v| (v.controls.n / merge.min(v.controls.n)).pow(2))
+        .max()
+        .unwrap_or(0);
+    let merge_groups = if merge > 1 {
+        most_groups.div_ceil(64)
+    } else {
+        0
+    };
     [
         [scene_lights.div_ceil(64), 1, 1],
         [most_blocks.div_ceil(64), layout.views.len() as u32, 1],
+        [merge_groups, layout.views.len() as u32, 1],
         [1, 1, 1],
         [layout.candidates.div_ceil(64), 1, 1],
     ]
 }
 
 /// What the layout says before the GPU counts anything.
-fn layout_report(pass: &str, scene_lights: u32, layout: &RsmLayout, room: u32) -> VplReport {
+fn layout_report(pass: &str, scene_lights: u32, layout: &RsmLayout, p: &VplSpawn) -> VplReport {
     VplReport {
         pass: pass.to_string(),
         lights: layout.lights,
@@ -178,7 +203,13 @@ fn layout_report(pass: &str, scene_lights: u32, layout: &RsmLayout, room: u32) -
         with_flux: 0,
         spawned: 0,
         dropped: 0,
-        room,
+        merged: 0,
+        negligible: 0,
+        negligible_flux: 0.0,
+        total_flux: 0.0,
+        min_flux: p.min_flux,
+        redistributed: p.redistribute,
+        room: p.max_vpls,
         scene_lights,
     }
 }
@@ -205,12 +236,12 @@ impl PreparedPass for VplSpawnPass {
         r.ctx.queue.write_buffer(
             &self.params,
             0,
-            bytemuck::cast_slice(&spawn_params(scene_lights, &layout, self.room)),
+            bytemuck::cast_slice(&spawn_params(scene_lights, &layout, &self.spawn)),
         );
         *self.groups.lock().unwrap_or_else(|e| e.into_inner()) =
-            dispatch_groups(scene_lights, &layout);
+            dispatch_groups(scene_lights, &layout, self.spawn.merge);
         *self.report.lock().unwrap_or_else(|e| e.into_inner()) =
-            layout_report(&self.name, scene_lights, &layout, self.room);
+            layout_report(&self.name, scene_lights, &layout, &self.spawn);
     }
 
     fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
@@ -243,6 +274,10 @@ impl PreparedPass for VplSpawnPass {
         report.spawned = w[0].saturating_sub(report.scene_lights);
         report.dropped = w[1];
         report.with_flux = w[5];
+        report.negligible = w[7];
+        report.negligible_flux = f32::from_bits(w[8]);
+        report.total_flux = f32::from_bits(w[9]);
+        report.merged = w[11];
         Ok(Some(PassReport::Vpl(report)))
     }
 }
