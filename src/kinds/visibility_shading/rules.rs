@@ -280,11 +280,6 @@ mod tests {
             ),
             "{e}"
         );
-        let e = errors(&pass(r#""atlas", "shadow_views=views", "bn", "bt""#), "hdr");
-        assert!(
-            e.contains("resource 'bn': a pass shadows its lights from the atlas and the ray-cast mask, not the BVH"),
-            "{e}"
-        );
     }
 
     /// The hybrid: the atlas for lights with a map, the mask of jobs that read the same
@@ -295,8 +290,8 @@ mod tests {
             format!(
                 r#"Pass(name: "a", kind: ShadowAtlas(policy: {policy}), reads: ["geometry"], writes: ["atlas", "views"]),
                 {VIS} {CULL}
-                Pass(name: "j", kind: ShadowRayJobs(), reads: ["vis", "vertices", "triangles", "lg", "lp", "lists"{job_views}], writes: ["jobs", "mask"]),
-                Pass(name: "r", kind: ShadowRayCast(), reads: ["jobs", "vis", "vertices", "triangles", "lg", "bn", "bt"], writes: ["mask"]),
+                Pass(name: "j", kind: ShadowRayJobs(), reads: ["visibility=vis", "vertices", "triangles", "lg", "lp", "lists"{job_views}], writes: ["jobs", "mask"]),
+                Pass(name: "r", kind: ShadowRayCast(), reads: ["jobs", "visibility=vis", "vertices", "triangles", "lg", "bn", "bt"], writes: ["mask"]),
                 Pass(name: "s", kind: {shading}, reads: [{READS}, "lists", "shadow_mask=mask", "atlas", "shadow_views=views"], writes: ["hdr"])"#
             )
         };
