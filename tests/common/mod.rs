@@ -4,6 +4,7 @@
 
 pub mod cornell;
 pub mod msaa;
+pub mod shadow_jobs;
 pub mod textured;
 
 use glam::{Vec2, Vec3, Vec4};
