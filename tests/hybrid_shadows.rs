@@ -198,11 +198,15 @@ fn check_hybrid(
         .map(|((a, b), d)| [0, 1, 2, 3].map(|c| a[c] + b[c] - d[c]))
         .collect();
     // The hybrid sums each pixel's lights in one loop, the parts in two: the same terms
-    // regrouped, each regrouping of under 32 fp32 terms moving the sum by a few ulps
-    // (2^-24 relative each) of the peak.
+    // regrouped (and the dark frame subtracted), which moves a sum of under 16 fp32 terms
+    // by at most 16 ulps (2^-24 relative each, 1e-6) of the peak; 1.3e-7 seen.
     let (worst, at) = max_rel_diff(&result.image, &sum);
+    eprintln!(
+        "{} dropped; image against rays + atlas: {worst:e} of the peak at worst",
+        atlas.dropped.len()
+    );
     assert!(
-        worst < 1e-5,
+        worst < 1e-6,
         "hybrid against rays + atlas: {worst} at pixel {at}"
     );
     // The mapped lights' maps shadow something (the rays do: `hidden` above).
