@@ -18,14 +18,14 @@ mod common;
 
 use common::shadow_jobs::{compare_with_cpu_twin, pixel_jobs, Surfaces};
 use common::{lambert, prepare_text, renderer, shadow_room, Rng};
-use glam::{DMat4, DVec3, DVec4, Vec3};
-use lightgraph::render::{FrameResult, PreparedFrame, Renderer, SceneGpu};
+use glam::{DVec3, Vec3};
+use lightgraph::render::{FrameResult, PreparedFrame, Renderer};
 use lightgraph::scene::geometry::MeshBuilder;
 use lightgraph::scene::{
     light_flags, AlphaMode, Camera, Light, LightShape, Scene, SurfaceMaterial,
 };
 use lightgraph::shadow::reference::near_edge;
-use lightgraph::shadow::{scene_triangles_f64, shadow_ray, ShadowBvh, Triangle64};
+use lightgraph::shadow::{scene_triangles_f64, shadow_ray};
 use std::collections::BTreeMap;
 use std::path::Path;
 
