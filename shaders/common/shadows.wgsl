@@ -103,7 +103,6 @@ fn shadow_atlas_entry(light: u32) -> u32 {
 #endif
 
 #if SHADOW_ATLAS
-
 // The cube face a direction from the light falls on (src/shadow/atlas.rs: cube_face).
 fn shadow_cube_face(d: vec3<f32>) -> u32 {
     let a = abs(d);

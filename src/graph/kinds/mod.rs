@@ -380,12 +380,10 @@ pub(crate) fn check_shadow_atlas(ctx: &KindCtx, errors: &mut Vec<GraphError>, wi
                 .filter(|s| !(with_mask && *s == shadow_ray_jobs::SHADOW_MASK))
                 .find_map(|s| ctx.slot(s));
             if let Some(other) = other {
-                let problem = if with_mask {
-                    "a pass shadows its lights from the atlas and the ray-cast mask, not the BVH"
-                } else {
-                    "a pass shadows its lights one way: from the atlas, the ray-cast mask or the BVH (VisibilityShading reads the atlas and the mask together)"
-                };
-                errors.push(ctx.mismatch(other, problem));
+                errors.push(ctx.mismatch(
+                    other,
+                    "a pass shadows its lights one way: from the atlas, the ray-cast mask or the BVH (VisibilityShading reads the atlas and the mask together)",
+                ));
             }
         }
         (None, None) => {}
