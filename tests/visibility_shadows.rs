@@ -16,15 +16,16 @@
 
 mod common;
 
+use common::shadow_jobs::{compare_with_cpu_twin, pixel_jobs, Surfaces};
 use common::{lambert, prepare_text, renderer, shadow_room, Rng};
-use glam::{DMat4, DVec3, DVec4, Vec3};
-use lightgraph::render::{FrameResult, PreparedFrame, Renderer, SceneGpu};
+use glam::{DVec3, Vec3};
+use lightgraph::render::{FrameResult, PreparedFrame, Renderer};
 use lightgraph::scene::geometry::MeshBuilder;
 use lightgraph::scene::{
     light_flags, AlphaMode, Camera, Light, LightShape, Scene, SurfaceMaterial,
 };
 use lightgraph::shadow::reference::near_edge;
-use lightgraph::shadow::{scene_triangles_f64, shadow_ray, ShadowBvh, Triangle64};
+use lightgraph::shadow::{scene_triangles_f64, shadow_ray};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -146,78 +147,6 @@ fn shadow_scene(lights: usize, seed: u64) -> Scene {
     }
 }
 
-/// Each pixel's jobs as light -> hidden, from the job buffer and the mask.
-fn pixel_jobs(r: &Renderer, prepared: &PreparedFrame) -> Vec<BTreeMap<u32, bool>> {
-    let words = |name: &str| -> Vec<u32> {
-        bytemuck::cast_slice(&prepared.read_buffer(r, name).unwrap()).to_vec()
-    };
-    let (jobs, mask) = (words("shadow_jobs"), words("shadow_mask"));
-    assert_eq!(mask.len(), (W * H * 4) as usize);
-    let count = jobs[0] as usize;
-    assert!(count <= (jobs.len() - 8) / 2, "jobs dropped");
-    let mut out = vec![BTreeMap::new(); (W * H) as usize];
-    for j in 0..count {
-        let (pixel, packed) = (jobs[8 + 2 * j], jobs[8 + 2 * j + 1]);
-        let (light, c) = (packed & 0xff_ffff, packed >> 24);
-        let hidden = mask[(pixel * 4 + c / 32) as usize] & (1 << (c % 32)) != 0;
-        assert!(
-            out[pixel as usize].insert(light, hidden).is_none(),
-            "two jobs for light {light} at pixel {pixel}"
-        );
-    }
-    out
-}
-
-/// The surface a visibility-buffer pixel shows, rebuilt on the CPU in f64 from its
-/// triangle: the camera ray through the pixel centre met with the triangle's plane, and
-/// the triangle's normal facing the eye.
-struct Surfaces {
-    /// Per merged triangle id: its three world positions.
-    triangles: Vec<[DVec3; 3]>,
-    inverse_view_proj: DMat4,
-    eye: DVec3,
-}
-
-impl Surfaces {
-    fn new(r: &Renderer, scene: &Scene) -> Self {
-        let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, scene).unwrap();
-        let mut triangles = Vec::new();
-        // Triangle ids in draw order (src/render/visibility_geometry.rs).
-        for mesh in gpu.opaque_draws() {
-            let gm = &gpu.meshes[mesh];
-            assert_eq!(gm.first_triangle as usize, triangles.len());
-            let m = &scene.meshes[gm.scene_mesh];
-            triangles.extend(
-                m.indices
-                    .chunks_exact(3)
-                    .map(|t| [0, 1, 2].map(|k| m.positions[t[k] as usize].as_dvec3())),
-            );
-        }
-        let vp = (scene.camera.projection(W as f32 / H as f32) * scene.camera.view()).as_dmat4();
-        Self {
-            triangles,
-            inverse_view_proj: vp.inverse(),
-            eye: scene.camera.eye.as_dvec3(),
-        }
-    }
-
-    fn at(&self, pixel: u32, id: u32) -> (DVec3, DVec3) {
-        let [a, b, c] = self.triangles[id as usize];
-        let (x, y) = (pixel % W, pixel / W);
-        let ndc = DVec4::new(
-            (x as f64 + 0.5) / W as f64 * 2.0 - 1.0,
-            1.0 - (y as f64 + 0.5) / H as f64 * 2.0,
-            0.5,
-            1.0,
-        );
-        let q = self.inverse_view_proj * ndc;
-        let dir = q.truncate() / q.w - self.eye;
-        let n = (b - a).cross(c - a).normalize();
-        let p = self.eye + dir * (n.dot(a - self.eye) / n.dot(dir));
-        (p, if n.dot(self.eye - p) < 0.0 { -n } else { n })
-    }
-}
-
 /// Whether light `l` sits on the boundary of what reaches and faces (p, ng), where f32
 /// may decide either way.
 fn borderline(l: &Light, p: DVec3, ng: DVec3) -> bool {
@@ -320,37 +249,6 @@ fn compare_with_forward(
     c
 }
 
-/// Every mask bit of the visibility-buffer frame against the CPU twin's ray from the
-/// surface rebuilt on the CPU: (agreeing, grazing an edge, failures).
-fn compare_with_cpu_twin(
-    scene: &Scene,
-    surfaces: &Surfaces,
-    ids: &[u32],
-    vis: &[BTreeMap<u32, bool>],
-) -> (usize, usize, Vec<String>) {
-    let bvh = ShadowBvh::build(scene).unwrap();
-    let tris: Vec<Triangle64> = scene_triangles_f64(scene);
-    let (mut agree, mut grazing, mut failures) = (0, 0, Vec::new());
-    for (pixel, jobs) in vis.iter().enumerate() {
-        if jobs.is_empty() {
-            continue;
-        }
-        let (p, ng) = surfaces.at(pixel as u32, ids[pixel]);
-        for (&light, &hidden) in jobs {
-            let lp = scene.lights[light as usize].position;
-            let (o, dir, t_max) = shadow_ray(p.as_vec3(), ng.as_vec3(), lp, OFFSET);
-            if bvh.occluded(o, dir, t_max) == hidden {
-                agree += 1;
-            } else if near_edge(&tris, o.as_dvec3(), dir.as_dvec3(), t_max as f64, 1e-4) {
-                grazing += 1;
-            } else {
-                failures.push(format!("pixel {pixel} light {light}: GPU hidden {hidden}"));
-            }
-        }
-    }
-    (agree, grazing, failures)
-}
-
 /// Runs the visibility-buffer shadow graph `vis_text` and Forward+ on `scene` and
 /// compares their jobs and masks, and the visibility frame's masks with the CPU twin.
 fn check_against_forward_and_cpu(
@@ -360,13 +258,13 @@ fn check_against_forward_and_cpu(
     max_raster_edge: usize,
 ) -> Comparison {
     let (prepared, _) = run(r, vis_text, scene);
-    let vis = pixel_jobs(r, &prepared);
+    let vis = pixel_jobs(r, &prepared, W * H);
     let ids = prepared.read_texture_bits(r, "visibility").unwrap();
     let (fwd_prepared, _) = run(r, &forward_inspection_graph(), scene);
-    let fwd = pixel_jobs(r, &fwd_prepared);
+    let fwd = pixel_jobs(r, &fwd_prepared, W * H);
     let positions = fwd_prepared.read_texture(r, "g_position").unwrap();
     let normals = fwd_prepared.read_texture(r, "g_geometric").unwrap();
-    let surfaces = Surfaces::new(r, scene);
+    let surfaces = Surfaces::new(r, scene, W, H);
     let c = compare_with_forward(scene, &surfaces, &ids, &vis, &positions, &normals, &fwd);
     eprintln!(
         "{}: {} pixels, {} on a raster edge; rays: {} agree, {} graze an edge; {} borderline jobs",
@@ -401,7 +299,7 @@ fn check_against_forward_and_cpu(
         "only {hidden} hidden rays: nothing to compare"
     );
 
-    let (agree, grazing, failures) = compare_with_cpu_twin(scene, &surfaces, &ids, &vis);
+    let (agree, grazing, failures) = compare_with_cpu_twin(scene, &surfaces, &ids, &vis, OFFSET);
     eprintln!("CPU twin: {agree} agree, {grazing} graze an edge");
     assert!(
         failures.is_empty(),

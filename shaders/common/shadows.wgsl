@@ -11,7 +11,9 @@
 // the position's magnitude), and in the light loop SHADOW_MASK (read the mask),
 // SHADOW_TRACE (cast in the loop: the naive variant; needs the BVH and `shadow_ng`) or
 // SHADOW_ATLAS (sample a ShadowAtlas pass's depth atlas, with SHADOW_PCF5 for the 5×5
-// filter, else one 2×2 hardware-comparison tap).
+// filter, else one 2×2 hardware-comparison tap), or SHADOW_HYBRID with both SHADOW_MASK
+// and SHADOW_ATLAS (the atlas for lights with a map this frame, the mask for the rest).
+// SHADOW_ATLAS_LIGHTS alone (job creation) reads only which lights have a map.
 //
 // The light loop asks `shadow_visibility` for the fraction of light that reaches p:
 // 0 or 1 from the mask and the tracer, filtered from the atlas.
@@ -50,9 +52,12 @@ fn shadow_faces(p: vec3<f32>, ng: vec3<f32>, light_pos: vec3<f32>) -> bool {
 }
 
 #if SHADOW_MASK
+#if SHADOW_HYBRID
+#else
 fn shadow_visibility(pixel_index: u32, caster: u32, light: u32, light_pos: vec3<f32>, p: ShadingPoint) -> f32 {
     return select(0.0, 1.0, shadow_visible(pixel_index, caster, light_pos, p.position));
 }
+#endif
 
 fn shadow_visible(pixel_index: u32, caster: u32, light_pos: vec3<f32>, p: vec3<f32>) -> bool {
     if (caster >= SHADOW_MAX_CASTERS) {
@@ -80,7 +85,7 @@ fn shadow_visible(pixel_index: u32, caster: u32, light_pos: vec3<f32>, p: vec3<f
 }
 #endif
 
-#if SHADOW_ATLAS
+#if SHADOW_ATLAS_LIGHTS
 // The view table (src/kinds/shadow_atlas/rules.rs): a header (views, atlas side, lights,
 // room for views), per view its view-projection, its tile in atlas UV (min, max) and
 // (texel size at unit distance, normal offset in texels); then per light its first
@@ -88,6 +93,16 @@ fn shadow_visible(pixel_index: u32, caster: u32, light_pos: vec3<f32>, p: vec3<f
 const SHADOW_VIEW_VEC4S: u32 = 6u;
 const SHADOW_CUBE_BIT: u32 = 0x80000000u;
 
+// The light's entry in the view table: 0 when it has no map this frame (left to rays
+// by the policy, dropped, or casting no shadow).
+fn shadow_atlas_entry(light: u32) -> u32 {
+    let header = bitcast<vec4<u32>>(shadow_views[0]);
+    let table = 1u + SHADOW_VIEW_VEC4S * header.w;
+    return bitcast<u32>(shadow_views[table + light / 4u][light % 4u]);
+}
+#endif
+
+#if SHADOW_ATLAS
 // The cube face a direction from the light falls on (src/shadow/atlas.rs: cube_face).
 fn shadow_cube_face(d: vec3<f32>) -> u32 {
     let a = abs(d);
@@ -116,8 +131,7 @@ fn shadow_atlas_tap(light: u32, light_pos: vec3<f32>, position: vec3<f32>, norma
     var tap: AtlasTap;
     tap.lit = true;
     let header = bitcast<vec4<u32>>(shadow_views[0]);
-    let table = 1u + SHADOW_VIEW_VEC4S * header.w;
-    let entry = bitcast<u32>(shadow_views[table + light / 4u][light % 4u]);
+    let entry = shadow_atlas_entry(light);
     if (entry == 0u) {
         return tap; // no room this frame: unshadowed (reported by the atlas pass)
     }
@@ -176,7 +190,7 @@ fn shadow_atlas_2x2(t: AtlasTap) -> f32 {
     return textureSampleCompareLevel(shadow_atlas, shadow_sampler, clamp(t.uv, t.lo, t.hi), t.depth);
 }
 
-fn shadow_visibility(pixel_index: u32, caster: u32, light: u32, light_pos: vec3<f32>, p: ShadingPoint) -> f32 {
+fn shadow_atlas_visibility(light: u32, light_pos: vec3<f32>, p: ShadingPoint) -> f32 {
     let tap = shadow_atlas_tap(light, light_pos, p.position, p.normal);
 #if SHADOW_PCF5
     return shadow_atlas_pcf5(tap);
@@ -184,4 +198,19 @@ fn shadow_visibility(pixel_index: u32, caster: u32, light: u32, light_pos: vec3<
     return shadow_atlas_2x2(tap);
 #endif
 }
+
+#if SHADOW_HYBRID
+// A light with a map this frame samples it; the others were ray-cast by job creation,
+// which skipped the mapped ones (shadow/shadow_ray_jobs.wgsl) and numbered casters alike.
+fn shadow_visibility(pixel_index: u32, caster: u32, light: u32, light_pos: vec3<f32>, p: ShadingPoint) -> f32 {
+    if (shadow_atlas_entry(light) != 0u) {
+        return shadow_atlas_visibility(light, light_pos, p);
+    }
+    return select(0.0, 1.0, shadow_visible(pixel_index, caster, light_pos, p.position));
+}
+#else
+fn shadow_visibility(pixel_index: u32, caster: u32, light: u32, light_pos: vec3<f32>, p: ShadingPoint) -> f32 {
+    return shadow_atlas_visibility(light, light_pos, p);
+}
+#endif
 #endif

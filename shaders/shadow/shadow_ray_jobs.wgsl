@@ -15,7 +15,12 @@
 // Surfaces come from the G-buffer (g_position, g_geometric) or, with VISIBILITY_IDS, from
 // a visibility buffer's triangle ids, rebuilt by visibility/surface.wgsl as visibility
 // shading rebuilds them.
-// Defines: TILE-free; JOB_CAPACITY, LIGHT_LISTS, SHADOW_NORMAL_OFFSET, VISIBILITY_IDS.
+// With SHADOW_ATLAS_LIGHTS (a ShadowAtlas pass's view table in the pass's reads), lights
+// with a map this frame get no job and no bit: the shading samples the atlas for them.
+// They keep their caster numbers, so every other light's bit is where it is without
+// the atlas.
+// Defines: TILE-free; JOB_CAPACITY, LIGHT_LISTS, SHADOW_NORMAL_OFFSET, VISIBILITY_IDS,
+// SHADOW_ATLAS_LIGHTS.
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"
@@ -25,6 +30,9 @@
 #include "common/light_inputs.wgsl"
 @group(0) @binding(7) var<storage, read_write> shadow_jobs: array<atomic<u32>>;
 @group(0) @binding(8) var<storage, read_write> shadow_mask: array<u32>;
+#if SHADOW_ATLAS_LIGHTS
+@group(0) @binding(9) var<storage, read> shadow_views: array<vec4<f32>>;
+#endif
 
 #include "common/shadows.wgsl"
 #include "shadow/surface_source.wgsl"
@@ -82,7 +90,12 @@ fn walk(px: Pixel, emit: bool) {
         if (!any(inc.radiance > vec3<f32>(0.0))) {
             continue;
         }
-        if (caster < SHADOW_MAX_CASTERS) {
+#if SHADOW_ATLAS_LIGHTS
+        let rays = shadow_atlas_entry(i) == 0u;
+#else
+        let rays = true;
+#endif
+        if (caster < SHADOW_MAX_CASTERS && rays) {
             if (shadow_faces(px.position, px.ng, g.position)) {
                 let bucket = min(k, BUCKETS - 1u);
                 if (emit) {

@@ -436,12 +436,28 @@ fn atlas_report(a: &lightgraph::render::AtlasReport) {
             .take(16)
             .map(|d| format!("light {} (wanted {}², {:?})", d.light, d.wanted, d.reason))
             .collect();
+        let more = if a.dropped.len() > 16 { ", ..." } else { "" };
+        if a.rays_for_the_rest {
+            println!(
+                "  {} shadow-casting lights in view got no room in '{}' and are ray-cast instead: {}{more}",
+                a.dropped.len(),
+                a.pass,
+                list.join(", "),
+            );
+        } else {
+            println!(
+                "  WARNING: {} shadow-casting lights in view got no room in '{}' and are lit unshadowed: {}{more}",
+                a.dropped.len(),
+                a.pass,
+                list.join(", "),
+            );
+        }
+    }
+    if !a.left_by_policy.is_empty() {
         println!(
-            "  WARNING: {} shadow-casting lights in view got no room in '{}' and are lit unshadowed: {}{}",
-            a.dropped.len(),
+            "  {}: the policy leaves {} shadow-casting lights in view to ray-cast shadows",
             a.pass,
-            list.join(", "),
-            if a.dropped.len() > 16 { ", ..." } else { "" }
+            a.left_by_policy.len()
         );
     }
 }

@@ -245,6 +245,11 @@ pub struct AtlasReport {
     pub shadowed: Vec<crate::shadow::atlas::AtlasLight>,
     /// Shadow-casting lights that found no tile, and why.
     pub dropped: Vec<crate::shadow::atlas::DroppedLight>,
+    /// Shadow-casting lights in view the pass's policy gave no tile (left to rays).
+    pub left_by_policy: Vec<u32>,
+    /// Whether a ShadowRayJobs pass reads the view table: the dropped lights and those
+    /// left by the policy are ray-cast; without one, dropped lights are lit unshadowed.
+    pub rays_for_the_rest: bool,
     /// Shadow-casting lights whose range misses the camera's frustum.
     pub off_screen: u32,
     /// Depth views rendered into the atlas (six per point light or wide spot light, else one).

@@ -8,15 +8,19 @@
 //!   `CUBE_SPOT_ANGLE`) asks for six such faces;
 //! - requests are ranked: larger first, then spot before point, then nearer the camera,
 //!   then by light index (so the same view always allocates the same way);
+//! - the pass's `policy` (`shadow::policy`) first leaves out the lights it gives to
+//!   ray-cast shadows (listed, not dropped);
 //! - past `max_lights`, the lowest ranked are dropped; then, while the tiles' total area
 //!   exceeds the atlas, every tile above `min_tile` is halved; when all are at
-//!   `min_tile`, the lowest ranked light is dropped instead;
+//!   `min_tile`, the lowest ranked light is dropped instead (with `fit: DropLights`, the
+//!   lowest ranked are dropped at once, tiles kept at their asked size);
 //! - tiles are placed in Morton order in decreasing size, which packs power-of-two
 //!   squares without gaps, so a set fits exactly when its area does.
 //!
 //! Cube faces are rendered with a field of view widened by [`GUARD_TEXELS`] on every
 //! side, so a 5×5 filter around any point of a face's inner 90° stays on that face.
 
+use super::policy::{self, AtlasFit, AtlasPolicy, Candidate};
 use crate::scene::{Camera, Light, LightShape};
 use glam::{Mat4, Vec3, Vec4};
 
@@ -38,6 +42,10 @@ pub(crate) struct AtlasConfig {
     pub(crate) max_tile: u32,
     pub(crate) importance: f32,
     pub(crate) max_lights: u32,
+    /// Which lights in view ask for a tile.
+    pub(crate) policy: AtlasPolicy,
+    /// Shrink tiles or drop lights when they do not fit.
+    pub(crate) fit: AtlasFit,
 }
 
 /// One rendered view: a square tile of the atlas and the projection that fills it.
@@ -92,6 +100,9 @@ pub(crate) struct Allocation {
     pub(crate) views: Vec<AtlasView>,
     pub lights: Vec<AtlasLight>,
     pub(crate) dropped: Vec<DroppedLight>,
+    /// Shadow-casting lights in view the policy left to ray-cast shadows (none with
+    /// `policy: All`), by light index.
+    pub(crate) left_by_policy: Vec<u32>,
     /// Shadow-casting lights whose range does not reach the camera's frustum.
     pub(crate) off_screen: u32,
     /// How many times the tiles were halved to fit.
@@ -106,6 +117,7 @@ struct Request {
     spot: bool,
     wanted: u32,
     tile: u32,
+    screen_px: f32,
     distance: f32,
 }
 
@@ -192,7 +204,8 @@ pub(crate) fn allocate(
             out.off_screen += 1;
             continue;
         }
-        let size = (screen_size(l, camera, height) * cfg.importance).ceil();
+        let screen_px = screen_size(l, camera, height);
+        let size = (screen_px * cfg.importance).ceil();
         let wanted = (size.max(1.0) as u32)
             .checked_next_power_of_two()
             .unwrap_or(cfg.max_tile)
@@ -203,9 +216,27 @@ pub(crate) fn allocate(
             spot: matches!(l.shape, LightShape::Spot { .. }),
             wanted,
             tile: wanted,
+            screen_px,
             distance: l.position.distance(camera.eye),
         });
     }
+    let candidates: Vec<Candidate> = requests
+        .iter()
+        .map(|r| Candidate {
+            light: r.light,
+            screen_px: r.screen_px,
+            distance: r.distance,
+        })
+        .collect();
+    let keep = policy::select(cfg.policy, &candidates);
+    let mut kept = keep.iter();
+    requests.retain(|r| {
+        let keep = *kept.next().expect("a verdict per request");
+        if !keep {
+            out.left_by_policy.push(r.light);
+        }
+        keep
+    });
     requests.sort_by(|a, b| {
         b.wanted
             .cmp(&a.wanted)
@@ -226,7 +257,7 @@ pub(crate) fn allocate(
     }
     let capacity = cfg.size as u64 * cfg.size as u64;
     while requests.iter().map(Request::area).sum::<u64>() > capacity {
-        if requests.iter().any(|r| r.tile > cfg.min_tile) {
+        if cfg.fit == AtlasFit::ShrinkTiles && requests.iter().any(|r| r.tile > cfg.min_tile) {
             for r in requests.iter_mut().filter(|r| r.tile > cfg.min_tile) {
                 r.tile /= 2;
             }
@@ -236,7 +267,8 @@ pub(crate) fn allocate(
             drop(r, DropReason::NoRoom, &mut out);
         }
     }
-    // Halving keeps the ranking's order of sizes, so tiles come in decreasing size.
+    // Halving keeps the ranking's order of sizes, and dropping from the end keeps the
+    // rest in it, so tiles come in decreasing size.
     let mut cursor = 0u64; // in min_tile cells, Morton order
     for r in &requests {
         let l = &lights[r.light as usize];
@@ -379,6 +411,8 @@ mod tests {
             max_tile: 1024,
             importance: 1.0,
             max_lights: 512,
+            policy: AtlasPolicy::All,
+            fit: AtlasFit::ShrinkTiles,
         }
     }
 
@@ -515,5 +549,61 @@ mod tests {
             assert!(center.x.abs() < 1e-5 && center.y.abs() < 1e-5);
             assert!(center.z > 0.0 && center.z < 1.0);
         }
+    }
+
+    #[test]
+    fn the_policy_leaves_lights_to_rays_before_the_budget() {
+        let lights: Vec<Light> = (0..10)
+            .map(|i| caster(Vec3::new(0.0, 1.0, 15.0 - 4.0 * i as f32), 2.0))
+            .collect();
+        let nearest = allocate(
+            &lights,
+            &camera(),
+            1920,
+            1080,
+            &AtlasConfig {
+                policy: AtlasPolicy::Nearest(3),
+                ..cfg(16384)
+            },
+        );
+        let mut kept: Vec<u32> = nearest.lights.iter().map(|l| l.light).collect();
+        kept.sort();
+        assert_eq!(kept, [0, 1, 2]);
+        assert_eq!(nearest.left_by_policy.len(), 7);
+        assert!(nearest.dropped.is_empty());
+        // The kept lights get the tiles they get with every light in the atlas.
+        let all = allocate(&lights, &camera(), 1920, 1080, &cfg(16384));
+        assert!(all.left_by_policy.is_empty());
+        for l in &nearest.lights {
+            let same = all.lights.iter().find(|a| a.light == l.light).unwrap();
+            assert_eq!(same.tile, l.tile);
+        }
+        check_packing(&nearest, 16384);
+    }
+
+    #[test]
+    fn drop_lights_keeps_tile_sizes_and_drops_the_lowest_ranked() {
+        let lights: Vec<Light> = (0..50)
+            .map(|i| caster(Vec3::new(i as f32 * 0.5 - 12.5, 1.0, 5.0), 3.0))
+            .collect();
+        let wanted = allocate(&lights, &camera(), 1920, 1080, &cfg(16384));
+        let fit = AtlasConfig {
+            fit: AtlasFit::DropLights,
+            ..cfg(2048)
+        };
+        let a = allocate(&lights, &camera(), 1920, 1080, &fit);
+        assert_eq!(a.halvings, 0);
+        assert!(!a.dropped.is_empty() && !a.lights.is_empty());
+        assert_eq!(a.lights.len() + a.dropped.len(), 50);
+        for l in &a.lights {
+            let w = wanted.lights.iter().find(|w| w.light == l.light).unwrap();
+            assert_eq!(w.tile, l.tile);
+        }
+        // The kept ones are the first of the ranking.
+        let ranked: Vec<u32> = wanted.lights.iter().map(|l| l.light).collect();
+        let kept: Vec<u32> = a.lights.iter().map(|l| l.light).collect();
+        assert_eq!(kept, ranked[..kept.len()]);
+        assert!(a.used_texels <= 2048 * 2048);
+        check_packing(&a, 2048);
     }
 }

@@ -15,6 +15,7 @@
 pub mod atlas;
 pub mod bvh;
 pub mod chunks;
+pub mod policy;
 pub mod reference;
 mod traverse;
 

@@ -5,6 +5,7 @@
 pub mod cornell;
 pub mod glass;
 pub mod msaa;
+pub mod shadow_jobs;
 pub mod textured;
 
 use glam::{Vec2, Vec3, Vec4};

@@ -55,6 +55,26 @@ impl InputsCtx<'_> {
     pub fn slot(&self, name: &str) -> Option<&str> {
         self.roles.slot(name)
     }
+    /// An error in the pass's parameters, at its declaration.
+    pub fn bad(&self, problem: impl Into<String>) -> GraphError {
+        GraphError::BadPass {
+            at: self.graph.source.of_declaration(&self.pass.name),
+            pass: self.pass.name.to_string(),
+            problem: problem.into(),
+        }
+    }
+    /// The pass being checked.
+    pub fn pass(&self) -> &PassDesc {
+        self.pass
+    }
+    /// Every pass of the graph with its matched slots, in declaration order.
+    pub fn passes(&self) -> impl Iterator<Item = (&PassDesc, &PassRoles)> + '_ {
+        self.graph
+            .desc
+            .passes
+            .iter()
+            .zip(self.graph.roles.iter().map(|r| r.as_ref()))
+    }
 }
 
 struct Graph<'a> {

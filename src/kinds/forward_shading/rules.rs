@@ -61,27 +61,29 @@ pub enum Shadows {
     Trace,
     /// Samples a shadow atlas, filtered as its ShadowAtlas pass says.
     Atlas(super::shadow_atlas::ShadowFilter),
+    /// Samples the atlas for lights with a map this frame and reads the ray-cast mask
+    /// for the rest (VisibilityShading only).
+    Hybrid(super::shadow_atlas::ShadowFilter),
 }
 
 /// The shadow source of a shading pass's slots; an atlas's filter is published on its
 /// view table's planned layout.
 pub fn shadows(roles: &crate::graph::PassRoles, plan: &crate::graph::ResourcePlan) -> Shadows {
     use super::shadow_atlas::SHADOW_VIEWS;
-    if roles.slot(SHADOW_MASK).is_some() {
-        Shadows::Mask
-    } else if roles.slot(BVH_NODES).is_some() {
-        Shadows::Trace
-    } else if let Some(views) = roles.slot(SHADOW_VIEWS) {
-        let filter = plan
-            .get(views)
+    let filter = |views: &str| {
+        plan.get(views)
             .and_then(|r| match r.layout {
                 Some(super::BufferLayout::ShadowViews { filter, .. }) => Some(filter),
                 _ => None,
             })
-            .unwrap_or_default();
-        Shadows::Atlas(filter)
-    } else {
-        Shadows::None
+            .unwrap_or_default()
+    };
+    match (roles.slot(SHADOW_MASK), roles.slot(SHADOW_VIEWS)) {
+        (Some(_), Some(views)) => Shadows::Hybrid(filter(views)),
+        (Some(_), None) => Shadows::Mask,
+        _ if roles.slot(BVH_NODES).is_some() => Shadows::Trace,
+        (None, Some(views)) => Shadows::Atlas(filter(views)),
+        (None, None) => Shadows::None,
     }
 }
 
@@ -95,7 +97,7 @@ pub(crate) fn check(p: &ForwardShading, ctx: &KindCtx, errors: &mut Vec<GraphErr
         ));
     }
     super::check_shadow_mask(ctx, errors);
-    super::check_shadow_atlas(ctx, errors);
+    super::check_shadow_atlas(ctx, errors, false);
     if let (Some(c), Some(d)) = (ctx.slot(slot::COLOR), ctx.slot(slot::DEPTH)) {
         let (cs, ds) = (ctx.samples(c), ctx.samples(d));
         if cs != ds {

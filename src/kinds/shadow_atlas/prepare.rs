@@ -23,6 +23,8 @@ use std::sync::{Arc, Mutex};
 pub(super) struct ShadowAtlasPass {
     name: Name,
     config: AtlasConfig,
+    /// A ShadowRayJobs pass reads the view table: lights without a map are ray-cast.
+    rays_for_the_rest: bool,
     /// Room for views in the table (six per light), as the planned layout has it.
     max_views: u64,
     normal_offset: f32,
@@ -129,7 +131,10 @@ pub(super) fn prepare(
             max_tile: p.max_tile,
             importance: p.importance,
             max_lights: p.max_lights,
+            policy: p.policy,
+            fit: p.fit,
         },
+        rays_for_the_rest: rays_read_views(cx, sp.required(SHADOW_VIEWS)),
         max_views: p.max_views(),
         normal_offset: p.normal_offset,
         size: cx.size,
@@ -150,6 +155,21 @@ pub(super) fn prepare(
     };
     pass.allocate();
     Ok(pass)
+}
+
+/// Whether a ShadowRayJobs pass of the graph reads the view table `views` (and so casts
+/// rays for the lights without a map).
+fn rays_read_views(cx: &PrepareCtx, views: &str) -> bool {
+    let checked = &cx.graph.checked;
+    checked
+        .desc
+        .passes
+        .iter()
+        .zip(&checked.roles)
+        .any(|(p, r)| {
+            matches!(p.kind, crate::graph::PassKind::ShadowRayJobs(_))
+                && r.slot(SHADOW_VIEWS) == Some(views)
+        })
 }
 
 /// Depth 1 over the viewport, whatever was there (no bindings, no fragment stage).
@@ -332,6 +352,8 @@ impl PreparedPass for ShadowAtlasPass {
             table_bytes: self.table_bytes,
             shadowed: a.lights.clone(),
             dropped: a.dropped.clone(),
+            left_by_policy: a.left_by_policy.clone(),
+            rays_for_the_rest: self.rays_for_the_rest,
             off_screen: a.off_screen,
             views: a.views.len() as u32,
             halvings: a.halvings,

@@ -4,10 +4,12 @@
 //! atlas and the view table that shading passes sample it through
 //! (`shaders/common/shadows.wgsl`, `SHADOW_ATLAS`).
 
+use super::contracts::InputsCtx;
 use super::{Access, BufferLayout, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
 use crate::graph::model::{ResourceDesc, TextureSize};
 use crate::graph::plan::FrameSize;
+pub use crate::shadow::policy::{AtlasFit, AtlasPolicy};
 use serde::{Deserialize, Serialize};
 
 /// `ShadowAtlas(filter: Pcf5x5, min_tile: 16, max_tile: 1024, importance: 1.0, ...)`.
@@ -38,6 +40,14 @@ pub struct ShadowAtlas {
     /// Offset of the shaded point along its normal, in texels of its view.
     #[serde(default = "default_normal_offset")]
     pub normal_offset: f32,
+    /// Which shadow-casting lights in view ask for a tile (`All` by default); the others
+    /// get ray-cast shadows from a `ShadowRayJobs` pass that reads the view table.
+    #[serde(default)]
+    pub policy: AtlasPolicy,
+    /// When the tiles do not fit: shrink them (`ShrinkTiles`, the default) or drop the
+    /// lowest-ranked lights (`DropLights`).
+    #[serde(default)]
+    pub fit: AtlasFit,
 }
 
 /// How a shading pass reads the atlas.
@@ -83,6 +93,8 @@ impl Default for ShadowAtlas {
             depth_bias: default_depth_bias(),
             slope_bias: default_slope_bias(),
             normal_offset: default_normal_offset(),
+            policy: AtlasPolicy::default(),
+            fit: AtlasFit::default(),
         }
     }
 }
@@ -157,6 +169,9 @@ pub(crate) fn check(p: &ShadowAtlas, ctx: &KindCtx, errors: &mut Vec<GraphError>
             errors.push(ctx.bad(format!("{name} {v} must be in [0, 64]")));
         }
     }
+    if let Some(problem) = p.policy.problem() {
+        errors.push(ctx.bad(problem));
+    }
     if let Some(atlas) = ctx.slot(SHADOW_ATLAS) {
         match atlas_side(ctx.graph.resources.get(atlas).copied()) {
             None => errors.push(ctx.mismatch(
@@ -172,12 +187,35 @@ pub(crate) fn check(p: &ShadowAtlas, ctx: &KindCtx, errors: &mut Vec<GraphError>
     }
 }
 
+/// A policy that leaves lights out of the atlas needs a `ShadowRayJobs` pass reading the
+/// view table: it casts their rays (nothing else would shadow them).
+fn check_ray_fallback(p: &ShadowAtlas, ctx: &InputsCtx, errors: &mut Vec<GraphError>) {
+    if !p.policy.leaves_lights_to_rays() {
+        return;
+    }
+    let Some(views) = ctx.slot(SHADOW_VIEWS) else {
+        return;
+    };
+    if super::shadow_ray_jobs::jobs_reading_views(ctx, views)
+        .next()
+        .is_none()
+    {
+        errors.push(ctx.bad(format!(
+            "policy {:?} leaves the other shadow-casting lights to ray-cast shadows, but no ShadowRayJobs pass reads '{views}' (the view table tells it which lights have a map): add it to that pass's reads, as graphs/visibility_hybrid_shadows.ron does, or use policy: All",
+            p.policy
+        )));
+    }
+}
+
 impl KindRules for ShadowAtlas {
     fn slots(&self) -> &'static [SlotSpec] {
         SLOTS
     }
     fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         check(self, ctx, errors)
+    }
+    fn check_inputs(&self, ctx: &InputsCtx, errors: &mut Vec<GraphError>) {
+        check_ray_fallback(self, ctx, errors)
     }
     fn buffer_layout(&self, slot: &str, frame: FrameSize) -> Option<BufferLayout> {
         (slot == SHADOW_VIEWS).then(|| BufferLayout::ShadowViews {

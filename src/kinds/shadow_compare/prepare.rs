@@ -46,6 +46,7 @@ pub(super) fn prepare(
         defines: defines(&[
             ("LIGHT_LISTS", "1".into()),
             ("SHADOW_ATLAS", "1".into()),
+            ("SHADOW_ATLAS_LIGHTS", "1".into()),
             ("SHADOW_NORMAL_OFFSET", format!("{DEFAULT_NORMAL_OFFSET:?}")),
         ]),
         virtual_code: BTreeMap::new(),

@@ -47,6 +47,14 @@ pub(super) fn prepare(
         ("SHADOW_NORMAL_OFFSET", format!("{DEFAULT_NORMAL_OFFSET:?}")),
     ];
     d.extend(surface_define(&sp.roles));
+    // The hybrid: lights with an atlas map this frame get no job.
+    if sp
+        .roles
+        .slot(crate::graph::kinds::shadow_atlas::SHADOW_VIEWS)
+        .is_some()
+    {
+        d.push(("SHADOW_ATLAS_LIGHTS", "1".into()));
+    }
     let key = |state: &str| PipelineKey {
         shader: "shadow/shadow_ray_jobs.wgsl".into(),
         defines: defines(&d),

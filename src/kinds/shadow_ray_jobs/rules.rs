@@ -7,13 +7,20 @@
 //! reads ([`SurfaceSource`]): a G-buffer's `g_position` and `g_geometric`, or a visibility
 //! buffer's `visibility` ids with the merged `vertices` and `triangles` (rebuilt as
 //! visibility shading rebuilds them, `shaders/shadow/surface_source.wgsl`).
+//!
+//! With a `ShadowAtlas` pass's `shadow_views` in its reads it emits jobs only for lights
+//! without a map this frame (the table's entry 0): the hybrid, where the atlas shadows
+//! the lights its policy picks and rays the rest, dropped lights included. Casters keep
+//! their numbers, so a light's mask bit is where the all-rays frame puts it.
 
+use super::contracts::InputsCtx;
 use super::g_buffer::{G_GEOMETRIC, G_POSITION};
+use super::shadow_atlas::SHADOW_VIEWS;
 use super::visibility_buffer::VISIBILITY;
 use super::visibility_shading::{TRIANGLES, VERTICES};
 use super::{slot, Access, BufferLayout, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
-use crate::graph::model::{ResourceDesc, SceneResource, TextureFormat};
+use crate::graph::model::{PassDesc, PassKind, ResourceDesc, SceneResource, TextureFormat};
 use crate::graph::plan::FrameSize;
 use crate::graph::PassRoles;
 use serde::{Deserialize, Serialize};
@@ -224,7 +231,52 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     .needs(&[Contents::LightLists]),
     SlotSpec::new(SHADOW_JOBS, SlotType::Buffer, Access::Write, Usage::Bound),
     SlotSpec::new(SHADOW_MASK, SlotType::Buffer, Access::Write, Usage::Bound),
+    // The hybrid: lights with an atlas map get no job.
+    super::SHADOW_VIEWS_READ,
 ];
+
+/// The `ShadowRayJobs` passes that read the view table `views` (they cast rays only for
+/// lights without a map in it).
+pub(crate) fn jobs_reading_views<'a>(
+    ctx: &'a InputsCtx,
+    views: &'a str,
+) -> impl Iterator<Item = &'a PassDesc> + 'a {
+    ctx.passes()
+        .filter(move |(p, r)| {
+            matches!(p.kind, PassKind::ShadowRayJobs(_)) && r.slot(SHADOW_VIEWS) == Some(views)
+        })
+        .map(|(p, _)| p)
+}
+
+/// A mask whose jobs skip the atlas's lights holds no answer for them: every pass that
+/// reads it must be a `VisibilityShading` pass sampling the same atlas for those lights.
+fn check_mask_readers(ctx: &InputsCtx, errors: &mut Vec<GraphError>) {
+    let (Some(views), Some(mask)) = (ctx.slot(SHADOW_VIEWS), ctx.slot(SHADOW_MASK)) else {
+        return;
+    };
+    for (p, r) in ctx.passes() {
+        if r.slot(SHADOW_MASK) != Some(mask) || p.writes.iter().any(|w| w == mask) {
+            continue;
+        }
+        let problem = if !matches!(p.kind, PassKind::VisibilityShading(_)) {
+            format!(
+                "'{}' ({}) reads '{mask}', whose jobs pass '{}' casts no rays for lights with a map in '{views}'; only VisibilityShading reads such a mask (sampling the atlas for those lights)",
+                p.name,
+                p.kind.label(),
+                ctx.pass().name
+            )
+        } else if r.slot(SHADOW_VIEWS) != Some(views) {
+            format!(
+                "'{}' reads '{mask}', whose jobs pass '{}' casts no rays for lights with a map in '{views}': read '{views}' and its atlas too, so those lights sample the atlas",
+                p.name,
+                ctx.pass().name
+            )
+        } else {
+            continue;
+        };
+        errors.push(ctx.mismatch(mask, problem));
+    }
+}
 
 pub(crate) fn check(p: &ShadowRayJobs, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     if !(p.jobs_per_pixel.is_finite() && p.jobs_per_pixel > 0.0 && p.jobs_per_pixel <= 128.0) {
@@ -242,6 +294,9 @@ impl KindRules for ShadowRayJobs {
     }
     fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         check(self, ctx, errors)
+    }
+    fn check_inputs(&self, ctx: &InputsCtx, errors: &mut Vec<GraphError>) {
+        check_mask_readers(ctx, errors)
     }
     fn buffer_layout(&self, slot: &str, frame: FrameSize) -> Option<BufferLayout> {
         match slot {

@@ -73,7 +73,7 @@ pub(crate) fn check(p: &TransparentShading, ctx: &KindCtx, errors: &mut Vec<Grap
             "the shadow mask holds the rays of the opaque surface behind the glass: read bvh_nodes and bvh_triangles instead, and the glass traces its own shadow rays",
         ));
     }
-    super::check_shadow_atlas(ctx, errors);
+    super::check_shadow_atlas(ctx, errors, false);
     super::check_float_depth_samples(ctx, errors);
     if let (Some(c), Some(d)) = (ctx.slot(slot::COLOR), ctx.slot(slot::DEPTH)) {
         let (cs, ds) = (ctx.samples(c), ctx.samples(d));

@@ -9,12 +9,14 @@
 //! `shadow_atlas` and `shadow_views` it samples a `ShadowAtlas` pass's maps as they do. Runs
 //! `shaders/visibility/visibility_shading.wgsl` (and `classify_materials.wgsl`).
 
+use super::contracts::InputsCtx;
 use super::deferred_shading::HDR;
+use super::shadow_atlas::SHADOW_VIEWS;
 use super::shadow_ray_jobs::SHADOW_MASK;
 use super::visibility_buffer::VISIBILITY;
 use super::{check_light_source, Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
-use crate::graph::model::{LightSource, SceneResource};
+use crate::graph::model::{LightSource, PassKind, SceneResource};
 use serde::{Deserialize, Serialize};
 
 /// `VisibilityShading(lights: Culled, light_loop: RangeFirst, workgroup: 16, materials: PerMaterial)`.
@@ -144,7 +146,30 @@ pub(crate) fn check(p: &VisibilityShading, ctx: &KindCtx, errors: &mut Vec<Graph
         errors,
     );
     super::check_shadow_mask(ctx, errors);
-    super::check_shadow_atlas(ctx, errors);
+    super::check_shadow_atlas(ctx, errors, true);
+}
+
+/// The hybrid (the atlas and the mask read together): the jobs pass that writes the mask
+/// reads the same view table, so it casts rays only for the lights without a map.
+fn check_hybrid_jobs(ctx: &InputsCtx, errors: &mut Vec<GraphError>) {
+    let (Some(mask), Some(views)) = (ctx.slot(SHADOW_MASK), ctx.slot(SHADOW_VIEWS)) else {
+        return;
+    };
+    for (p, r) in ctx.passes() {
+        let writes_mask = p.writes.iter().any(|w| w == mask);
+        if writes_mask
+            && matches!(p.kind, PassKind::ShadowRayJobs(_))
+            && r.slot(SHADOW_VIEWS) != Some(views)
+        {
+            errors.push(ctx.mismatch(
+                mask,
+                format!(
+                    "the pass samples the atlas for lights with a map in '{views}' and reads the mask for the rest, but jobs pass '{}' does not read '{views}': it would cast rays for every caster; add '{views}' to its reads",
+                    p.name
+                ),
+            ));
+        }
+    }
 }
 
 impl KindRules for VisibilityShading {
@@ -154,11 +179,14 @@ impl KindRules for VisibilityShading {
     fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         check(self, ctx, errors)
     }
+    fn check_inputs(&self, ctx: &InputsCtx, errors: &mut Vec<GraphError>) {
+        check_hybrid_jobs(ctx, errors)
+    }
 }
 
 #[cfg(test)]
 mod tests {
-    use crate::graph::kinds::test_support::{errors, validate, PREPASS};
+    use crate::graph::kinds::test_support::{errors, validate, CULL, PREPASS};
 
     const VIS: &str = r#"Pass(name: "v", kind: VisibilityBuffer, reads: ["geometry"], writes: ["depth", "vis"]),"#;
     const READS: &str = r#""vis", "vertices", "triangles", "material_triangles", "lg", "lp""#;
@@ -252,12 +280,61 @@ mod tests {
             ),
             "{e}"
         );
+    }
+
+    /// The hybrid: the atlas for lights with a map, the mask of jobs that read the same
+    /// view table for the rest.
+    #[test]
+    fn reads_the_atlas_and_the_mask_of_jobs_that_skip_mapped_lights() {
+        let graph = |policy: &str, job_views: &str, shading: &str| {
+            format!(
+                r#"Pass(name: "a", kind: ShadowAtlas(policy: {policy}), reads: ["geometry"], writes: ["atlas", "views"]),
+                {VIS} {CULL}
+                Pass(name: "j", kind: ShadowRayJobs(), reads: ["visibility=vis", "vertices", "triangles", "lg", "lp", "lists"{job_views}], writes: ["jobs", "mask"]),
+                Pass(name: "r", kind: ShadowRayCast(), reads: ["jobs", "visibility=vis", "vertices", "triangles", "lg", "bn", "bt"], writes: ["mask"]),
+                Pass(name: "s", kind: {shading}, reads: [{READS}, "lists", "shadow_mask=mask", "atlas", "shadow_views=views"], writes: ["hdr"])"#
+            )
+        };
+        let shading = "VisibilityShading(lights: Culled)";
+        let job_views = r#", "shadow_views=views""#;
+        for policy in ["All", "Nearest(16)", "ProjectedSize(64.0)", "Within(12.5)"] {
+            validate(&graph(policy, job_views, shading), "hdr").unwrap();
+        }
+        let e = errors(&graph("All", "", shading), "hdr");
+        assert!(
+            e.contains("pass 's', resource 'mask': the pass samples the atlas for lights with a map in 'views' and reads the mask for the rest, but jobs pass 'j' does not read 'views'"),
+            "{e}"
+        );
+        let e = errors(&graph("Nearest(4)", "", shading), "hdr");
+        assert!(
+            e.contains("pass 'a': policy Nearest(4) leaves the other shadow-casting lights to ray-cast shadows, but no ShadowRayJobs pass reads 'views'"),
+            "{e}"
+        );
+        for (policy, problem) in [
+            (
+                "Nearest(0)",
+                "policy Nearest(0): the count must be in 1..=65536",
+            ),
+            (
+                "ProjectedSize(-2.0)",
+                "policy ProjectedSize(-2): min_pixels must be in (0, 65536]",
+            ),
+            (
+                "Within(0.0)",
+                "policy Within(0): the distance must be positive and finite",
+            ),
+        ] {
+            let e = errors(&graph(policy, job_views, shading), "hdr");
+            assert!(e.contains(&format!("pass 'a': {problem}")), "{e}");
+        }
+        // A mask without the mapped lights' rays is read only by VisibilityShading with
+        // the same atlas.
         let e = errors(
-            &pass(r#""atlas", "shadow_views=views", "shadow_mask=mask""#),
+            &graph("All", job_views, shading).replace(r#", "atlas", "shadow_views=views"]"#, "]"),
             "hdr",
         );
         assert!(
-            e.contains("resource 'mask': a pass shadows its lights one way"),
+            e.contains("pass 'j', resource 'mask': 's' reads 'mask', whose jobs pass 'j' casts no rays for lights with a map in 'views': read 'views' and its atlas too"),
             "{e}"
         );
     }

@@ -128,14 +128,19 @@ pub(super) fn shadow_defines(shadows: Shadows) -> Vec<(&'static str, String)> {
             ("SHADOW_TRACE", "1".into()),
             ("SHADOW_NORMAL_OFFSET", offset),
         ],
-        Shadows::Atlas(filter) => {
+        Shadows::Atlas(filter) | Shadows::Hybrid(filter) => {
             let mut d = vec![
                 ("SHADOWS", "1".into()),
                 ("SHADOW_ATLAS", "1".into()),
+                ("SHADOW_ATLAS_LIGHTS", "1".into()),
                 ("SHADOW_NORMAL_OFFSET", offset),
             ];
             if filter == crate::graph::kinds::shadow_atlas::ShadowFilter::Pcf5x5 {
                 d.push(("SHADOW_PCF5", "1".into()));
+            }
+            if matches!(shadows, Shadows::Hybrid(_)) {
+                d.push(("SHADOW_MASK", "1".into()));
+                d.push(("SHADOW_HYBRID", "1".into()));
             }
             d
         }

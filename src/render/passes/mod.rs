@@ -287,7 +287,7 @@ impl PrepareCtx<'_> {
             return Shadows::None;
         }
         let s = shadows(&sp.roles, &self.graph.plan);
-        if let Shadows::Atlas(_) = s {
+        if let Shadows::Atlas(_) | Shadows::Hybrid(_) = s {
             offered.offer("shadow_sampler", comparison_sampler(&self.device()));
         }
         s
