@@ -59,8 +59,12 @@ pub enum Shadows {
     Mask,
     /// Casts a ray per light in the light loop.
     Trace,
-    /// Samples a shadow atlas, filtered as its ShadowAtlas pass says.
-    Atlas(super::shadow_atlas::ShadowFilter),
+    /// Samples a shadow atlas, filtered as its ShadowAtlas pass says; compared by hand
+    /// where its compute raster stored it as R32Float.
+    Atlas(
+        super::shadow_atlas::ShadowFilter,
+        super::shadow_atlas::AtlasRaster,
+    ),
 }
 
 /// The shadow source of a shading pass's slots; an atlas's filter is published on its
@@ -72,14 +76,16 @@ pub fn shadows(roles: &crate::graph::PassRoles, plan: &crate::graph::ResourcePla
     } else if roles.slot(BVH_NODES).is_some() {
         Shadows::Trace
     } else if let Some(views) = roles.slot(SHADOW_VIEWS) {
-        let filter = plan
+        let (filter, raster) = plan
             .get(views)
             .and_then(|r| match r.layout {
-                Some(super::BufferLayout::ShadowViews { filter, .. }) => Some(filter),
+                Some(super::BufferLayout::ShadowViews { filter, raster, .. }) => {
+                    Some((filter, raster))
+                }
                 _ => None,
             })
             .unwrap_or_default();
-        Shadows::Atlas(filter)
+        Shadows::Atlas(filter, raster)
     } else {
         Shadows::None
     }

@@ -1,0 +1,363 @@
+//! The shadow atlas drawn by the compute raster (`ShadowAtlas(raster: Compute)`) against
+//! the raster pipeline's, and maps kept across frames (`cache: true`) against maps drawn
+//! afresh: the atlases texel by texel, the shaded images pixel by pixel.
+
+mod common;
+
+use common::{renderer, shadow_room, Rng};
+use glam::Vec3;
+use lightgraph::render::{FrameResult, PreparedFrame, Renderer, SceneGpu};
+use lightgraph::scene::{light_flags, Camera, Light, LightShape, Scene};
+use std::collections::HashMap;
+
+const W: u32 = 80;
+const H: u32 = 48;
+const SIDE: u32 = 512;
+
+/// shadow_atlas.ron at a 512² atlas, drawn by `raster`, keeping maps if `cache`.
+fn graph(raster: &str, cache: bool) -> String {
+    let text = std::fs::read_to_string(common::graph_path("shadow_atlas.ron")).unwrap();
+    let format = if raster == "Compute" {
+        "R32Float"
+    } else {
+        "Depth32Float"
+    };
+    let out = text
+        .replace(
+            "Texture(name: \"shadow_atlas\", format: Depth32Float, size: Fixed(4096, 4096))",
+            &format!("Texture(name: \"shadow_atlas\", format: {format}, size: Fixed({SIDE}, {SIDE}))"),
+        )
+        .replace(
+            "ShadowAtlas(filter: Pcf5x5, min_tile: 16, max_tile: 1024, importance: 1.0)",
+            &format!("ShadowAtlas(filter: Pcf5x5, min_tile: 16, max_tile: 128, importance: 4.0, raster: {raster}, cache: {cache})"),
+        );
+    assert!(out.contains("R32Float") == (raster == "Compute") && out.contains("cache:"));
+    out
+}
+
+/// shadow_room with a spot light, a wide spot (six faces) and two point lights.
+fn scene() -> Scene {
+    let mut rng = Rng(7);
+    let caster = |l: Light| Light {
+        flags: light_flags::CASTS_SHADOW,
+        ..l
+    };
+    let spot = |position: Vec3, direction: Vec3, outer: f32| {
+        caster(Light {
+            shape: LightShape::Spot {
+                direction,
+                inner_angle: outer * 0.8,
+                outer_angle: outer,
+            },
+            ..Light::point(position, 14.0, Vec3::new(1.0, 0.9, 0.8), 6.0)
+        })
+    };
+    Scene {
+        name: "atlas room".into(),
+        meshes: shadow_room(&mut rng),
+        materials: vec![
+            common::lambert("floor", Vec3::splat(0.8)),
+            common::lambert("boxes", Vec3::new(0.7, 0.6, 0.5)),
+        ],
+        lights: vec![
+            spot(Vec3::new(-1.0, 4.5, -3.0), Vec3::new(0.2, -1.0, -0.1), 0.6),
+            spot(Vec3::new(2.0, 3.8, -5.0), Vec3::new(0.0, -1.0, 0.3), 1.2),
+            caster(Light::point(
+                Vec3::new(0.5, 1.8, -1.5),
+                9.0,
+                Vec3::new(0.9, 0.6, 0.4),
+                3.0,
+            )),
+            caster(Light::point(
+                Vec3::new(-3.0, 2.2, -6.0),
+                9.0,
+                Vec3::new(0.4, 0.7, 1.0),
+                3.0,
+            )),
+        ],
+        camera: Camera {
+            eye: Vec3::new(0.0, 5.0, 6.0),
+            target: Vec3::new(0.0, 0.0, -4.0),
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+}
+
+/// `text` prepared for `scene`, with the scene's light buffers (which light updates take).
+fn prepare(r: &mut Renderer, text: &str, scene: &Scene) -> (PreparedFrame, SceneGpu) {
+    use lightgraph::graph::{self, FrameSize};
+    let checked = graph::check_text(
+        std::path::Path::new("<test>"),
+        text,
+        &lightgraph::shader::ShaderLibrary::builtin(),
+    )
+    .expect("valid graph");
+    let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, scene).expect("materials");
+    let size = FrameSize {
+        width: W,
+        height: H,
+        lights: gpu.light_capacity,
+    };
+    let compiled = graph::compile(checked, &scene.features(), size);
+    let prepared = r
+        .prepare(compiled, scene, &gpu, size, false)
+        .expect("prepare");
+    (prepared, gpu)
+}
+
+/// A rendered frame and its atlas's texels (depth bits).
+struct Drawn {
+    frame: FrameResult,
+    atlas: Vec<u32>,
+    tiles: HashMap<(u32, u32), (u32, u32, u32)>,
+}
+
+fn draw(r: &Renderer, prepared: &PreparedFrame) -> Drawn {
+    let frame = prepared.render(r).unwrap();
+    let atlas = prepared.read_texture_bits(r, "shadow_atlas").unwrap();
+    assert_eq!(atlas.len(), (SIDE * SIDE) as usize, "atlas size");
+    let table = prepared.read_buffer(r, "shadow_views").unwrap();
+    Drawn {
+        frame,
+        atlas,
+        tiles: tiles(bytemuck::cast_slice(&table)),
+    }
+}
+
+/// Each (light, face)'s tile (x, y, side) from the view table (src/kinds/shadow_atlas):
+/// a header vec4, six vec4 a view (view-projection, tile in UV, ...), then per light its
+/// first view + 1 with bit 31 for six faces.
+fn tiles(table: &[u32]) -> HashMap<(u32, u32), (u32, u32, u32)> {
+    let (side, lights, max_views) = (table[1], table[2], table[3]);
+    let light_table = 4 * (1 + 6 * max_views as usize);
+    let mut out = HashMap::new();
+    for l in 0..lights {
+        let entry = table[light_table + l as usize];
+        if entry == 0 {
+            continue;
+        }
+        let first = (entry & 0x7fff_ffff) - 1;
+        let faces = if entry & 0x8000_0000 != 0 { 6 } else { 1 };
+        for f in 0..faces {
+            let uv = 4 * (1 + 6 * (first + f) as usize + 4);
+            let lo = [table[uv], table[uv + 1]]
+                .map(|b| (f32::from_bits(b) * side as f32).round() as u32);
+            let hi = f32::from_bits(table[uv + 2]) * side as f32;
+            out.insert((l, f), (lo[0], lo[1], hi.round() as u32 - lo[0]));
+        }
+    }
+    out
+}
+
+/// Texels of two atlases' tiles, (light, face) by (light, face), wherever each has it.
+struct TileDiff {
+    texels: usize,
+    /// Covered in one, the far depth in the other: a triangle's edge ran across it.
+    coverage: usize,
+    /// Covered in both at depths more than `DEPTH_TOL` apart.
+    depth: usize,
+    worst_depth: f32,
+}
+
+/// Depths of texels both rasterizers cover: equal bar the interpolation's rounding
+/// (the plane from unsnapped vertices in both, evaluated in another order) and the
+/// depth bias's rounding. 1e-5 is 80 of the bias's own units near depth 1 (2^-24 each):
+/// far below what separates a caster from a receiver (the bias is ≥ 2 units plus the
+/// slope term, the normal offset 1.5 texels).
+const DEPTH_TOL: f32 = 1e-5;
+
+fn compare_tiles(a: &Drawn, b: &Drawn) -> TileDiff {
+    let mut d = TileDiff {
+        texels: 0,
+        coverage: 0,
+        depth: 0,
+        worst_depth: 0.0,
+    };
+    assert_eq!(a.tiles.len(), b.tiles.len(), "the same views");
+    for (key, &(ax, ay, side)) in &a.tiles {
+        let &(bx, by, bside) = b.tiles.get(key).expect("the same views");
+        assert_eq!(side, bside, "{key:?}: the same tile side");
+        for y in 0..side {
+            for x in 0..side {
+                let p = a.atlas[((ay + y) * SIDE + ax + x) as usize];
+                let q = b.atlas[((by + y) * SIDE + bx + x) as usize];
+                d.texels += 1;
+                let far = 1.0f32.to_bits();
+                if (p == far) != (q == far) {
+                    d.coverage += 1;
+                } else {
+                    let delta = (f32::from_bits(p) - f32::from_bits(q)).abs();
+                    d.worst_depth = d.worst_depth.max(delta);
+                    if delta > DEPTH_TOL {
+                        d.depth += 1;
+                    }
+                }
+            }
+        }
+    }
+    d
+}
+
+/// Coverage may differ only where a triangle edge crosses a texel centre within the
+/// rounding of the two vertex transforms: a handful of texels per thousand edge texels.
+/// Bounded at 1 in 500 of the tiles' texels (the room's edges cross about 4% of them).
+fn assert_close(d: &TileDiff, what: &str) {
+    eprintln!(
+        "{what}: {} texels, {} coverage, {} depth (worst {:e})",
+        d.texels, d.coverage, d.depth, d.worst_depth
+    );
+    assert!(
+        d.texels > 10_000,
+        "{what}: only {} texels compared",
+        d.texels
+    );
+    assert!(
+        d.coverage * 500 <= d.texels,
+        "{what}: {} of {} texels covered in one atlas only",
+        d.coverage,
+        d.texels
+    );
+    assert_eq!(
+        d.depth, 0,
+        "{what}: depths apart by up to {}",
+        d.worst_depth
+    );
+}
+
+/// Pixels whose colours differ by more than `tol` of the brightest reference pixel.
+fn pixels_apart(a: &[[f32; 4]], b: &[[f32; 4]], tol: f32) -> usize {
+    assert_eq!(a.len(), (W * H) as usize, "image size");
+    assert_eq!(a.len(), b.len(), "image sizes");
+    let peak = b
+        .iter()
+        .flat_map(|p| p[..3].iter())
+        .fold(0.0f32, |m, &v| m.max(v));
+    assert!(peak > 0.0, "a black reference");
+    a.iter()
+        .zip(b)
+        .filter(|(p, q)| (0..3).any(|c| (p[c] - q[c]).abs() > tol * peak))
+        .count()
+}
+
+#[test]
+fn the_compute_atlas_matches_the_hardware_atlas() {
+    let mut r = renderer();
+    let scene = scene();
+    let (hw, _) = prepare(&mut r, &graph("Hardware", false), &scene);
+    let (cs, _) = prepare(&mut r, &graph("Compute", false), &scene);
+    let a = draw(&r, &hw);
+    let b = draw(&r, &cs);
+    assert_eq!(
+        a.frame.atlases[0].views,
+        1 + 6 + 12,
+        "{:?}",
+        a.frame.atlases[0]
+    );
+    assert_eq!(a.tiles, b.tiles, "the same allocation");
+    let report = b.frame.atlases[0]
+        .raster
+        .expect("the compute raster's report");
+    assert_eq!(
+        report.serial_triangles + report.serial_cells,
+        0,
+        "{report:?}"
+    );
+    assert!(
+        report.cells > 0,
+        "large triangles went through the cell list: {report:?}"
+    );
+    assert_close(&compare_tiles(&a, &b), "compute against hardware");
+    // Shading: the same filter by hand (exact weights against the hardware's 8-bit ones)
+    // over the same depths; pixels whose 5×5 footprint holds a coverage difference may
+    // differ by a tap's weight (1/25 of the light), 1 in 100 pixels at most. Elsewhere
+    // 2e-3 of the peak: the weights' rounding.
+    let apart = pixels_apart(&b.frame.image, &a.frame.image, 2e-3);
+    eprintln!("shaded pixels apart: {apart}");
+    assert!(apart * 100 <= (W * H) as usize, "{apart} pixels differ");
+    let far = pixels_apart(&b.frame.image, &a.frame.image, 0.05);
+    assert_eq!(far, 0, "pixels off by more than a tap");
+}
+
+#[test]
+fn kept_maps_equal_maps_drawn_afresh() {
+    for raster in ["Hardware", "Compute"] {
+        let mut r = renderer();
+        let start = scene();
+        let (cached, gpu) = prepare(&mut r, &graph(raster, true), &start);
+        let first = draw(&r, &cached);
+        let views = first.frame.atlases[0].views;
+        assert_eq!(
+            first.frame.atlases[0].views_rendered, views,
+            "{raster}: first frame"
+        );
+        // Nothing moved: nothing drawn, the same atlas and image.
+        let still = draw(&r, &cached);
+        assert_eq!(still.frame.atlases[0].views_rendered, 0, "{raster}: still");
+        assert_eq!(still.atlas, first.atlas, "{raster}: still atlas");
+        assert_eq!(
+            still.frame.image, first.frame.image,
+            "{raster}: still image"
+        );
+        // The first point light moves: its six faces are drawn, the rest kept.
+        let mut moved = start.clone();
+        moved.lights[2].position += Vec3::new(0.7, 0.3, -0.4);
+        cached.update_lights(&r, &gpu, &moved.lights).unwrap();
+        let after = draw(&r, &cached);
+        assert_eq!(
+            after.frame.atlases[0].views_rendered, 6,
+            "{raster}: after the move"
+        );
+        // A light changing colour only keeps its maps.
+        let mut tinted = moved.clone();
+        tinted.lights[0].color = Vec3::new(0.2, 0.9, 0.3);
+        cached.update_lights(&r, &gpu, &tinted.lights).unwrap();
+        let recoloured = draw(&r, &cached);
+        assert_eq!(
+            recoloured.frame.atlases[0].views_rendered, 0,
+            "{raster}: recoloured"
+        );
+        cached.update_lights(&r, &gpu, &moved.lights).unwrap();
+        let after = draw(&r, &cached);
+        // Against the moved scene drawn afresh: every map, placed elsewhere (hence the
+        // tolerance of two rasterizations of one view at other offsets).
+        let (fresh, _) = prepare(&mut r, &graph(raster, true), &moved);
+        let fresh = draw(&r, &fresh);
+        assert_eq!(fresh.frame.atlases[0].views_rendered, views);
+        assert_close(
+            &compare_tiles(&after, &fresh),
+            &format!("{raster}: kept against fresh"),
+        );
+        // The image against the same frames drawn without the cache (a light update's
+        // image and a fresh prepare's differ by themselves in ~100 of these pixels, with
+        // or without the cache): equal bar the order culling sums a tile's lights in.
+        let (plain, plain_gpu) = prepare(&mut r, &graph(raster, false), &start);
+        draw(&r, &plain);
+        plain.update_lights(&r, &plain_gpu, &moved.lights).unwrap();
+        let plain = draw(&r, &plain);
+        assert_eq!(plain.frame.atlases[0].views_rendered, views);
+        let (d, at) = common::max_rel_diff(&after.frame.image, &plain.frame.image);
+        assert!(
+            d <= 2e-6,
+            "{raster}: kept against drawn: {d:e} at pixel {at}"
+        );
+    }
+}
+
+#[test]
+fn the_compute_raster_refuses_alpha_masked_casters() {
+    let mut r = renderer();
+    let mut scene = scene();
+    let mut masked = common::lambert("leaves", Vec3::ONE);
+    masked.alpha_mode = lightgraph::scene::AlphaMode::Mask(0.5);
+    scene.materials[1] = masked;
+    let text = graph("Compute", false);
+    let e = common::prepare_text(&mut r, &text, &scene, W, H, false)
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        e.contains("shadow_maps") && e.contains("alpha-masked") && e.contains("raster: Hardware"),
+        "{e}"
+    );
+}
