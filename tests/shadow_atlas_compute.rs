@@ -158,6 +158,9 @@ struct TileDiff {
     /// Covered in both at depths more than `DEPTH_TOL` apart.
     depth: usize,
     worst_depth: f32,
+    /// Covered in both at exactly the same depth.
+    exact: usize,
+    covered: usize,
 }
 
 /// Depths of texels both rasterizers cover: equal bar the interpolation's rounding
@@ -173,6 +176,8 @@ fn compare_tiles(a: &Drawn, b: &Drawn) -> TileDiff {
         coverage: 0,
         depth: 0,
         worst_depth: 0.0,
+        exact: 0,
+        covered: 0,
     };
     assert_eq!(a.tiles.len(), b.tiles.len(), "the same views");
     for (key, &(ax, ay, side)) in &a.tiles {
@@ -186,7 +191,9 @@ fn compare_tiles(a: &Drawn, b: &Drawn) -> TileDiff {
                 let far = 1.0f32.to_bits();
                 if (p == far) != (q == far) {
                     d.coverage += 1;
-                } else {
+                } else if p != far {
+                    d.covered += 1;
+                    d.exact += usize::from(p == q);
                     let delta = (f32::from_bits(p) - f32::from_bits(q)).abs();
                     d.worst_depth = d.worst_depth.max(delta);
                     if delta > DEPTH_TOL {
@@ -200,12 +207,14 @@ fn compare_tiles(a: &Drawn, b: &Drawn) -> TileDiff {
 }
 
 /// Coverage may differ only where a triangle edge crosses a texel centre within the
-/// rounding of the two vertex transforms: a handful of texels per thousand edge texels.
-/// Bounded at 1 in 500 of the tiles' texels (the room's edges cross about 4% of them).
+/// rounding of the two vertex transforms (a vertex stage and a compute shader may
+/// contract the matrix product differently): on lavapipe none does in this scene; 1 in
+/// 20,000 of the tiles' texels allowed (3 here; a flipped fill rule shows 6, with depths
+/// apart on the shared edges).
 fn assert_close(d: &TileDiff, what: &str) {
     eprintln!(
-        "{what}: {} texels, {} coverage, {} depth (worst {:e})",
-        d.texels, d.coverage, d.depth, d.worst_depth
+        "{what}: {} texels, {} coverage, {} depth (worst {:e}), {} of {} covered equal",
+        d.texels, d.coverage, d.depth, d.worst_depth, d.exact, d.covered
     );
     assert!(
         d.texels > 10_000,
@@ -213,7 +222,7 @@ fn assert_close(d: &TileDiff, what: &str) {
         d.texels
     );
     assert!(
-        d.coverage * 500 <= d.texels,
+        d.coverage * 20_000 <= d.texels,
         "{what}: {} of {} texels covered in one atlas only",
         d.coverage,
         d.texels
@@ -223,21 +232,14 @@ fn assert_close(d: &TileDiff, what: &str) {
         "{what}: depths apart by up to {}",
         d.worst_depth
     );
-}
-
-/// Pixels whose colours differ by more than `tol` of the brightest reference pixel.
-fn pixels_apart(a: &[[f32; 4]], b: &[[f32; 4]], tol: f32) -> usize {
-    assert_eq!(a.len(), (W * H) as usize, "image size");
-    assert_eq!(a.len(), b.len(), "image sizes");
-    let peak = b
-        .iter()
-        .flat_map(|p| p[..3].iter())
-        .fold(0.0f32, |m, &v| m.max(v));
-    assert!(peak > 0.0, "a black reference");
-    a.iter()
-        .zip(b)
-        .filter(|(p, q)| (0..3).any(|c| (p[c] - q[c]).abs() > tol * peak))
-        .count()
+    // The constant bias (2 units of 2^(e − 23)) is below DEPTH_TOL: the same rule kept
+    // most texels bit for bit (two thirds here; 3% without the constant bias).
+    assert!(
+        d.exact * 2 >= d.covered,
+        "{what}: only {} of {} covered texels bit for bit",
+        d.exact,
+        d.covered
+    );
 }
 
 #[test]
@@ -268,15 +270,23 @@ fn the_compute_atlas_matches_the_hardware_atlas() {
         "large triangles went through the cell list: {report:?}"
     );
     assert_close(&compare_tiles(&a, &b), "compute against hardware");
-    // Shading: the same filter by hand (exact weights against the hardware's 8-bit ones)
-    // over the same depths; pixels whose 5×5 footprint holds a coverage difference may
-    // differ by a tap's weight (1/25 of the light), 1 in 100 pixels at most. Elsewhere
-    // 2e-3 of the peak: the weights' rounding.
-    let apart = pixels_apart(&b.frame.image, &a.frame.image, 2e-3);
-    eprintln!("shaded pixels apart: {apart}");
-    assert!(apart * 100 <= (W * H) as usize, "{apart} pixels differ");
-    let far = pixels_apart(&b.frame.image, &a.frame.image, 0.05);
-    assert_eq!(far, 0, "pixels off by more than a tap");
+    // Shading: the same filters by hand over the same depths. lavapipe weighs its
+    // comparison taps exactly, as the hand-written filter does: equal but for the
+    // summation order (1e-5 of the peak; GPUs with 8-bit filter weights would differ by
+    // up to 1/256 of a tap where a footprint straddles an edge).
+    assert_shaded_alike(&a.frame, &b.frame, "Pcf5x5");
+    let (hw, _) = prepare(&mut r, &graph("Hardware", false).replace("Pcf5x5", "Hardware2x2"), &scene);
+    let (cs, _) = prepare(&mut r, &graph("Compute", false).replace("Pcf5x5", "Hardware2x2"), &scene);
+    assert_shaded_alike(&hw.render(&r).unwrap(), &cs.render(&r).unwrap(), "Hardware2x2");
+}
+
+fn assert_shaded_alike(hardware: &FrameResult, compute: &FrameResult, filter: &str) {
+    assert_eq!(hardware.image.len(), (W * H) as usize, "image size");
+    let (d, at) = common::max_rel_diff(&compute.image, &hardware.image);
+    eprintln!("{filter}: shaded images apart by {d:e}");
+    assert!(d <= 1e-5, "{filter}: compute against hardware atlas: {d:e} at pixel {at}");
+    let shadowed = hardware.image.iter().zip(&compute.image).filter(|(p, _)| p[0] < 1e-3).count();
+    assert!(shadowed > 100, "{filter}: the scene shows shadows ({shadowed} dark pixels)");
 }
 
 #[test]

@@ -86,6 +86,7 @@ pub const CSV_COLUMNS: [&str; 55] = [
     "atlas_shadowed",
     "atlas_dropped",
     "atlas_views",
+    "atlas_views_rendered",
     "shadow_pairs",
     "pair_error_pcf5",
     "pair_error_2x2",
@@ -159,6 +160,7 @@ pub fn to_csv(rows: &[BenchRow]) -> String {
             opt(r.atlas_shadowed),
             opt(r.atlas_dropped),
             opt(r.atlas_views),
+            opt(r.atlas_views_rendered),
             opt(r.shadow_pairs),
             opt(r.pair_error_pcf5),
             opt(r.pair_error_2x2),
@@ -532,7 +534,7 @@ mod tests {
         let csv = to_csv(&[plain.clone(), shadowed.clone()]);
         let lines: Vec<&str> = csv.lines().collect();
         assert!(lines[0].ends_with(
-            ",passes_ms_total,reference,shadow_rays,shadow_rays_per_s,shadow_jobs_dropped,shadow_overflow_pixels,shadow_buffers_mib,bvh_mib,bvh_build_ms,atlas_mib,atlas_shadowed,atlas_dropped,atlas_views,shadow_pairs,pair_error_pcf5,pair_error_2x2,link_mib,links_per_list_pixel,link_scale,links_dropped"
+            ",passes_ms_total,reference,shadow_rays,shadow_rays_per_s,shadow_jobs_dropped,shadow_overflow_pixels,shadow_buffers_mib,bvh_mib,bvh_build_ms,atlas_mib,atlas_shadowed,atlas_dropped,atlas_views,atlas_views_rendered,shadow_pairs,pair_error_pcf5,pair_error_2x2,link_mib,links_per_list_pixel,link_scale,links_dropped"
         ));
         assert!(
             lines[1].ends_with(",0,,brute_force,,,,,,,,,,,,,,,,,,"),
