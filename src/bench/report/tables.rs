@@ -37,7 +37,7 @@ fn opt<T: ToString>(v: Option<T>) -> String {
 /// row (first-seen order): `pass_ms:<name>` (median), `pass_ms_p10:<name>`, `pass_ms_p90:<name>`,
 /// empty where a row lacks that pass. Time columns are empty, not 0, for untimed rows; the
 /// ray-cast shadow columns (`shadow_*`, `bvh_*`) are empty for graphs without those passes.
-pub const CSV_COLUMNS: [&str; 55] = [
+pub const CSV_COLUMNS: [&str; 56] = [
     "scene",
     "technique",
     "params",
@@ -537,12 +537,12 @@ mod tests {
             ",passes_ms_total,reference,shadow_rays,shadow_rays_per_s,shadow_jobs_dropped,shadow_overflow_pixels,shadow_buffers_mib,bvh_mib,bvh_build_ms,atlas_mib,atlas_shadowed,atlas_dropped,atlas_views,atlas_views_rendered,shadow_pairs,pair_error_pcf5,pair_error_2x2,link_mib,links_per_list_pixel,link_scale,links_dropped"
         ));
         assert!(
-            lines[1].ends_with(",0,,brute_force,,,,,,,,,,,,,,,,,,"),
+            lines[1].ends_with(",0,,brute_force,,,,,,,,,,,,,,,,,,,"),
             "{}",
             lines[1]
         );
         assert!(
-            lines[2].ends_with(",raycast_shadows_naive,16,2500000000,0,1,1.5,20.4,180,,,,,,,,,,,"),
+            lines[2].ends_with(",raycast_shadows_naive,16,2500000000,0,1,1.5,20.4,180,,,,,,,,,,,,"),
             "{}",
             lines[2]
         );

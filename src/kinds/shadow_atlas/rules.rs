@@ -294,4 +294,18 @@ mod tests {
         );
         assert!(e.contains("fixed power-of-two size"), "{e}");
     }
+
+    #[test]
+    fn the_atlas_format_follows_the_raster() {
+        // "atlas" is Depth32Float 2048² (test_support); "atlas_f" an R32Float one.
+        let e = errors(&PASSES.replace("ATLAS", "raster: Compute"), "hdr");
+        assert!(
+            e.contains("raster: Compute stores depths from compute") && e.contains("R32Float"),
+            "{e}"
+        );
+        let float = PASSES.replace("\"atlas\"", "\"atlas_f\"");
+        validate(&float.replace("ATLAS", "raster: Compute, cache: true"), "hdr").unwrap();
+        let e = errors(&float.replace("ATLAS", ""), "hdr");
+        assert!(e.contains("raster: Hardware draws depth into the atlas"), "{e}");
+    }
 }
