@@ -16,7 +16,12 @@ const SIDE: u32 = 512;
 
 /// shadow_atlas.ron at a 512² atlas, drawn by `raster`, keeping maps if `cache`.
 fn graph(raster: &str, cache: bool) -> String {
-    let text = std::fs::read_to_string(common::graph_path("shadow_atlas.ron")).unwrap();
+    graph_file("shadow_atlas.ron", raster, cache)
+}
+
+/// `file` (a graph with the shipped atlas) at a 512² atlas, drawn by `raster`.
+fn graph_file(file: &str, raster: &str, cache: bool) -> String {
+    let text = std::fs::read_to_string(common::graph_path(file)).unwrap();
     let format = if raster == "Compute" {
         "R32Float"
     } else {
@@ -31,7 +36,10 @@ fn graph(raster: &str, cache: bool) -> String {
             "ShadowAtlas(filter: Pcf5x5, min_tile: 16, max_tile: 1024, importance: 1.0)",
             &format!("ShadowAtlas(filter: Pcf5x5, min_tile: 16, max_tile: 128, importance: 4.0, raster: {raster}, cache: {cache})"),
         );
-    assert!(out.contains("R32Float") == (raster == "Compute") && out.contains("cache:"));
+    assert!(
+        out.contains(&format!("format: {format}, size: Fixed({SIDE}")) && out.contains("cache:"),
+        "{file}: the atlas replaced"
+    );
     out
 }
 
@@ -275,18 +283,51 @@ fn the_compute_atlas_matches_the_hardware_atlas() {
     // summation order (1e-5 of the peak; GPUs with 8-bit filter weights would differ by
     // up to 1/256 of a tap where a footprint straddles an edge).
     assert_shaded_alike(&a.frame, &b.frame, "Pcf5x5");
-    let (hw, _) = prepare(&mut r, &graph("Hardware", false).replace("Pcf5x5", "Hardware2x2"), &scene);
-    let (cs, _) = prepare(&mut r, &graph("Compute", false).replace("Pcf5x5", "Hardware2x2"), &scene);
-    assert_shaded_alike(&hw.render(&r).unwrap(), &cs.render(&r).unwrap(), "Hardware2x2");
+    let (hw, _) = prepare(
+        &mut r,
+        &graph("Hardware", false).replace("Pcf5x5", "Hardware2x2"),
+        &scene,
+    );
+    let (cs, _) = prepare(
+        &mut r,
+        &graph("Compute", false).replace("Pcf5x5", "Hardware2x2"),
+        &scene,
+    );
+    assert_shaded_alike(
+        &hw.render(&r).unwrap(),
+        &cs.render(&r).unwrap(),
+        "Hardware2x2",
+    );
+    // Every other shader that samples the atlas: deferred, the compute-first frame, glass.
+    for file in [
+        "tiled_deferred_shadow_atlas.ron",
+        "visibility_shadow_atlas.ron",
+        "transparent_shadow_atlas.ron",
+    ] {
+        let (hw, _) = prepare(&mut r, &graph_file(file, "Hardware", false), &scene);
+        let (cs, _) = prepare(&mut r, &graph_file(file, "Compute", false), &scene);
+        assert_shaded_alike(&hw.render(&r).unwrap(), &cs.render(&r).unwrap(), file);
+    }
 }
 
 fn assert_shaded_alike(hardware: &FrameResult, compute: &FrameResult, filter: &str) {
     assert_eq!(hardware.image.len(), (W * H) as usize, "image size");
     let (d, at) = common::max_rel_diff(&compute.image, &hardware.image);
     eprintln!("{filter}: shaded images apart by {d:e}");
-    assert!(d <= 1e-5, "{filter}: compute against hardware atlas: {d:e} at pixel {at}");
-    let shadowed = hardware.image.iter().zip(&compute.image).filter(|(p, _)| p[0] < 1e-3).count();
-    assert!(shadowed > 100, "{filter}: the scene shows shadows ({shadowed} dark pixels)");
+    assert!(
+        d <= 1e-5,
+        "{filter}: compute against hardware atlas: {d:e} at pixel {at}"
+    );
+    let shadowed = hardware
+        .image
+        .iter()
+        .zip(&compute.image)
+        .filter(|(p, _)| p[0] < 1e-3)
+        .count();
+    assert!(
+        shadowed > 100,
+        "{filter}: the scene shows shadows ({shadowed} dark pixels)"
+    );
 }
 
 #[test]

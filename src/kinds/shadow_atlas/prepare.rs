@@ -412,6 +412,9 @@ impl PreparedPass for ShadowAtlasPass {
                 .unwrap_or_else(|e| e.into_inner())
                 .hold(&frame.allocation);
             frame.to_draw.clear();
+            if let Raster::Compute(compute) = &self.raster {
+                compute.drawn();
+            }
         }
     }
 

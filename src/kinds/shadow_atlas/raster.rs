@@ -75,7 +75,8 @@ pub(super) struct ComputeAtlas {
     side: u32,
     max_groups: u32,
     bound: Mutex<Option<Bound>>,
-    /// This frame's pairs and pieces (zero once drawn, until the next upload).
+    /// The uploaded work's pairs and pieces, drawn by every frame until the next upload
+    /// (zero after `drawn`: the cache keeps what the last frame drew).
     pending: Mutex<(u32, u32)>,
     /// The first index of each caster draw in the merged index buffer.
     pub(super) index_base: Vec<u32>,
@@ -434,15 +435,20 @@ impl ComputeAtlas {
             (work.pairs, work.pieces.len() as u32);
     }
 
-    /// Draws the uploaded work (nothing if it was drawn already): one compute pass.
+    /// The atlas holds the uploaded work's views: later frames draw none until the next
+    /// upload (`cache: true`).
+    pub(super) fn drawn(&self) {
+        *self.pending.lock().unwrap_or_else(|e| e.into_inner()) = (0, 0);
+    }
+
+    /// Draws the uploaded work: one compute pass.
     pub(super) fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         label: &str,
         ts: Timestamps<'_>,
     ) {
-        let (pairs, pieces) =
-            std::mem::take(&mut *self.pending.lock().unwrap_or_else(|e| e.into_inner()));
+        let (pairs, pieces) = *self.pending.lock().unwrap_or_else(|e| e.into_inner());
         if pairs > 0 {
             encoder.clear_buffer(&self.counters, 0, None);
             encoder.clear_buffer(&self.args, 0, None);

@@ -304,8 +304,15 @@ mod tests {
             "{e}"
         );
         let float = PASSES.replace("\"atlas\"", "\"atlas_f\"");
-        validate(&float.replace("ATLAS", "raster: Compute, cache: true"), "hdr").unwrap();
+        validate(
+            &float.replace("ATLAS", "raster: Compute, cache: true"),
+            "hdr",
+        )
+        .unwrap();
         let e = errors(&float.replace("ATLAS", ""), "hdr");
-        assert!(e.contains("raster: Hardware draws depth into the atlas"), "{e}");
+        assert!(
+            e.contains("raster: Hardware draws depth into the atlas"),
+            "{e}"
+        );
     }
 }
