@@ -70,7 +70,7 @@ enum Raster {
         /// Writes the far depth over a tile (each view clears its own).
         clear: Arc<wgpu::RenderPipeline>,
     },
-    Compute(ComputeAtlas),
+    Compute(Box<ComputeAtlas>),
 }
 
 /// The current allocation, each view's culled caster ranges, and the views to draw when
@@ -165,7 +165,7 @@ pub(super) fn prepare(
                 p.depth_bias,
                 p.slope_bias,
             )?;
-            (Raster::Compute(compute), casters)
+            (Raster::Compute(Box::new(compute)), casters)
         }
     };
     let meshes = casters

@@ -149,7 +149,7 @@ impl ComputeAtlas {
             indices.extend(order.iter().map(|i| i + base));
         }
         let device = cx.device();
-        let limit = device.limits().max_storage_buffer_binding_size as u64;
+        let limit = device.limits().max_storage_buffer_binding_size;
         let depth_bytes = side as u64 * side as u64 * 4;
         for (what, bytes) in [
             ("the depth buffer", depth_bytes),
