@@ -264,7 +264,7 @@ pub struct AtlasReport {
     /// whose tile did not hold them yet (the rest of `views` were kept).
     pub views_rendered: u32,
     /// The compute raster's lists and serial fallbacks (`raster: Compute`).
-    pub raster: Option<crate::render::passes::AtlasRasterReport>,
+    pub raster: Option<crate::render::AtlasRasterReport>,
 }
 
 impl AtlasReport {

@@ -88,11 +88,17 @@ pub(super) struct ComputeAtlas {
 /// serially because a list was full, in the last frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct AtlasRasterReport {
+    /// Records of large triangles listed (at most the capacity).
     pub records: u32,
+    /// Room for records.
     pub records_capacity: u32,
+    /// 32×32 cell entries listed (at most the capacity).
     pub cells: u32,
+    /// Room for cell entries.
     pub cells_capacity: u32,
+    /// Fan triangles a setup thread rasterized itself (the record list was full).
     pub serial_triangles: u32,
+    /// Cells a setup thread rasterized itself (the cell list was full).
     pub serial_cells: u32,
 }
 
