@@ -395,6 +395,52 @@ fn kept_maps_equal_maps_drawn_afresh() {
     }
 }
 
+/// The compute atlas raster's test hook (src/kinds/shadow_atlas/raster.rs): caps on its
+/// record and cell lists, read when the pass is prepared.
+const TEST_LIMITS: &str = "LIGHTGRAPH_ATLAS_RASTER_TEST_LIMITS";
+
+#[test]
+fn full_lists_fall_back_to_serial_rasterization_with_the_same_atlas() {
+    // Set and cleared while holding the renderer: no other test prepares meanwhile.
+    let mut r = renderer();
+    let scene = scene();
+    let (listed, _) = prepare(&mut r, &graph("Compute", false), &scene);
+    let listed = draw(&r, &listed);
+    let mut reports = Vec::new();
+    for limits in ["records=1", "cells=3"] {
+        std::env::set_var(TEST_LIMITS, limits);
+        let prepared = prepare(&mut r, &graph("Compute", false), &scene);
+        std::env::remove_var(TEST_LIMITS);
+        let serial = draw(&r, &prepared.0);
+        let report = serial.frame.atlases[0].raster.expect("compute report");
+        assert!(
+            report.serial_triangles + report.serial_cells > 0,
+            "{limits}: nothing ran serially: {report:?}"
+        );
+        // An atomic min is order-independent and every path runs the same per-texel
+        // code: the same atlas, bit for bit.
+        let differ = serial
+            .atlas
+            .iter()
+            .zip(&listed.atlas)
+            .filter(|(a, b)| a != b)
+            .count();
+        assert_eq!(differ, 0, "{limits}: {differ} texels differ");
+        reports.push(report);
+    }
+    assert!(
+        reports[0].serial_triangles > 0 && reports[1].serial_cells > 0,
+        "{reports:?}"
+    );
+    std::env::set_var(TEST_LIMITS, "cells=0");
+    let e = common::prepare_text(&mut r, &graph("Compute", false), &scene, W, H, false)
+        .err()
+        .map(|e| e.to_string());
+    std::env::remove_var(TEST_LIMITS);
+    let e = e.expect("a bad hook value is refused");
+    assert!(e.contains(TEST_LIMITS) && e.contains("'cells=0'"), "{e}");
+}
+
 #[test]
 fn the_compute_raster_refuses_alpha_masked_casters() {
     let mut r = renderer();

@@ -32,6 +32,32 @@ const ENTRY_BYTES: u64 = 8;
 const MAX_RECORDS: u64 = 1 << 24;
 /// Counter words (the shader's RECORDS..SERIAL_CELLS).
 const COUNTERS: u64 = 4;
+/// Test hook: `records=N,cells=N` (either) caps the lists' capacities below what
+/// prepare sizes, so tests can fill them and watch the serial fallback. Read when the
+/// pass is prepared; a malformed value is an error naming it.
+pub const TEST_LIMITS_VAR: &str = "LIGHTGRAPH_ATLAS_RASTER_TEST_LIMITS";
+
+/// The test hook's caps on (records, cells).
+fn test_limits() -> Result<[Option<u32>; 2], String> {
+    let mut caps = [None, None];
+    let Ok(text) = std::env::var(TEST_LIMITS_VAR) else {
+        return Ok(caps);
+    };
+    for item in text.split(',').map(str::trim).filter(|i| !i.is_empty()) {
+        let bad = || {
+            format!("{TEST_LIMITS_VAR}: '{item}' is not records=COUNT or cells=COUNT (COUNT >= 1)")
+        };
+        let (name, value) = item.split_once('=').ok_or_else(bad)?;
+        let value: u32 = value.trim().parse().map_err(|_| bad())?;
+        let slot = match name.trim() {
+            "records" if value >= 1 => &mut caps[0],
+            "cells" if value >= 1 => &mut caps[1],
+            _ => return Err(bad()),
+        };
+        *slot = Some(value);
+    }
+    Ok(caps)
+}
 
 /// One frame's work, as the CPU listed it for the views to draw.
 #[derive(Default)]
@@ -198,7 +224,11 @@ impl ComputeAtlas {
         let cells = (16 * texels / (CELL as u64 * CELL as u64))
             .min(limit / ENTRY_BYTES)
             .max(1) as u32;
-        let capacity = [records.max(1), cells];
+        let caps = test_limits().map_err(|m| pass_error(pass, m))?;
+        let capacity = [
+            caps[0].map_or(records, |n| n.min(records)).max(1),
+            caps[1].map_or(cells, |n| n.min(cells)).max(1),
+        ];
         let records_buf = storage(
             &device,
             "atlas raster records",
