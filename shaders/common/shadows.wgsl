@@ -11,9 +11,11 @@
 // the position's magnitude), and in the light loop SHADOW_MASK (read the mask),
 // SHADOW_TRACE (cast in the loop: the naive variant; needs the BVH and `shadow_ng`) or
 // SHADOW_ATLAS (sample a ShadowAtlas pass's depth atlas, with SHADOW_PCF5 for the 5×5
-// filter, else one 2×2 hardware-comparison tap), or SHADOW_HYBRID with both SHADOW_MASK
-// and SHADOW_ATLAS (the atlas for lights with a map this frame, the mask for the rest).
-// SHADOW_ATLAS_LIGHTS alone (job creation) reads only which lights have a map.
+// filter, else one 2×2 hardware-comparison tap; SHADOW_ATLAS_FLOAT: the atlas is the
+// compute raster's R32Float, compared by hand with the same weights), or SHADOW_HYBRID
+// with both SHADOW_MASK and SHADOW_ATLAS (the atlas for lights with a map this frame, the
+// mask for the rest). SHADOW_ATLAS_LIGHTS alone (job creation) reads only which lights
+// have a map.
 //
 // The light loop asks `shadow_visibility` for the fraction of light that reaches p:
 // 0 or 1 from the mask and the tracer, filtered from the atlas.
@@ -167,11 +169,49 @@ fn shadow_atlas_tap(light: u32, light_pos: vec3<f32>, position: vec3<f32>, norma
     return tap;
 }
 
+#if SHADOW_ATLAS_FLOAT
+// The hardware's comparison filter by hand, for an R32Float atlas (a compute raster
+// cannot store Depth32Float, and a draw converting it would put the work back on the
+// raster units). A bilinear comparison tap at texel position p (uv × side − ½) weighs
+// texels floor(p) and floor(p) + 1 by (1 − fract, fract) per axis; a tap clamped to
+// [lo, hi] weighs exactly as the unclamped one with its texel indices clamped to the
+// tile, per axis. So the 5×5 grid of taps, all sharing one fraction, is a 6×6 footprint
+// of comparisons weighted (1 − f, 1, 1, 1, 1, f) per axis: 36 loads for 25 taps.
+// `taps` per axis: 1 (2×2) or 5 (PCF 5×5). The hardware weights with 8 fractional bits
+// on most GPUs; these are exact, a difference of at most 1/256 of a tap at an edge.
+fn shadow_atlas_manual(t: AtlasTap, taps: i32) -> f32 {
+    let side = 1.0 / t.texel;
+    let p = t.uv * side - 0.5;
+    let base = vec2<i32>(floor(p));
+    let f = p - floor(p);
+    // Texel bounds of the tile: the clamp range's half-texel inset, back in texels.
+    let lo = vec2<i32>(round(t.lo * side - 0.5));
+    let hi = vec2<i32>(round(t.hi * side - 0.5));
+    let reach = (taps - 1) / 2;
+    var sum = 0.0;
+    for (var j = 0; j <= taps; j++) {
+        let wy = select(select(1.0, f.y, j == taps), 1.0 - f.y, j == 0);
+        let y = clamp(base.y - reach + j, lo.y, hi.y);
+        for (var i = 0; i <= taps; i++) {
+            let wx = select(select(1.0, f.x, i == taps), 1.0 - f.x, i == 0);
+            let x = clamp(base.x - reach + i, lo.x, hi.x);
+            let stored = textureLoad(shadow_atlas, vec2<i32>(x, y), 0).x;
+            // Lit where the reference is at most the stored depth (LessEqual).
+            sum += select(0.0, wx * wy, t.depth <= stored);
+        }
+    }
+    return sum / f32(taps * taps);
+}
+#endif
+
 // 25 comparison taps on a 5×5 texel grid (AMD TiledLighting11).
 fn shadow_atlas_pcf5(t: AtlasTap) -> f32 {
     if (t.lit) {
         return 1.0;
     }
+#if SHADOW_ATLAS_FLOAT
+    return shadow_atlas_manual(t, 5);
+#else
     var sum = 0.0;
     for (var j = -2; j <= 2; j++) {
         for (var i = -2; i <= 2; i++) {
@@ -180,6 +220,7 @@ fn shadow_atlas_pcf5(t: AtlasTap) -> f32 {
         }
     }
     return sum / 25.0;
+#endif
 }
 
 // One comparison tap: the hardware's bilinear 2×2 comparison.
@@ -187,7 +228,11 @@ fn shadow_atlas_2x2(t: AtlasTap) -> f32 {
     if (t.lit) {
         return 1.0;
     }
+#if SHADOW_ATLAS_FLOAT
+    return shadow_atlas_manual(t, 1);
+#else
     return textureSampleCompareLevel(shadow_atlas, shadow_sampler, clamp(t.uv, t.lo, t.hi), t.depth);
+#endif
 }
 
 fn shadow_atlas_visibility(light: u32, light_pos: vec3<f32>, p: ShadingPoint) -> f32 {

@@ -14,8 +14,12 @@
 @group(0) @binding(6) var g_normal: texture_2d<f32>;
 @group(0) @binding(7) var<storage, read> shadow_mask: array<u32>;
 @group(0) @binding(8) var<storage, read> shadow_views: array<vec4<f32>>;
+#if SHADOW_ATLAS_FLOAT
+@group(0) @binding(9) var shadow_atlas: texture_2d<f32>;
+#else
 @group(0) @binding(9) var shadow_atlas: texture_depth_2d;
 @group(0) @binding(10) var shadow_sampler: sampler_comparison;
+#endif
 @group(0) @binding(11) var<storage, read_write> shadow_errors: array<atomic<u32>>;
 
 #include "common/shadows.wgsl"

@@ -19,6 +19,7 @@ pub(super) fn set_atlas_columns(row: &mut BenchRow, result: &crate::render::Fram
         row.atlas_shadowed = Some(a.iter().map(|a| a.shadowed.len() as u64).sum());
         row.atlas_dropped = Some(a.iter().map(|a| a.dropped.len() as u64).sum());
         row.atlas_views = Some(a.iter().map(|a| a.views as u64).sum());
+        row.atlas_views_rendered = Some(a.iter().map(|a| a.views_rendered as u64).sum());
     }
     if let Some(c) = result.shadow_compare.first() {
         row.shadow_pairs = Some(c.pairs);

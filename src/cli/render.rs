@@ -429,6 +429,22 @@ fn atlas_report(a: &lightgraph::render::AtlasReport) {
         a.triangles,
         a.off_screen
     );
+    println!(
+        "  {}: {} of {} views drawn this frame (the rest kept: cache: true)",
+        a.pass, a.views_rendered, a.views
+    );
+    if let Some(r) = &a.raster {
+        println!(
+            "  {}: compute raster: {} of {} records, {} of {} cells; drawn serially because a list was full: {} triangles, {} cells",
+            a.pass,
+            r.records,
+            r.records_capacity,
+            r.cells,
+            r.cells_capacity,
+            r.serial_triangles,
+            r.serial_cells
+        );
+    }
     if !a.dropped.is_empty() {
         let list: Vec<String> = a
             .dropped

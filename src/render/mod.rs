@@ -24,6 +24,7 @@ pub use device_limits::supported_sample_counts;
 pub(crate) use frame::LightCount;
 pub use frame::{LightUpdateError, MeshEditError, PreparedFrame, RenderTimings};
 pub use materials::MaterialProgram;
+pub use passes::AtlasRasterReport;
 pub use pipelines::{
     CacheCounters, GpuStateAtBuild, Pipeline, PipelineBuild, PipelineCache, PipelineKey,
 };

@@ -265,6 +265,11 @@ pub struct AtlasReport {
     /// Allocations made since prepare: one at prepare, then at most one a frame, before
     /// a frame whose camera or lights changed.
     pub allocations: u64,
+    /// Views the last recorded frame drew: all of them, or with `cache: true` those
+    /// whose tile did not hold them yet (the rest of `views` were kept).
+    pub views_rendered: u32,
+    /// The compute raster's lists and serial fallbacks (`raster: Compute`).
+    pub raster: Option<crate::render::AtlasRasterReport>,
 }
 
 impl AtlasReport {

@@ -300,7 +300,7 @@ pub(crate) fn allocate(
 }
 
 /// The (x, y) cell of Morton index `i` (x in the even bits).
-fn morton_decode(i: u64) -> (u32, u32) {
+pub(crate) fn morton_decode(i: u64) -> (u32, u32) {
     fn compact(mut v: u64) -> u32 {
         v &= 0x5555_5555_5555_5555;
         v = (v | (v >> 1)) & 0x3333_3333_3333_3333;

@@ -13,6 +13,7 @@
 //! off the surface is the caller's job.
 
 pub mod atlas;
+pub(crate) mod atlas_cache;
 pub mod bvh;
 pub mod chunks;
 pub mod policy;

@@ -116,6 +116,9 @@ pub struct BenchRow {
     pub atlas_dropped: Option<u64>,
     /// Atlas views (tiles) rendered: one per spot light, six per point light or wide spot.
     pub atlas_views: Option<u64>,
+    /// Of those, the views the measured frame drew: all, or with `cache: true` the ones
+    /// whose light or tile changed (the rest were kept from the frame before).
+    pub atlas_views_rendered: Option<u64>,
     /// (pixel, light) pairs a ShadowCompare pass checked, and the fraction where the
     /// atlas disagrees with ray-cast shadows, per filter.
     pub shadow_pairs: Option<u64>,

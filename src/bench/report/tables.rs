@@ -37,7 +37,7 @@ fn opt<T: ToString>(v: Option<T>) -> String {
 /// row (first-seen order): `pass_ms:<name>` (median), `pass_ms_p10:<name>`, `pass_ms_p90:<name>`,
 /// empty where a row lacks that pass. Time columns are empty, not 0, for untimed rows; the
 /// ray-cast shadow columns (`shadow_*`, `bvh_*`) are empty for graphs without those passes.
-pub const CSV_COLUMNS: [&str; 55] = [
+pub const CSV_COLUMNS: [&str; 56] = [
     "scene",
     "technique",
     "params",
@@ -86,6 +86,7 @@ pub const CSV_COLUMNS: [&str; 55] = [
     "atlas_shadowed",
     "atlas_dropped",
     "atlas_views",
+    "atlas_views_rendered",
     "shadow_pairs",
     "pair_error_pcf5",
     "pair_error_2x2",
@@ -159,6 +160,7 @@ pub fn to_csv(rows: &[BenchRow]) -> String {
             opt(r.atlas_shadowed),
             opt(r.atlas_dropped),
             opt(r.atlas_views),
+            opt(r.atlas_views_rendered),
             opt(r.shadow_pairs),
             opt(r.pair_error_pcf5),
             opt(r.pair_error_2x2),
@@ -532,15 +534,15 @@ mod tests {
         let csv = to_csv(&[plain.clone(), shadowed.clone()]);
         let lines: Vec<&str> = csv.lines().collect();
         assert!(lines[0].ends_with(
-            ",passes_ms_total,reference,shadow_rays,shadow_rays_per_s,shadow_jobs_dropped,shadow_overflow_pixels,shadow_buffers_mib,bvh_mib,bvh_build_ms,atlas_mib,atlas_shadowed,atlas_dropped,atlas_views,shadow_pairs,pair_error_pcf5,pair_error_2x2,link_mib,links_per_list_pixel,link_scale,links_dropped"
+            ",passes_ms_total,reference,shadow_rays,shadow_rays_per_s,shadow_jobs_dropped,shadow_overflow_pixels,shadow_buffers_mib,bvh_mib,bvh_build_ms,atlas_mib,atlas_shadowed,atlas_dropped,atlas_views,atlas_views_rendered,shadow_pairs,pair_error_pcf5,pair_error_2x2,link_mib,links_per_list_pixel,link_scale,links_dropped"
         ));
         assert!(
-            lines[1].ends_with(",0,,brute_force,,,,,,,,,,,,,,,,,,"),
+            lines[1].ends_with(",0,,brute_force,,,,,,,,,,,,,,,,,,,"),
             "{}",
             lines[1]
         );
         assert!(
-            lines[2].ends_with(",raycast_shadows_naive,16,2500000000,0,1,1.5,20.4,180,,,,,,,,,,,"),
+            lines[2].ends_with(",raycast_shadows_naive,16,2500000000,0,1,1.5,20.4,180,,,,,,,,,,,,"),
             "{}",
             lines[2]
         );

@@ -336,6 +336,19 @@ mod tests {
     }
 
     #[test]
+    fn the_atlas_raster_sweep_parses() {
+        let path =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/sweeps/shadow_atlas_raster.ron");
+        let s = Sweep::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        // Two scenes × (four atlas graphs + the ray-cast reference).
+        assert_eq!(s.point_count(), 10);
+        assert_eq!(
+            s.reference_for("../benches/graphs/visibility_shadow_atlas_compute_cached.ron"),
+            "visibility_raycast_shadows.ron"
+        );
+    }
+
+    #[test]
     fn the_shadow_sweep_parses() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/sweeps/raycast_shadows.ron");
         let s = Sweep::load(&path).unwrap_or_else(|e| panic!("{e}"));

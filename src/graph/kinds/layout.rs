@@ -42,6 +42,8 @@ pub enum BufferLayout {
         max_views: u64,
         /// How shading samples the atlas.
         filter: shadow_atlas::ShadowFilter,
+        /// Who draws it, so its format: shading compares by hand in an R32Float atlas.
+        raster: shadow_atlas::AtlasRaster,
     },
     /// A `VplVisibility` pass's bits: `words` a block of `block`×`block` pixels.
     VplVisibility {

@@ -488,6 +488,7 @@ pub(crate) mod test_support {
         Texture(name: "geo", format: Rgba32Float),
         Texture(name: "atlas", format: Depth32Float, size: Fixed(2048, 2048)),
         Texture(name: "atlas_odd", format: Depth32Float, size: Fixed(1000, 1000)),
+        Texture(name: "atlas_f", format: R32Float, size: Fixed(2048, 2048)),
         Buffer(name: "views"),
         Buffer(name: "shadow_views"),
         Buffer(name: "jobs"),

@@ -193,10 +193,11 @@ pub(crate) const LIGHT_LISTS_READ: SlotSpec = SlotSpec::new(
 .optional()
 .needs(&[Contents::LightLists, Contents::LightLinks]);
 
-/// Rows every shading pass shares: a ShadowAtlas pass's atlas and view table, read.
+/// Rows every shading pass shares: a ShadowAtlas pass's atlas (Depth32Float, or R32Float
+/// from its compute raster) and view table, read.
 pub(crate) const SHADOW_ATLAS_READ: SlotSpec = SlotSpec::new(
     shadow_atlas::SHADOW_ATLAS,
-    SlotType::DepthTexture,
+    SlotType::DepthValues,
     Access::Read,
     Usage::Sampled,
 )

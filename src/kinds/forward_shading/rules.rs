@@ -59,30 +59,45 @@ pub enum Shadows {
     Mask,
     /// Casts a ray per light in the light loop.
     Trace,
-    /// Samples a shadow atlas, filtered as its ShadowAtlas pass says.
-    Atlas(super::shadow_atlas::ShadowFilter),
+    /// Samples a shadow atlas, filtered as its ShadowAtlas pass says; compared by hand
+    /// where its compute raster stored it as R32Float.
+    Atlas(
+        super::shadow_atlas::ShadowFilter,
+        super::shadow_atlas::AtlasRaster,
+    ),
     /// Samples the atlas for lights with a map this frame and reads the ray-cast mask
     /// for the rest (VisibilityShading only).
-    Hybrid(super::shadow_atlas::ShadowFilter),
+    Hybrid(
+        super::shadow_atlas::ShadowFilter,
+        super::shadow_atlas::AtlasRaster,
+    ),
 }
 
 /// The shadow source of a shading pass's slots; an atlas's filter is published on its
 /// view table's planned layout.
 pub fn shadows(roles: &crate::graph::PassRoles, plan: &crate::graph::ResourcePlan) -> Shadows {
     use super::shadow_atlas::SHADOW_VIEWS;
-    let filter = |views: &str| {
+    let atlas = |views: &str| {
         plan.get(views)
             .and_then(|r| match r.layout {
-                Some(super::BufferLayout::ShadowViews { filter, .. }) => Some(filter),
+                Some(super::BufferLayout::ShadowViews { filter, raster, .. }) => {
+                    Some((filter, raster))
+                }
                 _ => None,
             })
             .unwrap_or_default()
     };
     match (roles.slot(SHADOW_MASK), roles.slot(SHADOW_VIEWS)) {
-        (Some(_), Some(views)) => Shadows::Hybrid(filter(views)),
+        (Some(_), Some(views)) => {
+            let (filter, raster) = atlas(views);
+            Shadows::Hybrid(filter, raster)
+        }
         (Some(_), None) => Shadows::Mask,
         _ if roles.slot(BVH_NODES).is_some() => Shadows::Trace,
-        (None, Some(views)) => Shadows::Atlas(filter(views)),
+        (None, Some(views)) => {
+            let (filter, raster) = atlas(views);
+            Shadows::Atlas(filter, raster)
+        }
         (None, None) => Shadows::None,
     }
 }

@@ -1,12 +1,17 @@
 //! `ShadowAtlas`: allocates the atlas for the current view on the CPU
 //! (`shadow::atlas::allocate`), uploads the view table, and draws every view's visible
 //! casters into its tile, all views in one render pass (a viewport each, the view as
-//! the instance index). The allocation is redone once before the next frame whenever the
-//! camera or the lights moved (a viewer moving both between two frames pays for one).
+//! the instance index), or with the compute raster (`raster: Compute`,
+//! `shadow_atlas_raster`). The allocation is redone once before the next frame whenever
+//! the camera or the lights moved (a viewer moving both between two frames pays for one).
+//! With `cache: true` the lights that kept their tile side keep their place
+//! (`shadow::atlas_cache::keep_places`) and only the views the atlas does not hold yet
+//! are drawn.
 
+use super::shadow_atlas_raster::{pieces, ComputeAtlas, Work};
 use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::shadow_atlas::{
-    atlas_side, view_table_bytes, ShadowAtlas, SHADOW_ATLAS, SHADOW_VIEWS, VIEW_VEC4S,
+    atlas_side, view_table_bytes, AtlasRaster, ShadowAtlas, SHADOW_ATLAS, SHADOW_VIEWS, VIEW_VEC4S,
 };
 use crate::graph::Name;
 use crate::graph::{FrameSize, ResourceDesc, ScheduledPass};
@@ -16,8 +21,9 @@ use crate::render::report::{AtlasReport, PassReport};
 use crate::render::{RenderError, Renderer};
 use crate::scene::{Camera, Light};
 use crate::shadow::atlas::{allocate, box_in_frustum, frustum_planes, Allocation, AtlasConfig};
+use crate::shadow::atlas_cache::{keep_places, AtlasCache};
 use std::collections::BTreeMap;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 pub(super) struct ShadowAtlasPass {
@@ -44,10 +50,12 @@ pub(super) struct ShadowAtlasPass {
     /// the frame runs (the planned buffer may be shared with passes before this one).
     staging: wgpu::Buffer,
     table_bytes: u64,
-    draws: MeshDraws,
-    /// Writes the far depth over a tile (each view clears its own).
-    clear: Arc<wgpu::RenderPipeline>,
-    frame: Mutex<(Allocation, Vec<ViewDraw>)>,
+    raster: Raster,
+    frame: Mutex<Frame>,
+    /// What the atlas holds, when the pass keeps views across frames (`cache: true`).
+    cache: Option<Mutex<AtlasCache>>,
+    /// Views drawn by the last recorded frame.
+    rendered: AtomicU32,
     /// The camera or the lights changed since the last allocation: allocate again before
     /// the next frame is recorded or reported.
     stale: AtomicBool,
@@ -55,6 +63,25 @@ pub(super) struct ShadowAtlasPass {
     allocations: AtomicU64,
     /// Writes the table the allocation makes.
     queue: wgpu::Queue,
+}
+
+/// Who draws the views.
+enum Raster {
+    Hardware {
+        draws: MeshDraws,
+        /// Writes the far depth over a tile (each view clears its own).
+        clear: Arc<wgpu::RenderPipeline>,
+    },
+    Compute(Box<ComputeAtlas>),
+}
+
+/// The current allocation, each view's culled caster ranges, and the views to draw when
+/// the next frame is recorded (all of them without the cache).
+#[derive(Default)]
+struct Frame {
+    allocation: Allocation,
+    draws: Vec<ViewDraw>,
+    to_draw: Vec<u32>,
 }
 
 pub(super) fn prepare(
@@ -104,21 +131,48 @@ pub(super) fn prepare(
         usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let mut offered = cx.declared(sp)?;
-    // The vertex stage reads the table it is about to receive.
-    offered.buffer("shadow_views", &views);
-    let mode = DrawMode::AtlasDepth {
-        format,
-        depth_bias: p.depth_bias as i32,
-        slope_bias_bits: p.slope_bias.to_bits(),
+    let atlas = cx.view(&sp.name, atlas_name)?;
+    let (raster, casters) = match p.raster {
+        AtlasRaster::Hardware => {
+            let mut offered = cx.declared(sp)?;
+            // The vertex stage reads the table it is about to receive.
+            offered.buffer("shadow_views", &views);
+            let mode = DrawMode::AtlasDepth {
+                format,
+                depth_bias: p.depth_bias as i32,
+                slope_bias_bits: p.slope_bias.to_bits(),
+            };
+            let draws = cx.renderer.mesh_draws(
+                cx.gpu,
+                mode,
+                MeshSet::ShadowCasters,
+                1,
+                &sp.name,
+                &offered,
+            )?;
+            let clear = tile_clear_pipeline(cx, &sp.name, format)?;
+            let casters: Vec<usize> = draws.meshes().collect();
+            (Raster::Hardware { draws, clear }, casters)
+        }
+        AtlasRaster::Compute => {
+            // The casters in the order the hardware path draws them.
+            let casters = cx.gpu.shadow_caster_draws();
+            let compute = ComputeAtlas::prepare(
+                cx,
+                &sp.name,
+                &casters,
+                atlas.clone(),
+                side,
+                &views,
+                p.depth_bias,
+                p.slope_bias,
+            )?;
+            (Raster::Compute(Box::new(compute)), casters)
+        }
     };
-    let draws =
-        cx.renderer
-            .mesh_draws(cx.gpu, mode, MeshSet::ShadowCasters, 1, &sp.name, &offered)?;
-    let clear = tile_clear_pipeline(cx, &sp.name, format)?;
-    let meshes = draws
-        .meshes()
-        .map(|m| (cx.gpu.meshes[m].bounds, cx.gpu.meshes[m].chunks.clone()))
+    let meshes = casters
+        .iter()
+        .map(|&m| (cx.gpu.meshes[m].bounds, cx.gpu.meshes[m].chunks.clone()))
         .collect();
     let bytes_per_texel = format
         .block_copy_size(Some(wgpu::TextureAspect::DepthOnly))
@@ -141,14 +195,15 @@ pub(super) fn prepare(
         lights: Mutex::new(cx.scene.lights.clone()),
         camera: Mutex::new(cx.scene.camera),
         meshes,
-        atlas: cx.view(&sp.name, atlas_name)?,
+        atlas,
         atlas_bytes: side as u64 * side as u64 * bytes_per_texel as u64,
         views,
         staging,
         table_bytes,
-        draws,
-        clear,
-        frame: Mutex::new((Allocation::default(), Vec::new())),
+        raster,
+        frame: Mutex::new(Frame::default()),
+        cache: p.cache.then(|| Mutex::new(AtlasCache::default())),
+        rendered: AtomicU32::new(0),
         stale: AtomicBool::new(false),
         allocations: AtomicU64::new(0),
         queue: cx.renderer.ctx.queue.clone(),
@@ -255,6 +310,21 @@ impl ShadowAtlasPass {
             self.size.height,
             &self.config,
         );
+        let mut frame = self.frame.lock().unwrap_or_else(|e| e.into_inner());
+        let (a, to_draw) = match &self.cache {
+            Some(cache) => {
+                let a = keep_places(&frame.allocation, a, &self.config);
+                let stale = cache
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .stale_views(&a);
+                (a, stale)
+            }
+            None => {
+                let all = (0..a.views.len() as u32).collect();
+                (a, all)
+            }
+        };
         let max_views = self.max_views as usize;
         let mut table = vec![[0u32; 4]; (self.table_bytes / 16) as usize];
         table[0] = [
@@ -285,7 +355,7 @@ impl ShadowAtlasPass {
         }
         self.queue
             .write_buffer(&self.staging, 0, bytemuck::cast_slice(&table));
-        let draws = a
+        let draws: Vec<ViewDraw> = a
             .views
             .iter()
             .map(|view| {
@@ -316,7 +386,14 @@ impl ShadowAtlasPass {
                 }
             })
             .collect();
-        *self.frame.lock().unwrap_or_else(|e| e.into_inner()) = (a, draws);
+        if let Raster::Compute(compute) = &self.raster {
+            compute.upload(&compute_work(compute, &draws, &to_draw));
+        }
+        *frame = Frame {
+            allocation: a,
+            draws,
+            to_draw,
+        };
     }
 }
 
@@ -324,27 +401,51 @@ impl PreparedPass for ShadowAtlasPass {
     fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
         self.allocate_if_stale();
         encoder.copy_buffer_to_buffer(&self.staging, 0, &self.views, 0, self.table_bytes);
-        let frame = self.frame.lock().unwrap_or_else(|e| e.into_inner());
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(&self.name),
-            color_attachments: &[],
-            // Tiles are cleared one by one (record_views): loading is free, clearing the
-            // whole atlas is not (about 55 GB/s measured on the H200).
-            depth_stencil_attachment: Some(crate::render::draws::depth_attachment(
-                &self.atlas,
-                false,
-            )),
-            timestamp_writes: ts.render(),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        self.draws.record_views(&mut pass, &frame.1, &self.clear);
+        let mut frame = self.frame.lock().unwrap_or_else(|e| e.into_inner());
+        match &self.raster {
+            Raster::Hardware { draws, clear } => {
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some(&self.name),
+                    color_attachments: &[],
+                    // Tiles are cleared one by one (record_views): loading is free,
+                    // clearing the whole atlas is not (about 55 GB/s measured on the H200),
+                    // and the cache keeps the tiles not drawn.
+                    depth_stencil_attachment: Some(crate::render::draws::depth_attachment(
+                        &self.atlas,
+                        false,
+                    )),
+                    timestamp_writes: ts.render(),
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                draws.record_views(&mut pass, &frame.draws, &frame.to_draw, clear);
+            }
+            Raster::Compute(compute) => compute.record(encoder, &self.name, ts),
+        }
+        self.rendered
+            .store(frame.to_draw.len() as u32, Ordering::Relaxed);
+        if let Some(cache) = &self.cache {
+            // Once recorded, the atlas holds every view: the next frame draws none unless
+            // something changes.
+            cache
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .hold(&frame.allocation);
+            frame.to_draw.clear();
+            if let Raster::Compute(compute) = &self.raster {
+                compute.drawn();
+            }
+        }
     }
 
     fn report(&self, _r: &Renderer) -> Result<Option<PassReport>, RenderError> {
         self.allocate_if_stale();
+        let raster = match &self.raster {
+            Raster::Compute(compute) => Some(compute.report(_r)?),
+            Raster::Hardware { .. } => None,
+        };
         let frame = self.frame.lock().unwrap_or_else(|e| e.into_inner());
-        let (a, draws) = &*frame;
+        let (a, draws) = (&frame.allocation, &frame.draws);
         Ok(Some(PassReport::Atlas(AtlasReport {
             pass: self.name.to_string(),
             side: self.config.size,
@@ -364,6 +465,8 @@ impl PreparedPass for ShadowAtlasPass {
                 .flat_map(|d| d.ranges.iter().map(|r| r.2 as u64 / 3))
                 .sum(),
             allocations: self.allocations.load(Ordering::Relaxed),
+            views_rendered: self.rendered.load(Ordering::Relaxed),
+            raster,
         })))
     }
 
@@ -378,4 +481,27 @@ impl PreparedPass for ShadowAtlasPass {
         *self.camera.lock().unwrap_or_else(|e| e.into_inner()) = *camera;
         self.stale.store(true, Ordering::Release);
     }
+}
+
+/// The compute raster's lists for the views at `to_draw`: a job per culled range, each
+/// view's tile, the pieces of the tiles to store.
+fn compute_work(compute: &ComputeAtlas, draws: &[ViewDraw], to_draw: &[u32]) -> Work {
+    let mut work = Work {
+        rects: draws.iter().map(|d| [d.x, d.y, d.tile, 0]).collect(),
+        ..Work::default()
+    };
+    for &v in to_draw {
+        let d = &draws[v as usize];
+        for &(draw, first, count) in &d.ranges {
+            work.jobs.push([
+                work.pairs,
+                (compute.index_base[draw] + first) / 3,
+                count / 3,
+                v,
+            ]);
+            work.pairs += count / 3;
+        }
+        pieces(d.x, d.y, d.tile, &mut work.pieces);
+    }
+    work
 }

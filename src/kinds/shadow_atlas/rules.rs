@@ -48,6 +48,26 @@ pub struct ShadowAtlas {
     /// lowest-ranked lights (`DropLights`).
     #[serde(default)]
     pub fit: AtlasFit,
+    /// Which units draw the views: the raster pipeline into a Depth32Float atlas, or
+    /// the compute rasterizer into an R32Float one (`shaders/shadow/atlas_raster.wgsl`).
+    #[serde(default)]
+    pub raster: AtlasRaster,
+    /// Keep the views whose light, tile and casters did not change since the last frame
+    /// instead of drawing them again (`shadow::atlas_cache`).
+    #[serde(default)]
+    pub cache: bool,
+}
+
+/// Who rasterizes the atlas's views.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
+pub enum AtlasRaster {
+    /// The raster pipeline: depth-only draws, a viewport a view, into Depth32Float.
+    #[default]
+    Hardware,
+    /// Compute: a thread per (view, triangle), 32-bit atomic min of the depth bits into
+    /// a buffer, stored into an R32Float atlas that shading compares by hand (compute
+    /// cannot store a depth format). Refuses alpha-masked casters.
+    Compute,
 }
 
 /// How a shading pass reads the atlas.
@@ -95,6 +115,8 @@ impl Default for ShadowAtlas {
             normal_offset: default_normal_offset(),
             policy: AtlasPolicy::default(),
             fit: AtlasFit::default(),
+            raster: AtlasRaster::default(),
+            cache: false,
         }
     }
 }
@@ -125,9 +147,9 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     super::GEOMETRY_READ,
     SlotSpec::new(
         SHADOW_ATLAS,
-        SlotType::DepthTexture,
+        SlotType::DepthValues,
         Access::Write,
-        Usage::Attachment,
+        Usage::AttachmentOrStorage,
     ),
     SlotSpec::new(SHADOW_VIEWS, SlotType::Buffer, Access::Write, Usage::Bound),
 ];
@@ -184,6 +206,24 @@ pub(crate) fn check(p: &ShadowAtlas, ctx: &KindCtx, errors: &mut Vec<GraphError>
             )),
             Some(_) => {}
         }
+        check_format(p, ctx, atlas, errors);
+    }
+}
+
+/// The atlas's format is the raster's: a depth format to draw into, R32Float to store
+/// from compute.
+fn check_format(p: &ShadowAtlas, ctx: &KindCtx, atlas: &str, errors: &mut Vec<GraphError>) {
+    let float = ctx.is_float_depth(atlas);
+    match p.raster {
+        AtlasRaster::Hardware if float => errors.push(ctx.mismatch(
+            atlas,
+            "raster: Hardware draws depth into the atlas: declare it format: Depth32Float (R32Float is for raster: Compute)",
+        )),
+        AtlasRaster::Compute if !float => errors.push(ctx.mismatch(
+            atlas,
+            "raster: Compute stores depths from compute, which cannot write a depth format: declare the atlas format: R32Float",
+        )),
+        _ => {}
     }
 }
 
@@ -222,6 +262,7 @@ impl KindRules for ShadowAtlas {
             lights: frame.lights,
             max_views: self.max_views(),
             filter: self.filter,
+            raster: self.raster,
         })
     }
 }
@@ -290,5 +331,26 @@ mod tests {
             "hdr",
         );
         assert!(e.contains("fixed power-of-two size"), "{e}");
+    }
+
+    #[test]
+    fn the_atlas_format_follows_the_raster() {
+        // "atlas" is Depth32Float 2048² (test_support); "atlas_f" an R32Float one.
+        let e = errors(&PASSES.replace("ATLAS", "raster: Compute"), "hdr");
+        assert!(
+            e.contains("raster: Compute stores depths from compute") && e.contains("R32Float"),
+            "{e}"
+        );
+        let float = PASSES.replace("\"atlas\"", "\"atlas_f\"");
+        validate(
+            &float.replace("ATLAS", "raster: Compute, cache: true"),
+            "hdr",
+        )
+        .unwrap();
+        let e = errors(&float.replace("ATLAS", ""), "hdr");
+        assert!(
+            e.contains("raster: Hardware draws depth into the atlas"),
+            "{e}"
+        );
     }
 }

@@ -3,6 +3,8 @@
 
 use super::{defines, dispatch, pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::gpu::readback::read_buffer_range;
+use crate::graph::kinds::forward_shading::Shadows;
+use crate::graph::kinds::shadow_atlas::ShadowFilter;
 use crate::graph::kinds::shadow_compare::{ERROR_WORDS, SHADOW_ERRORS};
 use crate::graph::kinds::shadow_ray_cast::DEFAULT_NORMAL_OFFSET;
 use crate::graph::Name;
@@ -41,14 +43,23 @@ pub(super) fn prepare(
     let params = cx.list_params(&sp.name, sp.required(slot::LIGHT_LISTS))?;
     offered.buffer("list_params", &params);
     offered.offer("shadow_sampler", super::comparison_sampler(&cx.device()));
+    // Both filters are compared; the atlas's raster says how it is read.
+    let raster = match crate::graph::kinds::forward_shading::shadows(&sp.roles, &cx.graph.plan) {
+        Shadows::Atlas(_, raster) => raster,
+        _ => Default::default(),
+    };
+    let mut d = vec![
+        ("LIGHT_LISTS", "1".into()),
+        ("SHADOW_NORMAL_OFFSET", format!("{DEFAULT_NORMAL_OFFSET:?}")),
+    ];
+    d.extend(
+        crate::render::draws::atlas_defines(ShadowFilter::Hardware2x2, raster)
+            .into_iter()
+            .filter(|(k, _)| *k != "SHADOW_PCF5"),
+    );
     let key = PipelineKey {
         shader: "shadow/shadow_compare.wgsl".into(),
-        defines: defines(&[
-            ("LIGHT_LISTS", "1".into()),
-            ("SHADOW_ATLAS", "1".into()),
-            ("SHADOW_ATLAS_LIGHTS", "1".into()),
-            ("SHADOW_NORMAL_OFFSET", format!("{DEFAULT_NORMAL_OFFSET:?}")),
-        ]),
+        defines: defines(&d),
         virtual_code: BTreeMap::new(),
         state: String::new(),
     };

@@ -128,17 +128,10 @@ pub(super) fn shadow_defines(shadows: Shadows) -> Vec<(&'static str, String)> {
             ("SHADOW_TRACE", "1".into()),
             ("SHADOW_NORMAL_OFFSET", offset),
         ],
-        Shadows::Atlas(filter) | Shadows::Hybrid(filter) => {
-            let mut d = vec![
-                ("SHADOWS", "1".into()),
-                ("SHADOW_ATLAS", "1".into()),
-                ("SHADOW_ATLAS_LIGHTS", "1".into()),
-                ("SHADOW_NORMAL_OFFSET", offset),
-            ];
-            if filter == crate::graph::kinds::shadow_atlas::ShadowFilter::Pcf5x5 {
-                d.push(("SHADOW_PCF5", "1".into()));
-            }
-            if matches!(shadows, Shadows::Hybrid(_)) {
+        Shadows::Atlas(filter, raster) | Shadows::Hybrid(filter, raster) => {
+            let mut d = vec![("SHADOWS", "1".into()), ("SHADOW_NORMAL_OFFSET", offset)];
+            d.extend(atlas_defines(filter, raster));
+            if matches!(shadows, Shadows::Hybrid(..)) {
                 d.push(("SHADOW_MASK", "1".into()));
                 d.push(("SHADOW_HYBRID", "1".into()));
             }
@@ -146,6 +139,28 @@ pub(super) fn shadow_defines(shadows: Shadows) -> Vec<(&'static str, String)> {
         }
     }
 }
+
+/// How the light loop samples a shadow atlas (`SHADOW_ATLAS`): its filter, and whether
+/// it compares by hand in an R32Float atlas (`SHADOW_ATLAS_FLOAT`, a compute raster's).
+pub(super) fn atlas_defines(
+    filter: crate::graph::kinds::shadow_atlas::ShadowFilter,
+    raster: crate::graph::kinds::shadow_atlas::AtlasRaster,
+) -> Vec<(&'static str, String)> {
+    use crate::graph::kinds::shadow_atlas::{AtlasRaster, ShadowFilter};
+    // The atlas's light entries (SHADOW_ATLAS_LIGHTS) come with every atlas read.
+    let mut d = vec![
+        ("SHADOW_ATLAS", "1".into()),
+        ("SHADOW_ATLAS_LIGHTS", "1".into()),
+    ];
+    if filter == ShadowFilter::Pcf5x5 {
+        d.push(("SHADOW_PCF5", "1".into()));
+    }
+    if raster == AtlasRaster::Compute {
+        d.push(("SHADOW_ATLAS_FLOAT", "1".into()));
+    }
+    d
+}
+
 /// The bind group the generated material code declares its textures in.
 pub(super) const MATERIAL_GROUP: u32 = 2;
 

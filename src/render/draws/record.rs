@@ -21,16 +21,18 @@ impl MeshDraws {
         self.draws.iter().map(|d| d.mesh)
     }
 
-    /// Clears each view's viewport with `clear` (a pipeline without bindings), then draws
-    /// its visible meshes there with the view's index as the instance (the shader reads
-    /// its projection from it).
+    /// Clears the viewport of each view at `which` (indices into `views`) with `clear` (a
+    /// pipeline without bindings), then draws its visible meshes there with the view's
+    /// index as the instance (the shader reads its projection from it).
     pub fn record_views(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
         views: &[ViewDraw],
+        which: &[u32],
         clear: &wgpu::RenderPipeline,
     ) {
-        for (v, view) in views.iter().enumerate() {
+        for &v in which {
+            let view = &views[v as usize];
             let (x, y, t) = (view.x, view.y, view.tile);
             pass.set_viewport(x as f32, y as f32, t as f32, t as f32, 0.0, 1.0);
             pass.set_scissor_rect(x, y, t, t);
@@ -40,7 +42,7 @@ impl MeshDraws {
             if let Some(bind) = &self.bind {
                 pass.set_bind_group(0, bind, &[]);
             }
-            let instance = v as u32;
+            let instance = v;
             let mut bound: Option<usize> = None;
             for &(draw, first, count) in &view.ranges {
                 let d = &self.draws[draw];

@@ -20,6 +20,7 @@ use crate::graph::kinds::built_in_kinds;
 use crate::graph::{
     CompiledGraph, FrameSize, PassKind, ResourceDesc, SceneResource, ScheduledPass,
 };
+pub use shadow_atlas_raster::AtlasRasterReport;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 pub(crate) use vpl_visibility::VplLookup;
@@ -287,7 +288,7 @@ impl PrepareCtx<'_> {
             return Shadows::None;
         }
         let s = shadows(&sp.roles, &self.graph.plan);
-        if let Shadows::Atlas(_) | Shadows::Hybrid(_) = s {
+        if let Shadows::Atlas(..) | Shadows::Hybrid(..) = s {
             offered.offer("shadow_sampler", comparison_sampler(&self.device()));
         }
         s

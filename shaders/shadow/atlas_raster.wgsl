@@ -1,0 +1,477 @@
+// The shadow atlas's compute raster (ShadowAtlas with raster: Compute): every view's
+// casters rasterized in compute, off the raster units (a GH100 runs graphics on a few of
+// its SMs and compute on all). Depth only, as the hardware atlas: a 32-bit atomic min of
+// the depth's bits per texel (non-negative floats order as their bits), so the result
+// does not depend on the order triangles land in.
+//
+// Per (view, triangle) pair, as the raster pipeline does for a depth-only draw into the
+// view's viewport: clip space from the view table's view-projection (the vertex stage's
+// expression), clipped against the near plane and the viewport's sides where a vertex
+// lies outside, vertices snapped to 1/256 texel in atlas coordinates, both faces drawn,
+// texel centres tested with exact 64-bit edge functions and the top-left rule, depth
+// from the triangle's plane, texels past the far plane dropped, then the pipeline's
+// depth bias (Vulkan's: DEPTH_BIAS units of 2^(e − 23), e the exponent of the largest
+// vertex depth, plus SLOPE_BIAS × the larger depth slope) and the clamp to [0, 1].
+// (visibility/compute_raster.wgsl is the frame's twin; this one has no ids and draws
+// into many small viewports.)
+//
+// Three dispatches:
+// - `setup` (SETUP), a thread per pair: the pair's job found by binary search in `jobs`
+//   (runs of one view's consecutive triangles, as the hardware path draws them); clip,
+//   snap; a fan triangle whose texel box holds at most SMALL_BOX texels is rasterized in
+//   the thread, a larger one recorded with an entry per CELL² cell its edges may reach.
+// - `raster` (RASTER, indirect), a workgroup per cell entry, four texels a thread.
+// - `store` (STORE), a workgroup per STORE_CELL² piece of a drawn view: the depth
+//   buffer's texels into the R32Float atlas, and the buffer back to the far depth, so it
+//   is clear for the next frame's views (it starts so).
+// A full list loses nothing: the thread rasterizes the triangle or cell itself, counted.
+
+struct Params {
+    // Pairs, jobs, workgroups per dispatch dimension, atlas side.
+    work: vec4<u32>,
+    // Capacities of the record and cell lists; unused.
+    capacity: vec4<u32>,
+};
+
+@group(0) @binding(0) var<uniform> params: Params;
+#if STORE
+// Pieces (x, y, side) of the drawn views, side at most STORE_CELL.
+@group(0) @binding(5) var<storage, read> pieces: array<vec4<u32>>;
+@group(0) @binding(6) var<storage, read_write> depth: array<u32>;
+@group(0) @binding(11) var atlas: texture_storage_2d<r32float, write>;
+#else
+@group(0) @binding(6) var<storage, read_write> depth: array<atomic<u32>>;
+#if SETUP
+@group(0) @binding(1) var<storage, read> shadow_views: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read> positions: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read> indices: array<u32>;
+// (first pair, first triangle, triangles, view), by first pair.
+@group(0) @binding(4) var<storage, read> jobs: array<vec4<u32>>;
+// Per view: its tile's x, y and side in the atlas.
+@group(0) @binding(5) var<storage, read> rects: array<vec4<u32>>;
+@group(0) @binding(7) var<storage, read_write> records: array<vec4<u32>>;
+@group(0) @binding(8) var<storage, read_write> cells: array<vec2<u32>>;
+@group(0) @binding(9) var<storage, read_write> counters: array<atomic<u32>, 4>;
+@group(0) @binding(10) var<storage, read_write> args: array<atomic<u32>, 4>;
+#endif
+#if RASTER
+@group(0) @binding(7) var<storage, read> records: array<vec4<u32>>;
+@group(0) @binding(8) var<storage, read> cells: array<vec2<u32>>;
+@group(0) @binding(9) var<storage, read> counters: array<u32, 4>;
+#endif
+#endif
+
+const SUBPIXEL: f32 = 256.0;
+const HALF_TEXEL: i32 = 128;
+const MAX_POLY: u32 = 8u;
+// Texels a fan triangle's box may hold to be rasterized in its setup thread.
+const SMALL_BOX: i32 = 64;
+// Texels per side of a cell entry (a 256-thread workgroup, four texels a thread).
+const CELL: u32 = 32u;
+const CELL_THREADS: u32 = 256u;
+// Counter slots: records and cells appended (past the capacity too), then fan triangles
+// and cells rasterized in setup because their list was full.
+const RECORDS: u32 = 0u;
+const CELLS: u32 = 1u;
+const SERIAL_TRIANGLES: u32 = 2u;
+const SERIAL_CELLS: u32 = 3u;
+const FAR_BITS: u32 = 0x3f800000u;
+
+#if STORE
+@compute @workgroup_size(STORE_CELL, STORE_CELL)
+fn store(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(local_invocation_id) local: vec3<u32>,
+) {
+    let i = wg.y * params.work.z + wg.x;
+    if (i >= params.work.x) {
+        return;
+    }
+    let piece = pieces[i];
+    if (any(local.xy >= vec2<u32>(piece.z))) {
+        return;
+    }
+    let p = piece.xy + local.xy;
+    let at = p.y * params.work.w + p.x;
+    textureStore(atlas, vec2<i32>(p), vec4<f32>(bitcast<f32>(depth[at]), 0.0, 0.0, 0.0));
+    depth[at] = FAR_BITS;
+}
+#else
+
+struct Tri {
+    // Snapped vertices (1/256 texel, atlas coordinates).
+    a: vec2<i32>,
+    b: vec2<i32>,
+    c: vec2<i32>,
+    // -1 on the edges b -> c, c -> a, a -> b that are not top or left edges, else 0.
+    bias: vec3<i32>,
+    // The first vertex unsnapped (x, y in texels, depth), the depth's slopes.
+    sa: vec3<f32>,
+    dz: vec2<f32>,
+    // The depth bias, added to every texel's depth.
+    offset: f32,
+    // Texels whose centres lie in the vertices' box, within the view's tile.
+    box: vec4<i32>,
+};
+
+fn edge(a: vec2<i32>, b: vec2<i32>, p: vec2<i32>) -> i64 {
+    return i64(b.x - a.x) * i64(p.y - a.y) - i64(b.y - a.y) * i64(p.x - a.x);
+}
+
+// Texel (px, py) of `t`, if its centre is covered and its depth within the far plane.
+fn cover(t: Tri, px: i32, py: i32) {
+    let p = vec2<i32>(px, py) * 256 + vec2<i32>(HALF_TEXEL);
+    if (edge(t.b, t.c, p) + i64(t.bias.x) < 0 || edge(t.c, t.a, p) + i64(t.bias.y) < 0 || edge(t.a, t.b, p) + i64(t.bias.z) < 0) {
+        return;
+    }
+    let centre = vec2<f32>(f32(px) + 0.5, f32(py) + 0.5);
+    let z = t.sa.z + t.dz.x * (centre.x - t.sa.x) + t.dz.y * (centre.y - t.sa.y);
+    if (!(z <= 1.0)) {
+        return;
+    }
+    let d = min(z + t.offset, 1.0);
+    // Clamped at 0 (also -0.0, whose bits would order last).
+    let bits = select(bitcast<u32>(d), 0u, !(d > 0.0));
+    atomicMin(&depth[u32(py) * params.work.w + u32(px)], bits);
+}
+
+// Every texel of `region` (x0, y0, x1, y1, inclusive) in this thread.
+fn raster_region(t: Tri, region: vec4<i32>) {
+    for (var y = region.y; y <= region.w; y++) {
+        for (var x = region.x; x <= region.z; x++) {
+            cover(t, x, y);
+        }
+    }
+}
+
+fn pack_point(p: vec2<i32>) -> u32 {
+    return u32(p.x) | (u32(p.y) << 16u);
+}
+
+fn unpack_point(v: u32) -> vec2<i32> {
+    return vec2<i32>(vec2<u32>(v & 0xffffu, v >> 16u));
+}
+
+fn load_record(r: u32) -> Tri {
+    let i = 4u * r;
+    let w0 = records[i];
+    let w1 = records[i + 1u];
+    let w2 = records[i + 2u];
+    let w3 = records[i + 3u];
+    var t: Tri;
+    t.a = bitcast<vec2<i32>>(w0.xy);
+    t.b = bitcast<vec2<i32>>(w0.zw);
+    t.c = bitcast<vec2<i32>>(w1.xy);
+    t.box = vec4<i32>(unpack_point(w1.z), unpack_point(w1.w));
+    t.sa = bitcast<vec3<f32>>(w2.xyz);
+    t.dz = vec2<f32>(bitcast<f32>(w2.w), bitcast<f32>(w3.x));
+    t.offset = bitcast<f32>(w3.y);
+    t.bias = -vec3<i32>(vec3<u32>(w3.z, w3.z >> 1u, w3.z >> 2u) & vec3<u32>(1u));
+    return t;
+}
+
+// The texels of cell `cell` within the triangle's box.
+fn cell_region(box: vec4<i32>, cell: vec2<u32>) -> vec4<i32> {
+    let lo = vec2<i32>(cell * CELL);
+    let hi = lo + vec2<i32>(i32(CELL) - 1);
+    return vec4<i32>(max(lo, box.xy), min(hi, box.zw));
+}
+
+#if SETUP
+
+fn store_record(r: u32, t: Tri) {
+    let i = 4u * r;
+    let flags = u32(-t.bias.x) | (u32(-t.bias.y) << 1u) | (u32(-t.bias.z) << 2u);
+    records[i] = bitcast<vec4<u32>>(vec4<i32>(t.a, t.b));
+    records[i + 1u] = vec4<u32>(bitcast<vec2<u32>>(t.c), pack_point(t.box.xy), pack_point(t.box.zw));
+    records[i + 2u] = vec4<u32>(bitcast<vec3<u32>>(t.sa), bitcast<u32>(t.dz.x));
+    records[i + 3u] = vec4<u32>(bitcast<u32>(t.dz.y), bitcast<u32>(t.offset), flags, 0u);
+}
+
+// The near plane (z >= 0) and the viewport's four sides.
+fn plane_distance(c: vec4<f32>, k: u32) -> f32 {
+    if (k == 0u) {
+        return c.z;
+    }
+    let axis = select(c.y, c.x, k < 3u);
+    return c.w + select(axis, -axis, k % 2u == 1u);
+}
+
+fn needs_clipping(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) -> bool {
+    for (var k = 0u; k < 5u; k++) {
+        if (plane_distance(a, k) < 0.0 || plane_distance(b, k) < 0.0 || plane_distance(c, k) < 0.0) {
+            return true;
+        }
+    }
+    return false;
+}
+
+struct Polygon {
+    v: array<vec4<f32>, MAX_POLY>,
+    n: u32,
+};
+
+// Sutherland-Hodgman, each new point computed from the outside vertex (as the frame's
+// compute raster and Mesa's clipper), fanned from vertex 0.
+fn clip_triangle(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) -> Polygon {
+    var p: Polygon;
+    p.v[0] = a;
+    p.v[1] = b;
+    p.v[2] = c;
+    p.n = 3u;
+    for (var k = 0u; k < 5u; k++) {
+        var outside = 0u;
+        for (var i = 0u; i < p.n; i++) {
+            outside += u32(plane_distance(p.v[i], k) < 0.0);
+        }
+        if (outside == 0u) {
+            continue;
+        }
+        var q: Polygon;
+        q.n = 0u;
+        for (var i = 0u; i < p.n; i++) {
+            let s = p.v[i];
+            let e = p.v[(i + 1u) % p.n];
+            let ds = plane_distance(s, k);
+            let de = plane_distance(e, k);
+            if (ds >= 0.0) {
+                q.v[q.n] = s;
+                q.n++;
+            }
+            if ((ds >= 0.0) != (de >= 0.0)) {
+                if (ds >= 0.0) {
+                    q.v[q.n] = e + de / (de - ds) * (s - e);
+                } else {
+                    q.v[q.n] = s + ds / (ds - de) * (e - s);
+                }
+                q.n++;
+            }
+        }
+        p = q;
+        if (p.n < 3u) {
+            p.n = 0u;
+            break;
+        }
+    }
+    return p;
+}
+
+// Atlas position (texels, y down) and depth, as the viewport transform of the view's
+// tile: `rect` is (x, y, side).
+fn to_screen(c: vec4<f32>, rect: vec4<u32>) -> vec3<f32> {
+    let ndc = c.xyz * (1.0 / c.w);
+    let half = f32(rect.z) * 0.5;
+    let origin = vec2<f32>(rect.xy) + vec2<f32>(half);
+    return vec3<f32>(ndc.x * half + origin.x, ndc.y * -half + origin.y, ndc.z);
+}
+
+fn snap(p: vec3<f32>) -> vec2<i32> {
+    return vec2<i32>(round(p.xy * SUBPIXEL));
+}
+
+// Texels whose centres lie in [lo, hi] (fixed point), within the tile.
+fn texel_box(lo: vec2<i32>, hi: vec2<i32>, rect: vec4<u32>) -> vec4<i32> {
+    let first = -((vec2<i32>(HALF_TEXEL) - lo) >> vec2<u32>(8u));
+    let last = (hi - vec2<i32>(HALF_TEXEL)) >> vec2<u32>(8u);
+    let tile_lo = vec2<i32>(rect.xy);
+    let tile_hi = tile_lo + vec2<i32>(i32(rect.z) - 1);
+    return vec4<i32>(max(first, tile_lo), min(last, tile_hi));
+}
+
+// The top-left rule for an edge of a clockwise triangle (y down).
+fn top_left(a: vec2<i32>, b: vec2<i32>) -> bool {
+    let d = b - a;
+    return d.y < 0 || (d.y == 0 && d.x > 0);
+}
+
+// Whether some texel centre of `region` may lie inside edge a -> b: its function is not
+// negative at the corner where it is largest (exact: the function is linear).
+fn edge_reaches(a: vec2<i32>, b: vec2<i32>, bias: i32, lo: vec2<i32>, hi: vec2<i32>) -> bool {
+    let p = vec2<i32>(select(lo.x, hi.x, b.y < a.y), select(lo.y, hi.y, b.x > a.x));
+    return edge(a, b, p) + i64(bias) >= 0;
+}
+
+fn may_cover(t: Tri, region: vec4<i32>) -> bool {
+    let lo = region.xy * 256 + vec2<i32>(HALF_TEXEL);
+    let hi = region.zw * 256 + vec2<i32>(HALF_TEXEL);
+    return edge_reaches(t.b, t.c, t.bias.x, lo, hi) && edge_reaches(t.c, t.a, t.bias.y, lo, hi) && edge_reaches(t.a, t.b, t.bias.z, lo, hi);
+}
+
+// The pipeline's depth bias for a triangle of vertex depths `z` and slopes `dz`.
+fn depth_bias(z: vec3<f32>, dz: vec2<f32>) -> f32 {
+    let top = max(abs(z.x), max(abs(z.y), abs(z.z)));
+    // 2^(e − 23): the exponent bits of the largest depth, 23 lower.
+    let exponent = bitcast<u32>(top) & 0x7f800000u;
+    let unit = select(0.0, bitcast<f32>(exponent - (23u << 23u)), exponent > (23u << 23u));
+    return DEPTH_BIAS * unit + SLOPE_BIAS * max(abs(dz.x), abs(dz.y));
+}
+
+fn setup_triangle(ca: vec4<f32>, cb: vec4<f32>, cc: vec4<f32>, rect: vec4<u32>) {
+    let sa = to_screen(ca, rect);
+    var sb = to_screen(cb, rect);
+    var sc = to_screen(cc, rect);
+    let a = snap(sa);
+    var b = snap(sb);
+    var c = snap(sc);
+    var area = edge(a, b, c);
+    if (area == 0) {
+        return;
+    }
+    // Both faces: orient clockwise (positive area) for the edge tests.
+    if (area < 0) {
+        let t = b;
+        b = c;
+        c = t;
+        let s = sb;
+        sb = sc;
+        sc = s;
+    }
+    let box = texel_box(min(a, min(b, c)), max(a, max(b, c)), rect);
+    if (box.x > box.z || box.y > box.w) {
+        return;
+    }
+    let e1 = sb - sa;
+    let e2 = sc - sa;
+    let det = e1.x * e2.y - e1.y * e2.x;
+    var t: Tri;
+    t.a = a;
+    t.b = b;
+    t.c = c;
+    t.bias = -vec3<i32>(select(1, 0, top_left(b, c)), select(1, 0, top_left(c, a)), select(1, 0, top_left(a, b)));
+    t.sa = sa;
+    t.dz = vec2<f32>((e1.z * e2.y - e2.z * e1.y) / det, (e2.z * e1.x - e1.z * e2.x) / det);
+    t.offset = depth_bias(vec3<f32>(sa.z, sb.z, sc.z), t.dz);
+    t.box = box;
+    let size = box.zw - box.xy + vec2<i32>(1);
+    if (size.x * size.y <= SMALL_BOX) {
+        raster_region(t, box);
+        return;
+    }
+    let r = atomicAdd(&counters[RECORDS], 1u);
+    if (r >= params.capacity.x) {
+        atomicAdd(&counters[SERIAL_TRIANGLES], 1u);
+        raster_region(t, box);
+        return;
+    }
+    store_record(r, t);
+    let first = vec2<u32>(box.xy) / CELL;
+    let last = vec2<u32>(box.zw) / CELL;
+    // Count the cells the edges may reach, reserve them at once, then list them.
+    var n = 0u;
+    for (var cy = first.y; cy <= last.y; cy++) {
+        for (var cx = first.x; cx <= last.x; cx++) {
+            n += u32(may_cover(t, cell_region(box, vec2<u32>(cx, cy))));
+        }
+    }
+    if (n == 0u) {
+        return;
+    }
+    // Reserved only while the list has room, so the counter passes the capacity by at
+    // most the racing threads' reservations and does not wrap.
+    let capacity = params.capacity.y;
+    var slot = capacity;
+    if (atomicLoad(&counters[CELLS]) < capacity) {
+        slot = atomicAdd(&counters[CELLS], n);
+    }
+    let end = min(slot + n, capacity);
+    if (end > slot) {
+        let groups = vec2<u32>(min(end, params.work.z), (end + params.work.z - 1u) / params.work.z);
+        atomicMax(&args[0], groups.x);
+        atomicMax(&args[1], groups.y);
+        atomicMax(&args[2], 1u);
+    }
+    var serial = 0u;
+    for (var cy = first.y; cy <= last.y; cy++) {
+        for (var cx = first.x; cx <= last.x; cx++) {
+            let region = cell_region(box, vec2<u32>(cx, cy));
+            if (!may_cover(t, region)) {
+                continue;
+            }
+            if (slot < capacity) {
+                cells[slot] = vec2<u32>(r, cx | (cy << 16u));
+            } else {
+                serial++;
+                raster_region(t, region);
+            }
+            slot++;
+        }
+    }
+    if (serial > 0u) {
+        atomicAdd(&counters[SERIAL_CELLS], serial);
+    }
+}
+
+// The job holding pair `i`: the last whose first pair is at most i.
+fn find_job(i: u32) -> u32 {
+    var lo = 0u;
+    var hi = params.work.y;
+    while (hi - lo > 1u) {
+        let mid = (lo + hi) / 2u;
+        if (jobs[mid].x <= i) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+fn clip_position(view_proj: mat4x4<f32>, v: u32) -> vec4<f32> {
+    return view_proj * vec4<f32>(positions[v].xyz, 1.0);
+}
+
+@compute @workgroup_size(GROUP)
+fn setup(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    let i = (wg.y * groups.x + wg.x) * GROUP + local;
+    if (i >= params.work.x) {
+        return;
+    }
+    let job = jobs[find_job(i)];
+    let tri = job.y + (i - job.x);
+    let base = 1u + 6u * job.w;
+    let view_proj = mat4x4<f32>(shadow_views[base], shadow_views[base + 1u], shadow_views[base + 2u], shadow_views[base + 3u]);
+    let rect = rects[job.w];
+    let a = clip_position(view_proj, indices[3u * tri]);
+    let b = clip_position(view_proj, indices[3u * tri + 1u]);
+    let c = clip_position(view_proj, indices[3u * tri + 2u]);
+    if (!needs_clipping(a, b, c)) {
+        setup_triangle(a, b, c, rect);
+        return;
+    }
+    let poly = clip_triangle(a, b, c);
+    for (var k = 1u; k + 1u < poly.n; k++) {
+        setup_triangle(poly.v[0], poly.v[k], poly.v[k + 1u], rect);
+    }
+}
+#endif
+#if RASTER
+
+// A workgroup per cell entry, four rows of texels a thread.
+@compute @workgroup_size(CELL_THREADS)
+fn raster(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+) {
+    let i = wg.y * params.work.z + wg.x;
+    if (i >= min(counters[CELLS], params.capacity.y)) {
+        return;
+    }
+    let entry = cells[i];
+    let t = load_record(entry.x);
+    let region = cell_region(t.box, vec2<u32>(unpack_point(entry.y)));
+    let rows = CELL_THREADS / CELL;
+    let x = region.x - region.x % i32(CELL) + i32(local % CELL);
+    let y0 = region.y - region.y % i32(CELL) + i32(local / CELL);
+    for (var k = 0u; k < CELL / rows; k++) {
+        let y = y0 + i32(k * rows);
+        if (x >= region.x && x <= region.z && y >= region.y && y <= region.w) {
+            cover(t, x, y);
+        }
+    }
+}
+#endif
+#endif

@@ -1,0 +1,559 @@
+//! `ShadowAtlas(raster: Compute)`: the atlas's views rasterized in compute
+//! (`shaders/shadow/atlas_raster.wgsl`). The casters are merged once into one position
+//! and one index buffer (each mesh's triangles in its shadow chunk order, as the
+//! hardware path draws them); per frame the CPU lists the views to draw as jobs (a run of
+//! one view's consecutive triangles) and their tiles; `setup` (a thread per view and
+//! triangle), `raster` (indirect, a workgroup per 32² cell of a large triangle) and
+//! `store` (the depth buffer into the R32Float atlas, and back to far) run in one
+//! compute pass.
+
+use super::{grid, pass_error, PrepareCtx, Timestamps};
+use crate::gpu::readback::read_buffer;
+use crate::render::pipelines::{Pipeline, PipelineKey};
+use crate::render::scene_gpu::SceneGpu;
+use crate::render::{RenderError, Renderer};
+use crate::scene::AlphaMode;
+use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex};
+use wgpu::util::DeviceExt;
+
+const SHADER: &str = "shadow/atlas_raster.wgsl";
+/// Threads per setup workgroup (a thread per view and triangle).
+const GROUP: u32 = 64;
+/// Texels per side of a store workgroup's piece.
+const STORE_CELL: u32 = 16;
+/// Texels per side of a cell entry (the shader's CELL).
+const CELL: u32 = 32;
+/// Bytes of a record and of a cell entry (as the shader's).
+const RECORD_BYTES: u64 = 64;
+const ENTRY_BYTES: u64 = 8;
+/// Most records (the record counter grows by one a fan triangle past it, at most six a
+/// pair).
+const MAX_RECORDS: u64 = 1 << 24;
+/// Counter words (the shader's RECORDS..SERIAL_CELLS).
+const COUNTERS: u64 = 4;
+/// Test hook: `records=N,cells=N` (either) caps the lists' capacities below what
+/// prepare sizes, so tests can fill them and watch the serial fallback. Read when the
+/// pass is prepared; a malformed value is an error naming it.
+pub const TEST_LIMITS_VAR: &str = "LIGHTGRAPH_ATLAS_RASTER_TEST_LIMITS";
+
+/// The test hook's caps on (records, cells).
+fn test_limits() -> Result<[Option<u32>; 2], String> {
+    let mut caps = [None, None];
+    let Ok(text) = std::env::var(TEST_LIMITS_VAR) else {
+        return Ok(caps);
+    };
+    for item in text.split(',').map(str::trim).filter(|i| !i.is_empty()) {
+        let bad = || {
+            format!("{TEST_LIMITS_VAR}: '{item}' is not records=COUNT or cells=COUNT (COUNT >= 1)")
+        };
+        let (name, value) = item.split_once('=').ok_or_else(bad)?;
+        let value: u32 = value.trim().parse().map_err(|_| bad())?;
+        let slot = match name.trim() {
+            "records" if value >= 1 => &mut caps[0],
+            "cells" if value >= 1 => &mut caps[1],
+            _ => return Err(bad()),
+        };
+        *slot = Some(value);
+    }
+    Ok(caps)
+}
+
+/// One frame's work, as the CPU listed it for the views to draw.
+#[derive(Default)]
+pub(super) struct Work {
+    /// (first pair, first triangle, triangles, view) per run of one view's triangles.
+    pub jobs: Vec<[u32; 4]>,
+    /// Per view of the table: its tile (x, y, side, 0).
+    pub rects: Vec<[u32; 4]>,
+    /// Pieces (x, y, side, 0) of the drawn views' tiles, at most STORE_CELL a side.
+    pub pieces: Vec<[u32; 4]>,
+    /// Pairs of a view and a triangle.
+    pub pairs: u32,
+}
+
+/// Grown buffers and the bind groups over them.
+struct Bound {
+    jobs: wgpu::Buffer,
+    rects: wgpu::Buffer,
+    pieces: wgpu::Buffer,
+    setup: wgpu::BindGroup,
+    store: wgpu::BindGroup,
+}
+
+pub(super) struct ComputeAtlas {
+    setup: Arc<wgpu::ComputePipeline>,
+    raster: Arc<wgpu::ComputePipeline>,
+    store: Arc<wgpu::ComputePipeline>,
+    raster_bind: wgpu::BindGroup,
+    params: wgpu::Buffer,
+    store_params: wgpu::Buffer,
+    positions: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    depth: wgpu::Buffer,
+    records: wgpu::Buffer,
+    cells: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    args: wgpu::Buffer,
+    table: wgpu::Buffer,
+    atlas: wgpu::TextureView,
+    capacity: [u32; 2],
+    side: u32,
+    max_groups: u32,
+    bound: Mutex<Option<Bound>>,
+    /// The uploaded work's pairs and pieces, drawn by every frame until the next upload
+    /// (zero after `drawn`: the cache keeps what the last frame drew).
+    pending: Mutex<(u32, u32)>,
+    /// The first index of each caster draw in the merged index buffer.
+    pub(super) index_base: Vec<u32>,
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+}
+
+/// The compute raster's share of the atlas report: its lists' fill and what was drawn
+/// serially because a list was full, in the last frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct AtlasRasterReport {
+    /// Records of large triangles listed (at most the capacity).
+    pub records: u32,
+    /// Room for records.
+    pub records_capacity: u32,
+    /// 32×32 cell entries listed (at most the capacity).
+    pub cells: u32,
+    /// Room for cell entries.
+    pub cells_capacity: u32,
+    /// Fan triangles a setup thread rasterized itself (the record list was full).
+    pub serial_triangles: u32,
+    /// Cells a setup thread rasterized itself (the cell list was full).
+    pub serial_cells: u32,
+}
+
+fn storage(
+    device: &wgpu::Device,
+    label: &str,
+    bytes: u64,
+    extra: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes.max(16),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | extra,
+        mapped_at_creation: false,
+    })
+}
+
+impl ComputeAtlas {
+    /// The rasterizer for `casters` (scene GPU mesh indices, in draw order) into `atlas`
+    /// (`side`² R32Float), reading view-projections from `table`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn prepare(
+        cx: &mut PrepareCtx,
+        pass: &str,
+        casters: &[usize],
+        atlas: wgpu::TextureView,
+        side: u32,
+        table: &wgpu::Buffer,
+        depth_bias: u32,
+        slope_bias: f32,
+    ) -> Result<Self, RenderError> {
+        let gpu: &SceneGpu = cx.gpu;
+        let mut positions: Vec<[f32; 4]> = Vec::new();
+        let mut indices: Vec<u32> = Vec::new();
+        let mut index_base = Vec::new();
+        for &m in casters {
+            let material = &gpu.materials[gpu.meshes[m].material];
+            if matches!(material.alpha_mode, AlphaMode::Mask(_)) {
+                return Err(pass_error(
+                    pass,
+                    format!(
+                        "raster: Compute draws no alpha masks, and caster material '{}' is alpha-masked: use raster: Hardware for this scene",
+                        material.name
+                    ),
+                ));
+            }
+            let mesh = &cx.scene.meshes[gpu.meshes[m].scene_mesh];
+            // The triangles as the hardware path draws them (shadow chunk order), so a
+            // view's culled ranges index both the same way.
+            let (order, _) = crate::shadow::chunks::chunk_triangles(&mesh.positions, &mesh.indices);
+            let base = positions.len() as u32;
+            index_base.push(indices.len() as u32);
+            positions.extend(mesh.positions.iter().map(|p| [p.x, p.y, p.z, 1.0]));
+            indices.extend(order.iter().map(|i| i + base));
+        }
+        let device = cx.device();
+        let limit = device.limits().max_storage_buffer_binding_size;
+        let depth_bytes = side as u64 * side as u64 * 4;
+        for (what, bytes) in [
+            ("the depth buffer", depth_bytes),
+            ("the casters' vertices", 16 * positions.len() as u64),
+            ("the casters' indices", 4 * indices.len() as u64),
+        ] {
+            if bytes > limit {
+                return Err(pass_error(
+                    pass,
+                    format!("raster: Compute needs {what} in one binding of {bytes} bytes; the device binds at most {limit}: use a smaller atlas or raster: Hardware"),
+                ));
+            }
+        }
+        let init = |label: &str, contents: &[u8]| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: if contents.is_empty() {
+                    &[0u8; 16]
+                } else {
+                    contents
+                },
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
+        let positions = init("atlas caster positions", bytemuck::cast_slice(&positions));
+        let indices = init("atlas caster indices", bytemuck::cast_slice(&indices));
+        // The far depth everywhere: `store` puts it back after each drawn view.
+        let far = vec![1.0f32.to_bits(); (side as usize) * (side as usize)];
+        let depth = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("atlas depth (atomic)"),
+            contents: bytemuck::cast_slice(&far),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        drop(far);
+        // Large triangles: room for a record per 64 texels of the atlas and sixteen
+        // cells per 32² of it (depth complexity 16 of large triangles); past that the
+        // setup thread draws them itself (counted).
+        let texels = side as u64 * side as u64;
+        let records = (texels / 64).min(limit / RECORD_BYTES).min(MAX_RECORDS) as u32;
+        let cells = (16 * texels / (CELL as u64 * CELL as u64))
+            .min(limit / ENTRY_BYTES)
+            .max(1) as u32;
+        let caps = test_limits().map_err(|m| pass_error(pass, m))?;
+        let capacity = [
+            caps[0].map_or(records, |n| n.min(records)).max(1),
+            caps[1].map_or(cells, |n| n.min(cells)).max(1),
+        ];
+        let records_buf = storage(
+            &device,
+            "atlas raster records",
+            RECORD_BYTES * capacity[0] as u64,
+            wgpu::BufferUsages::empty(),
+        );
+        let cells_buf = storage(
+            &device,
+            "atlas raster cells",
+            ENTRY_BYTES * capacity[1] as u64,
+            wgpu::BufferUsages::empty(),
+        );
+        let counters = storage(
+            &device,
+            "atlas raster counters",
+            4 * COUNTERS,
+            wgpu::BufferUsages::COPY_SRC,
+        );
+        let args = storage(
+            &device,
+            "atlas raster arguments",
+            16,
+            wgpu::BufferUsages::INDIRECT,
+        );
+        let uniform = |label: &str| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: 32,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let params = uniform("atlas raster parameters");
+        let store_params = uniform("atlas store parameters");
+        let max_groups = device.limits().max_compute_workgroups_per_dimension;
+        let pipeline = |cx: &mut PrepareCtx,
+                        stage: &str,
+                        entry: &str|
+         -> Result<Arc<wgpu::ComputePipeline>, RenderError> {
+            let d = [
+                (stage.to_string(), "1".to_string()),
+                ("GROUP".into(), GROUP.to_string()),
+                ("STORE_CELL".into(), STORE_CELL.to_string()),
+                ("DEPTH_BIAS".into(), format!("{:?}", depth_bias as f32)),
+                ("SLOPE_BIAS".into(), format!("{slope_bias:?}")),
+            ];
+            let key = PipelineKey {
+                shader: SHADER.into(),
+                defines: d.into_iter().collect(),
+                virtual_code: BTreeMap::new(),
+                state: String::new(),
+            };
+            let device = cx.device();
+            let layouts = cx.renderer.layouts.clone();
+            let (p, _) = cx
+                .renderer
+                .pipelines
+                .get_or_build_reflected(
+                    &cx.renderer.shaders,
+                    key,
+                    |_, module, bindings| {
+                        let bgl = layouts.get(
+                            &device,
+                            crate::render::bind::layout_entries(
+                                bindings,
+                                0,
+                                wgpu::ShaderStages::COMPUTE,
+                            ),
+                        );
+                        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                            label: Some(entry),
+                            bind_group_layouts: &[Some(&*bgl)],
+                            immediate_size: 0,
+                        });
+                        Pipeline::compute(&device, entry, Some(&pl), &module, entry)
+                    },
+                    &device,
+                )
+                .map_err(|source| RenderError::Shader {
+                    pass: pass.to_string(),
+                    source,
+                })?;
+            match p {
+                Pipeline::Compute(p) => Ok(p),
+                _ => Err(pass_error(pass, "expected a compute pipeline".into())),
+            }
+        };
+        let setup = pipeline(cx, "SETUP", "setup")?;
+        let raster = pipeline(cx, "RASTER", "raster")?;
+        let store = pipeline(cx, "STORE", "store")?;
+        let raster_bind = bind(
+            &device,
+            &raster,
+            &[
+                (0, params.as_entire_binding()),
+                (6, depth.as_entire_binding()),
+                (7, records_buf.as_entire_binding()),
+                (8, cells_buf.as_entire_binding()),
+                (9, counters.as_entire_binding()),
+            ],
+        );
+        let this = ComputeAtlas {
+            setup,
+            raster,
+            store,
+            raster_bind,
+            params,
+            store_params,
+            positions,
+            indices,
+            depth,
+            records: records_buf,
+            cells: cells_buf,
+            counters,
+            args,
+            table: table.clone(),
+            atlas,
+            capacity,
+            side,
+            max_groups,
+            bound: Mutex::new(None),
+            pending: Mutex::new((0, 0)),
+            index_base,
+            queue: cx.renderer.ctx.queue.clone(),
+            device,
+        };
+        let first = this.bind_lists(16, 16, 16);
+        *this.bound.lock().unwrap_or_else(|e| e.into_inner()) = Some(first);
+        Ok(this)
+    }
+
+    /// Lists of room for `jobs`, `rects` and `pieces` entries, bound.
+    fn bind_lists(&self, jobs: usize, rects: usize, pieces: usize) -> Bound {
+        let list = |label: &str, n: usize| {
+            storage(
+                &self.device,
+                label,
+                16 * n as u64,
+                wgpu::BufferUsages::empty(),
+            )
+        };
+        let jobs = list("atlas raster jobs", jobs);
+        let rects = list("atlas raster tiles", rects);
+        let pieces = list("atlas store pieces", pieces);
+        let setup = bind(
+            &self.device,
+            &self.setup,
+            &[
+                (0, self.params.as_entire_binding()),
+                (1, self.table.as_entire_binding()),
+                (2, self.positions.as_entire_binding()),
+                (3, self.indices.as_entire_binding()),
+                (4, jobs.as_entire_binding()),
+                (5, rects.as_entire_binding()),
+                (6, self.depth.as_entire_binding()),
+                (7, self.records.as_entire_binding()),
+                (8, self.cells.as_entire_binding()),
+                (9, self.counters.as_entire_binding()),
+                (10, self.args.as_entire_binding()),
+            ],
+        );
+        let store = bind(
+            &self.device,
+            &self.store,
+            &[
+                (0, self.store_params.as_entire_binding()),
+                (5, pieces.as_entire_binding()),
+                (6, self.depth.as_entire_binding()),
+                (11, wgpu::BindingResource::TextureView(&self.atlas)),
+            ],
+        );
+        Bound {
+            jobs,
+            rects,
+            pieces,
+            setup,
+            store,
+        }
+    }
+
+    /// Uploads a frame's work (written before the next submission).
+    pub(super) fn upload(&self, work: &Work) {
+        let mut guard = self.bound.lock().unwrap_or_else(|e| e.into_inner());
+        let room = |b: &wgpu::Buffer| (b.size() / 16) as usize;
+        let bound = match guard.take() {
+            Some(b)
+                if work.jobs.len() <= room(&b.jobs)
+                    && work.rects.len() <= room(&b.rects)
+                    && work.pieces.len() <= room(&b.pieces) =>
+            {
+                b
+            }
+            had => {
+                let grow = |n: usize, had: Option<&wgpu::Buffer>| {
+                    n.max(had.map_or(16, room)).next_power_of_two()
+                };
+                self.bind_lists(
+                    grow(work.jobs.len(), had.as_ref().map(|b| &b.jobs)),
+                    grow(work.rects.len(), had.as_ref().map(|b| &b.rects)),
+                    grow(work.pieces.len(), had.as_ref().map(|b| &b.pieces)),
+                )
+            }
+        };
+        let bound = &*guard.insert(bound);
+        for (buffer, list) in [
+            (&bound.jobs, &work.jobs),
+            (&bound.rects, &work.rects),
+            (&bound.pieces, &work.pieces),
+        ] {
+            if !list.is_empty() {
+                self.queue
+                    .write_buffer(buffer, 0, bytemuck::cast_slice(list));
+            }
+        }
+        let params = [
+            work.pairs,
+            work.jobs.len() as u32,
+            self.max_groups,
+            self.side,
+            self.capacity[0],
+            self.capacity[1],
+            0,
+            0,
+        ];
+        self.queue
+            .write_buffer(&self.params, 0, bytemuck::cast_slice(&params));
+        let store = [
+            work.pieces.len() as u32,
+            0,
+            self.max_groups,
+            self.side,
+            0,
+            0,
+            0,
+            0,
+        ];
+        self.queue
+            .write_buffer(&self.store_params, 0, bytemuck::cast_slice(&store));
+        *self.pending.lock().unwrap_or_else(|e| e.into_inner()) =
+            (work.pairs, work.pieces.len() as u32);
+    }
+
+    /// The atlas holds the uploaded work's views: later frames draw none until the next
+    /// upload (`cache: true`).
+    pub(super) fn drawn(&self) {
+        *self.pending.lock().unwrap_or_else(|e| e.into_inner()) = (0, 0);
+    }
+
+    /// Draws the uploaded work: one compute pass.
+    pub(super) fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        label: &str,
+        ts: Timestamps<'_>,
+    ) {
+        let (pairs, pieces) = *self.pending.lock().unwrap_or_else(|e| e.into_inner());
+        if pairs > 0 {
+            encoder.clear_buffer(&self.counters, 0, None);
+            encoder.clear_buffer(&self.args, 0, None);
+        }
+        let guard = self.bound.lock().unwrap_or_else(|e| e.into_inner());
+        let Some(bound) = guard.as_ref() else {
+            return;
+        };
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(label),
+            timestamp_writes: ts.compute(),
+        });
+        if pairs > 0 {
+            let [x, y, z] = grid(pairs, GROUP, self.max_groups);
+            pass.set_pipeline(&self.setup);
+            pass.set_bind_group(0, &bound.setup, &[]);
+            pass.dispatch_workgroups(x, y, z);
+            pass.set_pipeline(&self.raster);
+            pass.set_bind_group(0, &self.raster_bind, &[]);
+            pass.dispatch_workgroups_indirect(&self.args, 0);
+        }
+        if pieces > 0 {
+            let [x, y, z] = grid(pieces, 1, self.max_groups);
+            pass.set_pipeline(&self.store);
+            pass.set_bind_group(0, &bound.store, &[]);
+            pass.dispatch_workgroups(x, y, z);
+        }
+    }
+
+    /// The lists' fill and serial fallbacks of the last frame that drew.
+    pub(super) fn report(&self, r: &Renderer) -> Result<AtlasRasterReport, RenderError> {
+        let bytes = read_buffer(&r.ctx.device, &r.ctx.queue, &self.counters)?;
+        let c: &[u32] = bytemuck::cast_slice(&bytes);
+        Ok(AtlasRasterReport {
+            records: c[0].min(self.capacity[0]),
+            records_capacity: self.capacity[0],
+            cells: c[1].min(self.capacity[1]),
+            cells_capacity: self.capacity[1],
+            serial_triangles: c[2],
+            serial_cells: c[3],
+        })
+    }
+}
+
+/// Pieces of at most STORE_CELL² texels covering the tile at (x, y) of side `tile`.
+pub(super) fn pieces(x: u32, y: u32, tile: u32, out: &mut Vec<[u32; 4]>) {
+    let step = tile.min(STORE_CELL);
+    for py in (0..tile).step_by(step as usize) {
+        for px in (0..tile).step_by(step as usize) {
+            out.push([x + px, y + py, step, 0]);
+        }
+    }
+}
+
+fn bind(
+    device: &wgpu::Device,
+    pipeline: &wgpu::ComputePipeline,
+    entries: &[(u32, wgpu::BindingResource<'_>)],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = entries
+        .iter()
+        .map(|(binding, resource)| wgpu::BindGroupEntry {
+            binding: *binding,
+            resource: resource.clone(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("shadow atlas raster"),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &entries,
+    })
+}
