@@ -21,7 +21,9 @@
 // SHADOW_ATLAS (and SHADOW_PCF5): sampled from a ShadowAtlas pass's maps, filtered as
 // forward shading filters them (common/shadows.wgsl). VPL_VISIBILITY (with VPL_BLOCK,
 // VPL_WORDS): VPLs hidden from the pixel's block by a VplVisibility pass add nothing
-// (indirect/vpl_lookup.wgsl).
+// (indirect/vpl_lookup.wgsl). LIGHT_SAMPLES (with SAMPLE_EXACT, SAMPLE_COUNT,
+// SAMPLE_REGION; the Forward loop only): a LightSampling pass's exact lights and samples
+// stand for the shadow-casting lights (common/light_loop.wgsl).
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"
@@ -44,6 +46,10 @@
 #if VPL_VISIBILITY
 @group(0) @binding(16) var<storage, read> vpl_visibility: array<u32>;
 #include "indirect/vpl_lookup.wgsl"
+#endif
+#if LIGHT_SAMPLES
+@group(0) @binding(17) var<storage, read> light_samples: array<u32>;
+#include "common/light_samples.wgsl"
 #endif
 #if CLASSIFIED
 @group(0) @binding(11) var<storage, read> material_tiles: array<u32>;

@@ -10,6 +10,8 @@
 //! `shaders/visibility/visibility_shading.wgsl` (and `classify_materials.wgsl`).
 
 use super::deferred_shading::HDR;
+use super::light_sampling::LIGHT_SAMPLES;
+use super::shadow_atlas::SHADOW_ATLAS;
 use super::shadow_ray_jobs::SHADOW_MASK;
 use super::visibility_buffer::VISIBILITY;
 use super::{check_light_source, Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
@@ -123,6 +125,10 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     super::SHADOW_ATLAS_READ,
     super::SHADOW_VIEWS_READ,
     super::VPL_VISIBILITY_READ,
+    // Stochastic direct lighting: a LightSampling pass's exact lights and samples.
+    SlotSpec::new(LIGHT_SAMPLES, SlotType::Buffer, Access::Read, Usage::Bound)
+        .optional()
+        .needs(&[Contents::LightSamples]),
 ];
 
 pub(crate) fn check(p: &VisibilityShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
@@ -145,6 +151,20 @@ pub(crate) fn check(p: &VisibilityShading, ctx: &KindCtx, errors: &mut Vec<Graph
     );
     super::check_shadow_mask(ctx, errors);
     super::check_shadow_atlas(ctx, errors);
+    if let Some(samples) = ctx.slot(LIGHT_SAMPLES) {
+        if p.light_loop != LightLoop::Forward {
+            errors.push(ctx.mismatch(
+                samples,
+                "light samples are shaded by the Forward light loop: set light_loop: Forward",
+            ));
+        }
+        if ctx.slot(SHADOW_MASK).is_some() || ctx.slot(SHADOW_ATLAS).is_some() {
+            errors.push(ctx.mismatch(
+                samples,
+                "light samples carry their own shadow rays: read them, or a shadow mask, or an atlas, not two",
+            ));
+        }
+    }
 }
 
 impl KindRules for VisibilityShading {
