@@ -186,6 +186,66 @@ fn with_every_caster_exact_the_image_is_the_ray_cast_image() {
     assert!(shadowed > 300, "only {shadowed} pixels are in shadow");
 }
 
+/// The exact reference for any count of casters, graphs/visibility_raycast_shadows_naive.ron
+/// (the light loop casts every caster's ray), is the job-and-mask frame's image where the
+/// mask holds every caster; and past 128 casters a pixel it still shadows them, where the
+/// mask frame lights the extra ones unshadowed.
+#[test]
+fn the_traced_light_loop_is_the_exact_shadowed_frame() {
+    let mut r = renderer();
+    let s = scene(16, 3, true);
+    let naive = render_once(
+        &mut r,
+        &graph_text("visibility_raycast_shadows_naive.ron"),
+        &s,
+    );
+    let ray_cast = render_once(&mut r, &graph_text("visibility_raycast_shadows.ron"), &s);
+    let top = peak(&ray_cast);
+    let worst = naive
+        .iter()
+        .zip(&ray_cast)
+        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
+        .fold(0.0f32, f32::max);
+    // Same rays, same sums in the same order; compiled apart: rounding only.
+    assert!(
+        worst <= 1e-5 * top,
+        "largest difference {worst} (peak {top})"
+    );
+
+    // 160 casters, each reaching the whole room (range 40 m): every pixel has more than
+    // the mask's 128.
+    let mut many = scene(160, 5, false);
+    for l in &mut many.lights {
+        l.range = 40.0;
+        l.shape = LightShape::Point;
+        l.intensity *= 0.05;
+    }
+    let naive = render_once(
+        &mut r,
+        &graph_text("visibility_raycast_shadows_naive.ron"),
+        &many,
+    );
+    let ray_cast = render_once(&mut r, &graph_text("visibility_raycast_shadows.ron"), &many);
+    let brighter = naive
+        .iter()
+        .zip(&ray_cast)
+        .filter(|(n, m)| (0..3).any(|c| m[c] > n[c] * 1.001 + 1e-6))
+        .count();
+    let darker = naive
+        .iter()
+        .zip(&ray_cast)
+        .filter(|(n, m)| (0..3).any(|c| m[c] < n[c] * 0.999 - 1e-6))
+        .count();
+    assert_eq!(
+        darker, 0,
+        "the mask frame is never darker than the exact one"
+    );
+    assert!(
+        brighter > 1000,
+        "casters past 128 light the mask frame unshadowed: only {brighter} pixels brighter"
+    );
+}
+
 /// How the mean of many frames compares with the exact image.
 struct Convergence {
     /// Pixel channels whose mean lies outside Z·σ̂/√n (+ rounding) of the exact value.

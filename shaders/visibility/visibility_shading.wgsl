@@ -38,6 +38,11 @@
 #if SHADOW_MASK
 @group(0) @binding(10) var<storage, read> shadow_mask: array<u32>;
 #endif
+#if SHADOW_TRACE
+@group(0) @binding(18) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(0) @binding(19) var<storage, read> bvh_triangles: array<BvhTriangle>;
+#include "shadow/bvh.wgsl"
+#endif
 #if SHADOW_ATLAS
 @group(0) @binding(13) var<storage, read> shadow_views: array<vec4<f32>>;
 @group(0) @binding(14) var shadow_atlas: texture_depth_2d;
@@ -159,6 +164,9 @@ fn main(
 #if SHADOWS
     shadow_pixel = id.y * frame.size.x + id.x;
 #endif
+#if SHADOW_TRACE
+    shadow_ng = surface_geometry(id.xy, select(range.x, tri, shades)).ng;
+#endif
 #if VPL_VISIBILITY
     vpl_pixel = id.xy;
 #endif
@@ -201,6 +209,9 @@ fn main(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group
     }
 #if SHADOWS
     shadow_pixel = id.y * frame.size.x + id.x;
+#endif
+#if SHADOW_TRACE
+    shadow_ng = surface_geometry(id.xy, tri).ng;
 #endif
 #if VPL_VISIBILITY
     vpl_pixel = id.xy;

@@ -12,6 +12,7 @@
 use super::deferred_shading::HDR;
 use super::light_sampling::LIGHT_SAMPLES;
 use super::shadow_atlas::SHADOW_ATLAS;
+use super::shadow_ray_cast::{BVH_NODES, BVH_TRIANGLES};
 use super::shadow_ray_jobs::SHADOW_MASK;
 use super::visibility_buffer::VISIBILITY;
 use super::{check_light_source, Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
@@ -125,6 +126,21 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     super::SHADOW_ATLAS_READ,
     super::SHADOW_VIEWS_READ,
     super::VPL_VISIBILITY_READ,
+    // Shadows traced in the light loop (every caster, no mask): the exact reference.
+    SlotSpec::new(
+        BVH_NODES,
+        SlotType::Import(SceneResource::BvhNodes),
+        Access::Read,
+        Usage::Bound,
+    )
+    .optional(),
+    SlotSpec::new(
+        BVH_TRIANGLES,
+        SlotType::Import(SceneResource::BvhTriangles),
+        Access::Read,
+        Usage::Bound,
+    )
+    .optional(),
     // Stochastic direct lighting: a LightSampling pass's exact lights and samples.
     SlotSpec::new(LIGHT_SAMPLES, SlotType::Buffer, Access::Read, Usage::Bound)
         .optional()
@@ -151,6 +167,15 @@ pub(crate) fn check(p: &VisibilityShading, ctx: &KindCtx, errors: &mut Vec<Graph
     );
     super::check_shadow_mask(ctx, errors);
     super::check_shadow_atlas(ctx, errors);
+    super::check_bvh_trace(ctx, errors);
+    if let Some(nodes) = ctx.slot(BVH_NODES) {
+        if ctx.slot(SHADOW_MASK).is_some() || ctx.slot(SHADOW_ATLAS).is_some() {
+            errors.push(ctx.mismatch(
+                nodes,
+                "a pass traces the BVH, or reads a shadow mask or an atlas, not two",
+            ));
+        }
+    }
     if let Some(samples) = ctx.slot(LIGHT_SAMPLES) {
         if p.light_loop != LightLoop::Forward {
             errors.push(ctx.mismatch(
@@ -158,10 +183,13 @@ pub(crate) fn check(p: &VisibilityShading, ctx: &KindCtx, errors: &mut Vec<Graph
                 "light samples are shaded by the Forward light loop: set light_loop: Forward",
             ));
         }
-        if ctx.slot(SHADOW_MASK).is_some() || ctx.slot(SHADOW_ATLAS).is_some() {
+        if ctx.slot(SHADOW_MASK).is_some()
+            || ctx.slot(SHADOW_ATLAS).is_some()
+            || ctx.slot(BVH_NODES).is_some()
+        {
             errors.push(ctx.mismatch(
                 samples,
-                "light samples carry their own shadow rays: read them, or a shadow mask, or an atlas, not two",
+                "light samples carry their own shadow rays: read them, a shadow mask, an atlas or the BVH, not two",
             ));
         }
     }
