@@ -101,21 +101,15 @@ fn render_once(r: &mut Renderer, text: &str, scene: &Scene) -> Vec<[f32; 4]> {
     image
 }
 
-/// Per pixel and channel, the mean and the sample variance of `frames` frames of one
-/// prepared graph (each frame advances the sampler's frame counter: new numbers).
-fn frame_statistics(
-    r: &mut Renderer,
-    text: &str,
-    scene: &Scene,
-    frames: usize,
-) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
-    let prepared = prepare_text(r, text, scene, W, H, false).expect("prepare");
+/// Per pixel and channel, the mean and the sample variance of `images` (at least two).
+fn statistics(images: impl Iterator<Item = Vec<[f32; 4]>>) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
     let n = (W * H) as usize;
     let mut sum = vec![[0.0f64; 3]; n];
     let mut sum_sq = vec![[0.0f64; 3]; n];
-    for _ in 0..frames {
-        let image = prepared.render(r).expect("render").image;
+    let mut k = 0.0;
+    for image in images {
         assert_eq!(image.len(), n);
+        k += 1.0;
         for (i, p) in image.iter().enumerate() {
             for c in 0..3 {
                 let v = f64::from(p[c]);
@@ -124,7 +118,7 @@ fn frame_statistics(
             }
         }
     }
-    let k = frames as f64;
+    assert!(k >= 2.0);
     let mean: Vec<[f64; 3]> = sum.iter().map(|s| s.map(|v| v / k)).collect();
     let variance = sum_sq
         .iter()
@@ -268,11 +262,22 @@ struct Convergence {
 /// variance of RIS weights (heavy-tailed) was too small at a few pixels of the unbiased
 /// spatial estimate; from 256 frames on none was.
 fn convergence(params: &str, frames: usize, lights: usize) -> Convergence {
-    const Z: f64 = 5.0;
     let mut r = renderer();
     let s = scene(lights, 11, false);
-    let exact = render_once(&mut r, &graph_text("visibility_raycast_shadows.ron"), &s);
-    let (mean, variance) = frame_statistics(&mut r, &stochastic_graph(params), &s, frames);
+    let prepared = prepare_text(&mut r, &stochastic_graph(params), &s, W, H, false).unwrap();
+    let images: Vec<_> = (0..frames)
+        .map(|_| prepared.render(&r).expect("render").image)
+        .collect();
+    drop(prepared);
+    compare_mean(&mut r, &s, params, images)
+}
+
+/// [`convergence`]'s check of the mean of `images` (independent estimates) of `s`.
+fn compare_mean(r: &mut Renderer, s: &Scene, params: &str, images: Vec<Vec<[f32; 4]>>) -> Convergence {
+    const Z: f64 = 5.0;
+    let frames = images.len();
+    let exact = render_once(r, &graph_text("visibility_raycast_shadows.ron"), s);
+    let (mean, variance) = statistics(images.into_iter());
     let top = f64::from(peak(&exact));
     // Rounding: the f32 sums of the light loop, a few ulps of the peak.
     let rounding = 1e-5 * top;
@@ -352,5 +357,82 @@ fn biased_spatial_reuse_is_seen_biased() {
         c.failures.len() > 50,
         "only {} pixel channels outside 5σ",
         c.failures.len()
+    );
+}
+
+/// One frame's RMSE against `exact`, relative to its peak.
+fn relative_rmse(image: &[[f32; 4]], exact: &[[f32; 4]]) -> f64 {
+    assert_eq!(image.len(), exact.len());
+    let sq: f64 = image
+        .iter()
+        .zip(exact)
+        .flat_map(|(a, b)| (0..3).map(move |c| f64::from(a[c] - b[c]).powi(2)))
+        .sum();
+    (sq / (exact.len() * 3) as f64).sqrt() / f64::from(peak(exact))
+}
+
+/// On a still camera temporal reuse converges: each frame resamples the previous frame's
+/// reservoir too, so a frame's error falls as the history grows (to the cap of 32 × M
+/// candidates), where without history it stays at the first frame's.
+#[test]
+fn temporal_reuse_on_a_still_camera_converges() {
+    let mut r = renderer();
+    let s = scene(64, 11, false);
+    let exact = render_once(&mut r, &graph_text("visibility_raycast_shadows.ron"), &s);
+    let errors = |r: &mut Renderer, params: &str| -> Vec<f64> {
+        let prepared = prepare_text(r, &stochastic_graph(params), &s, W, H, false).unwrap();
+        (0..32)
+            .map(|_| relative_rmse(&prepared.render(r).unwrap().image, &exact))
+            .collect()
+    };
+    let without = errors(&mut r, "candidates: 4, samples: 1, exact_lights: 1");
+    let with = errors(&mut r, "candidates: 4, samples: 1, exact_lights: 1, history: 32");
+    eprintln!("without history: {without:.3?}\nwith history:    {with:.3?}");
+    // The first frame has no history: the same estimator, its error alike (other numbers).
+    assert!(
+        (with[0] / without[0] - 1.0).abs() < 0.2,
+        "{} against {}",
+        with[0],
+        without[0]
+    );
+    let late = |e: &[f64]| e[24..].iter().sum::<f64>() / 8.0;
+    let early_without = without[..8].iter().sum::<f64>() / 8.0;
+    // Without history the error does not fall.
+    assert!(late(&without) > 0.8 * early_without);
+    // With it, the last frames' error is under half the first frame's (effective
+    // candidates up to 32× more).
+    assert!(
+        late(&with) < 0.5 * with[0],
+        "error {} after 24 frames against {} at the first",
+        late(&with),
+        with[0]
+    );
+}
+
+/// On a still camera the temporal estimate stays unbiased: the previous frame's reservoir
+/// was drawn for the same surface and the same exact lights, so the 1/M weight is exact.
+/// The 8th frame of 48 runs with different seeds (independent estimates) averages to the
+/// exact image within the CLT bound of [`convergence`].
+#[test]
+fn temporal_reuse_on_a_still_camera_stays_unbiased() {
+    let mut r = renderer();
+    let s = scene(64, 11, false);
+    let params = "candidates: 4, samples: 1, exact_lights: 1, history: 32";
+    let images = (0..48)
+        .map(|seed| {
+            let text = stochastic_graph(&format!("{params}, seed: {seed}"));
+            let prepared = prepare_text(&mut r, &text, &s, W, H, false).unwrap();
+            for _ in 0..7 {
+                prepared.render(&r).unwrap();
+            }
+            prepared.render(&r).unwrap().image
+        })
+        .collect();
+    let c = compare_mean(&mut r, &s, params, images);
+    assert!(
+        c.failures.is_empty(),
+        "{} pixel channels outside 5σ of the exact image, e.g. {:?}",
+        c.failures.len(),
+        &c.failures[..c.failures.len().min(5)]
     );
 }

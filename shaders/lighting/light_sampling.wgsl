@@ -29,10 +29,15 @@
 // weight, unbiased because the target has no visibility in it. The chosen light's ray is
 // traced after the resampling.
 //
-// `advance` counts frames in the header, so every frame draws new numbers.
+// `temporal` (SAMPLE_TEMPORAL): see its comment below.
+//
+// `advance` counts frames in the header, so every frame draws new numbers, and keeps the
+// view-projection for the next frame's reprojection.
 // Defines: LIGHT_LISTS, VISIBILITY_IDS, SHADOW_NORMAL_OFFSET, SAMPLE_EXACT, EXACT_ARRAY
 // (max(SAMPLE_EXACT, 1)), SAMPLE_COUNT, SAMPLE_CANDIDATES, SAMPLE_SEED; SAMPLE_SPATIAL
-// with SPATIAL_NEIGHBOURS, SPATIAL_RADIUS and SPATIAL_UNBIASED.
+// with SPATIAL_NEIGHBOURS, SPATIAL_RADIUS and SPATIAL_UNBIASED; SAMPLE_TEMPORAL with
+// HISTORY_REGION and HISTORY_CAP; SAMPLE_REGIONS; TRACE_CANDIDATES or TRACE_TEMPORAL (the
+// dispatch that traces the chosen lights when no later one does).
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"
@@ -214,8 +219,7 @@ fn candidates(@builtin(global_invocation_id) gid: vec3<u32>) {
         var weight = 0.0;
         if (chosen != SAMPLE_NONE) {
             weight = wsum / (f32(SAMPLE_CANDIDATES) * chosen_t);
-#if SAMPLE_SPATIAL
-#else
+#if TRACE_CANDIDATES
             if (hidden(s, chosen)) {
                 weight = 0.0;
             }
@@ -225,14 +229,142 @@ fn candidates(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 }
 
-#if SAMPLE_SPATIAL
-// p̂ of `light` at another pixel's surface, with that pixel's exact lights left out.
+// p̂ of `light` at a pixel's surface, with that pixel's exact lights left out.
 fn target_at(pixel: u32, s: ShadowSurface, light: u32) -> f32 {
     if (is_exact(pixel, light)) {
         return 0.0;
     }
     return sample_target(light, s.position, s.ng);
 }
+
+#if SAMPLE_TEMPORAL
+fn surface_word(parity: u32, pixel: u32) -> u32 {
+    let first = SAMPLE_HEADER_WORDS + sample_pixels() * SAMPLE_EXACT
+        + SAMPLE_REGIONS * sample_pixels() * SAMPLE_COUNT * RESERVOIR_WORDS;
+    return first + (parity * sample_pixels() + pixel) * 6u;
+}
+
+fn load_vec3(word: u32) -> vec3<f32> {
+    return vec3<f32>(
+        bitcast<f32>(light_samples[word]),
+        bitcast<f32>(light_samples[word + 1u]),
+        bitcast<f32>(light_samples[word + 2u]),
+    );
+}
+
+fn store_vec3(word: u32, v: vec3<f32>) {
+    light_samples[word] = bitcast<u32>(v.x);
+    light_samples[word + 1u] = bitcast<u32>(v.y);
+    light_samples[word + 2u] = bitcast<u32>(v.z);
+}
+
+// The previous frame's view-projection, kept in the header by `advance`.
+fn previous_view_proj() -> mat4x4<f32> {
+    var m: mat4x4<f32>;
+    for (var c = 0u; c < 4u; c++) {
+        for (var r = 0u; r < 4u; r++) {
+            m[c][r] = bitcast<f32>(light_samples[4u + c * 4u + r]);
+        }
+    }
+    return m;
+}
+
+// The pixel whose surface the previous frame saw this point at, or SAMPLE_NONE: the point
+// projected with the previous view, kept where that pixel's position lies within 1% of
+// the distance to the eye and its normal within about 25°.
+fn previous_pixel(s: ShadowSurface, read: u32) -> u32 {
+    let clip = previous_view_proj() * vec4<f32>(s.position, 1.0);
+    if (!(clip.w > 0.0)) {
+        return SAMPLE_NONE;
+    }
+    let ndc = clip.xy / clip.w;
+    let size = vec2<f32>(frame.size);
+    let at = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * size;
+    if (any(at < vec2<f32>(0.0)) || any(at >= size)) {
+        return SAMPLE_NONE;
+    }
+    let q = vec2<u32>(at);
+    let qpixel = q.y * frame.size.x + q.x;
+    let word = surface_word(read, qpixel);
+    let position = load_vec3(word);
+    let ng = load_vec3(word + 3u);
+    let scale = max(length(s.position - frame.camera_pos.xyz), 1e-3);
+    if (length(position - s.position) > 0.01 * scale || dot(ng, s.ng) < 0.9) {
+        return SAMPLE_NONE;
+    }
+    return qpixel;
+}
+
+// Each reservoir resamples its own (from `candidates`) and the previous frame's at the
+// reprojected pixel, whose M is capped at HISTORY_CAP, weighted p̂_here(y) W M and
+// normalised by the M of both (1/M: exact where the two pixels' targets agree, as on a
+// still camera; biased where they differ). The result, before its shadow ray, is kept as
+// the next frame's history.
+@compute @workgroup_size(8, 8, 1)
+fn temporal(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (any(gid.xy >= frame.size)) {
+        return;
+    }
+    let pixel = gid.y * frame.size.x + gid.x;
+    let write = light_samples[0] % 2u;
+    let read = 1u - write;
+    let s = shadow_surface(gid.xy);
+    let keep = surface_word(write, pixel);
+    if (!s.valid) {
+        store_vec3(keep, vec3<f32>(0.0));
+        store_vec3(keep + 3u, vec3<f32>(0.0));
+        for (var j = 0u; j < SAMPLE_COUNT; j++) {
+            store_reservoir(HISTORY_REGION + write, pixel, j, SAMPLE_NONE, 0.0, 0.0);
+        }
+        return;
+    }
+    store_vec3(keep, s.position);
+    store_vec3(keep + 3u, s.ng);
+    seed_rng(pixel, 2u);
+    let previous = previous_pixel(s, read);
+    for (var j = 0u; j < SAMPLE_COUNT; j++) {
+        let own = load_reservoir(0u, pixel, j);
+        var wsum = 0.0;
+        var m = own.m;
+        var chosen = SAMPLE_NONE;
+        var chosen_t = 0.0;
+        if (own.light != SAMPLE_NONE) {
+            chosen_t = target_at(pixel, s, own.light);
+            wsum = chosen_t * own.w * own.m;
+            if (wsum > 0.0) {
+                chosen = own.light;
+            }
+        }
+        if (previous != SAMPLE_NONE) {
+            let past = load_reservoir(HISTORY_REGION + read, previous, j);
+            let past_m = min(past.m, HISTORY_CAP);
+            m += past_m;
+            if (past.light != SAMPLE_NONE) {
+                let t = target_at(pixel, s, past.light);
+                let w = t * past.w * past_m;
+                wsum += w;
+                if (w > 0.0 && rand() * wsum < w) {
+                    chosen = past.light;
+                    chosen_t = t;
+                }
+            }
+        }
+        var weight = 0.0;
+        if (chosen != SAMPLE_NONE) {
+            weight = wsum / (m * chosen_t);
+        }
+        store_reservoir(HISTORY_REGION + write, pixel, j, chosen, weight, m);
+#if TRACE_TEMPORAL
+        if (chosen != SAMPLE_NONE && hidden(s, chosen)) {
+            weight = 0.0;
+        }
+#endif
+        store_reservoir(0u, pixel, j, chosen, weight, m);
+    }
+}
+#endif
+
+#if SAMPLE_SPATIAL
 
 @compute @workgroup_size(8, 8, 1)
 fn spatial(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -320,4 +452,9 @@ fn spatial(@builtin(global_invocation_id) gid: vec3<u32>) {
 @compute @workgroup_size(1, 1, 1)
 fn advance() {
     light_samples[0] += 1u;
+    for (var c = 0u; c < 4u; c++) {
+        for (var r = 0u; r < 4u; r++) {
+            light_samples[4u + c * 4u + r] = bitcast<u32>(frame.view_proj[c][r]);
+        }
+    }
 }

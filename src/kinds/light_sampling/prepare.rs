@@ -1,6 +1,7 @@
 //! `LightSampling`: the candidates dispatch (exact lights traced, reservoirs filled and,
-//! without reuse, their rays traced), the spatial reuse dispatch when asked, and a
-//! one-invocation dispatch that counts frames for the random numbers; one compute pass.
+//! without reuse, their rays traced), the temporal and spatial reuse dispatches when
+//! asked, and a one-invocation dispatch that counts frames and keeps the view for the
+//! next frame's reprojection; one compute pass.
 
 use super::{defines, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::light_sampling::LightSampling;
@@ -16,6 +17,7 @@ const SHADER: &str = "lighting/light_sampling.wgsl";
 pub(super) struct LightSamplingPass {
     name: Name,
     candidates: Arc<wgpu::ComputePipeline>,
+    temporal: Option<Arc<wgpu::ComputePipeline>>,
     spatial: Option<Arc<wgpu::ComputePipeline>>,
     advance: Arc<wgpu::ComputePipeline>,
     bind: wgpu::BindGroup,
@@ -34,6 +36,20 @@ fn sampling_defines(p: &LightSampling) -> Vec<(&'static str, String)> {
         ("SAMPLE_CANDIDATES", format!("{}u", p.candidates)),
         ("SAMPLE_SEED", format!("{}u", p.seed)),
     ];
+    let spatial = u32::from(p.reuse.spatial().is_some());
+    d.push(("SAMPLE_REGIONS", format!("{}u", 1 + spatial + 2 * u32::from(p.history > 0))));
+    if spatial == 0 {
+        d.push(if p.history > 0 {
+            ("TRACE_TEMPORAL", "1".into())
+        } else {
+            ("TRACE_CANDIDATES", "1".into())
+        });
+    }
+    if p.history > 0 {
+        d.push(("SAMPLE_TEMPORAL", "1".into()));
+        d.push(("HISTORY_REGION", format!("{}u", 1 + spatial)));
+        d.push(("HISTORY_CAP", format!("{:?}", (p.history * p.candidates) as f32)));
+    }
     if let Some((neighbours, radius, unbiased)) = p.reuse.spatial() {
         d.push(("SAMPLE_SPATIAL", "1".into()));
         d.push(("SPATIAL_NEIGHBOURS", format!("{neighbours}u")));
@@ -69,10 +85,18 @@ pub(super) fn prepare(
         ),
         None => None,
     };
+    let temporal = match p.history {
+        0 => None,
+        _ => Some(
+            cx.compute_pipeline(&sp.name, key("temporal"), "temporal", &offered)?
+                .0,
+        ),
+    };
     let (advance, _) = cx.compute_pipeline(&sp.name, key("advance"), "advance", &offered)?;
     Ok(LightSamplingPass {
         name: sp.name.clone(),
         candidates,
+        temporal,
         spatial,
         advance,
         bind,
@@ -90,6 +114,10 @@ impl PreparedPass for LightSamplingPass {
         let [x, y, z] = self.groups;
         pass.set_pipeline(&self.candidates);
         pass.dispatch_workgroups(x, y, z);
+        if let Some(temporal) = &self.temporal {
+            pass.set_pipeline(temporal);
+            pass.dispatch_workgroups(x, y, z);
+        }
         if let Some(spatial) = &self.spatial {
             pass.set_pipeline(spatial);
             pass.dispatch_workgroups(x, y, z);

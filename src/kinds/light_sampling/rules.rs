@@ -36,6 +36,12 @@ pub struct LightSampling {
     /// Spatial reuse of the reservoirs over neighbouring pixels.
     #[serde(default)]
     pub reuse: SpatialReuse,
+    /// Temporal reuse: 0 for none; else each reservoir also resamples the previous
+    /// frame's reservoir of the pixel its surface was seen at (reprojected; rejected where
+    /// the position or normal changed), whose candidates count at most
+    /// `history` × `candidates`.
+    #[serde(default)]
+    pub history: u32,
     /// Mixed with the frame counter and the pixel into each pixel's random numbers.
     #[serde(default)]
     pub seed: u32,
@@ -101,15 +107,21 @@ pub(crate) const MAX_SAMPLES: u32 = 8;
 pub(crate) const MAX_EXACT_LIGHTS: u32 = 16;
 pub(crate) const MAX_NEIGHBOURS: u32 = 16;
 pub(crate) const MAX_RADIUS: u32 = 128;
+pub(crate) const MAX_HISTORY: u32 = 64;
 
-/// Words before the per-pixel data: the frame counter, then unused.
-pub(crate) const SAMPLE_HEADER_WORDS: u64 = 4;
+/// Words before the per-pixel data: the frame counter, three unused, the previous frame's
+/// view-projection (16 f32).
+pub(crate) const SAMPLE_HEADER_WORDS: u64 = 20;
+/// Words of a pixel's surface kept for the next frame (position, geometric normal).
+pub(crate) const SURFACE_WORDS: u64 = 6;
 /// Words a reservoir: light index, contribution weight W (f32), candidates M (f32).
 pub(crate) const RESERVOIR_WORDS: u64 = 3;
 
 /// The `light_samples` buffer: a header, `exact` light words a pixel (bit 31 set where
-/// the light is hidden), then `samples` reservoirs a pixel, twice with spatial reuse
-/// (before and after it); shading reads the last.
+/// the light is hidden), then regions of `samples` reservoirs a pixel: the pixel's own
+/// (after temporal reuse), after spatial reuse, and with temporal reuse two history
+/// regions and two of surfaces, one written and one read each frame; shading reads the
+/// own region, or the spatial one.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SampleLayout {
     /// Pixels of the frame.
@@ -120,15 +132,19 @@ pub struct SampleLayout {
     pub samples: u32,
     /// Whether a second region holds the reservoirs after spatial reuse.
     pub spatial: bool,
+    /// Whether history regions and surfaces follow (temporal reuse).
+    pub history: bool,
 }
 
 impl SampleLayout {
     /// The buffer's size in bytes.
     pub fn bytes(&self) -> u64 {
-        let regions = if self.spatial { 2 } else { 1 };
+        let regions = 1 + u64::from(self.spatial) + 2 * u64::from(self.history);
+        let surfaces = if self.history { 2 * SURFACE_WORDS } else { 0 };
         4 * (SAMPLE_HEADER_WORDS
             + self.pixels * u64::from(self.exact)
-            + regions * self.pixels * u64::from(self.samples) * RESERVOIR_WORDS)
+            + regions * self.pixels * u64::from(self.samples) * RESERVOIR_WORDS
+            + self.pixels * surfaces)
     }
 }
 
@@ -188,6 +204,7 @@ pub(crate) fn check(p: &LightSampling, ctx: &KindCtx, errors: &mut Vec<GraphErro
         range("reuse neighbours", neighbours, 1, MAX_NEIGHBOURS);
         range("reuse radius", radius, 1, MAX_RADIUS);
     }
+    range("history", p.history, 0, MAX_HISTORY);
     if !(p.normal_offset.is_finite() && (0.0..=0.1).contains(&p.normal_offset)) {
         errors.push(ctx.bad(format!(
             "normal_offset {} must be in [0, 0.1]",
@@ -211,6 +228,7 @@ impl KindRules for LightSampling {
                 exact: self.exact_lights,
                 samples: self.samples,
                 spatial: self.reuse.spatial().is_some(),
+                history: self.history > 0,
             })
         })
     }
