@@ -273,7 +273,12 @@ fn convergence(params: &str, frames: usize, lights: usize) -> Convergence {
 }
 
 /// [`convergence`]'s check of the mean of `images` (independent estimates) of `s`.
-fn compare_mean(r: &mut Renderer, s: &Scene, params: &str, images: Vec<Vec<[f32; 4]>>) -> Convergence {
+fn compare_mean(
+    r: &mut Renderer,
+    s: &Scene,
+    params: &str,
+    images: Vec<Vec<[f32; 4]>>,
+) -> Convergence {
     const Z: f64 = 5.0;
     let frames = images.len();
     let exact = render_once(r, &graph_text("visibility_raycast_shadows.ron"), s);
@@ -386,7 +391,10 @@ fn temporal_reuse_on_a_still_camera_converges() {
             .collect()
     };
     let without = errors(&mut r, "candidates: 4, samples: 1, exact_lights: 1");
-    let with = errors(&mut r, "candidates: 4, samples: 1, exact_lights: 1, history: 32");
+    let with = errors(
+        &mut r,
+        "candidates: 4, samples: 1, exact_lights: 1, history: 32",
+    );
     eprintln!("without history: {without:.3?}\nwith history:    {with:.3?}");
     // The first frame has no history: the same estimator, its error alike (other numbers).
     assert!(

@@ -37,7 +37,10 @@ fn sampling_defines(p: &LightSampling) -> Vec<(&'static str, String)> {
         ("SAMPLE_SEED", format!("{}u", p.seed)),
     ];
     let spatial = u32::from(p.reuse.spatial().is_some());
-    d.push(("SAMPLE_REGIONS", format!("{}u", 1 + spatial + 2 * u32::from(p.history > 0))));
+    d.push((
+        "SAMPLE_REGIONS",
+        format!("{}u", 1 + spatial + 2 * u32::from(p.history > 0)),
+    ));
     if spatial == 0 {
         d.push(if p.history > 0 {
             ("TRACE_TEMPORAL", "1".into())
@@ -48,7 +51,10 @@ fn sampling_defines(p: &LightSampling) -> Vec<(&'static str, String)> {
     if p.history > 0 {
         d.push(("SAMPLE_TEMPORAL", "1".into()));
         d.push(("HISTORY_REGION", format!("{}u", 1 + spatial)));
-        d.push(("HISTORY_CAP", format!("{:?}", (p.history * p.candidates) as f32)));
+        d.push((
+            "HISTORY_CAP",
+            format!("{:?}", (p.history * p.candidates) as f32),
+        ));
     }
     if let Some((neighbours, radius, unbiased)) = p.reuse.spatial() {
         d.push(("SAMPLE_SPATIAL", "1".into()));
