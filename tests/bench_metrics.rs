@@ -48,6 +48,21 @@ fn constant_offset_gives_known_rmse_and_psnr() {
     // Reference luminance stays below 1, so the peak is 1: PSNR = 10 log10(1 / 0.125²).
     let expected = 10.0 * (1.0 / (0.125f64 * 0.125)).log10();
     assert!((m.psnr - expected).abs() < 1e-4, "{} vs {expected}", m.psnr);
+    // Relative MSE, computed here in f64 from the same pixels: 0.125² / (ref² + 0.01).
+    let rel: f64 = a
+        .iter()
+        .flat_map(|p| {
+            p[..3]
+                .iter()
+                .map(|&r| 0.125f64.powi(2) / (f64::from(r).powi(2) + 0.01))
+        })
+        .sum::<f64>()
+        / (a.len() * 3) as f64;
+    assert!(
+        (m.rel_mse - rel).abs() < 1e-6 * rel,
+        "{} vs {rel}",
+        m.rel_mse
+    );
     assert_eq!(m.bad_pixels, (W * H) as usize);
     assert!(m.flip_mean.is_none());
 

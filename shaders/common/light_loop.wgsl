@@ -15,6 +15,9 @@ fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f
     var caster = 0u;
     let pixel_index = u32(pixel.y) * frame.size.x + u32(pixel.x);
 #endif
+#if LIGHT_SAMPLES
+    let sample_pixel = u32(pixel.y) * frame.size.x + u32(pixel.x);
+#endif
     for (var c = light_first(pixel, view_z); light_valid(c); c = light_next(c, view_z)) {
         let i = light_index(c);
         let props = light_properties[i];
@@ -25,6 +28,20 @@ fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f
             continue;
         }
 #endif
+#if LIGHT_SAMPLES
+        // A shadow-casting light is one of the pixel's exact lights (traced) or left to
+        // the samples added after the loop.
+        if ((props.flags & LIGHT_CASTS_SHADOW) != 0u && !exact_visible(sample_pixel, i)) {
+            continue;
+        }
+        if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
+            continue;
+        }
+        let inc = incident_light(light_geometry[i], props, p.position);
+        if (any(inc.radiance > vec3<f32>(0.0))) {
+            color += inc.radiance * material_eval(m, inc.dir);
+        }
+#else
 #if SHADOWS
         let g = light_geometry[i];
         let inc = incident_light(g, props, p.position);
@@ -45,6 +62,47 @@ fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f
             color += inc.radiance * material_eval(m, inc.dir);
         }
 #endif
+#endif
     }
+#if LIGHT_SAMPLES
+    color += sampled_light(sample_pixel, p, m);
+#endif
     return color;
 }
+
+#if LIGHT_SAMPLES
+// The flag of common/shadows.wgsl, which this loop does not include.
+const LIGHT_CASTS_SHADOW: u32 = 1u;
+
+// Whether `light` is one of the pixel's exact lights and its ray reached it.
+fn exact_visible(pixel: u32, light: u32) -> bool {
+    for (var j = 0u; j < SAMPLE_EXACT; j++) {
+        let word = light_samples[exact_word(pixel, j)];
+        if ((word & ~SAMPLE_HIDDEN) == light) {
+            return (word & SAMPLE_HIDDEN) == 0u;
+        }
+    }
+    return false;
+}
+
+// The sampled estimate of the other shadow-casting lights: each reservoir's light times
+// its contribution weight (zero when its ray was blocked), averaged over the reservoirs.
+fn sampled_light(pixel: u32, p: ShadingPoint, m: MaterialSample) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    for (var j = 0u; j < SAMPLE_COUNT; j++) {
+        let base = reservoir_word(SAMPLE_REGION, pixel, j);
+        let light = light_samples[base];
+        let weight = bitcast<f32>(light_samples[base + 1u]);
+        if (light == SAMPLE_NONE || !(weight > 0.0)) {
+            continue;
+        }
+        let props = light_properties[light];
+        if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
+            continue;
+        }
+        let inc = incident_light(light_geometry[light], props, p.position);
+        sum += (weight * inc.radiance) * material_eval(m, inc.dir);
+    }
+    return sum / f32(SAMPLE_COUNT);
+}
+#endif

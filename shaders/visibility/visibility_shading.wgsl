@@ -21,7 +21,9 @@
 // SHADOW_ATLAS (and SHADOW_PCF5): sampled from a ShadowAtlas pass's maps, filtered as
 // forward shading filters them (common/shadows.wgsl). VPL_VISIBILITY (with VPL_BLOCK,
 // VPL_WORDS): VPLs hidden from the pixel's block by a VplVisibility pass add nothing
-// (indirect/vpl_lookup.wgsl).
+// (indirect/vpl_lookup.wgsl). LIGHT_SAMPLES (with SAMPLE_EXACT, SAMPLE_COUNT,
+// SAMPLE_REGION; the Forward loop only): a LightSampling pass's exact lights and samples
+// stand for the shadow-casting lights (common/light_loop.wgsl).
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"
@@ -36,6 +38,11 @@
 #if SHADOW_MASK
 @group(0) @binding(10) var<storage, read> shadow_mask: array<u32>;
 #endif
+#if SHADOW_TRACE
+@group(0) @binding(18) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(0) @binding(19) var<storage, read> bvh_triangles: array<BvhTriangle>;
+#include "shadow/bvh.wgsl"
+#endif
 #if SHADOW_ATLAS
 @group(0) @binding(13) var<storage, read> shadow_views: array<vec4<f32>>;
 #if SHADOW_ATLAS_FLOAT
@@ -48,6 +55,10 @@
 #if VPL_VISIBILITY
 @group(0) @binding(16) var<storage, read> vpl_visibility: array<u32>;
 #include "indirect/vpl_lookup.wgsl"
+#endif
+#if LIGHT_SAMPLES
+@group(0) @binding(17) var<storage, read> light_samples: array<u32>;
+#include "common/light_samples.wgsl"
 #endif
 #if CLASSIFIED
 @group(0) @binding(11) var<storage, read> material_tiles: array<u32>;
@@ -157,6 +168,9 @@ fn main(
 #if SHADOWS
     shadow_pixel = id.y * frame.size.x + id.x;
 #endif
+#if SHADOW_TRACE
+    shadow_ng = surface_geometry(id.xy, select(range.x, tri, shades)).ng;
+#endif
 #if VPL_VISIBILITY
     vpl_pixel = id.xy;
 #endif
@@ -199,6 +213,9 @@ fn main(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group
     }
 #if SHADOWS
     shadow_pixel = id.y * frame.size.x + id.x;
+#endif
+#if SHADOW_TRACE
+    shadow_ng = surface_geometry(id.xy, tri).ng;
 #endif
 #if VPL_VISIBILITY
     vpl_pixel = id.xy;

@@ -110,7 +110,14 @@ pub struct ImageMetrics {
     pub test_non_finite: NonFinite,
     /// Mean FLIP error in `[0, 1]` of the tonemapped images, if requested and the image is not empty.
     pub flip_mean: Option<f64>,
+    /// Relative MSE: the mean over the compared pixels' channels of
+    /// `(test − ref)² / (ref² + REL_MSE_EPSILON)`, the error measure of the denoising and
+    /// resampling literature, where a dark pixel's error weighs as much as a bright one's.
+    pub rel_mse: f64,
 }
+
+/// Added to `ref²` in [`ImageMetrics::rel_mse`] so black reference pixels stay finite.
+pub const REL_MSE_EPSILON: f64 = 0.01;
 
 impl std::fmt::Display for ImageMetrics {
     /// One line per metric, for `lightgraph compare` and test failure messages.
@@ -277,6 +284,7 @@ pub fn compare<P: HdrPixel>(
     let rel_floor = (REL_ERROR_FLOOR * peak_channel).max(f64::MIN_POSITIVE);
     let mut max_rel = 0.0f64;
     let mut sum_sq = 0.0f64;
+    let mut sum_rel_sq = 0.0f64;
     let mut max_abs = 0.0f64;
     let mut compared = 0usize;
     let mut bad = 0usize;
@@ -301,6 +309,7 @@ pub fn compare<P: HdrPixel>(
         for c in 0..3 {
             let d = (r[c] as f64 - t[c] as f64).abs();
             sum_sq += d * d;
+            sum_rel_sq += d * d / ((r[c] as f64).powi(2) + REL_MSE_EPSILON);
             px_max = px_max.max(d);
             max_rel = max_rel.max(d / (r[c].abs() as f64).max(rel_floor));
         }
@@ -309,10 +318,11 @@ pub fn compare<P: HdrPixel>(
             bad += 1;
         }
     }
-    let mse = if compared == 0 {
-        0.0
+    let (mse, rel_mse) = if compared == 0 {
+        (0.0, 0.0)
     } else {
-        sum_sq / (3 * compared) as f64
+        let channels = (3 * compared) as f64;
+        (sum_sq / channels, sum_rel_sq / channels)
     };
     let psnr = if mse == 0.0 {
         f64::INFINITY
@@ -346,6 +356,7 @@ pub fn compare<P: HdrPixel>(
         reference_non_finite: ref_nf,
         test_non_finite: test_nf,
         flip_mean,
+        rel_mse,
     })
 }
 

@@ -4,6 +4,7 @@ pub use super::kinds::deferred_shading::DeferredShading;
 pub use super::kinds::forward_shading::ForwardShading;
 pub use super::kinds::light_culling::{LightCulling, ListMode};
 pub use super::kinds::light_linked_list::LightLinkedList;
+pub use super::kinds::light_sampling::LightSampling;
 pub use super::kinds::reflective_shadow_maps::ReflectiveShadowMaps;
 pub use super::kinds::shadow_atlas::ShadowAtlas;
 pub use super::kinds::shadow_ray_cast::ShadowRayCast;

@@ -26,6 +26,7 @@
 //!     output_size: (1280, 720),
 //!     ambient: (0, 0, 0),
 //!     shadow_bvh: Fast,                                      // ray-cast shadow BVH quality
+//!     all_lights_cast_shadows: false,                        // every light casts
 //! )
 //! ```
 //!
@@ -83,6 +84,11 @@ pub struct SceneFile {
     /// The ray-cast shadow BVH's build quality: Fastest, VeryFast, Fast (default), Medium.
     #[serde(default)]
     pub shadow_bvh: Option<super::BuildQuality>,
+    /// Every light of the built scene casts shadows, whatever its own setting, the built-in's,
+    /// the models' or the light sets' (default false): the "all lights casting" case of
+    /// the stochastic and exact shadow benchmarks.
+    #[serde(default)]
+    pub all_lights_cast_shadows: bool,
 }
 
 fn yes() -> bool {
@@ -637,6 +643,11 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
     }
     if let Some(q) = spec.shadow_bvh {
         scene.shadow_bvh = q;
+    }
+    if spec.all_lights_cast_shadows {
+        for light in &mut scene.lights {
+            light.flags |= light_flags::CASTS_SHADOW;
+        }
     }
     scene.source_path = Some(file.to_path_buf());
     Ok(Loaded {

@@ -60,6 +60,8 @@ pub struct BenchRow {
     pub psnr: Option<f64>,
     /// Mean FLIP against the reference.
     pub flip_mean: Option<f64>,
+    /// Relative MSE against the reference (`ImageMetrics::rel_mse`).
+    pub rel_mse: Option<f64>,
     /// Lights listed per tile (or cluster) over lights that really touch it; 1 is exact culling.
     pub listed_exact_ratio: Option<f64>,
     /// Largest per-tile light count.
@@ -147,6 +149,7 @@ impl BenchRow {
         self.max_rel = Some(m.max_rel);
         self.psnr = Some(m.psnr);
         self.flip_mean = m.flip_mean;
+        self.rel_mse = Some(m.rel_mse);
         self.nan_pixels = Some(m.test_non_finite.nan_pixels as u64);
         self.inf_pixels = Some(m.test_non_finite.inf_pixels as u64);
     }

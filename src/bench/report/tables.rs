@@ -37,7 +37,7 @@ fn opt<T: ToString>(v: Option<T>) -> String {
 /// row (first-seen order): `pass_ms:<name>` (median), `pass_ms_p10:<name>`, `pass_ms_p90:<name>`,
 /// empty where a row lacks that pass. Time columns are empty, not 0, for untimed rows; the
 /// ray-cast shadow columns (`shadow_*`, `bvh_*`) are empty for graphs without those passes.
-pub const CSV_COLUMNS: [&str; 56] = [
+pub const CSV_COLUMNS: [&str; 57] = [
     "scene",
     "technique",
     "params",
@@ -61,6 +61,7 @@ pub const CSV_COLUMNS: [&str; 56] = [
     "max_rel",
     "psnr",
     "flip_mean",
+    "rel_mse",
     "listed_exact_ratio",
     "max_lights_per_tile",
     "overflow_tiles",
@@ -135,6 +136,7 @@ pub fn to_csv(rows: &[BenchRow]) -> String {
             opt(r.max_rel),
             opt(r.psnr),
             opt(r.flip_mean),
+            opt(r.rel_mse),
             opt(r.listed_exact_ratio),
             opt(r.max_lights_per_tile),
             opt(r.overflow_tiles),

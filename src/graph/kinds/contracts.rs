@@ -31,6 +31,7 @@ impl Contents {
             Contents::RsmViews => "the view table of a ReflectiveShadowMaps pass",
             Contents::ShadowViews => "the view table of a ShadowAtlas pass",
             Contents::VplVisibility => "the visibility bits of a VplVisibility pass",
+            Contents::LightSamples => "the light samples of a LightSampling pass",
         }
     }
 }

@@ -1,7 +1,9 @@
 //! What a writer publishes about a buffer it lays out, and what a reading slot needs.
 
 use super::light_culling::ListLayout;
-use super::{light_linked_list, reflective_shadow_maps, shadow_atlas, shadow_ray_jobs};
+use super::{
+    light_linked_list, light_sampling, reflective_shadow_maps, shadow_atlas, shadow_ray_jobs,
+};
 
 /// What a buffer slot's writer says about its contents, published on the planned
 /// buffer so readers never search for the producer.
@@ -54,6 +56,8 @@ pub enum BufferLayout {
         /// Blocks of the frame.
         blocks: u64,
     },
+    /// A `LightSampling` pass's exact lights and reservoirs, per pixel.
+    LightSamples(light_sampling::SampleLayout),
 }
 
 /// What a laid-out buffer holds: a [`BufferLayout`] without its sizes, for contracts
@@ -76,6 +80,8 @@ pub enum Contents {
     ShadowViews,
     /// A `VplVisibility` pass's visibility bits.
     VplVisibility,
+    /// The exact lights and reservoirs of a `LightSampling` pass.
+    LightSamples,
 }
 
 impl Contents {
@@ -89,6 +95,7 @@ impl Contents {
             Contents::RsmViews => "ReflectiveShadowMaps",
             Contents::ShadowViews => "ShadowAtlas",
             Contents::VplVisibility => "VplVisibility",
+            Contents::LightSamples => "LightSampling",
         }
     }
 }
@@ -105,6 +112,7 @@ impl BufferLayout {
             BufferLayout::RsmViews { .. } => Contents::RsmViews,
             BufferLayout::ShadowViews { .. } => Contents::ShadowViews,
             BufferLayout::VplVisibility { .. } => Contents::VplVisibility,
+            BufferLayout::LightSamples(_) => Contents::LightSamples,
         }
     }
     /// The buffer's size in bytes.
@@ -122,6 +130,7 @@ impl BufferLayout {
                 lights, max_views, ..
             } => shadow_atlas::view_table_bytes(*lights, *max_views),
             BufferLayout::VplVisibility { words, blocks, .. } => 4 * u64::from(*words) * blocks,
+            BufferLayout::LightSamples(l) => l.bytes(),
         }
     }
 }

@@ -39,6 +39,9 @@ macro_rules! built_in_kinds {
             ShadowAtlas(params: ShadowAtlas) => shadow_atlas,
             /// Counts (pixel, light) pairs where the atlas and ray-cast shadows disagree.
             ShadowCompare => shadow_compare,
+            /// Stochastic direct lighting: the most important lights traced exactly, the
+            /// rest resampled (RIS reservoirs, optional spatial reuse), a shadow ray a sample.
+            LightSampling(params: LightSampling) => light_sampling,
             /// The nearest depth of blended meshes, for their own light lists.
             TransparentDepth => transparent_depth,
             /// Blended meshes, back to front, lit two-sided over the opaque colour.

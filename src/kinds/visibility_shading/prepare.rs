@@ -56,6 +56,7 @@ pub(super) fn prepare(
     // comparison sampler is offered here.
     let shadows = cx.shading_shadows(sp, &mut offered);
     let vpl = super::VplLookup::of(cx, sp);
+    let samples = sample_defines(cx, sp);
     let layout = tile_layout(cx, sp, lists);
     let side = p.workgroup_side();
     let light_loop = choose_light_loop(p.light_loop, layout, side);
@@ -106,6 +107,7 @@ pub(super) fn prepare(
         d.extend(loop_define(light_loop));
         d.extend(crate::render::draws::shadow_defines(shadows));
         d.extend(super::VplLookup::defines(vpl));
+        d.extend(samples.iter().cloned());
         // The shader's `@workgroup_size(SHADING_GROUP, SHADING_GROUP, 1)`.
         d.push(("SHADING_GROUP", format!("{side}u")));
         if light_loop == LightLoop::GroupList {
@@ -136,6 +138,29 @@ pub(super) fn prepare(
         classification,
         groups,
     })
+}
+
+/// The light loop's defines for a read `light_samples` buffer (common/light_samples.wgsl):
+/// its exact lights and samples a pixel and the region of reservoirs to read. None when the
+/// scene has no shadow-casting lights: the sampling pass is then culled (`when:
+/// ShadowCasters`) and every light is shaded exactly.
+fn sample_defines(cx: &PrepareCtx, sp: &ScheduledPass) -> Vec<(&'static str, String)> {
+    use crate::graph::kinds::light_sampling::LIGHT_SAMPLES;
+    if !cx.scene.features().has_shadow_casters {
+        return vec![];
+    }
+    let Some(name) = sp.roles.slot(LIGHT_SAMPLES) else {
+        return vec![];
+    };
+    match cx.graph.plan.get(name).and_then(|r| r.layout) {
+        Some(crate::graph::BufferLayout::LightSamples(l)) => vec![
+            ("LIGHT_SAMPLES", "1".into()),
+            ("SAMPLE_EXACT", format!("{}u", l.exact)),
+            ("SAMPLE_COUNT", format!("{}u", l.samples)),
+            ("SAMPLE_REGION", format!("{}u", u32::from(l.spatial))),
+        ],
+        _ => vec![],
+    }
 }
 
 /// The classification of `shaded` materials (slot k: `shaded[k]`) over `tiles` tiles of

@@ -11,7 +11,9 @@
 
 use super::contracts::InputsCtx;
 use super::deferred_shading::HDR;
-use super::shadow_atlas::SHADOW_VIEWS;
+use super::light_sampling::LIGHT_SAMPLES;
+use super::shadow_atlas::{SHADOW_ATLAS, SHADOW_VIEWS};
+use super::shadow_ray_cast::{BVH_NODES, BVH_TRIANGLES};
 use super::shadow_ray_jobs::SHADOW_MASK;
 use super::visibility_buffer::VISIBILITY;
 use super::{check_light_source, Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
@@ -125,6 +127,25 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     super::SHADOW_ATLAS_READ,
     super::SHADOW_VIEWS_READ,
     super::VPL_VISIBILITY_READ,
+    // Shadows traced in the light loop (every caster, no mask): the exact reference.
+    SlotSpec::new(
+        BVH_NODES,
+        SlotType::Import(SceneResource::BvhNodes),
+        Access::Read,
+        Usage::Bound,
+    )
+    .optional(),
+    SlotSpec::new(
+        BVH_TRIANGLES,
+        SlotType::Import(SceneResource::BvhTriangles),
+        Access::Read,
+        Usage::Bound,
+    )
+    .optional(),
+    // Stochastic direct lighting: a LightSampling pass's exact lights and samples.
+    SlotSpec::new(LIGHT_SAMPLES, SlotType::Buffer, Access::Read, Usage::Bound)
+        .optional()
+        .needs(&[Contents::LightSamples]),
 ];
 
 pub(crate) fn check(p: &VisibilityShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
@@ -147,6 +168,32 @@ pub(crate) fn check(p: &VisibilityShading, ctx: &KindCtx, errors: &mut Vec<Graph
     );
     super::check_shadow_mask(ctx, errors);
     super::check_shadow_atlas(ctx, errors, true);
+    super::check_bvh_trace(ctx, errors);
+    if let Some(nodes) = ctx.slot(BVH_NODES) {
+        if ctx.slot(SHADOW_MASK).is_some() || ctx.slot(SHADOW_ATLAS).is_some() {
+            errors.push(ctx.mismatch(
+                nodes,
+                "a pass traces the BVH, or reads a shadow mask or an atlas, not two",
+            ));
+        }
+    }
+    if let Some(samples) = ctx.slot(LIGHT_SAMPLES) {
+        if p.light_loop != LightLoop::Forward {
+            errors.push(ctx.mismatch(
+                samples,
+                "light samples are shaded by the Forward light loop: set light_loop: Forward",
+            ));
+        }
+        if ctx.slot(SHADOW_MASK).is_some()
+            || ctx.slot(SHADOW_ATLAS).is_some()
+            || ctx.slot(BVH_NODES).is_some()
+        {
+            errors.push(ctx.mismatch(
+                samples,
+                "light samples carry their own shadow rays: read them, a shadow mask, an atlas or the BVH, not two",
+            ));
+        }
+    }
 }
 
 /// The hybrid (the atlas and the mask read together): the jobs pass that writes the mask
