@@ -128,10 +128,16 @@ pub(crate) fn resolve(
     }
     for s in specs.iter().filter(|s| !s.optional) {
         if !roles.slots.contains_key(s.name) {
+            // A missing depth while an R32Float depth filled another slot (a shadow
+            // atlas takes one): say which kinds read such a depth.
+            let hint = match typed.iter().find(|(_, name, _)| float_depth(name)) {
+                Some((_, name, _)) if s.ty == SlotType::DepthTexture => depth_hint(name),
+                _ => String::new(),
+            };
             errors.push(ctx.bad(
                 pass,
                 format!(
-                    "{kind} needs {} {} (slot '{}')",
+                    "{kind} needs {} {} (slot '{}'){hint}",
                     s.ty.describe(),
                     s.access.describe(),
                     s.name

@@ -168,8 +168,10 @@ mod tests {
             "hdr",
         );
         assert!(e.contains("t.ron:"), "{e}");
+        // The R32Float fits the optional shadow-atlas slot (a compute atlas is R32Float),
+        // so what is missing is the depth.
         assert!(
-            e.contains("pass 'f', resource 'fdepth': ForwardShading has no free slot for a colour texture in reads"),
+            e.contains("pass 'f': ForwardShading needs a depth texture in reads or writes (slot 'depth')"),
             "{e}"
         );
         assert!(
