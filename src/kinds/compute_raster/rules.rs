@@ -171,7 +171,9 @@ mod tests {
         // The R32Float fits the optional shadow-atlas slot (a compute atlas is R32Float),
         // so what is missing is the depth.
         assert!(
-            e.contains("pass 'f': ForwardShading needs a depth texture in reads or writes (slot 'depth')"),
+            e.contains(
+                "pass 'f': ForwardShading needs a depth texture in reads or writes (slot 'depth')"
+            ),
             "{e}"
         );
         assert!(
