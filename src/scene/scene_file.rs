@@ -645,6 +645,7 @@ pub fn build_scene(spec: &SceneFile, file: &Path) -> Result<Loaded, SceneError> 
         scene.shadow_bvh = q;
     }
     if spec.all_lights_cast_shadows {
+        scene.all_lights_cast_shadows = true;
         for light in &mut scene.lights {
             light.flags |= light_flags::CASTS_SHADOW;
         }

@@ -340,6 +340,9 @@ pub struct Scene {
     /// How lights move over time (scene files: `motion:` on a light or a light set);
     /// `lights` holds them as placed, before any motion.
     pub light_motion: Vec<super::motion::LightMotion>,
+    /// Every light casts a shadow (scene files: `all_lights_cast_shadows: true`), the
+    /// lights a benchmark sweep generates for the scene included.
+    pub all_lights_cast_shadows: bool,
 }
 
 impl Scene {

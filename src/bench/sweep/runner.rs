@@ -31,6 +31,11 @@ pub fn with_light_count(scene: &Scene, count: u32) -> Scene {
         set.range = (r, r);
         set.intensity = (r * r * 0.5, r * r * 2.0);
         s.lights = set.generate(Some((lo, hi)));
+        if scene.all_lights_cast_shadows {
+            for light in &mut s.lights {
+                light.flags |= crate::scene::light_flags::CASTS_SHADOW;
+            }
+        }
         s.light_motion.clear();
     }
     s
@@ -331,4 +336,25 @@ fn check_graph(name: &str, renderer: &Renderer) -> Result<graph::CheckedGraph, S
         .read(&format!("graphs/{name}"))
         .map_err(|e| err(e.to_string()))?;
     graph::check_text(&path, &text, &renderer.shaders).map_err(|e| err(e.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::with_light_count;
+    use crate::scene::{builtin, light_flags};
+
+    #[test]
+    fn generated_lights_cast_where_the_scene_says_every_light_casts() {
+        let mut harada = builtin::by_name("harada").expect("built-in harada");
+        let casting = |s: &crate::scene::Scene| {
+            s.lights
+                .iter()
+                .filter(|l| l.flags & light_flags::CASTS_SHADOW != 0)
+                .count()
+        };
+        assert_eq!(casting(&with_light_count(&harada, 300)), 0);
+        harada.all_lights_cast_shadows = true;
+        let all = with_light_count(&harada, 300);
+        assert_eq!((all.lights.len(), casting(&all)), (300, 300));
+    }
 }
