@@ -61,9 +61,10 @@ struct Params {
 #endif
 #endif
 
-const SUBPIXEL: f32 = 256.0;
+#include "common/triangle_setup.wgsl"
+
+// Half a texel in snapped (1/SUBPIXEL) units: texel centres.
 const HALF_TEXEL: i32 = 128;
-const MAX_POLY: u32 = 8u;
 // Texels a fan triangle's box may hold to be rasterized in its setup thread.
 const SMALL_BOX: i32 = 64;
 // Texels per side of a cell entry (a 256-thread workgroup, four texels a thread).
@@ -113,10 +114,6 @@ struct Tri {
     // Texels whose centres lie in the vertices' box, within the view's tile.
     box: vec4<i32>,
 };
-
-fn edge(a: vec2<i32>, b: vec2<i32>, p: vec2<i32>) -> i64 {
-    return i64(b.x - a.x) * i64(p.y - a.y) - i64(b.y - a.y) * i64(p.x - a.x);
-}
 
 // Texel (px, py) of `t`, if its centre is covered and its depth within the far plane.
 fn cover(t: Tri, px: i32, py: i32) {
@@ -188,73 +185,7 @@ fn store_record(r: u32, t: Tri) {
     records[i + 3u] = vec4<u32>(bitcast<u32>(t.dz.y), bitcast<u32>(t.offset), flags, 0u);
 }
 
-// The near plane (z >= 0) and the viewport's four sides.
-fn plane_distance(c: vec4<f32>, k: u32) -> f32 {
-    if (k == 0u) {
-        return c.z;
-    }
-    let axis = select(c.y, c.x, k < 3u);
-    return c.w + select(axis, -axis, k % 2u == 1u);
-}
 
-fn needs_clipping(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) -> bool {
-    for (var k = 0u; k < 5u; k++) {
-        if (plane_distance(a, k) < 0.0 || plane_distance(b, k) < 0.0 || plane_distance(c, k) < 0.0) {
-            return true;
-        }
-    }
-    return false;
-}
-
-struct Polygon {
-    v: array<vec4<f32>, MAX_POLY>,
-    n: u32,
-};
-
-// Sutherland-Hodgman, each new point computed from the outside vertex (as the frame's
-// compute raster and Mesa's clipper), fanned from vertex 0.
-fn clip_triangle(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) -> Polygon {
-    var p: Polygon;
-    p.v[0] = a;
-    p.v[1] = b;
-    p.v[2] = c;
-    p.n = 3u;
-    for (var k = 0u; k < 5u; k++) {
-        var outside = 0u;
-        for (var i = 0u; i < p.n; i++) {
-            outside += u32(plane_distance(p.v[i], k) < 0.0);
-        }
-        if (outside == 0u) {
-            continue;
-        }
-        var q: Polygon;
-        q.n = 0u;
-        for (var i = 0u; i < p.n; i++) {
-            let s = p.v[i];
-            let e = p.v[(i + 1u) % p.n];
-            let ds = plane_distance(s, k);
-            let de = plane_distance(e, k);
-            if (ds >= 0.0) {
-                q.v[q.n] = s;
-                q.n++;
-            }
-            if ((ds >= 0.0) != (de >= 0.0)) {
-                if (ds >= 0.0) {
-                    q.v[q.n] = e + de / (de - ds) * (s - e);
-                } else {
-                    q.v[q.n] = s + ds / (ds - de) * (e - s);
-                }
-                q.n++;
-            }
-        }
-        p = q;
-        if (p.n < 3u) {
-            p.n = 0u;
-            break;
-        }
-    }
-    return p;
-}
 
 // Atlas position (texels, y down) and depth, as the viewport transform of the view's
 // tile: `rect` is (x, y, side).
@@ -265,10 +196,6 @@ fn to_screen(c: vec4<f32>, rect: vec4<u32>) -> vec3<f32> {
     return vec3<f32>(ndc.x * half + origin.x, ndc.y * -half + origin.y, ndc.z);
 }
 
-fn snap(p: vec3<f32>) -> vec2<i32> {
-    return vec2<i32>(round(p.xy * SUBPIXEL));
-}
-
 // Texels whose centres lie in [lo, hi] (fixed point), within the tile.
 fn texel_box(lo: vec2<i32>, hi: vec2<i32>, rect: vec4<u32>) -> vec4<i32> {
     let first = -((vec2<i32>(HALF_TEXEL) - lo) >> vec2<u32>(8u));
@@ -276,12 +203,6 @@ fn texel_box(lo: vec2<i32>, hi: vec2<i32>, rect: vec4<u32>) -> vec4<i32> {
     let tile_lo = vec2<i32>(rect.xy);
     let tile_hi = tile_lo + vec2<i32>(i32(rect.z) - 1);
     return vec4<i32>(max(first, tile_lo), min(last, tile_hi));
-}
-
-// The top-left rule for an edge of a clockwise triangle (y down).
-fn top_left(a: vec2<i32>, b: vec2<i32>) -> bool {
-    let d = b - a;
-    return d.y < 0 || (d.y == 0 && d.x > 0);
 }
 
 // Whether some texel centre of `region` may lie inside edge a -> b: its function is not

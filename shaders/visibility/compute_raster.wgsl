@@ -39,6 +39,7 @@
 // buffer. Each run counts into its own `counters`.
 
 #include "common/types.wgsl"
+#include "common/triangle_setup.wgsl"
 
 // Triangle count, workgroups per dispatch dimension, width, height.
 @group(0) @binding(1) var<uniform> raster_params: vec4<u32>;
@@ -99,14 +100,8 @@
 #endif
 
 const NO_TRIANGLE: u32 = 0xffffffffu;
-// Sub-pixel bits of snapped vertex positions (as lavapipe and most GPUs).
-const SUBPIXEL: f32 = 256.0;
+// Half a pixel in snapped (1/SUBPIXEL) units: pixel centres.
 const HALF_PIXEL: i32 = 128;
-// Where x and y clip: at the viewport's sides. lavapipe clips there too (and against the
-// near plane) when a triangle needs clipping: with the planes 2 viewports out instead,
-// 4 pixels of atrium_amd's near-clipped balustrade took another depth.
-const GUARD: f32 = 1.0;
-const MAX_POLY: u32 = 8u;
 // Counter slots: entries appended to each list (past the capacity too), then fan
 // triangles, tiles and blocks rasterized serially because their list was full.
 const RECORDS: u32 = 0u;
@@ -228,10 +223,6 @@ fn alpha_keeps(tri: u32, px: i32, py: i32) -> bool {
 }
 #endif
 
-fn edge(a: vec2<i32>, b: vec2<i32>, p: vec2<i32>) -> i64 {
-    return i64(b.x - a.x) * i64(p.y - a.y) - i64(b.y - a.y) * i64(p.x - a.x);
-}
-
 // The pixel (px, py) of `t`, if its centre is covered and its depth within the far plane.
 fn cover(t: Tri, px: i32, py: i32) {
     let p = vec2<i32>(px, py) * 256 + vec2<i32>(HALF_PIXEL);
@@ -331,87 +322,13 @@ fn clip_position(v: u32) -> vec4<f32> {
     return frame.view_proj * vec4<f32>(p, 1.0);
 }
 
-// Signed distance-like value of `c` to clip plane `k`: the near plane (z >= 0) and the
-// viewport's four sides.
-fn plane_distance(c: vec4<f32>, k: u32) -> f32 {
-    if (k == 0u) {
-        return c.z;
-    }
-    let axis = select(c.y, c.x, k < 3u);
-    return GUARD * c.w + select(axis, -axis, k % 2u == 1u);
-}
 
-// Whether `clip_triangle` would change the triangle: some vertex outside some plane.
-// Most triangles are inside: they skip the polygon array (local memory on GPUs).
-fn needs_clipping(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) -> bool {
-    for (var k = 0u; k < 5u; k++) {
-        if (plane_distance(a, k) < 0.0 || plane_distance(b, k) < 0.0 || plane_distance(c, k) < 0.0) {
-            return true;
-        }
-    }
-    return false;
-}
-
-// The triangle clipped to a convex polygon (Sutherland-Hodgman), fanned from vertex 0.
-struct Polygon {
-    v: array<vec4<f32>, MAX_POLY>,
-    n: u32,
-};
-
-fn clip_triangle(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) -> Polygon {
-    var p: Polygon;
-    p.v[0] = a;
-    p.v[1] = b;
-    p.v[2] = c;
-    p.n = 3u;
-    for (var k = 0u; k < 5u; k++) {
-        var outside = 0u;
-        for (var i = 0u; i < p.n; i++) {
-            outside += u32(plane_distance(p.v[i], k) < 0.0);
-        }
-        if (outside == 0u) {
-            continue;
-        }
-        var q: Polygon;
-        q.n = 0u;
-        for (var i = 0u; i < p.n; i++) {
-            let s = p.v[i];
-            let e = p.v[(i + 1u) % p.n];
-            let ds = plane_distance(s, k);
-            let de = plane_distance(e, k);
-            if (ds >= 0.0) {
-                q.v[q.n] = s;
-                q.n++;
-            }
-            if ((ds >= 0.0) != (de >= 0.0)) {
-                // From the outside vertex, so the two triangles sharing an edge get the
-                // same point (and as Mesa's clipper computes it).
-                if (ds >= 0.0) {
-                    q.v[q.n] = e + de / (de - ds) * (s - e);
-                } else {
-                    q.v[q.n] = s + ds / (ds - de) * (e - s);
-                }
-                q.n++;
-            }
-        }
-        p = q;
-        if (p.n < 3u) {
-            p.n = 0u;
-            break;
-        }
-    }
-    return p;
-}
 
 // Framebuffer position (x right, y down, pixels) and depth, as the viewport transform.
 fn to_screen(c: vec4<f32>) -> vec3<f32> {
     let ndc = c.xyz * (1.0 / c.w);
     let half = vec2<f32>(raster_params.zw) * 0.5;
     return vec3<f32>(ndc.x * half.x + half.x, ndc.y * -half.y + half.y, ndc.z);
-}
-
-fn snap(p: vec3<f32>) -> vec2<i32> {
-    return vec2<i32>(round(p.xy * SUBPIXEL));
 }
 
 // Pixels whose centres lie in [lo, hi] (fixed point), clamped to the viewport; empty
@@ -422,13 +339,6 @@ fn pixel_box(lo: vec2<i32>, hi: vec2<i32>) -> vec4<i32> {
     let last = (hi - vec2<i32>(HALF_PIXEL)) >> vec2<u32>(8u);
     let size = vec2<i32>(raster_params.zw);
     return vec4<i32>(max(first, vec2<i32>(0)), min(last, size - 1));
-}
-
-// The top-left rule, for an edge a -> b of a triangle with positive area (clockwise on
-// screen, y down): a left edge goes up, a top edge goes right.
-fn top_left(a: vec2<i32>, b: vec2<i32>) -> bool {
-    let d = b - a;
-    return d.y < 0 || (d.y == 0 && d.x > 0);
 }
 
 fn within_linear_range(p: vec2<i32>) -> bool {
