@@ -2,7 +2,10 @@
 """Writes benches/graphs/stochastic_k{K}_{REUSE}.ron from
 graphs/visibility_stochastic_shadows.ron: K = 1, 2, 4, 8 reservoirs (shadow rays) a pixel
 beyond its 4 exact lights, without reuse (off) and with unbiased spatial reuse (spatial);
-for K = 1 and 4 also temporal reuse (history 20) alone and with the spatial reuse."""
+for K = 1 and 4 also temporal reuse (history 20) alone and with the spatial reuse. And
+benches/graphs/stochastic_n0_k{K}_m{M}_{REUSE}.ron: no exact lights (the sampling pass
+never walks the whole tile list), K = 1, 2, 4 reservoirs of M = 8 or 32 candidates,
+without reuse and with temporal reuse."""
 import pathlib
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -10,19 +13,35 @@ SHIPPED = "LightSampling(candidates: 8, samples: 1, exact_lights: 4, reuse: Off,
 text = (ROOT / "graphs/visibility_stochastic_shadows.ron").read_text()
 assert SHIPPED in text, "the shipped parameters moved"
 body = text[text.index("Graph(") :]
+DESCRIBED = "the 4 strongest casting lights a pixel traced exactly, one resampled light for the rest"
+assert DESCRIBED in body, "the shipped description moved"
 SPATIAL = "Unbiased(neighbours: 4, radius: 16)"
 VARIANTS = [("off", "Off", 0), ("spatial", SPATIAL, 0), ("temporal", "Off", 20), ("spatiotemporal", SPATIAL, 20)]
+
+
+def write(name, k, m, exact, params, history):
+    words = {1: "one", 2: "two", 4: "four", 8: "eight"}
+    said = f"the {exact} strongest casting lights a pixel traced exactly, " if exact else "no light traced exactly, "
+    said += f"{words[k]} resampled light{'s' if k > 1 else ''} of {m} candidates for the rest"
+    out = body.replace(DESCRIBED, said).replace('name: "visibility_stochastic_shadows"', f'name: "{name}"').replace(
+        SHIPPED,
+        f"LightSampling(candidates: {m}, samples: {k}, exact_lights: {exact}, reuse: {params}, history: {history}, seed: 0)",
+    )
+    head = (
+        "// Written by scripts/stochastic_bench_graphs.py from graphs/visibility_stochastic_shadows.ron:\n"
+        f"// {k} reservoirs (shadow rays) of {m} candidates a pixel beyond its {exact} exact lights, spatial reuse {params}, history {history}.\n"
+    )
+    (ROOT / f"benches/graphs/{name}.ron").write_text(head + out)
+
+
 for k in [1, 2, 4, 8]:
     for reuse, params, history in VARIANTS:
         if history and k not in (1, 4):
             continue
-        name = f"stochastic_k{k}_{reuse}"
-        out = body.replace('name: "visibility_stochastic_shadows"', f'name: "{name}"').replace(
-            SHIPPED,
-            f"LightSampling(candidates: 8, samples: {k}, exact_lights: 4, reuse: {params}, history: {history}, seed: 0)",
-        )
-        head = (
-            "// Written by scripts/stochastic_bench_graphs.py from graphs/visibility_stochastic_shadows.ron:\n"
-            f"// {k} reservoirs (shadow rays) a pixel beyond its 4 exact lights, spatial reuse {params}, history {history}.\n"
-        )
-        (ROOT / f"benches/graphs/{name}.ron").write_text(head + out)
+        write(f"stochastic_k{k}_{reuse}", k, 8, 4, params, history)
+for k in [1, 2, 4]:
+    for m in [8, 32]:
+        for reuse, params, history in VARIANTS:
+            if params != "Off":
+                continue
+            write(f"stochastic_n0_k{k}_m{m}_{reuse}", k, m, 0, params, history)

@@ -18,6 +18,10 @@ fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f
 #if LIGHT_SAMPLES
     let sample_pixel = u32(pixel.y) * frame.size.x + u32(pixel.x);
 #endif
+#if SAMPLED_ONLY
+    // Every light casts (the scene has no other, and no VPLs): the exact lights and the
+    // samples after the loop stand for all of them, so the list is not walked.
+#else
     for (var c = light_first(pixel, view_z); light_valid(c); c = light_next(c, view_z)) {
         let i = light_index(c);
         let props = light_properties[i];
@@ -29,9 +33,9 @@ fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f
         }
 #endif
 #if LIGHT_SAMPLES
-        // A shadow-casting light is one of the pixel's exact lights (traced) or left to
-        // the samples added after the loop.
-        if ((props.flags & LIGHT_CASTS_SHADOW) != 0u && !exact_visible(sample_pixel, i)) {
+        // A shadow-casting light is one of the pixel's exact lights or left to the
+        // samples: both are added after the loop.
+        if ((props.flags & LIGHT_CASTS_SHADOW) != 0u) {
             continue;
         }
         if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
@@ -64,8 +68,9 @@ fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f
 #endif
 #endif
     }
+#endif
 #if LIGHT_SAMPLES
-    color += sampled_light(sample_pixel, p, m);
+    color += exact_light(sample_pixel, p, m) + sampled_light(sample_pixel, p, m);
 #endif
     return color;
 }
@@ -74,15 +79,25 @@ fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f
 // The flag of common/shadows.wgsl, which this loop does not include.
 const LIGHT_CASTS_SHADOW: u32 = 1u;
 
-// Whether `light` is one of the pixel's exact lights and its ray reached it.
-fn exact_visible(pixel: u32, light: u32) -> bool {
+// The pixel's exact lights whose rays reached them, unshadowed (SAMPLE_NONE has the
+// hidden bit too: light indices stay under 2^31).
+fn exact_light(pixel: u32, p: ShadingPoint, m: MaterialSample) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
     for (var j = 0u; j < SAMPLE_EXACT; j++) {
-        let word = light_samples[exact_word(pixel, j)];
-        if ((word & ~SAMPLE_HIDDEN) == light) {
-            return (word & SAMPLE_HIDDEN) == 0u;
+        let light = light_samples[exact_word(pixel, j)];
+        if ((light & SAMPLE_HIDDEN) != 0u) {
+            continue;
+        }
+        let props = light_properties[light];
+        if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
+            continue;
+        }
+        let inc = incident_light(light_geometry[light], props, p.position);
+        if (any(inc.radiance > vec3<f32>(0.0))) {
+            sum += inc.radiance * material_eval(m, inc.dir);
         }
     }
-    return false;
+    return sum;
 }
 
 // The sampled estimate of the other shadow-casting lights: each reservoir's light times

@@ -152,12 +152,14 @@ fn candidates(@builtin(global_invocation_id) gid: vec3<u32>) {
     seed_rng(pixel, 0u);
     let range = light_range(vec2<f32>(gid.xy) + 0.5, view_depth(s.position));
 
-    // The exact lights: the SAMPLE_EXACT largest p̂ of the list (ties to the first).
+    // The exact lights: the SAMPLE_EXACT largest p̂ of the list (ties to the first). The
+    // list is walked only when some are asked for.
     var exact: array<u32, EXACT_ARRAY>;
     var exact_t: array<f32, EXACT_ARRAY>;
     var n = 0u;
     var weakest = 0u;
-    for (var k = 0u; k < range.count; k++) {
+    let walked = select(0u, range.count, SAMPLE_EXACT > 0u);
+    for (var k = 0u; k < walked; k++) {
         let i = light_at(range, k);
         let t = sample_target(i, s.position, s.ng);
         if (t <= 0.0) {

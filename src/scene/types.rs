@@ -295,6 +295,8 @@ pub struct SceneFeatures {
     pub has_shadow_casters: bool,
     /// Some light has `INDIRECT` (spawns virtual point lights).
     pub has_indirect_lights: bool,
+    /// Some light casts no shadow (shaded without a shadow test).
+    pub has_unshadowed_lights: bool,
     /// Some light is a spot light.
     pub has_spot_lights: bool,
     /// The scene has at least one light.
@@ -373,6 +375,10 @@ impl Scene {
                 .lights
                 .iter()
                 .any(|l| l.flags & light_flags::INDIRECT != 0),
+            has_unshadowed_lights: self
+                .lights
+                .iter()
+                .any(|l| l.flags & light_flags::CASTS_SHADOW == 0),
             has_spot_lights: self
                 .lights
                 .iter()

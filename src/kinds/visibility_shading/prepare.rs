@@ -143,22 +143,31 @@ pub(super) fn prepare(
 /// The light loop's defines for a read `light_samples` buffer (common/light_samples.wgsl):
 /// its exact lights and samples a pixel and the region of reservoirs to read. None when the
 /// scene has no shadow-casting lights: the sampling pass is then culled (`when:
-/// ShadowCasters`) and every light is shaded exactly.
+/// ShadowCasters`) and every light is shaded exactly. `SAMPLED_ONLY` when every light the
+/// lists can name casts (no light without shadows, no VPLs): the loop then skips the list.
+/// A light update cannot add a light without shadows to such a scene (`NewFeature`).
 fn sample_defines(cx: &PrepareCtx, sp: &ScheduledPass) -> Vec<(&'static str, String)> {
     use crate::graph::kinds::light_sampling::LIGHT_SAMPLES;
-    if !cx.scene.features().has_shadow_casters {
+    let features = cx.scene.features();
+    if !features.has_shadow_casters {
         return vec![];
     }
     let Some(name) = sp.roles.slot(LIGHT_SAMPLES) else {
         return vec![];
     };
     match cx.graph.plan.get(name).and_then(|r| r.layout) {
-        Some(crate::graph::BufferLayout::LightSamples(l)) => vec![
-            ("LIGHT_SAMPLES", "1".into()),
-            ("SAMPLE_EXACT", format!("{}u", l.exact)),
-            ("SAMPLE_COUNT", format!("{}u", l.samples)),
-            ("SAMPLE_REGION", format!("{}u", u32::from(l.spatial))),
-        ],
+        Some(crate::graph::BufferLayout::LightSamples(l)) => {
+            let mut d = vec![
+                ("LIGHT_SAMPLES", "1".into()),
+                ("SAMPLE_EXACT", format!("{}u", l.exact)),
+                ("SAMPLE_COUNT", format!("{}u", l.samples)),
+                ("SAMPLE_REGION", format!("{}u", u32::from(l.spatial))),
+            ];
+            if !features.has_unshadowed_lights && !features.has_indirect_lights {
+                d.push(("SAMPLED_ONLY", "1".into()));
+            }
+            d
+        }
         _ => vec![],
     }
 }

@@ -213,6 +213,8 @@ fn check_features(had: &SceneFeatures, lights: &[Light]) -> Result<(), LightUpda
             Some("a light")
         } else if l.flags & light_flags::CASTS_SHADOW != 0 && !had.has_shadow_casters {
             Some("a shadow caster")
+        } else if l.flags & light_flags::CASTS_SHADOW == 0 && !had.has_unshadowed_lights {
+            Some("a light that casts no shadow")
         } else if l.flags & light_flags::INDIRECT != 0 && !had.has_indirect_lights {
             Some("an indirect light")
         } else if spot && !had.has_spot_lights {
@@ -229,4 +231,45 @@ fn check_features(had: &SceneFeatures, lights: &[Light]) -> Result<(), LightUpda
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{check_features, LightUpdateError};
+    use crate::scene::{light_flags, Light, SceneFeatures};
+    use glam::Vec3;
+
+    fn light(flags: u32) -> Light {
+        Light {
+            flags,
+            ..Light::point(Vec3::ZERO, 1.0, Vec3::ONE, 1.0)
+        }
+    }
+
+    /// A scene whose every light casts was compiled with the light loop skipped
+    /// (`SAMPLED_ONLY` beside a LightSampling pass): an update bringing a light without
+    /// shadows is refused, naming it, and one of casting lights is taken.
+    #[test]
+    fn a_light_without_shadows_is_new_to_an_all_casting_scene() {
+        let all_casting = SceneFeatures {
+            has_lights: true,
+            has_point_lights: true,
+            has_shadow_casters: true,
+            ..Default::default()
+        };
+        let casting = light(light_flags::CASTS_SHADOW);
+        assert!(check_features(&all_casting, &[casting, casting]).is_ok());
+        match check_features(&all_casting, &[casting, light(0)]) {
+            Err(LightUpdateError::NewFeature { index, feature }) => {
+                assert_eq!(index, 1);
+                assert_eq!(feature, "a light that casts no shadow");
+            }
+            other => panic!("expected NewFeature, got {other:?}"),
+        }
+        let mixed = SceneFeatures {
+            has_unshadowed_lights: true,
+            ..all_casting
+        };
+        assert!(check_features(&mixed, &[casting, light(0)]).is_ok());
+    }
 }
