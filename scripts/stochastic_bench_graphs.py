@@ -5,7 +5,8 @@ beyond its 4 exact lights, without reuse (off) and with unbiased spatial reuse (
 for K = 1 and 4 also temporal reuse (history 20) alone and with the spatial reuse. And
 benches/graphs/stochastic_n0_k{K}_m{M}_{REUSE}.ron: no exact lights (the sampling pass
 never walks the whole tile list), K = 1, 2, 4 reservoirs of M = 8 or 32 candidates,
-without reuse and with temporal reuse."""
+without reuse and with temporal reuse. And benches/graphs/stochastic_block{N}_k{K}_m8_{REUSE}.ron:
+N exact lights chosen once for each 8x8 block (exact_per: Block)."""
 import pathlib
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -19,17 +20,19 @@ SPATIAL = "Unbiased(neighbours: 4, radius: 16)"
 VARIANTS = [("off", "Off", 0), ("spatial", SPATIAL, 0), ("temporal", "Off", 20), ("spatiotemporal", SPATIAL, 20)]
 
 
-def write(name, k, m, exact, params, history):
+def write(name, k, m, exact, params, history, per=""):
     words = {1: "one", 2: "two", 4: "four", 8: "eight"}
     said = f"the {exact} strongest casting lights a pixel traced exactly, " if exact else "no light traced exactly, "
+    if per:
+        said = f"the {exact} strongest casting lights of each 8x8 block traced exactly, "
     said += f"{words[k]} resampled light{'s' if k > 1 else ''} of {m} candidates for the rest"
     out = body.replace(DESCRIBED, said).replace('name: "visibility_stochastic_shadows"', f'name: "{name}"').replace(
         SHIPPED,
-        f"LightSampling(candidates: {m}, samples: {k}, exact_lights: {exact}, reuse: {params}, history: {history}, seed: 0)",
+        f"LightSampling(candidates: {m}, samples: {k}, exact_lights: {exact}, {per}reuse: {params}, history: {history}, seed: 0)",
     )
     head = (
         "// Written by scripts/stochastic_bench_graphs.py from graphs/visibility_stochastic_shadows.ron:\n"
-        f"// {k} reservoirs (shadow rays) of {m} candidates a pixel beyond its {exact} exact lights, spatial reuse {params}, history {history}.\n"
+        f"// {k} reservoirs (shadow rays) of {m} candidates a pixel beyond its {exact} exact lights{' (chosen a block)' if per else ''}, spatial reuse {params}, history {history}.\n"
     )
     (ROOT / f"benches/graphs/{name}.ron").write_text(head + out)
 
@@ -45,3 +48,5 @@ for k in [1, 2, 4]:
             if params != "Off":
                 continue
             write(f"stochastic_n0_k{k}_m{m}_{reuse}", k, m, 0, params, history)
+for exact, k, reuse, history in [(4, 1, "off", 0), (4, 1, "temporal", 20), (4, 2, "temporal", 20), (8, 1, "temporal", 20)]:
+    write(f"stochastic_block{exact}_k{k}_m8_{reuse}", k, 8, exact, "Off", history, "exact_per: Block, ")

@@ -348,6 +348,51 @@ fn unbiased_spatial_reuse_averages_to_the_exact_image() {
     );
 }
 
+#[test]
+fn block_chosen_exact_lights_average_to_the_exact_image() {
+    assert_unbiased("candidates: 4, samples: 2, exact_lights: 2, exact_per: Block, reuse: Off");
+}
+
+/// The mean over pixel channels of the variance of `frames` estimates with `params`.
+fn mean_variance(r: &mut Renderer, s: &Scene, params: &str, frames: usize) -> f64 {
+    let prepared = prepare_text(r, &stochastic_graph(params), s, W, H, false).unwrap();
+    let images: Vec<_> = (0..frames)
+        .map(|_| prepared.render(r).expect("render").image)
+        .collect();
+    let (_, variance) = statistics(images.into_iter());
+    variance.iter().flatten().sum::<f64>() / (variance.len() * 3) as f64
+}
+
+/// Lights chosen once a block and traced exactly take most of the noise away, as lights
+/// chosen for each pixel do: with none chosen (or the choice lost) the variance stays that
+/// of sampling alone.
+#[test]
+fn block_chosen_exact_lights_take_most_of_the_noise() {
+    let mut r = renderer();
+    let s = scene(64, 11, false);
+    let sampled = "candidates: 4, samples: 1, exact_lights: 0, reuse: Off";
+    let none = mean_variance(&mut r, &s, sampled, 32);
+    let block = mean_variance(
+        &mut r,
+        &s,
+        &sampled.replace("0,", "4, exact_per: Block,"),
+        32,
+    );
+    let pixel = mean_variance(&mut r, &s, &sampled.replace("0,", "4,"), 32);
+    eprintln!(
+        "mean variance: no exact lights {none:.3e}, 4 a block {block:.3e}, 4 a pixel {pixel:.3e}"
+    );
+    assert!(none > 0.0);
+    assert!(
+        block < 0.25 * none,
+        "block {block:.3e} against none {none:.3e}"
+    );
+    assert!(
+        pixel < 0.25 * none,
+        "pixel {pixel:.3e} against none {none:.3e}"
+    );
+}
+
 /// The bound is tight enough to see the bias of the 1/M weight: a neighbour's light that
 /// this pixel's own candidates could not have drawn (behind it, out of its reach, or one
 /// of its exact lights) still counts its candidates, so the estimate runs dark.

@@ -133,8 +133,128 @@ fn view_depth(p: vec3<f32>) -> f32 {
     return -(frame.view * vec4<f32>(p, 1.0)).z;
 }
 
+#if EXACT_PER_BLOCK
+// The block's exact lights (EXACT_PER_BLOCK): the SAMPLE_EXACT lights of largest p̂ at any
+// of four points of the 8×8 block (the centres of its 4×4 quarters, those with a
+// surface). Each point's list is walked by the block's 64 invocations together, each
+// keeping its own best lights (one entry a light, its largest p̂); then SAMPLE_EXACT
+// rounds each take the largest entry left in the block (ties to the lower light index)
+// and drop that light from every invocation's entries.
+var<workgroup> block_point: array<ShadowSurface, 4>;
+var<workgroup> block_best: atomic<u32>;
+var<workgroup> block_winner: atomic<u32>;
+var<workgroup> round_best: u32;
+var<workgroup> round_winner: u32;
+var<workgroup> block_exact: array<u32, EXACT_ARRAY>;
+
+struct Kept {
+    light: array<u32, EXACT_ARRAY>,
+    t: array<f32, EXACT_ARRAY>,
+    n: u32,
+};
+
+// `light` at target t offered to `kept`: its entry raised if kept, else added while room
+// is left, else put in place of the weakest when stronger.
+fn keep(kept: ptr<function, Kept>, light: u32, t: f32) {
+    if (t <= 0.0) {
+        return;
+    }
+    var weakest = 0u;
+    for (var e = 0u; e < (*kept).n; e++) {
+        if ((*kept).light[e] == light) {
+            (*kept).t[e] = max((*kept).t[e], t);
+            return;
+        }
+        if ((*kept).t[e] < (*kept).t[weakest]) {
+            weakest = e;
+        }
+    }
+    if ((*kept).n < SAMPLE_EXACT) {
+        (*kept).light[(*kept).n] = light;
+        (*kept).t[(*kept).n] = t;
+        (*kept).n += 1u;
+    } else if (t > (*kept).t[weakest]) {
+        (*kept).light[weakest] = light;
+        (*kept).t[weakest] = t;
+    }
+}
+
+// The block's exact lights into block_exact; returns how many. Every invocation of the
+// workgroup calls it (barriers).
+fn choose_block_exact(lane: u32, block: vec2<u32>) -> u32 {
+    if (lane < 4u) {
+        let xy = min(block * 8u + vec2<u32>(2u + 4u * (lane % 2u), 2u + 4u * (lane / 2u)), frame.size - 1u);
+        block_point[lane] = shadow_surface(xy);
+    }
+    if (lane == 0u) {
+        atomicStore(&block_best, 0u);
+        atomicStore(&block_winner, SAMPLE_NONE);
+    }
+    workgroupBarrier();
+    var kept: Kept;
+    kept.n = 0u;
+    for (var q = 0u; q < 4u; q++) {
+        let point = block_point[q];
+        if (!point.valid) {
+            continue;
+        }
+        let xy = min(block * 8u + vec2<u32>(2u + 4u * (q % 2u), 2u + 4u * (q / 2u)), frame.size - 1u);
+        let range = light_range(vec2<f32>(xy) + 0.5, view_depth(point.position));
+        for (var k = lane; k < range.count; k += 64u) {
+            let i = light_at(range, k);
+            keep(&kept, i, sample_target(i, point.position, point.ng));
+        }
+    }
+    var n = 0u;
+    for (var j = 0u; j < SAMPLE_EXACT; j++) {
+        var mine = 0.0;
+        for (var e = 0u; e < kept.n; e++) {
+            mine = max(mine, kept.t[e]);
+        }
+        // p̂ is positive or zero, so its bits order as the values do.
+        atomicMax(&block_best, bitcast<u32>(mine));
+        workgroupBarrier();
+        if (lane == 0u) {
+            round_best = atomicLoad(&block_best);
+        }
+        let best = workgroupUniformLoad(&round_best);
+        if (best == 0u) {
+            break;
+        }
+        for (var e = 0u; e < kept.n; e++) {
+            if (bitcast<u32>(kept.t[e]) == best) {
+                atomicMin(&block_winner, kept.light[e]);
+            }
+        }
+        workgroupBarrier();
+        if (lane == 0u) {
+            round_winner = atomicLoad(&block_winner);
+            block_exact[j] = round_winner;
+            atomicStore(&block_best, 0u);
+            atomicStore(&block_winner, SAMPLE_NONE);
+        }
+        let winner = workgroupUniformLoad(&round_winner);
+        for (var e = 0u; e < kept.n; e++) {
+            if (kept.light[e] == winner) {
+                kept.t[e] = 0.0;
+            }
+        }
+        n = j + 1u;
+    }
+    return n;
+}
+#endif
+
 @compute @workgroup_size(8, 8, 1)
-fn candidates(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn candidates(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+    @builtin(workgroup_id) group: vec3<u32>,
+) {
+#if EXACT_PER_BLOCK
+    // Before any invocation leaves: the choice takes the whole workgroup.
+    let block_n = choose_block_exact(lane, group.xy);
+#endif
     if (any(gid.xy >= frame.size)) {
         return;
     }
@@ -158,6 +278,25 @@ fn candidates(@builtin(global_invocation_id) gid: vec3<u32>) {
     var exact_t: array<f32, EXACT_ARRAY>;
     var n = 0u;
     var weakest = 0u;
+#if EXACT_PER_BLOCK
+    // The block's lights: traced where they reach this pixel; one that does not (p̂ = 0:
+    // out of reach or behind the surface, which ray-cast shadows count hidden) is
+    // hidden without a ray. All are left out of the sampling.
+    for (var j = 0u; j < block_n; j++) {
+        exact[j] = block_exact[j];
+    }
+    n = block_n;
+    for (var j = 0u; j < SAMPLE_EXACT; j++) {
+        var word = SAMPLE_NONE;
+        if (j < n) {
+            word = exact[j];
+            if (!(sample_target(exact[j], s.position, s.ng) > 0.0) || hidden(s, exact[j])) {
+                word |= SAMPLE_HIDDEN;
+            }
+        }
+        light_samples[exact_word(pixel, j)] = word;
+    }
+#else
     let walked = select(0u, range.count, SAMPLE_EXACT > 0u);
     for (var k = 0u; k < walked; k++) {
         let i = light_at(range, k);
@@ -193,6 +332,7 @@ fn candidates(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         light_samples[exact_word(pixel, j)] = word;
     }
+#endif
 
     // The reservoirs over the rest of the list.
     let count = f32(range.count);

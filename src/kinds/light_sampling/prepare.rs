@@ -4,7 +4,7 @@
 //! next frame's reprojection; one compute pass.
 
 use super::{defines, PrepareCtx, PreparedPass, Timestamps};
-use crate::graph::kinds::light_sampling::LightSampling;
+use crate::graph::kinds::light_sampling::{ExactPer, LightSampling};
 use crate::graph::Name;
 use crate::graph::{slot, ScheduledPass};
 use crate::render::pipelines::PipelineKey;
@@ -36,6 +36,9 @@ fn sampling_defines(p: &LightSampling) -> Vec<(&'static str, String)> {
         ("SAMPLE_CANDIDATES", format!("{}u", p.candidates)),
         ("SAMPLE_SEED", format!("{}u", p.seed)),
     ];
+    if p.exact_per == ExactPer::Block && p.exact_lights > 0 {
+        d.push(("EXACT_PER_BLOCK", "1".into()));
+    }
     let spatial = u32::from(p.reuse.spatial().is_some());
     d.push((
         "SAMPLE_REGIONS",

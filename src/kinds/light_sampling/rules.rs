@@ -33,6 +33,10 @@ pub struct LightSampling {
     /// unshadowed contribution, left out of the sampling.
     #[serde(default = "default_exact_lights")]
     pub exact_lights: u32,
+    /// Where the exact lights are chosen: for each pixel from its whole list, or once for
+    /// each 8×8 block of pixels.
+    #[serde(default)]
+    pub exact_per: ExactPer,
     /// Spatial reuse of the reservoirs over neighbouring pixels.
     #[serde(default)]
     pub reuse: SpatialReuse,
@@ -48,6 +52,20 @@ pub struct LightSampling {
     /// Shadow ray origin offset, as `ShadowRayCast`'s.
     #[serde(default = "default_normal_offset")]
     pub normal_offset: f32,
+}
+
+/// Where a pixel's `exact_lights` come from.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
+pub enum ExactPer {
+    /// The lights of the pixel's list with the largest target at the pixel: its list is
+    /// walked once a pixel.
+    #[default]
+    Pixel,
+    /// The lights with the largest target at any of four points of the pixel's 8×8 block
+    /// (lists walked once a block, by the block's 64 invocations together); each pixel
+    /// traces the block's lights that reach it. Exact where the block's points see the
+    /// lights that matter to every pixel of it; the estimate stays unbiased either way.
+    Block,
 }
 
 /// Spatial reuse: each of a pixel's reservoirs resamples its own and the same reservoir
