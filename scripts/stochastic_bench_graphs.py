@@ -3,10 +3,10 @@
 graphs/visibility_stochastic_shadows.ron: K = 1, 2, 4, 8 reservoirs (shadow rays) a pixel
 beyond its 4 exact lights, without reuse (off) and with unbiased spatial reuse (spatial);
 for K = 1 and 4 also temporal reuse (history 20) alone and with the spatial reuse. And
-benches/graphs/stochastic_n0_k{K}_m{M}_{REUSE}.ron: no exact lights (the sampling pass
-never walks the whole tile list), K = 1, 2, 4 reservoirs of M = 8 or 32 candidates,
-without reuse and with temporal reuse. And benches/graphs/stochastic_block{N}_k{K}_m8_{REUSE}.ron:
-N exact lights chosen once for each 8x8 block (exact_per: Block)."""
+benches/graphs/stochastic_n0_k{K}_m8_temporal.ron: no exact lights (the sampling pass
+never walks the whole tile list), K = 1, 2, 4 reservoirs of 8 candidates, temporal reuse.
+And benches/graphs/stochastic_block4_k{K}_m8_{REUSE}.ron: 4 exact lights chosen once for
+each 8x8 block (exact_per: Block)."""
 import pathlib
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -43,10 +43,6 @@ for k in [1, 2, 4, 8]:
             continue
         write(f"stochastic_k{k}_{reuse}", k, 8, 4, params, history)
 for k in [1, 2, 4]:
-    for m in [8, 32]:
-        for reuse, params, history in VARIANTS:
-            if params != "Off":
-                continue
-            write(f"stochastic_n0_k{k}_m{m}_{reuse}", k, m, 0, params, history)
-for exact, k, reuse, history in [(4, 1, "off", 0), (4, 1, "temporal", 20), (4, 2, "temporal", 20), (8, 1, "temporal", 20)]:
+    write(f"stochastic_n0_k{k}_m8_temporal", k, 8, 0, "Off", 20)
+for exact, k, reuse, history in [(4, 1, "off", 0), (4, 1, "temporal", 20), (4, 2, "temporal", 20)]:
     write(f"stochastic_block{exact}_k{k}_m8_{reuse}", k, 8, exact, "Off", history, "exact_per: Block, ")
