@@ -15,6 +15,12 @@ fn main() {
     let out = std::env::var("OUT_DIR").expect("cargo sets OUT_DIR");
     let kinds = Path::new(&root).join("src/kinds");
     println!("cargo:rerun-if-changed=src/kinds");
+    // The built-in shaders, graphs and materials are copied into the binary by
+    // `include_dir!` (src/shader/assets.rs), which cargo does not track: without these a
+    // shader-only edit left a binary with the old copy.
+    for built_in in ["shaders", "graphs", "materials"] {
+        println!("cargo:rerun-if-changed={built_in}");
+    }
 
     let mut folders: Vec<_> = std::fs::read_dir(&kinds)
         .unwrap_or_else(|e| panic!("{}: {e}", kinds.display()))
