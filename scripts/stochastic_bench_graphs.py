@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Writes benches/graphs/stochastic_k{K}_{REUSE}.ron from
 graphs/visibility_stochastic_shadows.ron: K = 1, 2, 4, 8 reservoirs (shadow rays) a pixel
-beyond its 4 exact lights, without reuse (off) and with unbiased spatial reuse (spatial);
-for K = 1 and 4 also temporal reuse (history 20) alone and with the spatial reuse."""
+beyond its 4 exact lights, without reuse (off), with unbiased spatial reuse (spatial), with
+biased spatial reuse (biased) and with temporal reuse (history 20) alone (temporal); for
+K = 1 and 4 also temporal with the unbiased spatial reuse (spatiotemporal)."""
 import pathlib
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -11,10 +12,17 @@ text = (ROOT / "graphs/visibility_stochastic_shadows.ron").read_text()
 assert SHIPPED in text, "the shipped parameters moved"
 body = text[text.index("Graph(") :]
 SPATIAL = "Unbiased(neighbours: 4, radius: 16)"
-VARIANTS = [("off", "Off", 0), ("spatial", SPATIAL, 0), ("temporal", "Off", 20), ("spatiotemporal", SPATIAL, 20)]
+BIASED = "Biased(neighbours: 4, radius: 16)"
+VARIANTS = [
+    ("off", "Off", 0),
+    ("spatial", SPATIAL, 0),
+    ("biased", BIASED, 0),
+    ("temporal", "Off", 20),
+    ("spatiotemporal", SPATIAL, 20),
+]
 for k in [1, 2, 4, 8]:
     for reuse, params, history in VARIANTS:
-        if history and k not in (1, 4):
+        if reuse == "spatiotemporal" and k not in (1, 4):
             continue
         name = f"stochastic_k{k}_{reuse}"
         out = body.replace('name: "visibility_stochastic_shadows"', f'name: "{name}"').replace(
