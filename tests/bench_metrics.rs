@@ -390,9 +390,69 @@ fn report_writes_all_files() {
         std::fs::read_to_string(&files.non_finite).unwrap(),
         "scene,technique,params,light_count,width,height,kind,x,y,r,g,b\n"
     );
+    assert_eq!(files.time_vs_seed_error, None, "no row has seed columns");
     // Empty input gives empty tables and no plots.
     let empty = write_report(dir.path().join("empty"), &[]).unwrap();
     assert_eq!(empty.plots_skipped.as_deref(), Some("no rows"));
+}
+
+/// Rows with seed columns: CSV columns after rel_mse, a Markdown table of rel MSE beside
+/// its variance and bias² parts, and the time against expected error plot, whose series
+/// join the graphs that differ in their sample count.
+#[test]
+fn seed_columns_in_the_report() {
+    let mut rows = Vec::new();
+    for (k, ms, variance) in [(1, 0.7, 4e-3), (4, 0.95, 1e-3), (8, 1.4, 5e-4)] {
+        rows.push(BenchRow {
+            scene: "harada_all_casting".into(),
+            technique: format!("../benches/graphs/stochastic_k{k}_off"),
+            width: 64,
+            height: 36,
+            frame_ms: Some(spread(ms)),
+            rel_mse: Some(variance * 0.5),
+            seeds: Some(8),
+            seed_rel_variance: Some(variance),
+            seed_rel_bias2: Some(-1e-5),
+            ..Default::default()
+        });
+    }
+    let csv = to_csv(&rows);
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let at = |column: &str| header.iter().position(|h| *h == column).unwrap();
+    assert_eq!(
+        (at("seeds"), at("seed_rel_variance"), at("seed_rel_bias2")),
+        (at("rel_mse") + 1, at("rel_mse") + 2, at("rel_mse") + 3)
+    );
+    let second: Vec<&str> = csv.lines().nth(2).unwrap().split(',').collect();
+    assert_eq!(
+        [
+            second[at("seeds")],
+            second[at("seed_rel_variance")],
+            second[at("seed_rel_bias2")]
+        ],
+        ["8", "0.001", "-0.00001"]
+    );
+    let md = to_markdown(&rows);
+    assert!(
+        md.contains("| harada_all_casting | ../benches/graphs/stochastic_k4_off | 0 | 64x36 | 0.950 | 8 | 5.00e-4 | 0.0010 | -1.00e-5 |"),
+        "{md}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let files = write_report(dir.path(), &rows).unwrap();
+    let png = files.time_vs_seed_error.expect("seeded rows are plotted");
+    let img = image::open(png).unwrap().into_rgb8();
+    assert!(img.pixels().filter(|p| p.0 != [255, 255, 255]).count() > 1000);
+    // Without seed columns the plot is gone, not left stale.
+    let plain: Vec<BenchRow> = rows
+        .iter()
+        .map(|r| BenchRow {
+            seeds: None,
+            ..r.clone()
+        })
+        .collect();
+    let files = write_report(dir.path(), &plain).unwrap();
+    assert_eq!(files.time_vs_seed_error, None);
+    assert!(!dir.path().join("time_vs_seed_error.png").exists());
 }
 
 #[test]

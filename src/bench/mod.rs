@@ -30,9 +30,9 @@ pub use metrics::{
 };
 pub use pixel::{luminance, HdrPixel};
 pub use report::{
-    non_finite_csv, plot_time_vs_error, plot_time_vs_lights, summarize, to_csv, to_markdown,
-    untimed_reason, write_csv, write_markdown, write_report, BenchRow, ReportError, ReportFiles,
-    TimingSummary,
+    non_finite_csv, plot_time_vs_error, plot_time_vs_lights, plot_time_vs_seed_error, summarize,
+    to_csv, to_markdown, untimed_reason, write_csv, write_markdown, write_report, BenchRow,
+    ReportError, ReportFiles, TimingSummary,
 };
 pub use seed_spread::{seed_spread, SeedSpread, SeedSpreadAccumulator};
 pub use tonemap::{linear_to_srgb, srgb_to_linear, ToneCurve, Tonemap};

@@ -220,6 +220,66 @@ pub fn plot_time_vs_error(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(
     )
 }
 
+/// A graph's series in [`plot_time_vs_seed_error`]: its name (the last path component)
+/// without `k<N>` tokens, so graphs that differ only in their sample count (the stochastic
+/// graphs' `stochastic_k4_off`) form one curve: `stochastic_off`.
+fn family(technique: &str) -> String {
+    let stem = technique.rsplit('/').next().unwrap_or(technique);
+    let is_count =
+        |t: &&str| t.len() > 1 && t.starts_with('k') && t[1..].chars().all(|c| c.is_ascii_digit());
+    stem.split('_')
+        .filter(|t| !is_count(t))
+        .collect::<Vec<_>>()
+        .join("_")
+}
+
+/// Plot median frame time (p10–p90 bars) against the expected relative MSE of one frame,
+/// `seed_rel_bias2 + seed_rel_variance` (linear x from 0; rows without seed columns are left
+/// out): the error of a stochastic graph without the luck of one frame. Graphs that differ
+/// only in a `k<N>` token of their name form one series ([`family`]), joined in order of
+/// error: a sample-count sweep draws its trade-off curve. Where the rows hold several
+/// scenes or light counts, those are part of the series, as in [`plot_time_vs_error`].
+pub fn plot_time_vs_seed_error(
+    path: impl AsRef<Path>,
+    rows: &[BenchRow],
+) -> Result<(), ReportError> {
+    let with_error = || {
+        rows.iter().filter_map(|r| {
+            let e = r.seed_rel_bias2? + r.seed_rel_variance?;
+            Some((r, e, r.frame_ms?)).filter(|_| e.is_finite())
+        })
+    };
+    let first = with_error()
+        .next()
+        .map(|(r, ..)| (r.scene.clone(), r.light_count));
+    let several = with_error().any(|(r, ..)| Some((r.scene.clone(), r.light_count)) != first);
+    let mut series: BTreeMap<String, Vec<Point>> = BTreeMap::new();
+    for (r, e, t) in with_error() {
+        let mut name = family(&r.technique);
+        if several {
+            name = format!("{name} @ {} {} lights", r.scene, r.light_count);
+        }
+        series
+            .entry(name)
+            .or_default()
+            .push((e.max(0.0), t.median, t.p10, t.p90));
+    }
+    let series: Series = series
+        .into_iter()
+        .map(|(name, mut points)| {
+            points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            (name, points)
+        })
+        .collect();
+    render_plot(
+        path.as_ref(),
+        "Frame time vs expected error over seeds",
+        "rel MSE expected of one frame: bias² + variance over seeds (linear)",
+        false,
+        &series,
+    )
+}
+
 /// Time (y, ms) against error (x) for labelled (error, ms) series: the VPL error sweep.
 pub fn plot_time_vs_error_points(
     path: impl AsRef<Path>,
@@ -240,7 +300,21 @@ pub fn plot_time_vs_error_points(
 
 #[cfg(test)]
 mod tests {
-    use super::axis_label;
+    use super::{axis_label, family};
+
+    #[test]
+    fn sample_counts_are_dropped_from_the_series_name() {
+        assert_eq!(
+            family("../benches/graphs/stochastic_k4_spatiotemporal"),
+            "stochastic_spatiotemporal"
+        );
+        assert_eq!(family("stochastic_k16_off"), "stochastic_off");
+        assert_eq!(
+            family("visibility_raycast_shadows_naive"),
+            "visibility_raycast_shadows_naive"
+        );
+        assert_eq!(family("keep_k_kx"), "keep_k_kx");
+    }
 
     #[test]
     fn axis_labels_are_short() {
