@@ -6,6 +6,8 @@
 #             visibility shading's material classification (material_classification.ron);
 #   features  ray-cast shadows, the shadow atlas, transparency, MSAA, VPL indirect light, VPL visibility
 #             and the light linked list (their sweeps);
+#   stochastic (only when named) stochastic direct lighting's time against error with the
+#             spread over seeds, one sweep a scene (stochastic_seeds_*.ron);
 #   extras    the VPL bounce against its path-traced reference (vpl-error; the variants run
 #             puts with and without visibility and the cheaper VPLs on one plot) and hot-reload
 #             latency (reload-bench).
@@ -29,6 +31,13 @@ fi
 if [[ $stages == *" features "* ]]; then
     for s in raycast_shadows shadow_atlas transparency msaa indirect_vpl vpl_visibility vpl_cheaper light_linked_list; do
         run_sweep $s $s 150
+    done
+fi
+if [[ $stages == *" stochastic "* ]]; then
+    for s in harada gallery chairs harada_65536; do
+        run_sweep stochastic_seeds_$s stochastic_seeds_$s 300
+        awk '/^Spread over seeds/{f=1} f&&/^\|/{t=1;print;next} t{exit}' \
+            "$out/stochastic_seeds_$s/results.md" 2>/dev/null | cut -c1-200
     done
 fi
 if [[ $stages == *" extras "* ]]; then

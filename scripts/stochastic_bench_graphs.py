@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Writes benches/graphs/stochastic_k{K}_{REUSE}.ron from
 graphs/visibility_stochastic_shadows.ron: K = 1, 2, 4, 8 reservoirs (shadow rays) a pixel
-beyond its 4 exact lights, without reuse (off) and with unbiased spatial reuse (spatial);
-for K = 1 and 4 also temporal reuse (history 20) alone and with the spatial reuse. And
+beyond its 4 exact lights, without reuse (off), with unbiased spatial reuse (spatial), with
+biased spatial reuse (biased) and with temporal reuse (history 20) alone (temporal); for
+K = 1 and 4 also temporal with the unbiased spatial reuse (spatiotemporal). And
 benches/graphs/stochastic_n0_k{K}_m8_temporal.ron: no exact lights (the sampling pass
 never walks the whole tile list), K = 1, 2, 4 reservoirs of 8 candidates, temporal reuse.
 And benches/graphs/stochastic_block4_k{K}_m8_{REUSE}.ron: 4 exact lights chosen once for
@@ -17,7 +18,14 @@ body = text[text.index("Graph(") :]
 DESCRIBED = "the 4 strongest casting lights a pixel traced exactly, one resampled light for the rest"
 assert DESCRIBED in body, "the shipped description moved"
 SPATIAL = "Unbiased(neighbours: 4, radius: 16)"
-VARIANTS = [("off", "Off", 0), ("spatial", SPATIAL, 0), ("temporal", "Off", 20), ("spatiotemporal", SPATIAL, 20)]
+BIASED = "Biased(neighbours: 4, radius: 16)"
+VARIANTS = [
+    ("off", "Off", 0),
+    ("spatial", SPATIAL, 0),
+    ("biased", BIASED, 0),
+    ("temporal", "Off", 20),
+    ("spatiotemporal", SPATIAL, 20),
+]
 
 
 def write(name, k, m, exact, params, history, per=""):
@@ -39,7 +47,7 @@ def write(name, k, m, exact, params, history, per=""):
 
 for k in [1, 2, 4, 8]:
     for reuse, params, history in VARIANTS:
-        if history and k not in (1, 4):
+        if reuse == "spatiotemporal" and k not in (1, 4):
             continue
         write(f"stochastic_k{k}_{reuse}", k, 8, 4, params, history)
 for k in [1, 2, 4]:

@@ -390,9 +390,69 @@ fn report_writes_all_files() {
         std::fs::read_to_string(&files.non_finite).unwrap(),
         "scene,technique,params,light_count,width,height,kind,x,y,r,g,b\n"
     );
+    assert_eq!(files.time_vs_seed_error, None, "no row has seed columns");
     // Empty input gives empty tables and no plots.
     let empty = write_report(dir.path().join("empty"), &[]).unwrap();
     assert_eq!(empty.plots_skipped.as_deref(), Some("no rows"));
+}
+
+/// Rows with seed columns: CSV columns after rel_mse, a Markdown table of rel MSE beside
+/// its variance and bias² parts, and the time against expected error plot, whose series
+/// join the graphs that differ in their sample count.
+#[test]
+fn seed_columns_in_the_report() {
+    let mut rows = Vec::new();
+    for (k, ms, variance) in [(1, 0.7, 4e-3), (4, 0.95, 1e-3), (8, 1.4, 5e-4)] {
+        rows.push(BenchRow {
+            scene: "harada_all_casting".into(),
+            technique: format!("../benches/graphs/stochastic_k{k}_off"),
+            width: 64,
+            height: 36,
+            frame_ms: Some(spread(ms)),
+            rel_mse: Some(variance * 0.5),
+            seeds: Some(8),
+            seed_rel_variance: Some(variance),
+            seed_rel_bias2: Some(-1e-5),
+            ..Default::default()
+        });
+    }
+    let csv = to_csv(&rows);
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let at = |column: &str| header.iter().position(|h| *h == column).unwrap();
+    assert_eq!(
+        (at("seeds"), at("seed_rel_variance"), at("seed_rel_bias2")),
+        (at("rel_mse") + 1, at("rel_mse") + 2, at("rel_mse") + 3)
+    );
+    let second: Vec<&str> = csv.lines().nth(2).unwrap().split(',').collect();
+    assert_eq!(
+        [
+            second[at("seeds")],
+            second[at("seed_rel_variance")],
+            second[at("seed_rel_bias2")]
+        ],
+        ["8", "0.001", "-0.00001"]
+    );
+    let md = to_markdown(&rows);
+    assert!(
+        md.contains("| harada_all_casting | ../benches/graphs/stochastic_k4_off | 0 | 64x36 | 0.950 | 8 | 5.00e-4 | 0.0010 | -1.00e-5 |"),
+        "{md}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let files = write_report(dir.path(), &rows).unwrap();
+    let png = files.time_vs_seed_error.expect("seeded rows are plotted");
+    let img = image::open(png).unwrap().into_rgb8();
+    assert!(img.pixels().filter(|p| p.0 != [255, 255, 255]).count() > 1000);
+    // Without seed columns the plot is gone, not left stale.
+    let plain: Vec<BenchRow> = rows
+        .iter()
+        .map(|r| BenchRow {
+            seeds: None,
+            ..r.clone()
+        })
+        .collect();
+    let files = write_report(dir.path(), &plain).unwrap();
+    assert_eq!(files.time_vs_seed_error, None);
+    assert!(!dir.path().join("time_vs_seed_error.png").exists());
 }
 
 #[test]
@@ -517,4 +577,169 @@ fn compare_exr_files() {
     let err =
         compare_files(&a, dir.path().join("nope.exr"), &CompareOptions::default()).unwrap_err();
     assert!(err.to_string().contains("nope.exr"), "{err}");
+}
+
+/// `gradient()` with `offset(pixel, channel)` added to every channel.
+fn offset_gradient(offset: impl Fn(usize, usize) -> f32) -> Vec<[f32; 4]> {
+    gradient()
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            [
+                p[0] + offset(i, 0),
+                p[1] + offset(i, 1),
+                p[2] + offset(i, 2),
+                p[3],
+            ]
+        })
+        .collect()
+}
+
+/// The mean over the reference's channels of `f(channel) / (ref² + 0.01)`, in f64: rel_mse's
+/// weighting, written out here.
+fn rel_mean(reference: &[[f32; 4]], f: impl Fn(usize, usize) -> f64) -> f64 {
+    let mut sum = 0.0;
+    for (i, p) in reference.iter().enumerate() {
+        for (c, &r) in p[..3].iter().enumerate() {
+            sum += f(i, c) / (f64::from(r).powi(2) + 0.01);
+        }
+    }
+    sum / (reference.len() * 3) as f64
+}
+
+/// Four seeds at ref + b + a·(+1, −1, +1, −1), a and b varying by pixel and channel:
+/// their mean is ref + b and their sample variance (divided by S − 1 = 3) exactly 4a²/3,
+/// so the variance column is the mean of 4a²/3 and the bias² column (the squared error
+/// of the mean less the sample variance over S) the mean of b² − a²/3, both weighted as
+/// rel_mse weighs a squared error. Tolerance 1e-5 relative: the images are f32, whose
+/// rounding of ref + b ± a (ulp 6e-8 near 1) moves a² by about 1e-6 of itself.
+#[test]
+fn seed_spread_of_known_deviations() {
+    let reference = gradient();
+    let a = |i: usize, c: usize| 0.02 + 0.01 * ((i + c) % 5) as f32;
+    let b = |i: usize, c: usize| 0.03 * ((i * 3 + c) % 4) as f32;
+    let images: Vec<Vec<[f32; 4]>> = [1.0f32, -1.0, 1.0, -1.0]
+        .iter()
+        .map(|&sign| offset_gradient(|i, c| b(i, c) + sign * a(i, c)))
+        .collect();
+    let s = seed_spread(&reference, &images, W, H).unwrap();
+    let a2 = |i, c| f64::from(a(i, c)).powi(2);
+    let variance = rel_mean(&reference, |i, c| 4.0 * a2(i, c) / 3.0);
+    let bias2 = rel_mean(&reference, |i, c| {
+        f64::from(b(i, c)).powi(2) - a2(i, c) / 3.0
+    });
+    assert_eq!((s.seeds, s.compared_pixels), (4, (W * H) as usize));
+    assert!(
+        (s.rel_variance - variance).abs() <= 1e-5 * variance,
+        "variance {} against {variance}",
+        s.rel_variance
+    );
+    assert!(
+        (s.rel_bias2 - bias2).abs() <= 1e-5 * bias2.abs(),
+        "bias² {} against {bias2}",
+        s.rel_bias2
+    );
+    // The two parts add up to rel_mse averaged over the seeds: the mean over seeds of
+    // (x − ref)² is (m − ref)² + s²(S − 1)/S, and bias² + variance is (m − ref)² − s²/S + s².
+    // The same f32 images on both sides: only f64 summation order differs.
+    let mean_rel_mse = images
+        .iter()
+        .map(|image| {
+            compare(&reference, image, W, H, &no_flip())
+                .unwrap()
+                .rel_mse
+        })
+        .sum::<f64>()
+        / images.len() as f64;
+    assert!(
+        (s.rel_bias2 + s.rel_variance - mean_rel_mse).abs() <= 1e-12 * mean_rel_mse,
+        "bias² + variance {} against the seeds' mean rel_mse {mean_rel_mse}",
+        s.rel_bias2 + s.rel_variance
+    );
+}
+
+/// Random seeds with a known spread: 16 images of independent uniform noise of variance
+/// σ² = 0.02² around a grey reference of 0.5 plus a bias β = 0.05, 64×64 pixels. The
+/// variance column estimates σ² w and the bias² column β² w, w = 1 / (0.5² + 0.01). A
+/// channel's sample variance has a relative standard deviation of √(2/15 − 1.2/16) ≈ 0.24
+/// (uniform noise: excess kurtosis −1.2), so their mean over 12,288 channels one of 0.22%;
+/// a channel's bias² estimate, (β + e)² − s²/16 with e the mean's noise (σ/4), one of
+/// 2β(σ/4)/β² = 20%, so their mean one of 0.18%. 1.5% is over 6σ of either.
+#[test]
+fn seed_spread_of_random_noise() {
+    const SIDE: u32 = 64;
+    let (sigma, beta, grey) = (0.02f64, 0.05f64, 0.5f32);
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut uniform = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let half_width = sigma * 3f64.sqrt();
+    let reference = vec![[grey, grey, grey, 1.0]; (SIDE * SIDE) as usize];
+    let images: Vec<Vec<[f32; 4]>> = (0..16)
+        .map(|_| {
+            let mut channel =
+                || (f64::from(grey) + beta + (2.0 * uniform() - 1.0) * half_width) as f32;
+            (0..SIDE * SIDE)
+                .map(|_| [channel(), channel(), channel(), 1.0])
+                .collect()
+        })
+        .collect();
+    let s = seed_spread(&reference, &images, SIDE, SIDE).unwrap();
+    let w = 1.0 / (f64::from(grey).powi(2) + 0.01);
+    let (variance, bias2) = (sigma * sigma * w, beta * beta * w);
+    assert!(
+        (s.rel_variance / variance - 1.0).abs() < 0.015,
+        "variance {} against {variance}",
+        s.rel_variance
+    );
+    assert!(
+        (s.rel_bias2 / bias2 - 1.0).abs() < 0.015,
+        "bias² {} against {bias2}",
+        s.rel_bias2
+    );
+}
+
+#[test]
+fn seed_spread_skips_non_finite_pixels_and_needs_two_images() {
+    let reference = gradient();
+    let mut noisy = offset_gradient(|i, _| if i % 2 == 0 { 0.1 } else { 0.0 });
+    noisy[5][1] = f32::NAN;
+    let mut bright_reference = reference.clone();
+    bright_reference[9][0] = f32::INFINITY;
+    let s = seed_spread(&bright_reference, &[reference.clone(), noisy.clone()], W, H).unwrap();
+    assert_eq!(s.compared_pixels, (W * H) as usize - 2);
+    assert!(s.rel_variance.is_finite() && s.rel_variance > 0.0);
+    // The same frame every seed: no variance, and the bias² is the frame's rel_mse (over
+    // the same pixels: compare leaves the NaN pixel out too).
+    let same = seed_spread(
+        &reference,
+        &[noisy.clone(), noisy.clone(), noisy.clone()],
+        W,
+        H,
+    );
+    let same = same.unwrap();
+    let rel_mse = compare(&reference, &noisy, W, H, &no_flip())
+        .unwrap()
+        .rel_mse;
+    assert_eq!(same.rel_variance, 0.0);
+    assert!(
+        (same.rel_bias2 - rel_mse).abs() <= 1e-12 * rel_mse,
+        "{same:?} against {rel_mse}"
+    );
+    let e = seed_spread(&reference, std::slice::from_ref(&reference), W, H).unwrap_err();
+    assert_eq!(e, MetricsError::TooFewImages { images: 1 });
+    assert!(e.to_string().contains("at least 2 images"), "{e}");
+    let e = seed_spread(
+        &reference,
+        &[reference.clone(), reference[1..].to_vec()],
+        W,
+        H,
+    );
+    assert!(matches!(
+        e,
+        Err(MetricsError::SizeMismatch { test: 127, .. })
+    ));
 }

@@ -31,6 +31,12 @@ pub enum MetricsError {
         /// Test pixel count.
         test: usize,
     },
+    /// Statistics over seeds need at least two images (one has no variance).
+    #[error("the spread over seeds needs at least 2 images, got {images}")]
+    TooFewImages {
+        /// Images given.
+        images: usize,
+    },
 }
 
 /// What to compute in [`compare`].
@@ -118,6 +124,13 @@ pub struct ImageMetrics {
 
 /// Added to `ref²` in [`ImageMetrics::rel_mse`] so black reference pixels stay finite.
 pub const REL_MSE_EPSILON: f64 = 0.01;
+
+/// The weight of a squared channel error in [`ImageMetrics::rel_mse`] where the reference
+/// channel is `reference`: `1 / (ref² + REL_MSE_EPSILON)`. The seed statistics
+/// ([`crate::bench::seed_spread`]) use it too, so they share rel_mse's scale.
+pub(crate) fn rel_mse_weight(reference: f32) -> f64 {
+    1.0 / ((reference as f64).powi(2) + REL_MSE_EPSILON)
+}
 
 impl std::fmt::Display for ImageMetrics {
     /// One line per metric, for `lightgraph compare` and test failure messages.
@@ -309,7 +322,7 @@ pub fn compare<P: HdrPixel>(
         for c in 0..3 {
             let d = (r[c] as f64 - t[c] as f64).abs();
             sum_sq += d * d;
-            sum_rel_sq += d * d / ((r[c] as f64).powi(2) + REL_MSE_EPSILON);
+            sum_rel_sq += d * d * rel_mse_weight(r[c]);
             px_max = px_max.max(d);
             max_rel = max_rel.max(d / (r[c].abs() as f64).max(rel_floor));
         }

@@ -1,6 +1,7 @@
 //! Benchmark support: image error metrics (RMSE, max abs, PSNR, FLIP, bad / NaN pixels), the
-//! project's one tonemapper, HDR image I/O (EXR, tonemapped PNG), and reports (CSV, Markdown,
-//! PNG plots). Only the sweeps and the hot-reload latency benchmark need a GPU.
+//! spread of a seeded frame over seeds, the project's one tonemapper, HDR image I/O (EXR,
+//! tonemapped PNG), and reports (CSV, Markdown, PNG plots). Only the sweeps and the
+//! hot-reload latency benchmark need a GPU.
 
 pub(crate) mod animate;
 pub(crate) mod cases;
@@ -12,6 +13,7 @@ pub(crate) mod pixel;
 pub mod progress;
 pub mod reload_latency;
 pub mod report;
+pub mod seed_spread;
 pub mod sweep;
 mod sweep_columns;
 pub(crate) mod timing;
@@ -28,8 +30,9 @@ pub use metrics::{
 };
 pub use pixel::{luminance, HdrPixel};
 pub use report::{
-    non_finite_csv, plot_time_vs_error, plot_time_vs_lights, summarize, to_csv, to_markdown,
-    untimed_reason, write_csv, write_markdown, write_report, BenchRow, ReportError, ReportFiles,
-    TimingSummary,
+    non_finite_csv, plot_time_vs_error, plot_time_vs_lights, plot_time_vs_seed_error, summarize,
+    to_csv, to_markdown, untimed_reason, write_csv, write_markdown, write_report, BenchRow,
+    ReportError, ReportFiles, TimingSummary,
 };
+pub use seed_spread::{seed_spread, SeedSpread, SeedSpreadAccumulator};
 pub use tonemap::{linear_to_srgb, srgb_to_linear, ToneCurve, Tonemap};

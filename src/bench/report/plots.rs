@@ -42,13 +42,21 @@ fn axis_label(x: f64) -> String {
     s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
+/// Which axes of a plot are logarithmic.
+#[derive(Clone, Copy)]
+struct LogAxes {
+    x: bool,
+    y: bool,
+}
+
 fn render_plot(
     path: &Path,
     title: &str,
     x_desc: &str,
-    log_x: bool,
+    log: LogAxes,
     series: &Series,
 ) -> Result<(), ReportError> {
+    let log_x = log.x;
     register_fonts();
     let (w, h) = PLOT_SIZE;
     let mut buf = vec![0u8; (w * h * 3) as usize];
@@ -61,10 +69,12 @@ fn render_plot(
         root.fill(&WHITE).map_err(|e| plot_err(&e))?;
         let pts = series.iter().flat_map(|(_, p)| p);
         let (mut x0, mut x1, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
-        for &(x, _, _, yh) in pts {
+        let mut y0 = f64::INFINITY;
+        for &(x, _, yl, yh) in pts {
             x0 = x0.min(x);
             x1 = x1.max(x);
             y1 = y1.max(yh);
+            y0 = y0.min(yl);
         }
         if !x0.is_finite() {
             (x0, x1) = (1.0, 10.0);
@@ -78,7 +88,15 @@ fn render_plot(
             // Errors are non-negative: start the axis at 0 so "exact" sits on the axis.
             (x0, x1) = (if x0 >= 0.0 { 0.0 } else { x0 - pad }, x1 + pad);
         }
-        let y1 = if y1 > 0.0 { y1 * 1.1 } else { 1.0 };
+        let (y0, y1) = match (log.y, y1 > 0.0) {
+            (true, true) => {
+                let y0 = if y0 > 0.0 { y0 } else { y1 * 1e-3 };
+                (y0 / 1.5, y1.max(y0 * 10.0) * 1.5)
+            }
+            (true, false) => (0.1, 10.0),
+            (false, true) => (0.0, y1 * 1.1),
+            (false, false) => (0.0, 1.0),
+        };
         let mut builder = ChartBuilder::on(&root);
         builder
             .caption(title, ("sans-serif", 24))
@@ -93,7 +111,11 @@ fn render_plot(
                     .x_desc(x_desc)
                     .x_label_formatter(&|x: &f64| axis_label(*x))
                     .y_label_formatter(&|y: &f64| axis_label(*y))
-                    .y_desc("frame time, median (ms); bars p10-p90")
+                    .y_desc(if log.y {
+                        "frame time, median (ms, log); bars p10-p90"
+                    } else {
+                        "frame time, median (ms); bars p10-p90"
+                    })
                     .draw()
                     .map_err(|e| plot_err(&e))?;
                 for (i, (name, points)) in series.iter().enumerate() {
@@ -130,14 +152,19 @@ fn render_plot(
                     .map_err(|e| plot_err(&e))?;
             }};
         }
-        if log_x {
-            draw!(builder
-                .build_cartesian_2d((x0..x1).log_scale(), 0.0..y1)
-                .map_err(|e| plot_err(&e))?);
-        } else {
-            draw!(builder
-                .build_cartesian_2d(x0..x1, 0.0..y1)
-                .map_err(|e| plot_err(&e))?);
+        match (log_x, log.y) {
+            (true, true) => draw!(builder
+                .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+                .map_err(|e| plot_err(&e))?),
+            (true, false) => draw!(builder
+                .build_cartesian_2d((x0..x1).log_scale(), y0..y1)
+                .map_err(|e| plot_err(&e))?),
+            (false, true) => draw!(builder
+                .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
+                .map_err(|e| plot_err(&e))?),
+            (false, false) => draw!(builder
+                .build_cartesian_2d(x0..x1, y0..y1)
+                .map_err(|e| plot_err(&e))?),
         }
         root.present().map_err(|e| plot_err(&e))?;
     }
@@ -169,7 +196,7 @@ pub fn plot_time_vs_lights(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<
         path.as_ref(),
         "Frame time vs light count",
         "lights (log)",
-        true,
+        LogAxes { x: true, y: false },
         &series,
     )
 }
@@ -215,7 +242,80 @@ pub fn plot_time_vs_error(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(
         path.as_ref(),
         "Frame time vs error",
         "RMSE vs reference (linear)",
-        false,
+        LogAxes { x: false, y: false },
+        &series,
+    )
+}
+
+/// A graph's series in [`plot_time_vs_seed_error`]: its name (the last path component)
+/// without `k<N>` tokens, so graphs that differ only in their sample count (the stochastic
+/// graphs' `stochastic_k4_off`) form one curve: `stochastic_off`.
+fn family(technique: &str) -> String {
+    let stem = technique.rsplit('/').next().unwrap_or(technique);
+    let is_count =
+        |t: &&str| t.len() > 1 && t.starts_with('k') && t[1..].chars().all(|c| c.is_ascii_digit());
+    stem.split('_')
+        .filter(|t| !is_count(t))
+        .collect::<Vec<_>>()
+        .join("_")
+}
+
+/// Plot median frame time (p10–p90 bars) against the expected relative MSE of one frame,
+/// `seed_rel_bias2 + seed_rel_variance` (rows without seed columns are left out): the error
+/// of a stochastic graph without the luck of one frame. Both axes are logarithmic (errors
+/// and times span decades: the atlas beside one-sample frames); errors of 0 or below are
+/// drawn at the left edge, a third of the smallest positive one. Graphs that differ
+/// only in a `k<N>` token of their name form one series ([`family`]), joined in order of
+/// error: a sample-count sweep draws its trade-off curve. Where the rows hold several
+/// scenes or light counts, those are part of the series, as in [`plot_time_vs_error`].
+pub fn plot_time_vs_seed_error(
+    path: impl AsRef<Path>,
+    rows: &[BenchRow],
+) -> Result<(), ReportError> {
+    let with_error = || {
+        rows.iter().filter_map(|r| {
+            let e = r.seed_rel_bias2? + r.seed_rel_variance?;
+            Some((r, e, r.frame_ms?)).filter(|_| e.is_finite())
+        })
+    };
+    let first = with_error()
+        .next()
+        .map(|(r, ..)| (r.scene.clone(), r.light_count));
+    let several = with_error().any(|(r, ..)| Some((r.scene.clone(), r.light_count)) != first);
+    // Log axes: an error of 0 (the reference, exact graphs) or a slightly negative one is
+    // drawn a third of the way below the smallest positive error, at the axis's left edge.
+    let smallest = with_error()
+        .map(|(_, e, _)| e)
+        .filter(|&e| e > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    let floor = if smallest.is_finite() {
+        smallest / 3.0
+    } else {
+        1e-6
+    };
+    let mut series: BTreeMap<String, Vec<Point>> = BTreeMap::new();
+    for (r, e, t) in with_error() {
+        let mut name = family(&r.technique);
+        if several {
+            name = format!("{name} @ {} {} lights", r.scene, r.light_count);
+        }
+        series
+            .entry(name)
+            .or_default()
+            .push((e.max(floor), t.median, t.p10, t.p90));
+    }
+    let series: Series = series
+        .into_iter()
+        .map(|(name, mut points)| {
+            points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            (name, points)
+        })
+        .collect();
+    render_plot(
+        path.as_ref(),
+        "Frame time vs expected error over seeds",
+        "rel MSE expected of one frame: bias² + variance over seeds (log; 0 at the left edge)",
+        LogAxes { x: true, y: true },
         &series,
     )
 }
@@ -235,12 +335,32 @@ pub fn plot_time_vs_error_points(
             (name.clone(), p)
         })
         .collect();
-    render_plot(path.as_ref(), title, x_desc, true, &series)
+    render_plot(
+        path.as_ref(),
+        title,
+        x_desc,
+        LogAxes { x: true, y: false },
+        &series,
+    )
 }
 
 #[cfg(test)]
 mod tests {
-    use super::axis_label;
+    use super::{axis_label, family};
+
+    #[test]
+    fn sample_counts_are_dropped_from_the_series_name() {
+        assert_eq!(
+            family("../benches/graphs/stochastic_k4_spatiotemporal"),
+            "stochastic_spatiotemporal"
+        );
+        assert_eq!(family("stochastic_k16_off"), "stochastic_off");
+        assert_eq!(
+            family("visibility_raycast_shadows_naive"),
+            "visibility_raycast_shadows_naive"
+        );
+        assert_eq!(family("keep_k_kx"), "keep_k_kx");
+    }
 
     #[test]
     fn axis_labels_are_short() {

@@ -62,6 +62,14 @@ pub struct BenchRow {
     pub flip_mean: Option<f64>,
     /// Relative MSE against the reference (`ImageMetrics::rel_mse`).
     pub rel_mse: Option<f64>,
+    /// Seeds the seed columns are over (a sweep's `seeds`), when measured.
+    pub seeds: Option<u32>,
+    /// The mean over channels of each channel's sample variance over the seeds, weighted
+    /// as `rel_mse` weighs a squared error ([`crate::bench::SeedSpread::rel_variance`]).
+    pub seed_rel_variance: Option<f64>,
+    /// The squared bias of the seeds' mean against the reference on the same scale
+    /// ([`crate::bench::SeedSpread::rel_bias2`]).
+    pub seed_rel_bias2: Option<f64>,
     /// Lights listed per tile (or cluster) over lights that really touch it; 1 is exact culling.
     pub listed_exact_ratio: Option<f64>,
     /// Largest per-tile light count.

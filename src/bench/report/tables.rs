@@ -37,7 +37,7 @@ fn opt<T: ToString>(v: Option<T>) -> String {
 /// row (first-seen order): `pass_ms:<name>` (median), `pass_ms_p10:<name>`, `pass_ms_p90:<name>`,
 /// empty where a row lacks that pass. Time columns are empty, not 0, for untimed rows; the
 /// ray-cast shadow columns (`shadow_*`, `bvh_*`) are empty for graphs without those passes.
-pub const CSV_COLUMNS: [&str; 57] = [
+pub const CSV_COLUMNS: [&str; 60] = [
     "scene",
     "technique",
     "params",
@@ -62,6 +62,9 @@ pub const CSV_COLUMNS: [&str; 57] = [
     "psnr",
     "flip_mean",
     "rel_mse",
+    "seeds",
+    "seed_rel_variance",
+    "seed_rel_bias2",
     "listed_exact_ratio",
     "max_lights_per_tile",
     "overflow_tiles",
@@ -137,6 +140,9 @@ pub fn to_csv(rows: &[BenchRow]) -> String {
             opt(r.psnr),
             opt(r.flip_mean),
             opt(r.rel_mse),
+            opt(r.seeds),
+            opt(r.seed_rel_variance),
+            opt(r.seed_rel_bias2),
             opt(r.listed_exact_ratio),
             opt(r.max_lights_per_tile),
             opt(r.overflow_tiles),
@@ -299,6 +305,7 @@ pub fn to_markdown(rows: &[BenchRow]) -> String {
         );
     }
     lists_markdown(&mut out, rows);
+    seeds_markdown(&mut out, rows);
     shadow_markdown(&mut out, rows);
     atlas_markdown(&mut out, rows);
     links_markdown(&mut out, rows);
@@ -346,6 +353,38 @@ pub fn to_markdown(rows: &[BenchRow]) -> String {
         }
     }
     out
+}
+
+/// The spread over seeds, if some row measured it: rel_mse beside its variance and
+/// squared-bias parts.
+fn seeds_markdown(out: &mut String, rows: &[BenchRow]) {
+    if !rows.iter().any(|r| r.seeds.is_some()) {
+        return;
+    }
+    out.push_str(
+        "\nSpread over seeds (each graph's frame rendered with S other seeds; variance: the \
+         mean over channels of each channel's sample variance over the seeds, bias²: the \
+         squared error of their mean less its own variance, both weighted as rel MSE \
+         weighs a squared error, so rel MSE ≈ bias² + variance):\n\n\
+         | scene | technique | lights | size | frame ms | seeds | rel MSE | rel variance | rel bias² |\n\
+         |---|---|--:|--:|--:|--:|--:|--:|--:|\n",
+    );
+    for r in rows.iter().filter(|r| r.seeds.is_some()) {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {}x{} | {} | {} | {} | {} | {} |",
+            md_cell(&r.scene),
+            md_cell(&r.technique),
+            r.light_count,
+            r.width,
+            r.height,
+            md_num(r.frame_ms.map(|t| t.median), 3),
+            opt(r.seeds),
+            md_num(r.rel_mse, 4),
+            md_num(r.seed_rel_variance, 4),
+            md_num(r.seed_rel_bias2, 4),
+        );
+    }
 }
 
 fn has_shadow_columns(r: &BenchRow) -> bool {

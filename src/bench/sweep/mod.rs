@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 mod runner;
+mod seeds;
 pub use runner::{run, with_light_count, SweepEvent};
 
 /// A sweep file (RON, scene-file extensions: `Some(..)` may be left out, `Random(count: ..)`).
@@ -67,6 +68,14 @@ pub struct Sweep {
     /// the lights there (`PreparedFrame::update_lights`). See [`crate::bench::animate`].
     #[serde(default)]
     pub(crate) animate: Option<f64>,
+    /// The spread over seeds: each graph's frame is rendered this many more times with
+    /// other seeds (passes that take one, `LightSampling`, get seed + 1 ..= seed + S;
+    /// other graphs render the same frame again), and the row gets the sample variance
+    /// and squared bias over them on rel_mse's scale ([`crate::bench::seed_spread`]).
+    /// 0, the default, is off; else 2..=[`MAX_SEEDS`]. Needs a reference image; not with
+    /// `animate`.
+    #[serde(default)]
+    pub seeds: u32,
 }
 
 fn yes() -> bool {
@@ -100,6 +109,9 @@ pub const MAX_WARMUP_FRAMES: u32 = 100_000;
 /// every point renders and times each of its graphs, so 100,000 already take days; the
 /// product of five long lists would also overflow the count.
 pub const MAX_POINTS: u64 = 100_000;
+/// Most seeds a sweep's `seeds` asks for: each is a frame prepared (its pipelines built
+/// for the seed) and rendered per graph and point.
+pub const MAX_SEEDS: u32 = 1024;
 /// Most rounds per point: each round keeps a median; more rounds than timed frames do not
 /// run anyway (one frame a round at least).
 pub const MAX_ROUNDS: u32 = 10_000;
@@ -206,6 +218,19 @@ impl Sweep {
             let line = line_of("animate");
             return Err(error(format!(
                 "{line}animate {step} must be a finite number of seconds > 0"
+            )));
+        }
+        if sweep.seeds == 1 || sweep.seeds > MAX_SEEDS {
+            let line = field_line(text, "seeds");
+            return Err(error(format!(
+                "{line}seeds {} must be 0 (off) or lie in 2..={MAX_SEEDS}: a variance needs two images",
+                sweep.seeds
+            )));
+        }
+        if sweep.seeds > 0 && sweep.animate.is_some() {
+            let line = field_line(text, "seeds");
+            return Err(error(format!(
+                "{line}seeds cannot be combined with animate: the seeded frames run with still lights, while the measured frame's history (temporal reuse) saw them move"
             )));
         }
         if !(0.0..=3600.0).contains(&sweep.warmup_seconds) {

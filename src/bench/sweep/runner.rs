@@ -1,6 +1,7 @@
 //! Running a sweep: each point's scene, graphs and reference prepared, the graphs timed
 //! together (`bench::timing`), each image compared with the reference, one row a graph.
 
+use super::seeds::{set_seed_columns, SeedRun};
 use super::{Sweep, SweepError};
 use crate::bench::cases::SceneCase;
 use crate::bench::metrics::non_finite_pixels;
@@ -190,6 +191,16 @@ pub fn run(
                         row.reference = reference.map(|r| r.0.trim_end_matches(".ron").to_string());
                         let reference = reference.map(|r| r.1.as_slice());
                         fill_row(sweep, g, frame, &point, reference, renderer, &mut row)?;
+                        if let (s @ 1.., Some(reference)) = (sweep.seeds, reference) {
+                            let run = SeedRun {
+                                prepared: frame,
+                                scene: &scene,
+                                gpu: &gpu,
+                                size,
+                                graph_name: g,
+                            };
+                            set_seed_columns(&mut row, &run, reference, s, renderer)?;
+                        }
                         rows.push(row);
                         progress(SweepEvent::Done {
                             done: rows.len(),
