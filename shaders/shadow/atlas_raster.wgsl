@@ -389,6 +389,10 @@ fn setup(
         setup_triangle(a, b, c, rect, tri);
         return;
     }
+    // Most of a view's triangles lie wholly outside it.
+    if (outside_one_plane(a, b, c)) {
+        return;
+    }
     let poly = clip_triangle(a, b, c);
     for (var k = 1u; k + 1u < poly.n; k++) {
         setup_triangle(poly.v[0], poly.v[k], poly.v[k + 1u], rect, tri);
