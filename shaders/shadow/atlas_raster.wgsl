@@ -30,9 +30,9 @@
 // indirect/rsm_raster.wgsl) runs `setup` and `raster` twice over its views (VIEW_VEC4S
 // words a view in its table, no depth bias): first for the depth as here, then with IDS
 // for the nearest triangle: each covered texel whose depth bits equal the buffer's
-// (the same arithmetic gives the same bits) takes the larger triangle id + 1 by a 32-bit
-// atomic max in `ids`, as the raster pipeline's LessEqual test keeps the later draw of
-// equal depth. Two 32-bit passes instead of one 64-bit atomic of (depth, id): no device
+// (the same arithmetic gives the same bits) takes the larger visibility id + 1
+// (`tri_ids`: the triangles are in shadow chunk order) by a 32-bit atomic max in `ids`,
+// as the raster pipeline's LessEqual test keeps the later draw of equal depth. Two 32-bit passes instead of one 64-bit atomic of (depth, id): no device
 // feature needed, and the views are small, so the second pass costs little.
 
 struct Params {
@@ -53,6 +53,10 @@ struct Params {
 // The first pass's depths (read only) and the nearest triangle's id + 1 (0: none).
 @group(0) @binding(6) var<storage, read> depth: array<u32>;
 @group(0) @binding(12) var<storage, read_write> ids: array<atomic<u32>>;
+#if SETUP
+// Per triangle of `indices`, the id `ids` keeps (its visibility id).
+@group(0) @binding(13) var<storage, read> tri_ids: array<u32>;
+#endif
 #else
 @group(0) @binding(6) var<storage, read_write> depth: array<atomic<u32>>;
 #endif
@@ -128,7 +132,7 @@ struct Tri {
     offset: f32,
     // Texels whose centres lie in the vertices' box, within the view's tile.
     box: vec4<i32>,
-    // The triangle's index in `indices` (IDS: what a texel it is nearest in keeps).
+    // IDS: the triangle's id (`tri_ids`), what a texel it is nearest in keeps.
     id: u32,
 };
 
@@ -385,8 +389,13 @@ fn setup(
     let a = clip_position(view_proj, indices[3u * tri]);
     let b = clip_position(view_proj, indices[3u * tri + 1u]);
     let c = clip_position(view_proj, indices[3u * tri + 2u]);
+#if IDS
+    let id = tri_ids[tri];
+#else
+    let id = 0u;
+#endif
     if (!needs_clipping(a, b, c)) {
-        setup_triangle(a, b, c, rect, tri);
+        setup_triangle(a, b, c, rect, id);
         return;
     }
     // Most of a view's triangles lie wholly outside it.
@@ -395,7 +404,7 @@ fn setup(
     }
     let poly = clip_triangle(a, b, c);
     for (var k = 1u; k + 1u < poly.n; k++) {
-        setup_triangle(poly.v[0], poly.v[k], poly.v[k + 1u], rect, tri);
+        setup_triangle(poly.v[0], poly.v[k], poly.v[k + 1u], rect, id);
     }
 }
 #endif

@@ -3,11 +3,12 @@
 //!
 //! The triangles go through the shadow atlas's compute rasterizer
 //! (`shadow_atlas_raster`, `shaders/shadow/atlas_raster.wgsl`) over the RSM view table:
-//! the opaque meshes in draw order (so a triangle's index is its visibility id), each
-//! view given the meshes whose bounds touch its frustum, no depth bias. Its first pass
-//! keeps each texel's nearest depth by a 32-bit atomic min; its second (IDS) the
-//! nearest triangle, by an atomic max of the id where the depth matches (ties go to the
-//! later draw, as the hardware pass's LessEqual test). Two 32-bit passes rather than one
+//! the opaque meshes, each view given the shadow chunks (`shadow::chunks`) whose bounds
+//! touch its frustum (the hardware pass draws every mesh whole into every view: a
+//! chunk outside draws nothing), no depth bias. Its first pass keeps each texel's
+//! nearest depth by a 32-bit atomic min; its second (IDS) the nearest triangle, by an
+//! atomic max of its visibility id where the depth matches (ties go to the later draw,
+//! as the hardware pass's LessEqual test). Two 32-bit passes rather than one
 //! 64-bit atomic of (depth, id): they need no device feature (`ComputeRaster`'s 64-bit
 //! atomic min is an optional one, with a hardware fallback), and the second pass only
 //! redoes the small views' setup. Then `shaders/indirect/rsm_raster.wgsl`: a resolve
@@ -16,7 +17,7 @@
 //! writes the depth, clears the texels nothing covers and puts the buffers back.
 //! All in one compute pass.
 
-use super::shadow_atlas_raster::{ComputeAtlas, RasterTarget, TriangleOrder, Work};
+use super::shadow_atlas_raster::{ComputeAtlas, RasterTarget, Work};
 use super::{defines, grid, pass_error, PrepareCtx, Timestamps};
 use crate::graph::kinds::reflective_shadow_maps::{ReflectiveShadowMaps, VIEW_VEC4S};
 use crate::graph::ScheduledPass;
@@ -24,6 +25,7 @@ use crate::indirect::rsm_views::RsmLayout;
 use crate::render::pipelines::PipelineKey;
 use crate::render::RenderError;
 use crate::shadow::atlas::{box_in_frustum, frustum_planes};
+use crate::shadow::chunks::Chunk;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
@@ -57,8 +59,8 @@ pub(super) struct ComputeRsm {
     /// (pieces, workgroups per dimension, texels a row, tile).
     params: wgpu::Buffer,
     pieces: wgpu::Buffer,
-    /// Each caster mesh's world bounds and its triangles (first, count), in draw order.
-    meshes: Vec<([glam::Vec3; 2], u32, u32)>,
+    /// Each caster mesh's world bounds and shadow chunks, in draw order.
+    meshes: Vec<([glam::Vec3; 2], Arc<[Chunk]>)>,
     tile: u32,
     width: u32,
     max_groups: u32,
@@ -84,7 +86,6 @@ impl ComputeRsm {
             cx,
             &sp.name,
             &casters,
-            TriangleOrder::Draw,
             RasterTarget::Buffers { width, height },
             views,
             VIEW_VEC4S,
@@ -109,10 +110,7 @@ impl ComputeRsm {
         let ranges = geometry.material_ranges.clone();
         let meshes = casters
             .iter()
-            .map(|&m| {
-                let gm = &cx.gpu.meshes[m];
-                (gm.bounds, gm.first_triangle, gm.index_count / 3)
-            })
+            .map(|&m| (cx.gpu.meshes[m].bounds, cx.gpu.meshes[m].chunks.clone()))
             .collect();
         let step = p.tile.min(PIECE);
         let most_pieces = (width / step) as u64 * (height / step) as u64;
@@ -209,7 +207,8 @@ impl ComputeRsm {
     }
 
     /// Lists the work for `layout`'s views (written before the next submission): per
-    /// view a job for each mesh whose bounds touch its frustum, and its tile's pieces.
+    /// view a job for each run of chunks whose bounds touch its frustum (as the atlas
+    /// culls its views), and its tile's pieces.
     pub(super) fn upload(&self, layout: &RsmLayout) {
         let mut work = Work::default();
         let mut pieces: Vec<[u32; 4]> = Vec::new();
@@ -218,12 +217,23 @@ impl ComputeRsm {
             let v = v as u32;
             work.rects.push([view.x, view.y, self.tile, 0]);
             let planes = frustum_planes(view.view_proj);
-            for &([lo, hi], first, count) in &self.meshes {
-                if count == 0 || !box_in_frustum(&planes, lo, hi) {
+            for (draw, ([lo, hi], chunks)) in self.meshes.iter().enumerate() {
+                if !box_in_frustum(&planes, *lo, *hi) {
                     continue;
                 }
-                work.jobs.push([work.pairs, first, count, v]);
-                work.pairs += count;
+                let base = self.raster.index_base[draw];
+                for c in chunks
+                    .iter()
+                    .filter(|c| box_in_frustum(&planes, c.min, c.max))
+                {
+                    let (first, count) = ((base + c.first) / 3, c.count / 3);
+                    // Consecutive chunks make one job.
+                    match work.jobs.last_mut() {
+                        Some(job) if job[3] == v && job[1] + job[2] == first => job[2] += count,
+                        _ => work.jobs.push([work.pairs, first, count, v]),
+                    }
+                    work.pairs += count;
+                }
             }
             for py in (0..self.tile).step_by(step as usize) {
                 for px in (0..self.tile).step_by(step as usize) {

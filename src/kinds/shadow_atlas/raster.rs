@@ -9,8 +9,8 @@
 //!
 //! The reflective shadow maps' compute raster (`ReflectiveShadowMaps(raster: Compute)`)
 //! runs the same rasterizer over its own views ([`RasterTarget::Buffers`]): no store,
-//! the triangles in draw order (an index is the visibility id), and a second `setup`
-//! and `raster` (IDS) that keep each texel's nearest triangle.
+//! and a second `setup` and `raster` (IDS) that keep each texel's nearest triangle by
+//! its visibility id (`tri_ids`: the merged triangles are in shadow chunk order).
 
 use super::{grid, pass_error, PrepareCtx, Timestamps};
 use crate::gpu::readback::read_buffer;
@@ -88,23 +88,12 @@ struct Bound {
     store: Option<wgpu::BindGroup>,
 }
 
-/// The order the casters' triangles are merged in.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum TriangleOrder {
-    /// Each mesh's triangles in its shadow chunk order, as the atlas's hardware path
-    /// draws them (its culled ranges index both the same way).
-    ShadowChunks,
-    /// Each mesh's triangles in its index order: with the opaque draws as casters, a
-    /// merged triangle's index is its visibility id (`render::visibility_geometry`).
-    Draw,
-}
-
 /// Where the rasterized depth goes.
 pub(super) enum RasterTarget {
     /// `store` writes the drawn views' depth into this `side`² R32Float atlas.
     Atlas { atlas: wgpu::TextureView, side: u32 },
-    /// The depth (and, from the IDS pass, each texel's nearest triangle's index + 1)
-    /// stay in the buffers, `width` texels a row, for the caller to read and put back
+    /// The depth (and, from the IDS pass, each texel's nearest triangle's visibility id
+    /// + 1: the casters must be the opaque draws) stay in the buffers, `width` texels a row, for the caller to read and put back
     /// to far and zero: [`ComputeAtlas::depth`], [`ComputeAtlas::ids`].
     Buffers { width: u32, height: u32 },
 }
@@ -118,6 +107,8 @@ struct IdsPass {
     counters: wgpu::Buffer,
     args: wgpu::Buffer,
     ids: wgpu::Buffer,
+    /// Per merged triangle, its visibility id.
+    tri_ids: wgpu::Buffer,
 }
 
 pub(super) struct ComputeAtlas {
@@ -184,15 +175,14 @@ fn storage(
 }
 
 impl ComputeAtlas {
-    /// The rasterizer for `casters` (scene GPU mesh indices, in draw order, their
-    /// triangles merged in `order`) into `target`, reading view-projections from
-    /// `table` (`view_vec4s` words a view, after a header vec4).
+    /// The rasterizer for `casters` (scene GPU mesh indices, in draw order) into
+    /// `target`, reading view-projections from `table` (`view_vec4s` words a view, after
+    /// a header vec4).
     #[allow(clippy::too_many_arguments)]
     pub(super) fn prepare(
         cx: &mut PrepareCtx,
         pass: &str,
         casters: &[usize],
-        order: TriangleOrder,
         target: RasterTarget,
         table: &wgpu::Buffer,
         view_vec4s: u64,
@@ -203,6 +193,9 @@ impl ComputeAtlas {
         let mut positions: Vec<[f32; 4]> = Vec::new();
         let mut indices: Vec<u32> = Vec::new();
         let mut index_base = Vec::new();
+        // Per merged triangle, its visibility id (the IDS pass's).
+        let mut tri_ids: Vec<u32> = Vec::new();
+        let ids = matches!(target, RasterTarget::Buffers { .. });
         for &m in casters {
             let material = &gpu.materials[gpu.meshes[m].material];
             if matches!(material.alpha_mode, AlphaMode::Mask(_)) {
@@ -218,13 +211,14 @@ impl ComputeAtlas {
             let base = positions.len() as u32;
             index_base.push(indices.len() as u32);
             positions.extend(mesh.positions.iter().map(|p| [p.x, p.y, p.z, 1.0]));
-            match order {
-                TriangleOrder::ShadowChunks => {
-                    let (order, _) =
-                        crate::shadow::chunks::chunk_triangles(&mesh.positions, &mesh.indices);
-                    indices.extend(order.iter().map(|i| i + base));
-                }
-                TriangleOrder::Draw => indices.extend(mesh.indices.iter().map(|i| i + base)),
+            // The triangles as the hardware path draws them (shadow chunk order), so a
+            // view's culled ranges index both the same way.
+            let (order, _, sources) =
+                crate::shadow::chunks::chunk_triangles_with_sources(&mesh.positions, &mesh.indices);
+            indices.extend(order.iter().map(|i| i + base));
+            if ids {
+                let first = gpu.meshes[m].first_triangle;
+                tri_ids.extend(sources.iter().map(|t| first + t));
             }
         }
         let (side, rows, atlas) = match target {
@@ -414,7 +408,9 @@ impl ComputeAtlas {
                         (12, ids.as_entire_binding()),
                     ],
                 );
+                let tri_ids = init("rsm raster visibility ids", bytemuck::cast_slice(&tri_ids));
                 Some(IdsPass {
+                    tri_ids,
                     setup,
                     raster,
                     raster_bind,
@@ -482,7 +478,7 @@ impl ComputeAtlas {
         let setup_bind = |pipeline: &wgpu::ComputePipeline,
                           counters: &wgpu::Buffer,
                           args: &wgpu::Buffer,
-                          ids: Option<&wgpu::Buffer>| {
+                          ids: Option<&IdsPass>| {
             let mut entries = vec![
                 (0, self.params.as_entire_binding()),
                 (1, self.table.as_entire_binding()),
@@ -496,8 +492,9 @@ impl ComputeAtlas {
                 (9, counters.as_entire_binding()),
                 (10, args.as_entire_binding()),
             ];
-            if let Some(ids) = ids {
-                entries.push((12, ids.as_entire_binding()));
+            if let Some(p) = ids {
+                entries.push((12, p.ids.as_entire_binding()));
+                entries.push((13, p.tri_ids.as_entire_binding()));
             }
             bind(&self.device, pipeline, &entries)
         };
@@ -505,7 +502,7 @@ impl ComputeAtlas {
         let setup_ids = self
             .ids_pass
             .as_ref()
-            .map(|p| setup_bind(&p.setup, &p.counters, &p.args, Some(&p.ids)));
+            .map(|p| setup_bind(&p.setup, &p.counters, &p.args, Some(p)));
         let store = match (&self.store, &self.atlas) {
             (Some(store), Some(atlas)) => Some(bind(
                 &self.device,
@@ -665,8 +662,8 @@ impl ComputeAtlas {
         &self.depth
     }
 
-    /// With [`RasterTarget::Buffers`]: each texel's nearest triangle's index + 1 (0:
-    /// none), as the depth buffer is laid out.
+    /// With [`RasterTarget::Buffers`]: each texel's nearest triangle's visibility id + 1
+    /// (0: none), as the depth buffer is laid out.
     pub(super) fn ids(&self) -> Option<&wgpu::Buffer> {
         self.ids_pass.as_ref().map(|p| &p.ids)
     }
