@@ -58,13 +58,15 @@ pub(super) struct RsmPass {
 
 /// Who draws the views.
 enum Raster {
-    /// One render pass: the mesh draws, a viewport a view, over the depth attachment.
-    Hardware {
-        depth: wgpu::TextureView,
-        targets: [wgpu::TextureView; 3],
-        draws: MeshDraws,
-    },
+    Hardware(Box<HardwareMaps>),
     Compute(Box<ComputeRsm>),
+}
+
+/// One render pass: the mesh draws, a viewport a view, over the depth attachment.
+struct HardwareMaps {
+    depth: wgpu::TextureView,
+    targets: [wgpu::TextureView; 3],
+    draws: MeshDraws,
 }
 
 /// The maps' size and the views laid out on them, as both RSM passes compute it.
@@ -144,7 +146,7 @@ pub(super) fn prepare(
                 &offered,
             )?;
             let target = |slot: &str| cx.view(&sp.name, sp.required(slot));
-            Raster::Hardware {
+            Raster::Hardware(Box::new(HardwareMaps {
                 depth: target(RSM_DEPTH)?,
                 targets: [
                     target(RSM_NORMAL)?,
@@ -152,7 +154,7 @@ pub(super) fn prepare(
                     target(RSM_POSITION)?,
                 ],
                 draws,
-            }
+            }))
         }
         RsmRaster::Compute => {
             let compute = ComputeRsm::prepare(cx, sp, p, (w, h), &views)?;
@@ -194,12 +196,12 @@ impl PreparedPass for RsmPass {
 
     fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
         encoder.copy_buffer_to_buffer(&self.staging, 0, &self.views, 0, self.table_bytes);
-        let (depth, targets, draws) = match &self.raster {
-            Raster::Hardware {
-                depth,
-                targets,
-                draws,
-            } => (depth, targets, draws),
+        let HardwareMaps {
+            depth,
+            targets,
+            draws,
+        } = match &self.raster {
+            Raster::Hardware(maps) => &**maps,
             Raster::Compute(compute) => return compute.record(encoder, &self.name, ts),
         };
         // The maps are small (a few MiB at most): clearing them whole costs nothing and

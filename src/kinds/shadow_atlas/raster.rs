@@ -92,9 +92,10 @@ struct Bound {
 pub(super) enum RasterTarget {
     /// `store` writes the drawn views' depth into this `side`² R32Float atlas.
     Atlas { atlas: wgpu::TextureView, side: u32 },
-    /// The depth (and, from the IDS pass, each texel's nearest triangle's visibility id
-    /// + 1: the casters must be the opaque draws) stay in the buffers, `width` texels a row, for the caller to read and put back
-    /// to far and zero: [`ComputeAtlas::depth`], [`ComputeAtlas::ids`].
+    /// The depth (and, from the IDS pass, one more than each texel's nearest triangle's
+    /// visibility id: the casters must be the opaque draws) stay in the buffers, `width`
+    /// texels a row, for the caller to read and put back to far and zero:
+    /// [`ComputeAtlas::depth`], [`ComputeAtlas::ids`].
     Buffers { width: u32, height: u32 },
 }
 
