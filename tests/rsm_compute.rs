@@ -56,6 +56,7 @@ fn with_raster(text: &str, raster: &str) -> String {
 struct Frame {
     prepared: PreparedFrame,
     result: FrameResult,
+    gpu: SceneGpu,
 }
 
 fn prepare(r: &mut Renderer, text: &str, scene: &Scene, w: u32, h: u32) -> Result<Frame, String> {
@@ -72,7 +73,11 @@ fn prepare(r: &mut Renderer, text: &str, scene: &Scene, w: u32, h: u32) -> Resul
         .prepare(compiled, scene, &gpu, size, false)
         .map_err(|e| e.to_string())?;
     let result = prepared.render(r).map_err(|e| e.to_string())?;
-    Ok(Frame { prepared, result })
+    Ok(Frame {
+        prepared,
+        result,
+        gpu,
+    })
 }
 
 /// The maps of one frame, read back.
@@ -329,4 +334,89 @@ fn alpha_masked_materials_are_refused_naming_the_material() {
     );
     // The hardware pass draws masks.
     prepare(&mut r, &with_raster(&text, "Hardware"), &s, W, H).unwrap();
+}
+
+/// The Cornell box (which has no uvs) with a checker-textured quad on its floor: the
+/// resolve samples it with the uv footprint of the texel's 2×2 quad, as the fragment
+/// stage's implicit derivatives do.
+#[test]
+fn a_textured_floor_reflects_the_same_flux() {
+    use common::textured::{checker, quad};
+    use lightgraph::scene::SurfaceMaterial;
+    let mut r = renderer();
+    let mut s = load("cornell_indirect.ron");
+    let tex = std::sync::Arc::new(checker("checker", 64, 8, [230, 120, 40], [40, 90, 200]));
+    s.materials.push(SurfaceMaterial {
+        name: "checker_floor".into(),
+        base_color_texture: Some(tex),
+        ..Default::default()
+    });
+    let m = s.materials.len() - 1;
+    s.meshes.push(quad(
+        "checker_floor",
+        glam::Vec3::new(0.0, 0.01, 0.0),
+        glam::Vec3::X * 0.7,
+        glam::Vec3::Z * 0.7,
+        m,
+    ));
+    let text = graph_text("indirect_vpl.ron");
+    let hw = prepare(&mut r, &with_raster(&text, "Hardware"), &s, W, H).unwrap();
+    let cs = prepare(&mut r, &with_raster(&text, "Compute"), &s, W, H).unwrap();
+    let (mh, mc) = (maps(&r, &hw), maps(&r, &cs));
+    let d = compare(&mh, &mc);
+    println!("textured: {d:?}");
+    // The checker shows in the flux: its two colours' red/blue ratios differ by 30×.
+    let ratios: Vec<f32> = mh
+        .texels()
+        .into_iter()
+        .filter(|&i| mh.flux[i][2] > 0.0)
+        .map(|i| mh.flux[i][0] / mh.flux[i][2])
+        .collect();
+    let (lo, hi) = ratios
+        .iter()
+        .fold((f32::MAX, 0.0f32), |(l, h), &x| (l.min(x), h.max(x)));
+    assert!(hi > 10.0 * lo, "no checker in the flux: ratios {lo}..{hi}");
+    let edges = d.coverage + d.other_triangle;
+    assert!(edges * 500 <= d.texels, "{edges} texels differ: {d:?}");
+    assert!(d.depth <= DEPTH_ULPS, "{d:?}");
+}
+
+/// A moved light (`update_lights`) lays the compute pass's views and jobs out again:
+/// the maps equal a fresh prepare's at the new place, exactly (the same work in the
+/// same order).
+#[test]
+fn a_moved_light_rasterizes_its_new_views() {
+    let mut r = renderer();
+    let s = load("cornell_indirect.ron");
+    let text = with_raster(&graph_text("indirect_vpl.ron"), "Compute");
+    let start = prepare(&mut r, &text, &s, W, H).unwrap();
+    let before = maps(&r, &start);
+    let mut moved = s.clone();
+    moved.lights[0].position.x += 0.5;
+    start
+        .prepared
+        .update_lights(&r, &start.gpu, &moved.lights)
+        .unwrap();
+    start.prepared.render(&r).unwrap();
+    let after = maps(&r, &start);
+    let fresh = prepare(&mut r, &text, &moved, W, H).unwrap();
+    let fresh = maps(&r, &fresh);
+    assert_eq!(after.tiles, fresh.tiles);
+    let mut changed = 0;
+    for i in fresh.texels() {
+        assert_eq!(
+            after.depth[i].to_bits(),
+            fresh.depth[i].to_bits(),
+            "texel {i}"
+        );
+        assert_eq!(after.normal[i], fresh.normal[i], "texel {i}");
+        assert_eq!(after.flux[i], fresh.flux[i], "texel {i}");
+        assert_eq!(after.position[i], fresh.position[i], "texel {i}");
+        changed += usize::from(after.position[i] != before.position[i]);
+    }
+    // The move changed what the views see (the test can fail).
+    assert!(
+        changed * 2 > fresh.texels().len(),
+        "{changed} texels changed"
+    );
 }
