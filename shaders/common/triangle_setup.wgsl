@@ -47,6 +47,17 @@ fn needs_clipping(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) -> bool {
     return false;
 }
 
+// Whether all three vertices lie outside one plane: the triangle is wholly outside,
+// and `clip_triangle` would leave nothing of it (cheaply, without the polygon arrays).
+fn outside_one_plane(a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) -> bool {
+    for (var k = 0u; k < 5u; k++) {
+        if (plane_distance(a, k) < 0.0 && plane_distance(b, k) < 0.0 && plane_distance(c, k) < 0.0) {
+            return true;
+        }
+    }
+    return false;
+}
+
 // The triangle clipped to a convex polygon (Sutherland-Hodgman), fanned from vertex 0.
 struct Polygon {
     v: array<vec4<f32>, MAX_POLY>,

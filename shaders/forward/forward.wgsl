@@ -58,7 +58,6 @@ enable primitive_index;
 // A ReflectiveShadowMaps pass: the instance index is the view (src/indirect/rsm_views.rs).
 #include "common/light_inputs.wgsl"
 @group(0) @binding(11) var<storage, read> rsm_views: array<vec4<f32>>;
-const RSM_VIEW_VEC4S: u32 = 8u;
 #endif
 
 #include "common/shading_point.wgsl"
@@ -66,6 +65,9 @@ const RSM_VIEW_VEC4S: u32 = 8u;
 #include <material>
 #if SHADE
 #include "common/light_loop.wgsl"
+#endif
+#if RSM
+#include "indirect/rsm_texel.wgsl"
 #endif
 
 struct VertexIn {
@@ -276,9 +278,7 @@ fn fs_visibility(
 #endif
 
 #if RSM
-// What a texel of an indirect light's map reflects: the flux the light sends through the
-// texel (intensity × its solid angle, whatever the surface's slope), times the diffuse
-// albedo; the normal faces the light.
+// What a texel of an indirect light's map reflects (indirect/rsm_texel.wgsl).
 struct RsmOut {
     @location(0) normal: vec4<f32>,
     @location(1) flux: vec4<f32>,
@@ -287,33 +287,13 @@ struct RsmOut {
 
 @fragment
 fn fs_rsm(in: VertexOut) -> RsmOut {
-    let b = 1u + RSM_VIEW_VEC4S * in.view;
-    let info = bitcast<vec4<u32>>(rsm_views[b + 4u]);
-    let texel_solid_angle = rsm_views[b + 5u].x;
-    let axis = rsm_views[b + 7u].xyz;
-    let g = light_geometry[info.z];
-    let to_light = g.position - in.world;
-    var p = shading_point(in, true);
-    if (dot(p.normal, to_light) < 0.0) {
-        p.normal = -p.normal;
-    }
-    p.view = normalize(to_light);
-    let m = material_setup(p);
+    let t = rsm_texel(shading_point(in, true), in.view);
 #if ALPHA_MASK
-    if (material_alpha(m) < ALPHA_CUTOFF) {
+    if (t.alpha < ALPHA_CUTOFF) {
         discard;
     }
 #endif
-    let props = light_properties[info.z];
-    var inc = incident_light(g, props, in.world);
-    // A surface the light does not light reflects none of it.
-    if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
-        inc.radiance = vec3<f32>(0.0);
-    }
-    let dist_sq = dot(to_light, to_light);
-    let c = max(dot(axis, -inc.dir), 0.0);
-    let flux = material_diffuse(m) * inc.radiance * (dist_sq * texel_solid_angle * c * c * c);
-    return RsmOut(vec4<f32>(p.normal, 1.0), vec4<f32>(flux, 1.0), vec4<f32>(in.world, 1.0));
+    return RsmOut(vec4<f32>(t.normal, 1.0), vec4<f32>(t.flux, 1.0), vec4<f32>(in.world, 1.0));
 }
 #endif
 

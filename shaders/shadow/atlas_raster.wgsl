@@ -25,6 +25,15 @@
 //   buffer's texels into the R32Float atlas, and the buffer back to the far depth, so it
 //   is clear for the next frame's views (it starts so).
 // A full list loses nothing: the thread rasterizes the triangle or cell itself, counted.
+//
+// The reflective shadow maps' compute raster (ReflectiveShadowMaps with raster: Compute,
+// indirect/rsm_raster.wgsl) runs `setup` and `raster` twice over its views (VIEW_VEC4S
+// words a view in its table, no depth bias): first for the depth as here, then with IDS
+// for the nearest triangle: each covered texel whose depth bits equal the buffer's
+// (the same arithmetic gives the same bits) takes the larger visibility id + 1
+// (`tri_ids`: the triangles are in shadow chunk order) by a 32-bit atomic max in `ids`,
+// as the raster pipeline's LessEqual test keeps the later draw of equal depth. Two 32-bit passes instead of one 64-bit atomic of (depth, id): no device
+// feature needed, and the views are small, so the second pass costs little.
 
 struct Params {
     // Pairs, jobs, workgroups per dispatch dimension, atlas side.
@@ -40,7 +49,17 @@ struct Params {
 @group(0) @binding(6) var<storage, read_write> depth: array<u32>;
 @group(0) @binding(11) var atlas: texture_storage_2d<r32float, write>;
 #else
+#if IDS
+// The first pass's depths (read only) and the nearest triangle's id + 1 (0: none).
+@group(0) @binding(6) var<storage, read> depth: array<u32>;
+@group(0) @binding(12) var<storage, read_write> ids: array<atomic<u32>>;
+#if SETUP
+// Per triangle of `indices`, the id `ids` keeps (its visibility id).
+@group(0) @binding(13) var<storage, read> tri_ids: array<u32>;
+#endif
+#else
 @group(0) @binding(6) var<storage, read_write> depth: array<atomic<u32>>;
+#endif
 #if SETUP
 @group(0) @binding(1) var<storage, read> shadow_views: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> positions: array<vec4<f32>>;
@@ -113,6 +132,8 @@ struct Tri {
     offset: f32,
     // Texels whose centres lie in the vertices' box, within the view's tile.
     box: vec4<i32>,
+    // IDS: the triangle's id (`tri_ids`), what a texel it is nearest in keeps.
+    id: u32,
 };
 
 // Texel (px, py) of `t`, if its centre is covered and its depth within the far plane.
@@ -129,7 +150,14 @@ fn cover(t: Tri, px: i32, py: i32) {
     let d = min(z + t.offset, 1.0);
     // Clamped at 0 (also -0.0, whose bits would order last).
     let bits = select(bitcast<u32>(d), 0u, !(d > 0.0));
-    atomicMin(&depth[u32(py) * params.work.w + u32(px)], bits);
+    let at = u32(py) * params.work.w + u32(px);
+#if IDS
+    if (bits == depth[at]) {
+        atomicMax(&ids[at], t.id + 1u);
+    }
+#else
+    atomicMin(&depth[at], bits);
+#endif
 }
 
 // Every texel of `region` (x0, y0, x1, y1, inclusive) in this thread.
@@ -164,6 +192,7 @@ fn load_record(r: u32) -> Tri {
     t.dz = vec2<f32>(bitcast<f32>(w2.w), bitcast<f32>(w3.x));
     t.offset = bitcast<f32>(w3.y);
     t.bias = -vec3<i32>(vec3<u32>(w3.z, w3.z >> 1u, w3.z >> 2u) & vec3<u32>(1u));
+    t.id = w3.w;
     return t;
 }
 
@@ -182,7 +211,7 @@ fn store_record(r: u32, t: Tri) {
     records[i] = bitcast<vec4<u32>>(vec4<i32>(t.a, t.b));
     records[i + 1u] = vec4<u32>(bitcast<vec2<u32>>(t.c), pack_point(t.box.xy), pack_point(t.box.zw));
     records[i + 2u] = vec4<u32>(bitcast<vec3<u32>>(t.sa), bitcast<u32>(t.dz.x));
-    records[i + 3u] = vec4<u32>(bitcast<u32>(t.dz.y), bitcast<u32>(t.offset), flags, 0u);
+    records[i + 3u] = vec4<u32>(bitcast<u32>(t.dz.y), bitcast<u32>(t.offset), flags, t.id);
 }
 
 
@@ -227,7 +256,7 @@ fn depth_bias(z: vec3<f32>, dz: vec2<f32>) -> f32 {
     return DEPTH_BIAS * unit + SLOPE_BIAS * max(abs(dz.x), abs(dz.y));
 }
 
-fn setup_triangle(ca: vec4<f32>, cb: vec4<f32>, cc: vec4<f32>, rect: vec4<u32>) {
+fn setup_triangle(ca: vec4<f32>, cb: vec4<f32>, cc: vec4<f32>, rect: vec4<u32>, id: u32) {
     let sa = to_screen(ca, rect);
     var sb = to_screen(cb, rect);
     var sc = to_screen(cc, rect);
@@ -263,6 +292,7 @@ fn setup_triangle(ca: vec4<f32>, cb: vec4<f32>, cc: vec4<f32>, rect: vec4<u32>) 
     t.dz = vec2<f32>((e1.z * e2.y - e2.z * e1.y) / det, (e2.z * e1.x - e1.z * e2.x) / det);
     t.offset = depth_bias(vec3<f32>(sa.z, sb.z, sc.z), t.dz);
     t.box = box;
+    t.id = id;
     let size = box.zw - box.xy + vec2<i32>(1);
     if (size.x * size.y <= SMALL_BOX) {
         raster_region(t, box);
@@ -353,19 +383,28 @@ fn setup(
     }
     let job = jobs[find_job(i)];
     let tri = job.y + (i - job.x);
-    let base = 1u + 6u * job.w;
+    let base = 1u + VIEW_VEC4S * job.w;
     let view_proj = mat4x4<f32>(shadow_views[base], shadow_views[base + 1u], shadow_views[base + 2u], shadow_views[base + 3u]);
     let rect = rects[job.w];
     let a = clip_position(view_proj, indices[3u * tri]);
     let b = clip_position(view_proj, indices[3u * tri + 1u]);
     let c = clip_position(view_proj, indices[3u * tri + 2u]);
+#if IDS
+    let id = tri_ids[tri];
+#else
+    let id = 0u;
+#endif
     if (!needs_clipping(a, b, c)) {
-        setup_triangle(a, b, c, rect);
+        setup_triangle(a, b, c, rect, id);
+        return;
+    }
+    // Most of a view's triangles lie wholly outside it.
+    if (outside_one_plane(a, b, c)) {
         return;
     }
     let poly = clip_triangle(a, b, c);
     for (var k = 1u; k + 1u < poly.n; k++) {
-        setup_triangle(poly.v[0], poly.v[k], poly.v[k + 1u], rect);
+        setup_triangle(poly.v[0], poly.v[k], poly.v[k + 1u], rect, id);
     }
 }
 #endif

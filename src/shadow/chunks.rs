@@ -23,10 +23,21 @@ pub struct Chunk {
 /// The mesh's indices reordered into chunks, and the chunks. Triangles with an index
 /// past `positions` are left out (the draw would read garbage).
 pub(crate) fn chunk_triangles(positions: &[Vec3], indices: &[u32]) -> (Vec<u32>, Vec<Chunk>) {
-    let tris: Vec<[u32; 3]> = indices
+    let (out, chunks, _) = chunk_triangles_with_sources(positions, indices);
+    (out, chunks)
+}
+
+/// [`chunk_triangles`], and for each reordered triangle its index in `indices` (what a
+/// pass that names triangles by their place in the mesh, as visibility ids do, needs).
+pub(crate) fn chunk_triangles_with_sources(
+    positions: &[Vec3],
+    indices: &[u32],
+) -> (Vec<u32>, Vec<Chunk>, Vec<u32>) {
+    let tris: Vec<(u32, [u32; 3])> = indices
         .chunks_exact(3)
-        .map(|t| [t[0], t[1], t[2]])
-        .filter(|t| t.iter().all(|&i| (i as usize) < positions.len()))
+        .enumerate()
+        .map(|(n, t)| (n as u32, [t[0], t[1], t[2]]))
+        .filter(|(_, t)| t.iter().all(|&i| (i as usize) < positions.len()))
         .collect();
     let corner = |t: &[u32; 3], f: fn(Vec3, Vec3) -> Vec3| {
         t.iter()
@@ -36,25 +47,26 @@ pub(crate) fn chunk_triangles(positions: &[Vec3], indices: &[u32]) -> (Vec<u32>,
     };
     let (lo, hi) = tris
         .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), t| {
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), (_, t)| {
             (lo.min(corner(t, Vec3::min)), hi.max(corner(t, Vec3::max)))
         });
     let extent = (hi - lo).max(Vec3::splat(f32::MIN_POSITIVE));
-    let mut keyed: Vec<(u64, [u32; 3])> = tris
+    let mut keyed: Vec<(u64, u32, [u32; 3])> = tris
         .into_iter()
-        .map(|t| {
+        .map(|(n, t)| {
             let c = t.iter().map(|&i| positions[i as usize]).sum::<Vec3>() / 3.0;
             let q = ((c - lo) / extent * 1023.0).clamp(Vec3::ZERO, Vec3::splat(1023.0));
-            (morton3(q.x as u32, q.y as u32, q.z as u32), t)
+            (morton3(q.x as u32, q.y as u32, q.z as u32), n, t)
         })
         .collect();
-    keyed.sort_by_key(|(k, _)| *k);
+    keyed.sort_by_key(|(k, _, _)| *k);
     let mut out = Vec::with_capacity(keyed.len() * 3);
     let mut chunks = Vec::new();
+    let sources = keyed.iter().map(|(_, n, _)| *n).collect();
     for run in keyed.chunks(CHUNK_TRIANGLES) {
         let first = out.len() as u32;
         let (mut min, mut max) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-        for (_, t) in run {
+        for (_, _, t) in run {
             for &i in t {
                 let p = positions[i as usize];
                 min = min.min(p);
@@ -69,7 +81,7 @@ pub(crate) fn chunk_triangles(positions: &[Vec3], indices: &[u32]) -> (Vec<u32>,
             max,
         });
     }
-    (out, chunks)
+    (out, chunks, sources)
 }
 
 /// Interleaves the low 10 bits of x, y, z.
@@ -104,8 +116,18 @@ mod tests {
             }
         }
         indices.extend([0, 1, 100_000]); // an index past the vertices is left out
-        let (out, chunks) = chunk_triangles(&positions, &indices);
+        let (out, chunks, sources) = chunk_triangles_with_sources(&positions, &indices);
+        assert_eq!(
+            (out.clone(), chunks.clone()),
+            chunk_triangles(&positions, &indices)
+        );
         assert_eq!(out.len(), indices.len() - 3);
+        // Each reordered triangle names its place in `indices`.
+        assert_eq!(sources.len() * 3, out.len());
+        for (t, &n) in sources.iter().enumerate() {
+            let n = n as usize;
+            assert_eq!(out[3 * t..3 * t + 3], indices[3 * n..3 * n + 3]);
+        }
         let mut sorted_in: Vec<[u32; 3]> = indices[..indices.len() - 3]
             .chunks(3)
             .map(|t| [t[0], t[1], t[2]])

@@ -498,6 +498,7 @@ pub(crate) mod test_support {
         Buffer(name: "mask"),
         Buffer(name: "small_buf", size: Bytes(16)),
         Texture(name: "rsm_depth", format: Depth32Float, size: Fixed(256, 256)),
+        Texture(name: "rsm_depth_f", format: R32Float, size: Fixed(256, 256)),
         Texture(name: "rsm_normal", format: Rgba32Float, size: Fixed(256, 256)),
         Texture(name: "rsm_flux", format: Rgba32Float, size: Fixed(256, 256)),
         Texture(name: "rsm_position", format: Rgba32Float, size: Fixed(256, 256)),

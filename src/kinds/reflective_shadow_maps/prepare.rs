@@ -3,11 +3,14 @@
 //! (normal, flux and position targets over depth; the view as the instance index). The
 //! layout depends only on the lights (not the camera): made at prepare, and again on the
 //! CPU for every light update, written into the same table (no pipeline or bind group
-//! changes).
+//! changes). With `raster: Compute` the views are rasterized in compute instead
+//! (`reflective_shadow_maps_raster`).
 
+use super::reflective_shadow_maps_raster::ComputeRsm;
 use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::reflective_shadow_maps::{
-    fixed_size, ReflectiveShadowMaps, RSM_DEPTH, RSM_FLUX, RSM_NORMAL, RSM_POSITION, RSM_VIEWS,
+    fixed_size, ReflectiveShadowMaps, RsmRaster, RSM_DEPTH, RSM_FLUX, RSM_NORMAL, RSM_POSITION,
+    RSM_VIEWS,
 };
 use crate::graph::Name;
 use crate::graph::ScheduledPass;
@@ -47,11 +50,22 @@ pub(super) struct RsmPass {
     rules: RsmLayoutRules,
     /// Each view's tile origin, as the last layout placed them.
     origins: Mutex<Vec<(u32, u32)>>,
-    depth: wgpu::TextureView,
-    targets: [wgpu::TextureView; 3],
     views: wgpu::Buffer,
     staging: wgpu::Buffer,
     table_bytes: u64,
+    raster: Raster,
+}
+
+/// Who draws the views.
+enum Raster {
+    Hardware(Box<HardwareMaps>),
+    Compute(Box<ComputeRsm>),
+}
+
+/// One render pass: the mesh draws, a viewport a view, over the depth attachment.
+struct HardwareMaps {
+    depth: wgpu::TextureView,
+    targets: [wgpu::TextureView; 3],
     draws: MeshDraws,
 }
 
@@ -119,32 +133,44 @@ pub(super) fn prepare(
         .ctx
         .queue
         .write_buffer(&staging, 0, bytemuck::cast_slice(&table));
-    let mut offered = cx.declared(sp)?;
-    offered.buffer("rsm_views", &views);
-    let draws = cx.renderer.mesh_draws(
-        cx.gpu,
-        DrawMode::Rsm,
-        MeshSet::Opaque,
-        1,
-        &sp.name,
-        &offered,
-    )?;
-    let target = |slot: &str| cx.view(&sp.name, sp.required(slot));
+    let raster = match p.raster {
+        RsmRaster::Hardware => {
+            let mut offered = cx.declared(sp)?;
+            offered.buffer("rsm_views", &views);
+            let draws = cx.renderer.mesh_draws(
+                cx.gpu,
+                DrawMode::Rsm,
+                MeshSet::Opaque,
+                1,
+                &sp.name,
+                &offered,
+            )?;
+            let target = |slot: &str| cx.view(&sp.name, sp.required(slot));
+            Raster::Hardware(Box::new(HardwareMaps {
+                depth: target(RSM_DEPTH)?,
+                targets: [
+                    target(RSM_NORMAL)?,
+                    target(RSM_FLUX)?,
+                    target(RSM_POSITION)?,
+                ],
+                draws,
+            }))
+        }
+        RsmRaster::Compute => {
+            let compute = ComputeRsm::prepare(cx, sp, p, (w, h), &views)?;
+            compute.upload(&l);
+            Raster::Compute(Box::new(compute))
+        }
+    };
     Ok(RsmPass {
         name: sp.name.clone(),
         tile: p.tile,
         rules: rsm_layout_rules(cx, p, w, h),
         origins: Mutex::new(l.views.iter().map(|v| (v.x, v.y)).collect()),
-        depth: target(RSM_DEPTH)?,
-        targets: [
-            target(RSM_NORMAL)?,
-            target(RSM_FLUX)?,
-            target(RSM_POSITION)?,
-        ],
         views,
         staging,
         table_bytes,
-        draws,
+        raster,
     })
 }
 
@@ -163,27 +189,37 @@ impl PreparedPass for RsmPass {
             .write_buffer(&self.staging, 0, bytemuck::cast_slice(&table));
         *self.origins.lock().unwrap_or_else(|e| e.into_inner()) =
             l.views.iter().map(|v| (v.x, v.y)).collect();
+        if let Raster::Compute(compute) = &self.raster {
+            compute.upload(&l);
+        }
     }
 
     fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
         encoder.copy_buffer_to_buffer(&self.staging, 0, &self.views, 0, self.table_bytes);
+        let HardwareMaps {
+            depth,
+            targets,
+            draws,
+        } = match &self.raster {
+            Raster::Hardware(maps) => &**maps,
+            Raster::Compute(compute) => return compute.record(encoder, &self.name, ts),
+        };
         // The maps are small (a few MiB at most): clearing them whole costs nothing and
         // leaves unused tiles at zero flux.
         let clear = Some(wgpu::Color::TRANSPARENT);
-        let colors: Vec<_> = self
-            .targets
+        let colors: Vec<_> = targets
             .iter()
             .map(|t| Some(color_attachment(t, clear, None)))
             .collect();
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(&self.name),
             color_attachments: &colors,
-            depth_stencil_attachment: Some(depth_attachment(&self.depth, true)),
+            depth_stencil_attachment: Some(depth_attachment(depth, true)),
             timestamp_writes: ts.render(),
             occlusion_query_set: None,
             multiview_mask: None,
         });
         let origins = self.origins.lock().unwrap_or_else(|e| e.into_inner());
-        self.draws.record_tiles(&mut pass, &origins, self.tile);
+        draws.record_tiles(&mut pass, &origins, self.tile);
     }
 }

@@ -2,7 +2,9 @@
 //! (Harada, McKee, Yang, "Forward+"; AMD's TiledLighting11 sample: 32×32 a light): depth, normal, reflected flux and
 //! world position, a tile per spot light and six cube faces per point light, all views
 //! in one render pass. Writes the four textures and the view table the `VplSpawn` pass
-//! reads (`src/indirect/rsm_views.rs` allocates the tiles).
+//! reads (`src/indirect/rsm_views.rs` allocates the tiles). With `raster: Compute` the
+//! views are rasterized in compute instead (`prepare`'s `raster.rs`), into an R32Float
+//! depth.
 
 use super::{Access, BufferLayout, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
@@ -10,7 +12,7 @@ use crate::graph::model::{ResourceDesc, TextureFormat, TextureSize};
 use crate::graph::plan::FrameSize;
 use serde::{Deserialize, Serialize};
 
-/// `ReflectiveShadowMaps(tile: 32, max_lights: 64)`.
+/// `ReflectiveShadowMaps(tile: 32, max_lights: 64, raster: Hardware)`.
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
 #[serde(deny_unknown_fields)]
 pub struct ReflectiveShadowMaps {
@@ -20,6 +22,25 @@ pub struct ReflectiveShadowMaps {
     /// Indirect lights a frame at most (six views each at most): the view table's room.
     #[serde(default = "default_max_lights")]
     pub max_lights: u32,
+    /// Which units draw the views: the raster pipeline (a Depth32Float depth), or the
+    /// compute rasterizer (an R32Float depth).
+    #[serde(default)]
+    pub raster: RsmRaster,
+}
+
+/// Who rasterizes the maps' views.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
+pub enum RsmRaster {
+    /// The raster pipeline: every view in one render pass (a viewport each), the
+    /// material's RSM fragment stage writing the three targets over a depth attachment.
+    #[default]
+    Hardware,
+    /// Compute: the nearest depth of each texel by a 32-bit atomic min, then the
+    /// nearest triangle's id where the depth matches, then per material the texels of
+    /// its triangles set up and stored (`shaders/indirect/rsm_raster.wgsl`). The depth
+    /// is stored into an R32Float texture (compute cannot store a depth format).
+    /// Refuses alpha-masked materials.
+    Compute,
 }
 
 fn default_tile() -> u32 {
@@ -34,6 +55,7 @@ impl Default for ReflectiveShadowMaps {
         Self {
             tile: default_tile(),
             max_lights: default_max_lights(),
+            raster: RsmRaster::default(),
         }
     }
 }
@@ -67,27 +89,27 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     super::LIGHT_PROPERTIES_READ,
     SlotSpec::new(
         RSM_DEPTH,
-        SlotType::DepthTexture,
+        SlotType::DepthValues,
         Access::Write,
-        Usage::Attachment,
+        Usage::AttachmentOrStorage,
     ),
     SlotSpec::new(
         RSM_NORMAL,
         SlotType::ColorTexture,
         Access::Write,
-        Usage::Attachment,
+        Usage::AttachmentOrStorage,
     ),
     SlotSpec::new(
         RSM_FLUX,
         SlotType::ColorTexture,
         Access::Write,
-        Usage::Attachment,
+        Usage::AttachmentOrStorage,
     ),
     SlotSpec::new(
         RSM_POSITION,
         SlotType::ColorTexture,
         Access::Write,
-        Usage::Attachment,
+        Usage::AttachmentOrStorage,
     ),
     SlotSpec::new(RSM_VIEWS, SlotType::Buffer, Access::Write, Usage::Bound),
 ];
@@ -124,7 +146,9 @@ pub(crate) fn check(p: &ReflectiveShadowMaps, ctx: &KindCtx, errors: &mut Vec<Gr
                 "a reflective shadow map is a single-sample texture of a fixed size: size: Fixed(1024, 1024)",
             )),
             Some((w, h, format)) => {
-                if slot != RSM_DEPTH && format != TextureFormat::Rgba32Float {
+                if slot == RSM_DEPTH {
+                    check_depth_format(p, ctx, name, errors);
+                } else if format != TextureFormat::Rgba32Float {
                     errors.push(ctx.mismatch(name, format!("slot '{slot}' takes an Rgba32Float texture")));
                 }
                 if p.tile == 0
@@ -148,6 +172,28 @@ pub(crate) fn check(p: &ReflectiveShadowMaps, ctx: &KindCtx, errors: &mut Vec<Gr
                 }
             }
         }
+    }
+}
+
+/// The depth's format is the raster's: a depth format to draw into, R32Float to store
+/// from compute.
+fn check_depth_format(
+    p: &ReflectiveShadowMaps,
+    ctx: &KindCtx,
+    depth: &str,
+    errors: &mut Vec<GraphError>,
+) {
+    let float = ctx.is_float_depth(depth);
+    match p.raster {
+        RsmRaster::Hardware if float => errors.push(ctx.mismatch(
+            depth,
+            "raster: Hardware draws the maps' depth as an attachment: declare it format: Depth32Float (R32Float is for raster: Compute)",
+        )),
+        RsmRaster::Compute if !float => errors.push(ctx.mismatch(
+            depth,
+            "raster: Compute stores the maps' depth from compute, which cannot write a depth format: declare it format: R32Float",
+        )),
+        _ => {}
     }
 }
 
@@ -195,6 +241,25 @@ mod tests {
             "hdr",
         );
         assert!(e.contains("fixed size"), "{e}");
+    }
+
+    #[test]
+    fn the_depth_format_follows_the_raster() {
+        // "rsm_depth" is Depth32Float, "rsm_depth_f" R32Float (test_support).
+        let e = errors(&PASSES.replace("RSM", "raster: Compute"), "hdr");
+        assert!(
+            e.contains("raster: Compute stores the maps' depth from compute")
+                && e.contains("R32Float")
+                && e.contains("rsm_depth"),
+            "{e}"
+        );
+        let float = PASSES.replace("\"rsm_depth\"", "\"rsm_depth=rsm_depth_f\"");
+        validate(&float.replace("RSM", "raster: Compute"), "hdr").unwrap();
+        let e = errors(&float.replace("RSM", ""), "hdr");
+        assert!(
+            e.contains("raster: Hardware draws the maps' depth") && e.contains("rsm_depth_f"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -8,7 +8,7 @@
 //! (`shadow::atlas_cache::keep_places`) and only the views the atlas does not hold yet
 //! are drawn.
 
-use super::shadow_atlas_raster::{pieces, ComputeAtlas, Work};
+use super::shadow_atlas_raster::{pieces, ComputeAtlas, RasterTarget, Work};
 use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::shadow_atlas::{
     atlas_side, view_table_bytes, AtlasRaster, ShadowAtlas, SHADOW_ATLAS, SHADOW_VIEWS, VIEW_VEC4S,
@@ -161,9 +161,12 @@ pub(super) fn prepare(
                 cx,
                 &sp.name,
                 &casters,
-                atlas.clone(),
-                side,
+                RasterTarget::Atlas {
+                    atlas: atlas.clone(),
+                    side,
+                },
                 &views,
+                VIEW_VEC4S,
                 p.depth_bias,
                 p.slope_bias,
             )?;

@@ -6,6 +6,11 @@
 //! triangle), `raster` (indirect, a workgroup per 32² cell of a large triangle) and
 //! `store` (the depth buffer into the R32Float atlas, and back to far) run in one
 //! compute pass.
+//!
+//! The reflective shadow maps' compute raster (`ReflectiveShadowMaps(raster: Compute)`)
+//! runs the same rasterizer over its own views ([`RasterTarget::Buffers`]): no store,
+//! and a second `setup` and `raster` (IDS) that keep each texel's nearest triangle by
+//! its visibility id (`tri_ids`: the merged triangles are in shadow chunk order).
 
 use super::{grid, pass_error, PrepareCtx, Timestamps};
 use crate::gpu::readback::read_buffer;
@@ -78,13 +83,40 @@ struct Bound {
     rects: wgpu::Buffer,
     pieces: wgpu::Buffer,
     setup: wgpu::BindGroup,
-    store: wgpu::BindGroup,
+    /// The IDS pass's setup (with [`RasterTarget::Buffers`]).
+    setup_ids: Option<wgpu::BindGroup>,
+    store: Option<wgpu::BindGroup>,
+}
+
+/// Where the rasterized depth goes.
+pub(super) enum RasterTarget {
+    /// `store` writes the drawn views' depth into this `side`² R32Float atlas.
+    Atlas { atlas: wgpu::TextureView, side: u32 },
+    /// The depth (and, from the IDS pass, one more than each texel's nearest triangle's
+    /// visibility id: the casters must be the opaque draws) stay in the buffers, `width`
+    /// texels a row, for the caller to read and put back to far and zero:
+    /// [`ComputeAtlas::depth`], [`ComputeAtlas::ids`].
+    Buffers { width: u32, height: u32 },
+}
+
+/// The IDS pass: its pipelines, its own counters and arguments (the two passes run in
+/// one compute pass, so neither clears the other's), and the ids.
+struct IdsPass {
+    setup: Arc<wgpu::ComputePipeline>,
+    raster: Arc<wgpu::ComputePipeline>,
+    raster_bind: wgpu::BindGroup,
+    counters: wgpu::Buffer,
+    args: wgpu::Buffer,
+    ids: wgpu::Buffer,
+    /// Per merged triangle, its visibility id.
+    tri_ids: wgpu::Buffer,
 }
 
 pub(super) struct ComputeAtlas {
     setup: Arc<wgpu::ComputePipeline>,
     raster: Arc<wgpu::ComputePipeline>,
-    store: Arc<wgpu::ComputePipeline>,
+    store: Option<Arc<wgpu::ComputePipeline>>,
+    ids_pass: Option<IdsPass>,
     raster_bind: wgpu::BindGroup,
     params: wgpu::Buffer,
     store_params: wgpu::Buffer,
@@ -96,8 +128,9 @@ pub(super) struct ComputeAtlas {
     counters: wgpu::Buffer,
     args: wgpu::Buffer,
     table: wgpu::Buffer,
-    atlas: wgpu::TextureView,
+    atlas: Option<wgpu::TextureView>,
     capacity: [u32; 2],
+    /// Texels a row of the depth buffer.
     side: u32,
     max_groups: u32,
     bound: Mutex<Option<Bound>>,
@@ -143,16 +176,17 @@ fn storage(
 }
 
 impl ComputeAtlas {
-    /// The rasterizer for `casters` (scene GPU mesh indices, in draw order) into `atlas`
-    /// (`side`² R32Float), reading view-projections from `table`.
+    /// The rasterizer for `casters` (scene GPU mesh indices, in draw order) into
+    /// `target`, reading view-projections from `table` (`view_vec4s` words a view, after
+    /// a header vec4).
     #[allow(clippy::too_many_arguments)]
     pub(super) fn prepare(
         cx: &mut PrepareCtx,
         pass: &str,
         casters: &[usize],
-        atlas: wgpu::TextureView,
-        side: u32,
+        target: RasterTarget,
         table: &wgpu::Buffer,
+        view_vec4s: u64,
         depth_bias: u32,
         slope_bias: f32,
     ) -> Result<Self, RenderError> {
@@ -160,6 +194,9 @@ impl ComputeAtlas {
         let mut positions: Vec<[f32; 4]> = Vec::new();
         let mut indices: Vec<u32> = Vec::new();
         let mut index_base = Vec::new();
+        // Per merged triangle, its visibility id (the IDS pass's).
+        let mut tri_ids: Vec<u32> = Vec::new();
+        let ids = matches!(target, RasterTarget::Buffers { .. });
         for &m in casters {
             let material = &gpu.materials[gpu.meshes[m].material];
             if matches!(material.alpha_mode, AlphaMode::Mask(_)) {
@@ -172,17 +209,26 @@ impl ComputeAtlas {
                 ));
             }
             let mesh = &cx.scene.meshes[gpu.meshes[m].scene_mesh];
-            // The triangles as the hardware path draws them (shadow chunk order), so a
-            // view's culled ranges index both the same way.
-            let (order, _) = crate::shadow::chunks::chunk_triangles(&mesh.positions, &mesh.indices);
             let base = positions.len() as u32;
             index_base.push(indices.len() as u32);
             positions.extend(mesh.positions.iter().map(|p| [p.x, p.y, p.z, 1.0]));
+            // The triangles as the hardware path draws them (shadow chunk order), so a
+            // view's culled ranges index both the same way.
+            let (order, _, sources) =
+                crate::shadow::chunks::chunk_triangles_with_sources(&mesh.positions, &mesh.indices);
             indices.extend(order.iter().map(|i| i + base));
+            if ids {
+                let first = gpu.meshes[m].first_triangle;
+                tri_ids.extend(sources.iter().map(|t| first + t));
+            }
         }
+        let (side, rows, atlas) = match target {
+            RasterTarget::Atlas { atlas, side } => (side, side, Some(atlas)),
+            RasterTarget::Buffers { width, height } => (width, height, None),
+        };
         let device = cx.device();
         let limit = device.limits().max_storage_buffer_binding_size;
-        let depth_bytes = side as u64 * side as u64 * 4;
+        let depth_bytes = side as u64 * rows as u64 * 4;
         for (what, bytes) in [
             ("the depth buffer", depth_bytes),
             ("the casters' vertices", 16 * positions.len() as u64),
@@ -209,7 +255,7 @@ impl ComputeAtlas {
         let positions = init("atlas caster positions", bytemuck::cast_slice(&positions));
         let indices = init("atlas caster indices", bytemuck::cast_slice(&indices));
         // The far depth everywhere: `store` puts it back after each drawn view.
-        let far = vec![1.0f32.to_bits(); (side as usize) * (side as usize)];
+        let far = vec![1.0f32.to_bits(); (side as usize) * (rows as usize)];
         let depth = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("atlas depth (atomic)"),
             contents: bytemuck::cast_slice(&far),
@@ -219,7 +265,7 @@ impl ComputeAtlas {
         // Large triangles: room for a record per 64 texels of the atlas and sixteen
         // cells per 32² of it (depth complexity 16 of large triangles); past that the
         // setup thread draws them itself (counted).
-        let texels = side as u64 * side as u64;
+        let texels = side as u64 * rows as u64;
         let records = (texels / 64).min(limit / RECORD_BYTES).min(MAX_RECORDS) as u32;
         let cells = (16 * texels / (CELL as u64 * CELL as u64))
             .min(limit / ENTRY_BYTES)
@@ -266,15 +312,20 @@ impl ComputeAtlas {
         let max_groups = device.limits().max_compute_workgroups_per_dimension;
         let pipeline = |cx: &mut PrepareCtx,
                         stage: &str,
-                        entry: &str|
+                        entry: &str,
+                        ids: bool|
          -> Result<Arc<wgpu::ComputePipeline>, RenderError> {
-            let d = [
+            let mut d = vec![
                 (stage.to_string(), "1".to_string()),
                 ("GROUP".into(), GROUP.to_string()),
                 ("STORE_CELL".into(), STORE_CELL.to_string()),
                 ("DEPTH_BIAS".into(), format!("{:?}", depth_bias as f32)),
+                ("VIEW_VEC4S".into(), format!("{view_vec4s}u")),
                 ("SLOPE_BIAS".into(), format!("{slope_bias:?}")),
             ];
+            if ids {
+                d.push(("IDS".into(), "1".into()));
+            }
             let key = PipelineKey {
                 shader: SHADER.into(),
                 defines: d.into_iter().collect(),
@@ -316,9 +367,60 @@ impl ComputeAtlas {
                 _ => Err(pass_error(pass, "expected a compute pipeline".into())),
             }
         };
-        let setup = pipeline(cx, "SETUP", "setup")?;
-        let raster = pipeline(cx, "RASTER", "raster")?;
-        let store = pipeline(cx, "STORE", "store")?;
+        let setup = pipeline(cx, "SETUP", "setup", false)?;
+        let raster = pipeline(cx, "RASTER", "raster", false)?;
+        let store = match atlas {
+            Some(_) => Some(pipeline(cx, "STORE", "store", false)?),
+            None => None,
+        };
+        let ids_pass = match atlas {
+            Some(_) => None,
+            None => {
+                let setup = pipeline(cx, "SETUP", "setup", true)?;
+                let raster = pipeline(cx, "RASTER", "raster", true)?;
+                let counters = storage(
+                    &device,
+                    "rsm raster id counters",
+                    4 * COUNTERS,
+                    wgpu::BufferUsages::COPY_SRC,
+                );
+                let args = storage(
+                    &device,
+                    "rsm raster id arguments",
+                    16,
+                    wgpu::BufferUsages::INDIRECT,
+                );
+                // Zero: no triangle (the reader puts it back to zero after reading).
+                let ids = storage(
+                    &device,
+                    "rsm raster nearest triangles",
+                    depth_bytes,
+                    wgpu::BufferUsages::empty(),
+                );
+                let raster_bind = bind(
+                    &device,
+                    &raster,
+                    &[
+                        (0, params.as_entire_binding()),
+                        (6, depth.as_entire_binding()),
+                        (7, records_buf.as_entire_binding()),
+                        (8, cells_buf.as_entire_binding()),
+                        (9, counters.as_entire_binding()),
+                        (12, ids.as_entire_binding()),
+                    ],
+                );
+                let tri_ids = init("rsm raster visibility ids", bytemuck::cast_slice(&tri_ids));
+                Some(IdsPass {
+                    tri_ids,
+                    setup,
+                    raster,
+                    raster_bind,
+                    counters,
+                    args,
+                    ids,
+                })
+            }
+        };
         let raster_bind = bind(
             &device,
             &raster,
@@ -334,6 +436,7 @@ impl ComputeAtlas {
             setup,
             raster,
             store,
+            ids_pass,
             raster_bind,
             params,
             store_params,
@@ -373,10 +476,11 @@ impl ComputeAtlas {
         let jobs = list("atlas raster jobs", jobs);
         let rects = list("atlas raster tiles", rects);
         let pieces = list("atlas store pieces", pieces);
-        let setup = bind(
-            &self.device,
-            &self.setup,
-            &[
+        let setup_bind = |pipeline: &wgpu::ComputePipeline,
+                          counters: &wgpu::Buffer,
+                          args: &wgpu::Buffer,
+                          ids: Option<&IdsPass>| {
+            let mut entries = vec![
                 (0, self.params.as_entire_binding()),
                 (1, self.table.as_entire_binding()),
                 (2, self.positions.as_entire_binding()),
@@ -386,25 +490,39 @@ impl ComputeAtlas {
                 (6, self.depth.as_entire_binding()),
                 (7, self.records.as_entire_binding()),
                 (8, self.cells.as_entire_binding()),
-                (9, self.counters.as_entire_binding()),
-                (10, self.args.as_entire_binding()),
-            ],
-        );
-        let store = bind(
-            &self.device,
-            &self.store,
-            &[
-                (0, self.store_params.as_entire_binding()),
-                (5, pieces.as_entire_binding()),
-                (6, self.depth.as_entire_binding()),
-                (11, wgpu::BindingResource::TextureView(&self.atlas)),
-            ],
-        );
+                (9, counters.as_entire_binding()),
+                (10, args.as_entire_binding()),
+            ];
+            if let Some(p) = ids {
+                entries.push((12, p.ids.as_entire_binding()));
+                entries.push((13, p.tri_ids.as_entire_binding()));
+            }
+            bind(&self.device, pipeline, &entries)
+        };
+        let setup = setup_bind(&self.setup, &self.counters, &self.args, None);
+        let setup_ids = self
+            .ids_pass
+            .as_ref()
+            .map(|p| setup_bind(&p.setup, &p.counters, &p.args, Some(p)));
+        let store = match (&self.store, &self.atlas) {
+            (Some(store), Some(atlas)) => Some(bind(
+                &self.device,
+                store,
+                &[
+                    (0, self.store_params.as_entire_binding()),
+                    (5, pieces.as_entire_binding()),
+                    (6, self.depth.as_entire_binding()),
+                    (11, wgpu::BindingResource::TextureView(atlas)),
+                ],
+            )),
+            _ => None,
+        };
         Bound {
             jobs,
             rects,
             pieces,
             setup,
+            setup_ids,
             store,
         }
     }
@@ -484,19 +602,37 @@ impl ComputeAtlas {
         label: &str,
         ts: Timestamps<'_>,
     ) {
-        let (pairs, pieces) = *self.pending.lock().unwrap_or_else(|e| e.into_inner());
-        if pairs > 0 {
-            encoder.clear_buffer(&self.counters, 0, None);
-            encoder.clear_buffer(&self.args, 0, None);
-        }
-        let guard = self.bound.lock().unwrap_or_else(|e| e.into_inner());
-        let Some(bound) = guard.as_ref() else {
-            return;
-        };
+        self.clear_lists(encoder);
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some(label),
             timestamp_writes: ts.compute(),
         });
+        self.record_into(&mut pass);
+    }
+
+    /// Resets the lists' counters and arguments (outside any pass) before
+    /// [`Self::record_into`].
+    pub(super) fn clear_lists(&self, encoder: &mut wgpu::CommandEncoder) {
+        let (pairs, _) = *self.pending.lock().unwrap_or_else(|e| e.into_inner());
+        if pairs == 0 {
+            return;
+        }
+        encoder.clear_buffer(&self.counters, 0, None);
+        encoder.clear_buffer(&self.args, 0, None);
+        if let Some(ids) = &self.ids_pass {
+            encoder.clear_buffer(&ids.counters, 0, None);
+            encoder.clear_buffer(&ids.args, 0, None);
+        }
+    }
+
+    /// The uploaded work's dispatches into `pass`: setup and raster (then again with
+    /// IDS), then the store.
+    pub(super) fn record_into(&self, pass: &mut wgpu::ComputePass<'_>) {
+        let (pairs, pieces) = *self.pending.lock().unwrap_or_else(|e| e.into_inner());
+        let guard = self.bound.lock().unwrap_or_else(|e| e.into_inner());
+        let Some(bound) = guard.as_ref() else {
+            return;
+        };
         if pairs > 0 {
             let [x, y, z] = grid(pairs, GROUP, self.max_groups);
             pass.set_pipeline(&self.setup);
@@ -505,13 +641,32 @@ impl ComputeAtlas {
             pass.set_pipeline(&self.raster);
             pass.set_bind_group(0, &self.raster_bind, &[]);
             pass.dispatch_workgroups_indirect(&self.args, 0);
+            if let (Some(ids), Some(setup_ids)) = (&self.ids_pass, &bound.setup_ids) {
+                pass.set_pipeline(&ids.setup);
+                pass.set_bind_group(0, setup_ids, &[]);
+                pass.dispatch_workgroups(x, y, z);
+                pass.set_pipeline(&ids.raster);
+                pass.set_bind_group(0, &ids.raster_bind, &[]);
+                pass.dispatch_workgroups_indirect(&ids.args, 0);
+            }
         }
-        if pieces > 0 {
+        if let (true, Some(store), Some(bind)) = (pieces > 0, &self.store, &bound.store) {
             let [x, y, z] = grid(pieces, 1, self.max_groups);
-            pass.set_pipeline(&self.store);
-            pass.set_bind_group(0, &bound.store, &[]);
+            pass.set_pipeline(store);
+            pass.set_bind_group(0, bind, &[]);
             pass.dispatch_workgroups(x, y, z);
         }
+    }
+
+    /// The depth buffer (`width` u32 depth bits a row; far where nothing was drawn).
+    pub(super) fn depth(&self) -> &wgpu::Buffer {
+        &self.depth
+    }
+
+    /// With [`RasterTarget::Buffers`]: each texel's nearest triangle's visibility id + 1
+    /// (0: none), as the depth buffer is laid out.
+    pub(super) fn ids(&self) -> Option<&wgpu::Buffer> {
+        self.ids_pass.as_ref().map(|p| &p.ids)
     }
 
     /// The lists' fill and serial fallbacks of the last frame that drew.
