@@ -326,8 +326,21 @@ pub fn prepare_file_with_gpu(
     capacity: u32,
 ) -> (PreparedFrame, SceneGpu) {
     let text = std::fs::read_to_string(graph_path(graph_file)).unwrap();
-    let checked = graph::check_text(Path::new(graph_file), &text, &ShaderLibrary::builtin())
-        .expect("valid graph");
+    prepare_text_with_gpu(r, graph_file, &text, scene, width, height, capacity)
+}
+
+/// [`prepare_file_with_gpu`] for a graph given as text (`name` for its errors).
+pub fn prepare_text_with_gpu(
+    r: &mut Renderer,
+    name: &str,
+    text: &str,
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    capacity: u32,
+) -> (PreparedFrame, SceneGpu) {
+    let checked =
+        graph::check_text(Path::new(name), text, &ShaderLibrary::builtin()).expect("valid graph");
     let gpu = SceneGpu::upload_with_light_capacity(&r.ctx.device, &r.ctx.queue, scene, capacity)
         .expect("materials");
     let size = FrameSize {
