@@ -316,24 +316,41 @@ fn the_vpls_and_the_image_equal_the_hardware_paths() {
     }
 }
 
+/// The compute raster draws no alpha masks: with a masked caster, `raster: Compute` has
+/// the raster units draw the maps (into an internal Depth32Float, copied into its
+/// R32Float depth), so they are the hardware pass's to the bit, depth included, and the
+/// frame is the hardware frame's.
 #[test]
-fn alpha_masked_materials_are_refused_naming_the_material() {
+fn alpha_masked_casters_fall_back_to_the_hardware_maps() {
     let mut r = renderer();
     let mut s = load("cornell_indirect.ron");
     s.materials[0].alpha_mode = AlphaMode::Mask(0.5);
-    let name = s.materials[0].name.clone();
     let text = graph_text("indirect_vpl.ron");
-    let e = prepare(&mut r, &with_raster(&text, "Compute"), &s, W, H)
-        .err()
-        .expect("refused");
-    assert!(
-        e.contains("'rsm'")
-            && e.contains(&format!("'{name}' is alpha-masked"))
-            && e.contains("raster: Hardware"),
-        "{e}"
+    let hw = prepare(&mut r, &with_raster(&text, "Hardware"), &s, W, H).unwrap();
+    let cs = prepare(&mut r, &with_raster(&text, "Compute"), &s, W, H).unwrap();
+    let (mh, mc) = (maps(&r, &hw), maps(&r, &cs));
+    assert_eq!(mh.depth.len(), mc.depth.len());
+    assert_eq!(mh.tiles, mc.tiles);
+    let texels = mh.texels();
+    assert!(!texels.is_empty());
+    // Some texels of the tiles are drawn (depth under the clear value 1.0).
+    assert!(texels.iter().filter(|&&t| mh.depth[t] < 1.0).count() > texels.len() / 2);
+    for &t in &texels {
+        assert_eq!(
+            mh.depth[t].to_bits(),
+            mc.depth[t].to_bits(),
+            "depth at texel {t}"
+        );
+        assert_eq!(mh.normal[t], mc.normal[t], "normal at texel {t}");
+        assert_eq!(mh.flux[t], mc.flux[t], "flux at texel {t}");
+        assert_eq!(mh.position[t], mc.position[t], "position at texel {t}");
+    }
+    let (ih, ic) = (
+        hw.prepared.render(&r).unwrap().image,
+        cs.prepared.render(&r).unwrap().image,
     );
-    // The hardware pass draws masks.
-    prepare(&mut r, &with_raster(&text, "Hardware"), &s, W, H).unwrap();
+    assert_eq!(ih.len(), (W * H) as usize);
+    assert_eq!(ih, ic, "the frames differ");
 }
 
 /// The Cornell box (which has no uvs) with a checker-textured quad on its floor: the

@@ -4,10 +4,12 @@
 //! layout depends only on the lights (not the camera): made at prepare, and again on the
 //! CPU for every light update, written into the same table (no pipeline or bind group
 //! changes). With `raster: Compute` the views are rasterized in compute instead
-//! (`reflective_shadow_maps_raster`).
+//! (`reflective_shadow_maps_raster`), unless a caster is alpha-masked (the compute raster
+//! draws no masks): then the raster units draw them into an internal Depth32Float, copied
+//! into the R32Float depth, and a warning names the material.
 
 use super::reflective_shadow_maps_raster::ComputeRsm;
-use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
+use super::{defines, pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::reflective_shadow_maps::{
     fixed_size, ReflectiveShadowMaps, RsmRaster, RSM_DEPTH, RSM_FLUX, RSM_NORMAL, RSM_POSITION,
     RSM_VIEWS,
@@ -15,11 +17,13 @@ use crate::graph::kinds::reflective_shadow_maps::{
 use crate::graph::Name;
 use crate::graph::ScheduledPass;
 use crate::indirect::rsm_views::{layout, layout_lights, view_table, RsmLayout};
+use crate::render::bind::Bound;
 use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws, MeshSet};
+use crate::render::pipelines::PipelineKey;
 use crate::render::{RenderError, Renderer};
-use crate::scene::{Light, VplControls};
+use crate::scene::{AlphaMode, Light, VplControls};
 use std::collections::BTreeMap;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 /// What laying out the views again for new lights needs.
 #[derive(Clone)]
@@ -62,11 +66,106 @@ enum Raster {
     Compute(Box<ComputeRsm>),
 }
 
-/// One render pass: the mesh draws, a viewport a view, over the depth attachment.
+/// One render pass: the mesh draws, a viewport a view, over the depth attachment; with
+/// an R32Float depth (`raster: Compute` meeting an alpha-masked caster) the attachment is
+/// an internal Depth32Float and a dispatch copies it.
 struct HardwareMaps {
     depth: wgpu::TextureView,
     targets: [wgpu::TextureView; 3],
     draws: MeshDraws,
+    copy: Option<DepthCopy>,
+}
+
+/// The dispatch copying the drawn Depth32Float into the R32Float depth.
+type DepthCopy = (Arc<wgpu::ComputePipeline>, wgpu::BindGroup, [u32; 3]);
+
+const COPY_SHADER: &str = "visibility/compute_raster_depth_copy.wgsl";
+
+/// The first opaque caster material that is alpha-masked, by name.
+fn masked_caster(cx: &PrepareCtx) -> Option<String> {
+    let gpu = cx.gpu;
+    gpu.opaque_draws().into_iter().find_map(|m| {
+        let material = &gpu.materials[gpu.meshes[m].material];
+        matches!(material.alpha_mode, AlphaMode::Mask(_)).then(|| material.name.clone())
+    })
+}
+
+/// The internal Depth32Float (w × h) the draws write, and the dispatch copying it into the
+/// pass's R32Float depth (bit-exact: a depth load gives the stored f32).
+fn depth_copy(
+    cx: &mut PrepareCtx,
+    sp: &ScheduledPass,
+    (w, h): (u32, u32),
+) -> Result<(wgpu::TextureView, DepthCopy), RenderError> {
+    let drawn = cx
+        .device()
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some("reflective shadow maps: drawn depth"),
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Depth32Float,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        })
+        .create_view(&Default::default());
+    let mut offered = cx.declared(sp)?;
+    offered.offer("drawn_depth", Bound::View(drawn.clone()));
+    offered.offer(
+        "depth",
+        Bound::View(cx.view(&sp.name, sp.required(RSM_DEPTH))?),
+    );
+    let key = PipelineKey {
+        shader: COPY_SHADER.into(),
+        defines: defines(&[]),
+        virtual_code: BTreeMap::new(),
+        state: "copy_depth".into(),
+    };
+    let (pipeline, bind) = cx.compute_pipeline(&sp.name, key, "copy_depth", &offered)?;
+    Ok((drawn, (pipeline, bind, [w.div_ceil(8), h.div_ceil(8), 1])))
+}
+
+/// The maps drawn by the raster units; `float_depth`: into an internal Depth32Float,
+/// copied into the R32Float `rsm_depth`.
+fn hardware_maps(
+    cx: &mut PrepareCtx,
+    sp: &ScheduledPass,
+    views: &wgpu::Buffer,
+    float_depth: Option<(u32, u32)>,
+) -> Result<HardwareMaps, RenderError> {
+    let mut offered = cx.declared(sp)?;
+    offered.buffer("rsm_views", views);
+    let draws = cx.renderer.mesh_draws(
+        cx.gpu,
+        DrawMode::Rsm,
+        MeshSet::Opaque,
+        1,
+        &sp.name,
+        &offered,
+    )?;
+    let (depth, copy) = match float_depth {
+        Some(size) => {
+            let (drawn, copy) = depth_copy(cx, sp, size)?;
+            (drawn, Some(copy))
+        }
+        None => (cx.view(&sp.name, sp.required(RSM_DEPTH))?, None),
+    };
+    let target = |slot: &str| cx.view(&sp.name, sp.required(slot));
+    Ok(HardwareMaps {
+        depth,
+        targets: [
+            target(RSM_NORMAL)?,
+            target(RSM_FLUX)?,
+            target(RSM_POSITION)?,
+        ],
+        draws,
+        copy,
+    })
 }
 
 /// The maps' size and the views laid out on them, as both RSM passes compute it.
@@ -133,30 +232,18 @@ pub(super) fn prepare(
         .ctx
         .queue
         .write_buffer(&staging, 0, bytemuck::cast_slice(&table));
-    let raster = match p.raster {
-        RsmRaster::Hardware => {
-            let mut offered = cx.declared(sp)?;
-            offered.buffer("rsm_views", &views);
-            let draws = cx.renderer.mesh_draws(
-                cx.gpu,
-                DrawMode::Rsm,
-                MeshSet::Opaque,
-                1,
-                &sp.name,
-                &offered,
-            )?;
-            let target = |slot: &str| cx.view(&sp.name, sp.required(slot));
-            Raster::Hardware(Box::new(HardwareMaps {
-                depth: target(RSM_DEPTH)?,
-                targets: [
-                    target(RSM_NORMAL)?,
-                    target(RSM_FLUX)?,
-                    target(RSM_POSITION)?,
-                ],
-                draws,
-            }))
+    let raster = match (p.raster, masked_caster(cx)) {
+        (RsmRaster::Hardware, _) => {
+            Raster::Hardware(Box::new(hardware_maps(cx, sp, &views, None)?))
         }
-        RsmRaster::Compute => {
+        (RsmRaster::Compute, Some(material)) => {
+            log::warn!(
+                "pass '{}': caster material '{material}' is alpha-masked, which the compute raster does not draw: the reflective shadow maps are drawn by the raster units",
+                sp.name
+            );
+            Raster::Hardware(Box::new(hardware_maps(cx, sp, &views, Some((w, h)))?))
+        }
+        (RsmRaster::Compute, None) => {
             let compute = ComputeRsm::prepare(cx, sp, p, (w, h), &views)?;
             compute.upload(&l);
             Raster::Compute(Box::new(compute))
@@ -200,6 +287,7 @@ impl PreparedPass for RsmPass {
             depth,
             targets,
             draws,
+            copy,
         } = match &self.raster {
             Raster::Hardware(maps) => &**maps,
             Raster::Compute(compute) => return compute.record(encoder, &self.name, ts),
@@ -221,5 +309,15 @@ impl PreparedPass for RsmPass {
         });
         let origins = self.origins.lock().unwrap_or_else(|e| e.into_inner());
         draws.record_tiles(&mut pass, &origins, self.tile);
+        drop(pass);
+        if let Some((pipeline, bind, groups)) = copy {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(&self.name),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, bind, &[]);
+            pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
+        }
     }
 }

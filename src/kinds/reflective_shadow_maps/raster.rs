@@ -81,7 +81,8 @@ impl ComputeRsm {
     ) -> Result<Self, RenderError> {
         let device = cx.device();
         let casters = cx.gpu.opaque_draws();
-        // Refuses alpha-masked materials (naming the first) and what does not bind.
+        // Alpha-masked casters never reach here (the pass draws them with the raster
+        // units); the atlas raster would refuse them, naming the first.
         let raster = ComputeAtlas::prepare(
             cx,
             &sp.name,
