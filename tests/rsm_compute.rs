@@ -319,7 +319,7 @@ fn the_vpls_and_the_image_equal_the_hardware_paths() {
 /// The compute raster draws no alpha masks: with a masked caster, `raster: Compute` has
 /// the raster units draw the maps (into an internal Depth32Float, copied into its
 /// R32Float depth), so they are the hardware pass's to the bit, depth included, and the
-/// frame is the hardware frame's.
+/// frame is the hardware frame's (to the order its VPLs are summed in).
 #[test]
 fn alpha_masked_casters_fall_back_to_the_hardware_maps() {
     let mut r = renderer();
@@ -345,12 +345,13 @@ fn alpha_masked_casters_fall_back_to_the_hardware_maps() {
         assert_eq!(mh.flux[t], mc.flux[t], "flux at texel {t}");
         assert_eq!(mh.position[t], mc.position[t], "position at texel {t}");
     }
-    let (ih, ic) = (
-        hw.prepared.render(&r).unwrap().image,
-        cs.prepared.render(&r).unwrap().image,
-    );
-    assert_eq!(ih.len(), (W * H) as usize);
-    assert_eq!(ih, ic, "the frames differ");
+    // The same maps spawn the same VPLs, but threads take their slots in any order, so
+    // the frame sums them in another order: equal to rounding (f32 sums of a few hundred
+    // VPLs, well under 1e-5 relative; 5e-5 as the hardware-path test allows).
+    assert_eq!(hw.result.image.len(), (W * H) as usize);
+    assert_eq!(cs.result.image.len(), hw.result.image.len());
+    let (image, px) = max_rel_diff(&hw.result.image, &cs.result.image);
+    assert!(image <= 5e-5, "image differs by {image:e} at pixel {px}");
 }
 
 /// The Cornell box (which has no uvs) with a checker-textured quad on its floor: the
