@@ -59,10 +59,6 @@ fn render_reading(
     Ok((result, bits))
 }
 
-fn graph_text(name: &str) -> String {
-    std::fs::read_to_string(graph_path(name)).unwrap()
-}
-
 /// The shipped compute-only graph, and the same with a Depth32Float depth.
 fn compute_raster_graphs() -> [(&'static str, String); 2] {
     let float = graph_text("visibility_compute_raster.ron");

@@ -13,7 +13,7 @@
 
 mod common;
 
-use common::{lambert, render_text_with, renderer};
+use common::{graph_text, lambert, render_text_with, renderer};
 use glam::{DMat4, DVec3, DVec4, Vec2, Vec3, Vec4};
 use lightgraph::render::{FrameResult, Renderer};
 use lightgraph::scene::geometry::MeshBuilder;
@@ -40,10 +40,6 @@ const ATLAS_GRAPHS: [&str; 3] = [
     "tiled_deferred_shadow_atlas.ron",
     "transparent_shadow_atlas.ron",
 ];
-
-fn graph_text(name: &str) -> String {
-    std::fs::read_to_string(common::graph_path(name)).unwrap()
-}
 
 fn render(r: &mut Renderer, graph: &str, scene: &Scene) -> Vec<[f32; 4]> {
     render_result(r, graph, scene).image

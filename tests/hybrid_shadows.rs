@@ -15,7 +15,7 @@
 mod common;
 
 use common::shadow_jobs::{compare_with_cpu_twin, pixel_jobs, Surfaces};
-use common::{lambert, max_rel_diff, prepare_text, renderer, shadow_room, Rng};
+use common::{graph_text, lambert, max_rel_diff, prepare_text, renderer, shadow_room, Rng};
 use glam::Vec3;
 use lightgraph::graph::{self, FrameSize};
 use lightgraph::render::{AtlasReport, FrameResult, PreparedFrame, Renderer, SceneGpu};
@@ -29,15 +29,6 @@ const W: u32 = 96;
 const H: u32 = 64;
 /// Shaders' SHADOW_NORMAL_OFFSET default (ShadowRayCast's normal_offset).
 const OFFSET: f32 = 1e-4;
-
-fn graph_text(name: &str) -> String {
-    std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("graphs")
-            .join(name),
-    )
-    .unwrap()
-}
 
 fn run(r: &mut Renderer, text: &str, scene: &Scene) -> (PreparedFrame, FrameResult) {
     let prepared = prepare_text(r, text, scene, W, H, false).expect("prepare");

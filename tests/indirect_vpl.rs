@@ -4,7 +4,7 @@
 mod common;
 use common::cornell::{floor_points, redness};
 
-use common::renderer;
+use common::{graph_text, renderer};
 use glam::{Vec3, Vec4};
 use lightgraph::graph::{self, FrameSize};
 use lightgraph::indirect::reference::{indirect_part, relative_mse, OneBounce};
@@ -15,10 +15,6 @@ use std::path::Path;
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn graph_text(name: &str) -> String {
-    std::fs::read_to_string(root().join("graphs").join(name)).unwrap()
 }
 
 /// The Cornell box with its indirect point light, every view split into n×n VPLs.

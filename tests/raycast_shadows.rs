@@ -12,7 +12,7 @@
 
 mod common;
 
-use common::{lambert, renderer, shadow_room, Rng};
+use common::{graph_text, lambert, renderer, shadow_room, Rng};
 use glam::{DVec3, Vec3};
 use lightgraph::graph::{self, FrameSize};
 use lightgraph::render::{FrameResult, PreparedFrame, Renderer, SceneGpu};
@@ -27,14 +27,6 @@ const W: u32 = 96;
 const H: u32 = 64;
 /// Shaders' SHADOW_NORMAL_OFFSET default (ShadowRayCast's normal_offset).
 const OFFSET: f32 = 1e-4;
-
-fn root() -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf()
-}
-
-fn graph_text(name: &str) -> String {
-    std::fs::read_to_string(root().join("graphs").join(name)).unwrap()
-}
 
 /// raycast_shadows.ron without its shading pass, the G-buffer as the output and the
 /// casting pass kept as a side effect: what the shadow passes leave can be read back

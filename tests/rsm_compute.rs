@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{max_rel_diff, renderer};
+use common::{graph_text, max_rel_diff, renderer};
 use lightgraph::graph::{self, FrameSize};
 use lightgraph::render::{FrameResult, PreparedFrame, Renderer, SceneGpu};
 use lightgraph::scene::{self, AlphaMode, Scene};
@@ -13,10 +13,6 @@ use std::path::Path;
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn graph_text(name: &str) -> String {
-    std::fs::read_to_string(root().join("graphs").join(name)).unwrap()
 }
 
 fn load(name: &str) -> Scene {

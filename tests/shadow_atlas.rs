@@ -10,7 +10,7 @@
 
 mod common;
 
-use common::{lambert, renderer};
+use common::{graph_text, lambert, renderer};
 use glam::{Vec2, Vec3};
 use lightgraph::render::{FrameResult, Renderer};
 use lightgraph::scene::geometry::MeshBuilder;
@@ -20,15 +20,6 @@ use std::path::Path;
 
 const W: u32 = 96;
 const H: u32 = 64;
-
-fn graph_text(name: &str) -> String {
-    std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("graphs")
-            .join(name),
-    )
-    .unwrap()
-}
 
 fn render(r: &mut Renderer, text: &str, scene: &Scene) -> FrameResult {
     common::render_text(r, text, scene, W, H)

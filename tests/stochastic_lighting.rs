@@ -10,24 +10,16 @@
 
 mod common;
 
-use common::{lambert, prepare_text, prepare_text_with_gpu, renderer, shadow_room, Rng};
+use common::{
+    graph_text, lambert, prepare_text, prepare_text_with_gpu, renderer, shadow_room, Rng,
+};
 use glam::Vec3;
 use lightgraph::render::Renderer;
 use lightgraph::scene::geometry::MeshBuilder;
 use lightgraph::scene::{light_flags, Camera, Light, LightShape, Scene, SurfaceMaterial};
-use std::path::Path;
 
 const W: u32 = 96;
 const H: u32 = 64;
-
-fn graph_text(name: &str) -> String {
-    std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("graphs")
-            .join(name),
-    )
-    .unwrap()
-}
 
 /// The stochastic graph with its sampling parameters replaced by `params`.
 fn stochastic_graph(params: &str) -> String {

@@ -17,7 +17,7 @@
 mod common;
 
 use common::shadow_jobs::{compare_with_cpu_twin, pixel_jobs, Surfaces};
-use common::{lambert, prepare_text, renderer, shadow_room, Rng};
+use common::{graph_text, lambert, prepare_text, renderer, shadow_room, Rng};
 use glam::{DVec3, Vec3};
 use lightgraph::render::{FrameResult, PreparedFrame, Renderer};
 use lightgraph::scene::geometry::MeshBuilder;
@@ -33,15 +33,6 @@ const W: u32 = 96;
 const H: u32 = 64;
 /// Shaders' SHADOW_NORMAL_OFFSET default (ShadowRayCast's normal_offset).
 const OFFSET: f32 = 1e-4;
-
-fn graph_text(name: &str) -> String {
-    std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("graphs")
-            .join(name),
-    )
-    .unwrap()
-}
 
 /// visibility_raycast_shadows.ron with its ids drawn by the hardware visibility buffer
 /// (VisibilityBuffer into a Depth32Float depth) instead of the compute rasterizer.

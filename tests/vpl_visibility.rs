@@ -7,14 +7,10 @@
 mod common;
 use common::cornell::{floor_points, redness};
 
-use common::{graph_path, render_text};
+use common::{graph_text, render_text};
 use glam::Vec3;
 use lightgraph::indirect::reference::{indirect_part, OneBounce};
 use lightgraph::scene::{self, light_flags, Camera, Light, LightShape, Scene, VplControls};
-
-fn graph_text(name: &str) -> String {
-    std::fs::read_to_string(graph_path(name)).unwrap()
-}
 
 /// `text` without its shading pass's `vpl_visibility` read: the same VPLs, lighting every
 /// pixel in range.

@@ -265,6 +265,11 @@ pub fn graph_path(name: &str) -> std::path::PathBuf {
         .join(name)
 }
 
+/// The text of graphs/`name`.
+pub fn graph_text(name: &str) -> String {
+    std::fs::read_to_string(graph_path(name)).unwrap_or_else(|e| panic!("graphs/{name}: {e}"))
+}
+
 /// Compiles graph text for the scene and renders one frame with light statistics.
 pub fn render_text(
     r: &mut Renderer,
