@@ -207,7 +207,8 @@ impl GpuLinkParams {
 
 /// One light as culling and shading read it: the one conversion from [`Light`], which
 /// every upload and update of the light buffers writes out. Spot directions are taken as
-/// they are: unit length, as `LightShape::Spot` says (normalised where lights come in).
+/// they are: unit length, as `LightShape::Spot` says (the buffers' writer normalises
+/// them, src/render/scene_gpu.rs).
 pub fn gpu_light(l: &Light) -> (GpuLightGeometry, GpuLightProperties) {
     let (direction, cos_outer, cos_inner) = match l.shape {
         LightShape::Point => (Vec3::ZERO, -1.0, -1.0),

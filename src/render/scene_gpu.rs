@@ -163,15 +163,9 @@ impl SceneGpu {
             queue.write_buffer_with(&self.light_geometry, 0, bytes),
             queue.write_buffer_with(&self.light_properties, 0, bytes),
         ) {
-            // The caller's lights are checked (above) and normalised once, here.
-            let unit = lights.iter().map(|l| {
-                let mut l = *l;
-                if let crate::scene::LightShape::Spot { direction, .. } = &mut l.shape {
-                    *direction = direction.normalize();
-                }
-                l
-            });
-            write_light_bytes(unit, g.slice(..), p.slice(..));
+            // The caller's lights are checked (above); write_light_bytes normalises them
+            // as it does at upload.
+            write_light_bytes(lights.iter().copied(), g.slice(..), p.slice(..));
         }
         Ok(())
     }
@@ -444,7 +438,9 @@ pub(super) fn light_storage(
 }
 
 /// The one place lights are written out as the bytes culling and shading read: each
-/// light's [`gpu_light`] (32 bytes into each array), in order from the start.
+/// light's [`gpu_light`] (32 bytes into each array), in order from the start, its spot
+/// direction normalised here, so an upload and an update of the same lights write the
+/// same bytes (normalising a unit vector again can move its last bit).
 fn write_light_bytes(
     lights: impl Iterator<Item = Light>,
     geometry: wgpu::WriteOnly<[u8]>,
@@ -452,7 +448,10 @@ fn write_light_bytes(
 ) {
     let (geometry, _) = geometry.into_chunks::<LIGHT_BYTES>();
     let (properties, _) = properties.into_chunks::<LIGHT_BYTES>();
-    for ((l, g), p) in lights.zip(geometry).zip(properties) {
+    for ((mut l, g), p) in lights.zip(geometry).zip(properties) {
+        if let crate::scene::LightShape::Spot { direction, .. } = &mut l.shape {
+            *direction = direction.normalize();
+        }
         let (lg, lp) = gpu_light(&l);
         g.write(bytemuck::cast(lg));
         p.write(bytemuck::cast(lp));
