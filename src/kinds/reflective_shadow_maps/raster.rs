@@ -17,7 +17,8 @@
 //! writes the depth, clears the texels nothing covers and puts the buffers back.
 //! All in one compute pass.
 
-use super::shadow_atlas_raster::{ComputeAtlas, RasterTarget, Work};
+use super::shadow_atlas_raster::{ComputeAtlas, RasterTarget};
+use super::shadow_atlas_raster_input::Work;
 use super::{defines, grid, pass_error, PrepareCtx, Timestamps};
 use crate::graph::kinds::reflective_shadow_maps::{ReflectiveShadowMaps, VIEW_VEC4S};
 use crate::graph::ScheduledPass;

@@ -8,7 +8,8 @@
 //! (`shadow::atlas_cache::keep_places`) and only the views the atlas does not hold yet
 //! are drawn.
 
-use super::shadow_atlas_raster::{pieces, ComputeAtlas, RasterTarget, Work};
+use super::shadow_atlas_raster::{ComputeAtlas, RasterTarget};
+use super::shadow_atlas_raster_input::{pieces, Work};
 use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::shadow_atlas::{
     atlas_side, view_table_bytes, AtlasRaster, ShadowAtlas, SHADOW_ATLAS, SHADOW_VIEWS, VIEW_VEC4S,

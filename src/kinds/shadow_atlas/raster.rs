@@ -5,19 +5,21 @@
 //! one view's consecutive triangles) and their tiles; `setup` (a thread per view and
 //! triangle), `raster` (indirect, a workgroup per 32² cell of a large triangle) and
 //! `store` (the depth buffer into the R32Float atlas, and back to far) run in one
-//! compute pass.
+//! compute pass. What the CPU hands it (the merged casters, the work lists, their
+//! capacities) is in raster_input.rs.
 //!
 //! The reflective shadow maps' compute raster (`ReflectiveShadowMaps(raster: Compute)`)
 //! runs the same rasterizer over its own views ([`RasterTarget::Buffers`]): no store,
 //! and a second `setup` and `raster` (IDS) that keep each texel's nearest triangle by
 //! its visibility id (`tri_ids`: the merged triangles are in shadow chunk order).
 
+use super::shadow_atlas_raster_input::{
+    list_capacity, merge_casters, MergedCasters, Work, ENTRY_BYTES, RECORD_BYTES, STORE_CELL,
+};
 use super::{grid, pass_error, PrepareCtx, Timestamps};
 use crate::gpu::readback::read_buffer;
 use crate::render::pipelines::{Pipeline, PipelineKey};
-use crate::render::scene_gpu::SceneGpu;
 use crate::render::{RenderError, Renderer};
-use crate::scene::AlphaMode;
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 use wgpu::util::DeviceExt;
@@ -25,58 +27,8 @@ use wgpu::util::DeviceExt;
 const SHADER: &str = "shadow/atlas_raster.wgsl";
 /// Threads per setup workgroup (a thread per view and triangle).
 const GROUP: u32 = 64;
-/// Texels per side of a store workgroup's piece.
-const STORE_CELL: u32 = 16;
-/// Texels per side of a cell entry (the shader's CELL).
-const CELL: u32 = 32;
-/// Bytes of a record and of a cell entry (as the shader's).
-const RECORD_BYTES: u64 = 64;
-const ENTRY_BYTES: u64 = 8;
-/// Most records (the record counter grows by one a fan triangle past it, at most six a
-/// pair).
-const MAX_RECORDS: u64 = 1 << 24;
 /// Counter words (the shader's RECORDS..SERIAL_CELLS).
 const COUNTERS: u64 = 4;
-/// Test hook: `records=N,cells=N` (either) caps the lists' capacities below what
-/// prepare sizes, so tests can fill them and watch the serial fallback. Read when the
-/// pass is prepared; a malformed value is an error naming it.
-pub const TEST_LIMITS_VAR: &str = "LIGHTGRAPH_ATLAS_RASTER_TEST_LIMITS";
-
-/// The test hook's caps on (records, cells).
-fn test_limits() -> Result<[Option<u32>; 2], String> {
-    let mut caps = [None, None];
-    let Ok(text) = std::env::var(TEST_LIMITS_VAR) else {
-        return Ok(caps);
-    };
-    for item in text.split(',').map(str::trim).filter(|i| !i.is_empty()) {
-        let bad = || {
-            format!("{TEST_LIMITS_VAR}: '{item}' is not records=COUNT or cells=COUNT (COUNT >= 1)")
-        };
-        let (name, value) = item.split_once('=').ok_or_else(bad)?;
-        let value: u32 = value.trim().parse().map_err(|_| bad())?;
-        let slot = match name.trim() {
-            "records" if value >= 1 => &mut caps[0],
-            "cells" if value >= 1 => &mut caps[1],
-            _ => return Err(bad()),
-        };
-        *slot = Some(value);
-    }
-    Ok(caps)
-}
-
-/// One frame's work, as the CPU listed it for the views to draw.
-#[derive(Default)]
-pub(super) struct Work {
-    /// (first pair, first triangle, triangles, view) per run of one view's triangles.
-    pub jobs: Vec<[u32; 4]>,
-    /// Per view of the table: its tile (x, y, side, 0).
-    pub rects: Vec<[u32; 4]>,
-    /// Pieces (x, y, side, 0) of the drawn views' tiles, at most STORE_CELL a side.
-    pub pieces: Vec<[u32; 4]>,
-    /// Pairs of a view and a triangle.
-    pub pairs: u32,
-}
-
 /// Grown buffers and the bind groups over them.
 struct Bound {
     jobs: wgpu::Buffer,
@@ -175,6 +127,24 @@ fn storage(
     })
 }
 
+/// A raster run's counters (read back for the report) and its indirect arguments.
+fn counters_and_args(device: &wgpu::Device, what: &str) -> [wgpu::Buffer; 2] {
+    [
+        storage(
+            device,
+            &format!("{what} counters"),
+            4 * COUNTERS,
+            wgpu::BufferUsages::COPY_SRC,
+        ),
+        storage(
+            device,
+            &format!("{what} arguments"),
+            16,
+            wgpu::BufferUsages::INDIRECT,
+        ),
+    ]
+}
+
 impl ComputeAtlas {
     /// The rasterizer for `casters` (scene GPU mesh indices, in draw order) into
     /// `target`, reading view-projections from `table` (`view_vec4s` words a view, after
@@ -190,38 +160,13 @@ impl ComputeAtlas {
         depth_bias: u32,
         slope_bias: f32,
     ) -> Result<Self, RenderError> {
-        let gpu: &SceneGpu = cx.gpu;
-        let mut positions: Vec<[f32; 4]> = Vec::new();
-        let mut indices: Vec<u32> = Vec::new();
-        let mut index_base = Vec::new();
-        // Per merged triangle, its visibility id (the IDS pass's).
-        let mut tri_ids: Vec<u32> = Vec::new();
         let ids = matches!(target, RasterTarget::Buffers { .. });
-        for &m in casters {
-            let material = &gpu.materials[gpu.meshes[m].material];
-            if matches!(material.alpha_mode, AlphaMode::Mask(_)) {
-                return Err(pass_error(
-                    pass,
-                    format!(
-                        "raster: Compute draws no alpha masks, and caster material '{}' is alpha-masked: use raster: Hardware for this scene",
-                        material.name
-                    ),
-                ));
-            }
-            let mesh = &cx.scene.meshes[gpu.meshes[m].scene_mesh];
-            let base = positions.len() as u32;
-            index_base.push(indices.len() as u32);
-            positions.extend(mesh.positions.iter().map(|p| [p.x, p.y, p.z, 1.0]));
-            // The triangles as the hardware path draws them (shadow chunk order), so a
-            // view's culled ranges index both the same way.
-            let (order, _, sources) =
-                crate::shadow::chunks::chunk_triangles_with_sources(&mesh.positions, &mesh.indices);
-            indices.extend(order.iter().map(|i| i + base));
-            if ids {
-                let first = gpu.meshes[m].first_triangle;
-                tri_ids.extend(sources.iter().map(|t| first + t));
-            }
-        }
+        let MergedCasters {
+            positions,
+            indices,
+            index_base,
+            tri_ids,
+        } = merge_casters(cx, pass, casters, ids)?;
         let (side, rows, atlas) = match target {
             RasterTarget::Atlas { atlas, side } => (side, side, Some(atlas)),
             RasterTarget::Buffers { width, height } => (width, height, None),
@@ -262,19 +207,8 @@ impl ComputeAtlas {
             usage: wgpu::BufferUsages::STORAGE,
         });
         drop(far);
-        // Large triangles: room for a record per 64 texels of the atlas and sixteen
-        // cells per 32² of it (depth complexity 16 of large triangles); past that the
-        // setup thread draws them itself (counted).
-        let texels = side as u64 * rows as u64;
-        let records = (texels / 64).min(limit / RECORD_BYTES).min(MAX_RECORDS) as u32;
-        let cells = (16 * texels / (CELL as u64 * CELL as u64))
-            .min(limit / ENTRY_BYTES)
-            .max(1) as u32;
-        let caps = test_limits().map_err(|m| pass_error(pass, m))?;
-        let capacity = [
-            caps[0].map_or(records, |n| n.min(records)).max(1),
-            caps[1].map_or(cells, |n| n.min(cells)).max(1),
-        ];
+        let capacity =
+            list_capacity(side as u64 * rows as u64, limit).map_err(|m| pass_error(pass, m))?;
         let records_buf = storage(
             &device,
             "atlas raster records",
@@ -287,18 +221,7 @@ impl ComputeAtlas {
             ENTRY_BYTES * capacity[1] as u64,
             wgpu::BufferUsages::empty(),
         );
-        let counters = storage(
-            &device,
-            "atlas raster counters",
-            4 * COUNTERS,
-            wgpu::BufferUsages::COPY_SRC,
-        );
-        let args = storage(
-            &device,
-            "atlas raster arguments",
-            16,
-            wgpu::BufferUsages::INDIRECT,
-        );
+        let [counters, args] = counters_and_args(&device, "atlas raster");
         let uniform = |label: &str| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -378,18 +301,7 @@ impl ComputeAtlas {
             None => {
                 let setup = pipeline(cx, "SETUP", "setup", true)?;
                 let raster = pipeline(cx, "RASTER", "raster", true)?;
-                let counters = storage(
-                    &device,
-                    "rsm raster id counters",
-                    4 * COUNTERS,
-                    wgpu::BufferUsages::COPY_SRC,
-                );
-                let args = storage(
-                    &device,
-                    "rsm raster id arguments",
-                    16,
-                    wgpu::BufferUsages::INDIRECT,
-                );
+                let [counters, args] = counters_and_args(&device, "rsm raster id");
                 // Zero: no triangle (the reader puts it back to zero after reading).
                 let ids = storage(
                     &device,
@@ -681,16 +593,6 @@ impl ComputeAtlas {
             serial_triangles: c[2],
             serial_cells: c[3],
         })
-    }
-}
-
-/// Pieces of at most STORE_CELL² texels covering the tile at (x, y) of side `tile`.
-pub(super) fn pieces(x: u32, y: u32, tile: u32, out: &mut Vec<[u32; 4]>) {
-    let step = tile.min(STORE_CELL);
-    for py in (0..tile).step_by(step as usize) {
-        for px in (0..tile).step_by(step as usize) {
-            out.push([x + px, y + py, step, 0]);
-        }
     }
 }
 
