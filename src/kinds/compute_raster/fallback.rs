@@ -39,7 +39,7 @@ pub(super) fn prepare(
 
 /// The dispatch copying the drawn Depth32Float into an R32Float depth: its pipeline,
 /// bindings and workgroup grid.
-type DepthCopy = (Arc<wgpu::ComputePipeline>, wgpu::BindGroup, [u32; 3]);
+pub(super) type DepthCopy = (Arc<wgpu::ComputePipeline>, wgpu::BindGroup, [u32; 3]);
 
 struct HardwareRaster {
     name: Name,
@@ -81,7 +81,9 @@ impl HardwareRaster {
         // A depth format is drawn into directly; an R32Float depth is drawn into an
         // internal Depth32Float, then copied.
         let (drawn, copy) = if cx.float_depth(depth) {
-            let (drawn, copy) = depth_copy(cx, sp)?;
+            let size = (cx.size.width, cx.size.height);
+            let target = cx.view(&sp.name, depth)?;
+            let (drawn, copy) = depth_copy(cx, sp, size, target)?;
             (drawn, Some(copy))
         } else {
             (cx.view(&sp.name, depth)?, None)
@@ -101,19 +103,22 @@ impl HardwareRaster {
     }
 }
 
-/// The internal Depth32Float the draws write for an R32Float depth, and the dispatch
-/// copying it into the pass's depth.
-fn depth_copy(
+/// The internal Depth32Float (`width` × `height`) that draws write for an R32Float
+/// `depth` of that size, and the dispatch copying it there (bit-exact: a depth load gives
+/// the stored f32). Also the reflective shadow maps' fallback for alpha-masked casters.
+pub(super) fn depth_copy(
     cx: &mut PrepareCtx,
     sp: &ScheduledPass,
+    (width, height): (u32, u32),
+    depth: wgpu::TextureView,
 ) -> Result<(wgpu::TextureView, DepthCopy), RenderError> {
     let device = cx.device();
     let drawn = device
         .create_texture(&wgpu::TextureDescriptor {
-            label: Some("compute raster fallback depth"),
+            label: Some("hardware fallback depth"),
             size: wgpu::Extent3d {
-                width: cx.size.width,
-                height: cx.size.height,
+                width,
+                height,
                 depth_or_array_layers: 1,
             },
             mip_level_count: 1,
@@ -126,6 +131,7 @@ fn depth_copy(
         .create_view(&Default::default());
     let mut offered = cx.declared(sp)?;
     offered.offer("drawn_depth", Bound::View(drawn.clone()));
+    offered.offer("depth", Bound::View(depth));
     let key = PipelineKey {
         shader: COPY_SHADER.into(),
         defines: defines(&[]),
@@ -133,11 +139,7 @@ fn depth_copy(
         state: "copy_depth".into(),
     };
     let (pipeline, bind) = cx.compute_pipeline(&sp.name, key, "copy_depth", &offered)?;
-    let groups = [
-        cx.size.width.div_ceil(TILE),
-        cx.size.height.div_ceil(TILE),
-        1,
-    ];
+    let groups = [width.div_ceil(TILE), height.div_ceil(TILE), 1];
     Ok((drawn, (pipeline, bind, groups)))
 }
 

@@ -8,8 +8,9 @@
 //! draws no masks): then the raster units draw them into an internal Depth32Float, copied
 //! into the R32Float depth, and a warning names the material.
 
+use super::compute_raster_fallback::{depth_copy, DepthCopy};
 use super::reflective_shadow_maps_raster::ComputeRsm;
-use super::{defines, pass_error, PrepareCtx, PreparedPass, Timestamps};
+use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::reflective_shadow_maps::{
     fixed_size, ReflectiveShadowMaps, RsmRaster, RSM_DEPTH, RSM_FLUX, RSM_NORMAL, RSM_POSITION,
     RSM_VIEWS,
@@ -17,13 +18,11 @@ use crate::graph::kinds::reflective_shadow_maps::{
 use crate::graph::Name;
 use crate::graph::ScheduledPass;
 use crate::indirect::rsm_views::{layout, layout_lights, view_table, RsmLayout};
-use crate::render::bind::Bound;
 use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws, MeshSet};
-use crate::render::pipelines::PipelineKey;
 use crate::render::{RenderError, Renderer};
 use crate::scene::{AlphaMode, Light, VplControls};
 use std::collections::BTreeMap;
-use std::sync::{Arc, Mutex};
+use std::sync::Mutex;
 
 /// What laying out the views again for new lights needs.
 #[derive(Clone)]
@@ -76,11 +75,6 @@ struct HardwareMaps {
     copy: Option<DepthCopy>,
 }
 
-/// The dispatch copying the drawn Depth32Float into the R32Float depth.
-type DepthCopy = (Arc<wgpu::ComputePipeline>, wgpu::BindGroup, [u32; 3]);
-
-const COPY_SHADER: &str = "visibility/compute_raster_depth_copy.wgsl";
-
 /// The first opaque caster material that is alpha-masked, by name.
 fn masked_caster(cx: &PrepareCtx) -> Option<String> {
     let gpu = cx.gpu;
@@ -88,46 +82,6 @@ fn masked_caster(cx: &PrepareCtx) -> Option<String> {
         let material = &gpu.materials[gpu.meshes[m].material];
         matches!(material.alpha_mode, AlphaMode::Mask(_)).then(|| material.name.clone())
     })
-}
-
-/// The internal Depth32Float (w × h) the draws write, and the dispatch copying it into the
-/// pass's R32Float depth (bit-exact: a depth load gives the stored f32).
-fn depth_copy(
-    cx: &mut PrepareCtx,
-    sp: &ScheduledPass,
-    (w, h): (u32, u32),
-) -> Result<(wgpu::TextureView, DepthCopy), RenderError> {
-    let drawn = cx
-        .device()
-        .create_texture(&wgpu::TextureDescriptor {
-            label: Some("reflective shadow maps: drawn depth"),
-            size: wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Depth32Float,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        })
-        .create_view(&Default::default());
-    let mut offered = cx.declared(sp)?;
-    offered.offer("drawn_depth", Bound::View(drawn.clone()));
-    offered.offer(
-        "depth",
-        Bound::View(cx.view(&sp.name, sp.required(RSM_DEPTH))?),
-    );
-    let key = PipelineKey {
-        shader: COPY_SHADER.into(),
-        defines: defines(&[]),
-        virtual_code: BTreeMap::new(),
-        state: "copy_depth".into(),
-    };
-    let (pipeline, bind) = cx.compute_pipeline(&sp.name, key, "copy_depth", &offered)?;
-    Ok((drawn, (pipeline, bind, [w.div_ceil(8), h.div_ceil(8), 1])))
 }
 
 /// The maps drawn by the raster units; `float_depth`: into an internal Depth32Float,
@@ -150,7 +104,8 @@ fn hardware_maps(
     )?;
     let (depth, copy) = match float_depth {
         Some(size) => {
-            let (drawn, copy) = depth_copy(cx, sp, size)?;
+            let target = cx.view(&sp.name, sp.required(RSM_DEPTH))?;
+            let (drawn, copy) = depth_copy(cx, sp, size, target)?;
             (drawn, Some(copy))
         }
         None => (cx.view(&sp.name, sp.required(RSM_DEPTH))?, None),
