@@ -154,6 +154,18 @@ const BOUND_LAMBERT: Bound = Bound {
     p999: 1.5e-4,
 };
 
+/// Against forward brute force on Khronos's MetalRoughSpheresNoTextures (98 materials
+/// shaded by one dispatch, 512 random lights), at 333x197 on lavapipe (2026-12-06): worst
+/// 4.98e-2, 99.9% of pixels within 1.57e-3, the same to three digits as with each
+/// material's constants written into its own code (measured with the code swapped): the
+/// rebuilt point's few-ulp offset (see BOUND_LAMBERT), magnified by the sharp highlights
+/// of the smoothest metal spheres and by lights close to their surfaces. About twice
+/// the worst.
+const BOUND_SPHERES: Bound = Bound {
+    worst: 0.1,
+    p999: 3e-3,
+};
+
 #[test]
 fn every_visibility_graph_matches_brute_force_on_the_culling_scenes() {
     let mut pillar = pillar_scene(500);
@@ -592,7 +604,7 @@ fn staged_and_range_first_loops_match_brute_force_on_harada() {
 }
 
 /// `graph_text` with its VisibilityShading pass's materials dispatched as `how`
-/// (`Classified` or `PerMaterial`).
+/// (`PerShader`, `Classified` or `PerMaterial`).
 fn with_materials(graph_text: &str, how: &str) -> String {
     assert!(
         graph_text.contains("VisibilityShading("),
@@ -604,17 +616,18 @@ fn with_materials(graph_text: &str, how: &str) -> String {
     )
 }
 
-/// Classification only chooses which workgroups run each material's shader: every pixel
-/// is shaded by the same code from the same inputs, so the classified frame equals the
-/// per-material dispatches to the bit. Checked with harada (two materials) through the
-/// hardware and compute visibility buffers with each light loop and both workgroup
-/// sides, the textured scene (textured, normal-mapped, alpha-masked, double-sided)
-/// through the hardware one with 16- and 8-pixel workgroups, and 98 materials (Khronos's
-/// MetalRoughSpheresNoTextures, 2,048 random lights) through the compute-first frame
-/// (each configuration builds 98 pipelines, slow on lavapipe); 333×197 leaves partial
-/// tiles at the right and bottom edges.
+/// Grouping and classification only choose which dispatch and which workgroups shade a
+/// pixel: every pixel is shaded by its material's code with its constants from the same
+/// inputs, so the shared-code groups (the default), their classified dispatches and one
+/// dispatch per material give the same image to the bit. Checked with harada (two
+/// materials) through the hardware and compute visibility buffers with each light loop
+/// and both workgroup sides, the textured scene (textured, normal-mapped, alpha-masked,
+/// double-sided) through the hardware one with 16- and 8-pixel workgroups, and 98
+/// materials (Khronos's MetalRoughSpheresNoTextures, 2,048 random lights, one group of
+/// shared code) through the compute-first frame (98 pipelines per material, slow on
+/// lavapipe); 333×197 leaves partial tiles at the right and bottom edges.
 #[test]
-fn classified_shading_equals_per_material_dispatches_to_the_bit() {
+fn grouped_and_classified_shading_equal_per_material_dispatches_to_the_bit() {
     let mut r = renderer();
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let spheres_path = root
@@ -644,15 +657,57 @@ fn classified_shading_equals_per_material_dispatches_to_the_bit() {
         for graph in graphs.iter() {
             for kind in loops.iter() {
                 let text = with_loop(&file(graph), kind);
+                let grouped = render_text(&mut r, &with_materials(&text, "PerShader"), s, W, H);
                 let classified = render_text(&mut r, &with_materials(&text, "Classified"), s, W, H);
                 let whole = render_text(&mut r, &with_materials(&text, "PerMaterial"), s, W, H);
+                let what = format!("{} {graph} {kind}", s.name);
                 let pair = (
                     ("classified", &classified.image[..]),
-                    ("per material", &whole.image[..]),
+                    ("grouped", &grouped.image[..]),
                 );
-                compare_bits(&format!("{} {graph} {kind}", s.name), pair, &mut failures);
+                compare_bits(&what, pair, &mut failures);
+                let pair = (
+                    ("per material", &whole.image[..]),
+                    ("grouped", &grouped.image[..]),
+                );
+                compare_bits(&what, pair, &mut failures);
             }
         }
     }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Materials that differ only in constants share one shading pipeline and dispatch: the
+/// spheres' 98 untextured metallic-roughness materials build one visibility-shading
+/// pipeline (a fresh renderer, so nothing comes from the cache), named for its first
+/// material and the 97 that share its code; each sphere still shades with its own
+/// constants, as forward brute force (its constants written into its own code) shades it.
+#[test]
+fn materials_that_differ_only_in_constants_share_one_dispatch() {
+    let mut r = lightgraph::render::Renderer::headless().expect("a wgpu adapter");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let path = root
+        .join("tests/assets/khronos/MetalRoughSpheresNoTextures/MetalRoughSpheresNoTextures.gltf");
+    let spheres = scene::load(&path).unwrap().scene;
+    let spheres = lightgraph::bench::sweep::with_light_count(&spheres, 64);
+    let text = std::fs::read_to_string(graph_path("visibility_compute_raster.ron")).unwrap();
+    let prepared = prepare_text(&mut r, &text, &spheres, 64, 48, false).expect("prepare");
+    // The spheres' 98 in one group; the scene's one other material (the default for
+    // primitives without one) in its own.
+    let shading: Vec<&String> = prepared
+        .stats()
+        .pipelines_built
+        .iter()
+        .filter(|l| l.starts_with("visibility/visibility_shading.wgsl"))
+        .collect();
+    assert_eq!(shading.len(), 2, "{shading:?}");
+    assert!(
+        shading.iter().any(|l| l.contains("MEMBERS_COUNT=98u")),
+        "{shading:?}"
+    );
+    drop(r);
+    let spheres = lightgraph::bench::sweep::with_light_count(&spheres, 512);
+    let graphs = [("visibility_compute_raster.ron".to_string(), text)];
+    let failures = check_graph_texts(&spheres, "brute_force.ron", BOUND_SPHERES, &graphs);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

@@ -1,22 +1,25 @@
-// Material classification for visibility shading: which materials each tile holds, so
-// each material's shading dispatch runs over its own tiles only. A tile is one shading
-// workgroup's SHADING_GROUP × SHADING_GROUP pixels.
+// Material classification for visibility shading: which shading groups (materials that
+// share their code, shaded by one dispatch) each tile holds, so each group's dispatch runs
+// over its own tiles only. A tile is one shading workgroup's SHADING_GROUP × SHADING_GROUP
+// pixels.
 //
-// `classify`, one workgroup per tile: every invocation finds its pixel's material slot
-// (the binary search below) and sets its bit; then each slot present appends the tile to
+// `classify`, one workgroup per tile: every invocation finds its pixel's group (the
+// binary search below) and sets its bit; then each group present appends the tile to
 // its list (`material_tiles[slot * TILES + n]`, n from `material_tile_counts[slot]`).
 // Pixels nothing covers are cleared to black here. `dispatch_args`, one invocation per
-// slot: turns each count into indirect dispatch arguments, folded into y past the
+// group: turns each count into indirect dispatch arguments, folded into y past the
 // 65,535 workgroups a dimension takes (the shading shader flattens them back).
-// Defines: SHADING_GROUP, SLOTS (materials shaded), TILES (tiles in the frame).
+// Defines: SHADING_GROUP, SLOTS (groups shaded), MEMBERS (materials shaded), TILES (tiles
+// in the frame).
 
 #include "common/types.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(5) var visibility: texture_2d<u32>;
 @group(0) @binding(9) var hdr: texture_storage_2d<rgba32float, write>;
-// Per slot, in ascending order: (its material's first triangle id, end).
-@group(0) @binding(10) var<storage, read> slot_triangles: array<vec2<u32>>;
+// Per material shaded, ascending by first triangle: (first triangle id, end, its group,
+// unused).
+@group(0) @binding(10) var<storage, read> slot_triangles: array<vec4<u32>>;
 @group(0) @binding(11) var<storage, read_write> material_tiles: array<u32>;
 @group(0) @binding(12) var<storage, read_write> material_tile_counts: array<atomic<u32>>;
 @group(0) @binding(13) var<storage, read_write> material_dispatch: array<u32>;
@@ -28,11 +31,11 @@ const MAX_GROUPS: u32 = 65535u;
 
 var<workgroup> present: array<atomic<u32>, MASK_WORDS>;
 
-// The slot whose triangles hold `tri`: the last slot starting at or before it, if it
-// ends after it (triangles of blended materials are in no slot's range).
+// The group whose triangles hold `tri`: that of the last material starting at or before
+// it, if it ends after it (triangles of blended materials are in no material's range).
 fn slot_of(tri: u32) -> u32 {
     var lo = 0u;
-    var hi = SLOTS;
+    var hi = MEMBERS;
     while (hi - lo > 1u) {
         let mid = (lo + hi) / 2u;
         if (slot_triangles[mid].x <= tri) {
@@ -42,7 +45,7 @@ fn slot_of(tri: u32) -> u32 {
         }
     }
     let r = slot_triangles[lo];
-    return select(NO_SLOT, lo, tri >= r.x && tri < r.y);
+    return select(NO_SLOT, r.z, tri >= r.x && tri < r.y);
 }
 
 @compute @workgroup_size(SHADING_GROUP, SHADING_GROUP, 1)

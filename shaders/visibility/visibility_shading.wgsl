@@ -1,15 +1,16 @@
-// Visibility-buffer shading in a compute shader: one dispatch per material, over the
-// whole frame or (CLASSIFIED) over the tiles visibility/classify_materials.wgsl listed
-// for it; each invocation whose pixel holds a triangle of this material (its id in
-// `material_triangles[MATERIAL_INDEX]`) fetches the triangle's three vertices, rebuilds
-// the surface at the pixel centre and shades it with the same material code and light
-// loop as forward shading. Ids: src/render/visibility_geometry.rs (NO_TRIANGLE where
-// nothing was drawn).
+// Visibility-buffer shading in a compute shader: one dispatch per group of materials that
+// share their code (src/render/materials.rs's shared_wgsl: the same code but for the
+// constants, which it reads from `material_constants`), over the whole frame or
+// (CLASSIFIED) over the tiles visibility/classify_materials.wgsl listed for the group;
+// each invocation whose pixel holds a triangle of one of the group's materials (found in
+// `shading_members`) fetches the triangle's three vertices, rebuilds the surface at the
+// pixel centre and shades it with the same material code and light loop as forward
+// shading. Ids: src/render/visibility_geometry.rs (NO_TRIANGLE where nothing was drawn).
 // Defines: SHADING_GROUP (the workgroup's side in pixels; 8 with STAGED_LIGHTS),
-// MATERIAL_INDEX, CLEARS (this dispatch stores black where nothing was drawn),
-// CLASSIFIED with MATERIAL_SLOT and TILES (this material's tiles are the workgroups:
-// `material_tiles[MATERIAL_SLOT * TILES + n]`, n from the workgroup id, folded into y
-// past 65,535),
+// MEMBERS_FIRST and MEMBERS_COUNT (the group's entries in `shading_members`), CLEARS
+// (this dispatch stores black where nothing was drawn), CLASSIFIED with MATERIAL_SLOT and
+// TILES (the group's tiles are the workgroups: `material_tiles[MATERIAL_SLOT * TILES + n]`,
+// n from the workgroup id, folded into y past 65,535),
 // LIGHT_LISTS (tile lists) or LINKED_LISTS (a light linked list), and the light loop:
 // STAGED_LIGHTS (the workgroup's one tile list staged in workgroup memory, in
 // visibility/staged_lights.wgsl), RANGE_FIRST (the per-pixel cursor with the range test
@@ -33,7 +34,9 @@
 @group(0) @binding(5) var visibility: texture_2d<u32>;
 @group(0) @binding(6) var<storage, read> vertices: array<f32>;
 @group(0) @binding(7) var<storage, read> triangles: array<u32>;
-@group(0) @binding(8) var<storage, read> material_triangles: array<vec2<u32>>;
+// Each group's materials, ascending by first triangle: (first triangle, end, first
+// constant in material_constants, unused).
+@group(0) @binding(8) var<storage, read> shading_members: array<vec4<u32>>;
 @group(0) @binding(9) var hdr: texture_storage_2d<rgba32float, write>;
 #if SHADOW_MASK
 @group(0) @binding(10) var<storage, read> shadow_mask: array<u32>;
@@ -70,15 +73,36 @@
 #include "common/shadows.wgsl"
 #endif
 
-// Material code generated with WgslOptions::sample_grad when it has textures: it samples
-// with material_uv_ddx / material_uv_ddy, set by surface_point before material_setup.
+// Material code generated with WgslOptions::constants_binding (its constants read from
+// material_constants at material_constant_base, set here per pixel) and, when it has
+// textures, sample_grad: it samples with material_uv_ddx / material_uv_ddy, set by
+// surface_point before material_setup.
 #include <material>
 #include "common/light_loop.wgsl"
 #include "visibility/staged_lights.wgsl"
 
 const NO_TRIANGLE: u32 = 0xffffffffu;
-// A workgroup past the end of its material's tile list.
+// A workgroup past the end of its group's tile list.
 const NO_TILE: u32 = 0xffffffffu;
+// A triangle of no material of this group.
+const NO_MEMBER: u32 = 0xffffffffu;
+
+// The entry of the group's material whose triangles hold `tri`, or NO_MEMBER (another
+// group's material, or NO_TRIANGLE): a binary search over the group's ranges.
+fn member_of(tri: u32) -> u32 {
+    var lo = MEMBERS_FIRST;
+    var hi = MEMBERS_FIRST + MEMBERS_COUNT;
+    while (hi - lo > 1u) {
+        let mid = (lo + hi) / 2u;
+        if (shading_members[mid].x <= tri) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let r = shading_members[lo];
+    return select(NO_MEMBER, lo, tri >= r.x && tri < r.y);
+}
 
 #if CLASSIFIED
 var<workgroup> listed_tile: u32;
@@ -125,11 +149,11 @@ fn rebuild(id: vec2<u32>, tri: u32) -> Surface {
 }
 
 #if STAGED_LIGHTS
-// Whether any pixel of the workgroup is this material's (zeroed at workgroup start).
+// Whether any pixel of the workgroup is this group's (zeroed at workgroup start).
 var<workgroup> group_shades: atomic<u32>;
 
 // Every invocation, its pixel in the frame or not, takes part in staging the lights: the
-// barriers need all of them. A workgroup none of whose pixels is this material's leaves
+// barriers need all of them. A workgroup none of whose pixels is this group's leaves
 // before loading anything.
 @compute @workgroup_size(8, 8, 1)
 fn main(
@@ -152,29 +176,32 @@ fn main(
         textureStore(hdr, id.xy, vec4<f32>(0.0));
     }
 #endif
-    let range = material_triangles[MATERIAL_INDEX];
-    let shades = tri != NO_TRIANGLE && tri >= range.x && tri < range.y;
+    let member = member_of(tri);
+    let shades = member != NO_MEMBER;
     if (shades) {
         atomicOr(&group_shades, 1u);
     }
     if (workgroupUniformLoad(&group_shades) == 0u) {
         return;
     }
-    // Every invocation rebuilds a surface (one of this material's triangles where its
-    // pixel has none of them) and the light loop skips those that do not shade: a
+    // Every invocation rebuilds a surface (the group's first triangle where its pixel
+    // has none of the group's) and the light loop skips those that do not shade: a
     // surface rebuilt in a branch and shaded after it came out one ulp off in a few
     // pixels on lavapipe (the compiler fuses the arithmetic differently). A warp with
-    // any pixel of this material pays for the rebuild anyway.
+    // any pixel of this group pays for the rebuild anyway.
+    let shown = shading_members[select(MEMBERS_FIRST, member, shades)];
+    let surface_tri = select(shown.x, tri, shades);
+    material_constant_base = shown.z;
 #if SHADOWS
     shadow_pixel = id.y * frame.size.x + id.x;
 #endif
 #if SHADOW_TRACE
-    shadow_ng = surface_geometry(id.xy, select(range.x, tri, shades)).ng;
+    shadow_ng = surface_geometry(id.xy, surface_tri).ng;
 #endif
 #if VPL_VISIBILITY
     vpl_pixel = id.xy;
 #endif
-    let s = rebuild(id.xy, select(range.x, tri, shades));
+    let s = rebuild(id.xy, surface_tri);
     let color = staged_lights(surface_unlit(s.p, s.m), shades, s.p, s.m, lane, group_list(tile));
     if (shades) {
         textureStore(hdr, id.xy, vec4<f32>(color, material_alpha(s.m)));
@@ -201,16 +228,17 @@ fn main(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group
         return;
     }
     let tri = textureLoad(visibility, id.xy, 0).x;
-    let range = material_triangles[MATERIAL_INDEX];
     if (tri == NO_TRIANGLE) {
 #if CLEARS
         textureStore(hdr, id.xy, vec4<f32>(0.0));
 #endif
         return;
     }
-    if (tri < range.x || tri >= range.y) {
+    let member = member_of(tri);
+    if (member == NO_MEMBER) {
         return;
     }
+    material_constant_base = shading_members[member].z;
 #if SHADOWS
     shadow_pixel = id.y * frame.size.x + id.x;
 #endif

@@ -241,18 +241,33 @@ impl Material {
     /// place of its `#include` (the renderer's composer resolves the include, from the
     /// root first).
     pub fn wgsl_with(&self, options: &WgslOptions) -> Result<String, MaterialError> {
-        let code = wgsl::generate(self, options);
+        Ok(self.wgsl_with_constants(options)?.0)
+    }
+    /// [`Self::wgsl_with`] and the constants the code reads from its buffer (empty
+    /// without `WgslOptions::constants_binding`).
+    pub fn wgsl_with_constants(
+        &self,
+        options: &WgslOptions,
+    ) -> Result<(String, Vec<f32>), MaterialError> {
+        let (code, constants) = wgsl::generate_with_constants(self, options);
         if options.include_library {
             let standalone = code.replacen(wgsl::LOBE_LIBRARY_INCLUDE, wgsl::LOBE_LIBRARY, 1);
             wgsl::validate(&standalone, self.name())?;
         } else {
             wgsl::validate(&code, self.name())?;
         }
-        Ok(code)
+        Ok((code, constants))
     }
     /// The material's code as the renderer composes it: the lobe library by `#include`.
     pub(crate) fn renderer_wgsl(&self, options: &WgslOptions) -> Result<String, MaterialError> {
-        self.wgsl_with(&WgslOptions {
+        Ok(self.renderer_wgsl_with_constants(options)?.0)
+    }
+    /// [`Self::renderer_wgsl`] and the constants its buffer holds.
+    pub(crate) fn renderer_wgsl_with_constants(
+        &self,
+        options: &WgslOptions,
+    ) -> Result<(String, Vec<f32>), MaterialError> {
+        self.wgsl_with_constants(&WgslOptions {
             include_library: true,
             ..options.clone()
         })

@@ -9,6 +9,38 @@ use crate::scene::{AlphaMode, Scene, SurfaceMaterial};
 use std::path::PathBuf;
 use wgpu::util::DeviceExt;
 
+/// Where `MaterialProgram::shared_wgsl` binds its constants (group 0): a binding every
+/// shader that includes shared material code leaves free.
+pub(crate) const CONSTANTS_BINDING: u32 = 20;
+
+/// The materials of `shaded` (indices into `materials`, ascending) in groups that one
+/// visibility-shading dispatch shades together, in the order of their first material,
+/// each ascending. With `share`, materials whose `shared_wgsl` is the same text (they
+/// differ only in constants) form one group; a textured material stays alone, as its
+/// textures are bound per dispatch. Without, every material is a group of its own.
+pub fn shared_code_groups(
+    materials: &[MaterialProgram],
+    shaded: &[usize],
+    share: bool,
+) -> Vec<Vec<usize>> {
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    let mut by_code: std::collections::HashMap<&str, usize> = Default::default();
+    for &i in shaded {
+        let m = &materials[i];
+        let shares = share && m.textures.is_none();
+        match by_code.get(m.shared_wgsl.as_str()) {
+            Some(&g) if shares => groups[g].push(i),
+            _ => {
+                if shares {
+                    by_code.insert(&m.shared_wgsl, groups.len());
+                }
+                groups.push(vec![i]);
+            }
+        }
+    }
+    groups
+}
+
 /// One scene material compiled for the GPU: its generated WGSL, its textures uploaded and
 /// bound, and what pipelines need to know about it.
 #[derive(Clone)]
@@ -20,6 +52,13 @@ pub struct MaterialProgram {
     /// The same for compute shaders (textures sampled with explicit derivatives, see
     /// `WgslOptions::sample_grad`); None when `wgsl` has no textures, so serves as is.
     pub compute_wgsl: Option<String>,
+    /// The compute code with its constants read from a buffer (`WgslOptions::
+    /// constants_binding` at [`CONSTANTS_BINDING`]): the same text for every material
+    /// that differs from this one only in its constants, so visibility shading shades
+    /// them in one dispatch.
+    pub shared_wgsl: String,
+    /// The constants `shared_wgsl` reads, in its order.
+    pub constants: Vec<f32>,
     /// How the material blends: opaque, alpha-masked or blended.
     pub alpha_mode: AlphaMode,
     /// Whether back faces are drawn (and lit) too.
@@ -57,6 +96,12 @@ impl MaterialProgram {
                 ..Default::default()
             })?)
         };
+        let (shared_wgsl, constants) =
+            material.renderer_wgsl_with_constants(&crate::material::WgslOptions {
+                sample_grad: !slots.is_empty(),
+                constants_binding: Some(CONSTANTS_BINDING),
+                ..Default::default()
+            })?;
         // Offered by the names the generated WGSL declares (`material_sampler`,
         // `material_tex{i}`); the layout comes from reflecting the composed shader.
         let mut texture_bytes = 0u64;
@@ -141,6 +186,8 @@ impl MaterialProgram {
             name: material.name().to_string(),
             wgsl,
             compute_wgsl,
+            shared_wgsl,
+            constants,
             alpha_mode,
             double_sided,
             textures,

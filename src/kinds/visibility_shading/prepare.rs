@@ -61,8 +61,9 @@ pub(super) fn prepare(
     let side = p.workgroup_side();
     let light_loop = choose_light_loop(p.light_loop, layout, side);
     let ranges = cx.merged(&sp.name)?.material_ranges.clone();
-    // Only materials that own triangles get a dispatch (blended ones never do); the first
-    // also clears pixels nothing covers, so one runs even for a scene without triangles.
+    // Only materials that own triangles are shaded (blended ones never do); the first
+    // dispatch also clears pixels nothing covers, so one runs even for a scene without
+    // triangles.
     let mut shaded: Vec<usize> = (0..cx.gpu.materials.len())
         .filter(|&i| ranges.get(i).is_some_and(|r| r[0] < r[1]))
         .collect();
@@ -74,13 +75,18 @@ pub(super) fn prepare(
         cx.size.height.div_ceil(side),
         1,
     ];
-    let classified = p.materials == MaterialDispatch::Classified && shaded.len() > 1;
+    let share = p.materials != MaterialDispatch::PerMaterial;
+    let shader_groups =
+        crate::render::materials::shared_code_groups(&cx.gpu.materials, &shaded, share);
+    let members = Members::new(&cx.gpu.materials, &shader_groups, &ranges);
+    offer_members(cx, &members, &mut offered);
+    let classified = p.materials == MaterialDispatch::Classified && shader_groups.len() > 1;
     let tiles = groups[0] * groups[1];
     let classification = if classified {
         Some(classification(
             cx,
             sp,
-            &shaded,
+            &shader_groups,
             &ranges,
             side,
             tiles,
@@ -90,9 +96,12 @@ pub(super) fn prepare(
         None
     };
     let mut dispatches = Vec::new();
-    for (slot, &index) in shaded.iter().enumerate() {
-        let m = &cx.gpu.materials[index];
-        let mut d = vec![("MATERIAL_INDEX", index.to_string())];
+    for (slot, group) in shader_groups.iter().enumerate() {
+        let m = &cx.gpu.materials[group[0]];
+        let mut d = vec![
+            ("MEMBERS_FIRST", format!("{}u", members.first[slot])),
+            ("MEMBERS_COUNT", format!("{}u", group.len())),
+        ];
         if classified {
             d.push(("CLASSIFIED", "1".into()));
             d.push(("MATERIAL_SLOT", format!("{slot}u")));
@@ -116,13 +125,18 @@ pub(super) fn prepare(
         let key = PipelineKey {
             shader: "visibility/visibility_shading.wgsl".into(),
             defines: defines(&d),
-            virtual_code: BTreeMap::from([(
-                "material".to_string(),
-                m.wgsl_for_compute().to_string(),
-            )]),
+            virtual_code: BTreeMap::from([("material".to_string(), m.shared_wgsl.clone())]),
             state: String::new(),
         };
-        let label = format!("{} (material '{}')", sp.name, m.name);
+        let label = match group.len() {
+            1 => format!("{} (material '{}')", sp.name, m.name),
+            n => format!(
+                "{} (material '{}' and {} sharing its code)",
+                sp.name,
+                m.name,
+                n - 1
+            ),
+        };
         let textures = m.textures.clone();
         let (pipeline, bind, textures) =
             cx.compute_pipeline_with_material(&label, key, "main", &offered, textures.as_ref())?;
@@ -138,6 +152,67 @@ pub(super) fn prepare(
         classification,
         groups,
     })
+}
+
+/// The shading groups' materials as the shader finds them: per material
+/// (group by group) its triangle range and first constant, and the constants.
+struct Members {
+    /// (first triangle, end, first constant, 0) per material, group by group.
+    table: Vec<[u32; 4]>,
+    /// Each group's first entry in `table`.
+    first: Vec<u32>,
+    /// Every shaded material's constants, one after another.
+    constants: Vec<f32>,
+}
+
+impl Members {
+    fn new(
+        materials: &[crate::render::materials::MaterialProgram],
+        groups: &[Vec<usize>],
+        ranges: &[[u32; 2]],
+    ) -> Self {
+        let mut out = Members {
+            table: Vec::new(),
+            first: Vec::new(),
+            constants: Vec::new(),
+        };
+        for group in groups {
+            out.first.push(out.table.len() as u32);
+            for &i in group {
+                let [first, end] = ranges.get(i).copied().unwrap_or([0, 0]);
+                out.table.push([first, end, out.constants.len() as u32, 0]);
+                out.constants.extend_from_slice(&materials[i].constants);
+            }
+        }
+        // A binding is never empty.
+        if out.constants.is_empty() {
+            out.constants.push(0.0);
+        }
+        out
+    }
+}
+
+/// Offers the members' table and constants to the shading dispatches.
+fn offer_members(
+    cx: &PrepareCtx,
+    members: &Members,
+    offered: &mut crate::render::bind::BindingSet,
+) {
+    let device = cx.device();
+    let table = storage_buffer(
+        &device,
+        "shading members",
+        bytemuck::cast_slice(&members.table),
+        wgpu::BufferUsages::empty(),
+    );
+    let constants = storage_buffer(
+        &device,
+        "material constants",
+        bytemuck::cast_slice(&members.constants),
+        wgpu::BufferUsages::empty(),
+    );
+    offered.buffer("shading_members", &table);
+    offered.buffer("material_constants", &constants);
 }
 
 /// The light loop's defines for a read `light_samples` buffer (common/light_samples.wgsl):
@@ -172,21 +247,29 @@ fn sample_defines(cx: &PrepareCtx, sp: &ScheduledPass) -> Vec<(&'static str, Str
     }
 }
 
-/// The classification of `shaded` materials (slot k: `shaded[k]`) over `tiles` tiles of
+/// The classification of the shading groups (slot k: `groups[k]`) over `tiles` tiles of
 /// `side` pixels; offers its buffers to the shading dispatches in `offered`.
 fn classification(
     cx: &mut PrepareCtx,
     sp: &ScheduledPass,
-    shaded: &[usize],
+    groups: &[Vec<usize>],
     ranges: &[[u32; 2]],
     side: u32,
     tiles: u32,
     offered: &mut crate::render::bind::BindingSet,
 ) -> Result<Classification, RenderError> {
     let device = cx.device();
-    let slots = shaded.len() as u32;
-    // Ascending by first triangle: draws are sorted by material, so shaded[] is too.
-    let slot_triangles: Vec<u32> = shaded.iter().flat_map(|&m| ranges[m]).collect();
+    let slots = groups.len() as u32;
+    // Every shaded material with its group, ascending by first triangle: draws are sorted
+    // by material, so material indices are too.
+    let mut slot_triangles: Vec<[u32; 4]> = groups
+        .iter()
+        .enumerate()
+        .flat_map(|(g, group)| group.iter().map(move |&m| (m, g as u32)))
+        .map(|(m, g)| [ranges[m][0], ranges[m][1], g, 0])
+        .collect();
+    slot_triangles.sort_unstable();
+    let members = slot_triangles.len() as u32;
     let storage = wgpu::BufferUsages::STORAGE;
     // Checked against the device's limits, naming the pass: the tile lists grow with the
     // materials times the tiles.
@@ -230,6 +313,7 @@ fn classification(
     let d = [
         ("SHADING_GROUP", format!("{side}u")),
         ("SLOTS", format!("{slots}u")),
+        ("MEMBERS", format!("{members}u")),
         ("TILES", format!("{tiles}u")),
     ];
     let key = |entry: &str| PipelineKey {

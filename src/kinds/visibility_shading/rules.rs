@@ -1,9 +1,10 @@
 //! `VisibilityShading`: every material shaded in a compute shader from a visibility
-//! buffer, one dispatch per material: each pixel whose triangle id lies in the material's
-//! range fetches the triangle, rebuilds its attributes at the pixel centre and runs the
-//! light loop. With `materials: Classified` and more than one material the frame is first
-//! classified: each workgroup-sized tile is listed under every material it holds, and each
-//! material's dispatch runs over its own tiles only. With `shadow_mask` in its reads the
+//! buffer, one dispatch per group of materials that share their code (they differ only in
+//! constants, read from a buffer): each pixel whose triangle id lies in one of the group's
+//! materials' ranges fetches the triangle, rebuilds its attributes at the pixel centre and
+//! runs the light loop. With `materials: Classified` and more than one group the frame is
+//! first classified: each workgroup-sized tile is listed under every group it holds, and
+//! each group's dispatch runs over its own tiles only. With `shadow_mask` in its reads the
 //! light loop shadows each caster from a ray-cast mask (`ShadowRayJobs`,
 //! `ShadowRayCast`), numbered as forward and deferred shading number them; with
 //! `shadow_atlas` and `shadow_views` it samples a `ShadowAtlas` pass's maps as they do. Runs
@@ -21,7 +22,7 @@ use crate::graph::error::GraphError;
 use crate::graph::model::{LightSource, PassKind, SceneResource};
 use serde::{Deserialize, Serialize};
 
-/// `VisibilityShading(lights: Culled, light_loop: RangeFirst, workgroup: 16, materials: PerMaterial)`.
+/// `VisibilityShading(lights: Culled, light_loop: RangeFirst, workgroup: 16, materials: PerShader)`.
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
 #[serde(deny_unknown_fields)]
 pub struct VisibilityShading {
@@ -42,23 +43,30 @@ pub struct VisibilityShading {
         skip_serializing_if = "Option::is_none"
     )]
     pub workgroup: Option<u32>,
-    /// Which tiles each material's dispatch covers (`PerMaterial` by default).
+    /// Which materials each dispatch shades and over which tiles (`PerShader` by
+    /// default).
     #[serde(default)]
     pub materials: MaterialDispatch,
 }
 
-/// Which tiles each material's dispatch covers.
+/// Which materials each dispatch shades and over which tiles.
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
 pub enum MaterialDispatch {
-    /// The default: every material's dispatch covers the whole frame (its invocations
-    /// skip pixels of other materials). On an H100 this was faster than `Classified` on
-    /// every scene measured, from 2 to 98 materials (docs/visibility_buffer.md).
+    /// The default: materials whose generated code is the same but for its constants (a
+    /// glTF scene's untextured metallic-roughness materials, say) share one dispatch over
+    /// the whole frame, each pixel reading its material's constants from a buffer; a
+    /// textured material has a dispatch of its own (its textures are bound per dispatch).
+    /// Each dispatch's invocations skip pixels of other groups.
     #[default]
+    PerShader,
+    /// One dispatch per material over the whole frame: the cost `PerShader` removes, kept
+    /// to measure it. The same image to the bit.
     PerMaterial,
-    /// A classification dispatch lists each tile (a workgroup's pixels) under every
-    /// material it holds, then each material runs an indirect dispatch over its tiles
-    /// only, so a material that covers no pixel costs no workgroups; the image is the same
-    /// to the bit. With one shaded material the frame is one dispatch either way.
+    /// `PerShader`'s groups, each over its own tiles: a classification dispatch lists each
+    /// tile (a workgroup's pixels) under every group it holds, then each group runs an
+    /// indirect dispatch over its tiles only, so a group that covers no pixel costs no
+    /// workgroups; the image is the same to the bit. With one group the frame is one
+    /// dispatch either way.
     Classified,
 }
 
