@@ -326,3 +326,53 @@ fn materials_plug_into_the_forward_shader() {
         }
     }
 }
+
+/// With constants from a buffer, two materials that differ only in their constants
+/// generate the same code (what lets visibility shading shade them in one dispatch), each
+/// with its own values in the code's order, and the code is valid WGSL (naga validates
+/// it); `material_eval`'s constants are loaded once by `material_setup`, so the light loop
+/// does not read the buffer. A different structure (a second lobe) gives other code.
+#[test]
+fn materials_that_differ_only_in_constants_share_their_code() {
+    let text = std::fs::read_to_string(root().join("materials/gltf_pbr.ron")).unwrap();
+    let other = text
+        .replace("roughness: 0.5", "roughness: 0.25")
+        .replace("(0.8, 0.8, 0.8)", "(0.1, 0.2, 0.3)");
+    assert_ne!(text, other);
+    let opts = lightgraph::material::WgslOptions {
+        constants_binding: Some(20),
+        ..Default::default()
+    };
+    let a = Material::parse(&text, "a.ron").unwrap();
+    let b = Material::parse(&other, "b.ron").unwrap();
+    let (code_a, consts_a) = a.wgsl_with_constants(&opts).unwrap();
+    let (code_b, consts_b) = b.wgsl_with_constants(&opts).unwrap();
+    assert_eq!(code_a, code_b);
+    assert_eq!(consts_a.len(), consts_b.len());
+    assert!(
+        consts_a.contains(&0.5) && !consts_a.contains(&0.25),
+        "{consts_a:?}"
+    );
+    assert!(
+        consts_b.contains(&0.25) && !consts_b.contains(&0.5),
+        "{consts_b:?}"
+    );
+    assert!(consts_b.contains(&0.3) && !consts_a.contains(&0.3));
+    let own = &code_a[code_a.find("// ---- material ----").unwrap()..];
+    assert!(
+        !own.contains("0.5"),
+        "a constant written into shared code: {own}"
+    );
+    // The eval's constants: registers loaded in material_setup, not buffer reads.
+    let eval = &code_a[code_a.find("fn material_eval(").unwrap()..];
+    assert!(!eval.contains("material_constants["), "{eval}");
+    assert!(eval.contains("material_k"), "{eval}");
+    // Literal code is unchanged: the material's own constants written in.
+    assert!(a.wgsl().unwrap().contains("0.5"));
+    let two_lobes = text.replace(
+        "Lambert(color: Mix(a: (0.8, 0.8, 0.8), b: (0.0, 0.0, 0.0), t: 0.0)),",
+        "Lambert(color: Mix(a: (0.8, 0.8, 0.8), b: (0.0, 0.0, 0.0), t: 0.0)), Lambert(color: (0.1, 0.1, 0.1)),",
+    );
+    let c = Material::parse(&two_lobes, "c.ron").unwrap();
+    assert_ne!(c.wgsl_with_constants(&opts).unwrap().0, code_a);
+}

@@ -49,6 +49,10 @@ pub struct WgslOptions {
     pub constants_binding: Option<u32>,
 }
 
+/// Where `material_setup` loads `material_eval`'s constants (replaced once the code is
+/// generated; nothing without constants from a buffer).
+const EVAL_LOADS: &str = "{EVAL_LOADS}";
+
 fn lit(x: f32) -> String {
     let s = format!("{x:?}");
     if s.contains('.') || s.contains('e') || s.contains("inf") || s.contains("NaN") {
@@ -63,6 +67,10 @@ struct Gen<'a> {
     /// The constants read from the buffer so far (`WgslOptions::constants_binding`);
     /// None writes them into the code.
     constants: Option<std::cell::RefCell<Vec<f32>>>,
+    /// The constants `material_eval` and `material_diffuse` read: copied into private
+    /// variables by `material_setup`, so the light loop, which calls `material_eval` once
+    /// a light, reads registers instead of the buffer.
+    eval_constants: std::cell::RefCell<Vec<usize>>,
 }
 
 impl Gen<'_> {
@@ -77,6 +85,20 @@ impl Gen<'_> {
                     "material_constants[material_constant_base + {}u]",
                     c.len() - 1
                 )
+            }
+        }
+    }
+    /// A constant of `material_eval` or `material_diffuse`: a literal, or a private
+    /// variable `material_setup` loads (see `eval_constants`).
+    fn eval_num(&self, x: f32) -> String {
+        match &self.constants {
+            None => lit(x),
+            Some(c) => {
+                let mut c = c.borrow_mut();
+                c.push(x);
+                let k = c.len() - 1;
+                self.eval_constants.borrow_mut().push(k);
+                format!("material_k{k}")
             }
         }
     }
@@ -153,6 +175,7 @@ pub(crate) fn generate_with_constants(m: &Material, opts: &WgslOptions) -> (Stri
             .map(|(i, s)| (s.name.as_str(), i))
             .collect(),
         constants: opts.constants_binding.map(|_| Default::default()),
+        eval_constants: Default::default(),
     };
     let mut o = String::new();
     match opts.constants_binding {
@@ -244,7 +267,7 @@ pub(crate) fn generate_with_constants(m: &Material, opts: &WgslOptions) -> (Stri
 
     // material_setup
     o.push_str(
-        "fn material_setup(p: ShadingPoint) -> MaterialSample {\n    var m: MaterialSample;\n",
+        "fn material_setup(p: ShadingPoint) -> MaterialSample {\n    var m: MaterialSample;\n{EVAL_LOADS}",
     );
     for (i, slot) in slots.iter().enumerate() {
         let smp = super::sampler_wgsl_name(sampler_of[i]);
@@ -396,7 +419,7 @@ pub(crate) fn generate_with_constants(m: &Material, opts: &WgslOptions) -> (Stri
         }
         let _ = writeln!(o, "    var s{i} = vec3<f32>(0.0);");
         for (j, lobe) in layer.lobes.iter().enumerate() {
-            let w = g.num(lobe.weight());
+            let w = g.eval_num(lobe.weight());
             let f = match lobe {
                 Lobe::Lambert { .. } => format!("lg_lambert(m.c{i}_{j})"),
                 Lobe::OrenNayar { .. } => format!("lg_oren_nayar(m.c{i}_{j}, m.r{i}_{j}, d)"),
@@ -417,12 +440,12 @@ pub(crate) fn generate_with_constants(m: &Material, opts: &WgslOptions) -> (Stri
             let _ = writeln!(
                 o,
                 "    acc = s{i} + lg_through({}, {}, {}, vec3<f32>({}, {}, {}), {}u, d) * acc;",
-                g.num(layer.ior.unwrap_or(1.0)),
-                g.num(layer.weight),
-                g.num(layer.transmission),
-                g.num(a.0 * th),
-                g.num(a.1 * th),
-                g.num(a.2 * th),
+                g.eval_num(layer.ior.unwrap_or(1.0)),
+                g.eval_num(layer.weight),
+                g.eval_num(layer.transmission),
+                g.eval_num(a.0 * th),
+                g.eval_num(a.1 * th),
+                g.eval_num(a.2 * th),
                 layer.coupling as u32
             );
         }
@@ -436,12 +459,29 @@ pub(crate) fn generate_with_constants(m: &Material, opts: &WgslOptions) -> (Stri
     for (i, layer) in desc.layers.iter().enumerate() {
         for (j, lobe) in layer.lobes.iter().enumerate() {
             if matches!(lobe, Lobe::Lambert { .. } | Lobe::OrenNayar { .. }) {
-                let _ = writeln!(o, "    acc += m.c{i}_{j} * {};", g.num(lobe.weight()));
+                let _ = writeln!(o, "    acc += m.c{i}_{j} * {};", g.eval_num(lobe.weight()));
             }
         }
     }
     o.push_str("    return acc;\n}\n\n");
     o.push_str("fn material_emission(m: MaterialSample) -> vec3<f32> {\n    return m.emission;\n}\n\nfn material_alpha(m: MaterialSample) -> f32 {\n    return m.alpha;\n}\n\n// Ambient occlusion for the renderer's ambient/indirect term; material_eval ignores it.\nfn material_occlusion(m: MaterialSample) -> f32 {\n    return m.occlusion;\n}\n");
+    // material_eval's constants: private copies, declared before material_setup and
+    // loaded where it starts.
+    let eval = g.eval_constants.into_inner();
+    let mut decls = String::new();
+    let mut loads = String::new();
+    for k in &eval {
+        let _ = writeln!(decls, "var<private> material_k{k}: f32;");
+        let _ = writeln!(
+            loads,
+            "    material_k{k} = material_constants[material_constant_base + {k}u];"
+        );
+    }
+    let mut o = o.replacen(EVAL_LOADS, &loads, 1);
+    if !decls.is_empty() {
+        let at = o.find("fn material_setup(").unwrap_or(o.len());
+        o.insert_str(at, &format!("// material_eval's constants.\n{decls}\n"));
+    }
     let constants = g.constants.map(|c| c.into_inner()).unwrap_or_default();
     (o, constants)
 }
