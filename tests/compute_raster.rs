@@ -639,9 +639,10 @@ fn masked_materials_match_the_prepass_alpha_test() {
 
 /// A triangle covering the whole viewport behind a field of small triangles (some under
 /// a pixel, some single-sided and facing away, many across tile and block borders): the
-/// tiled path (setup, bin, raster) against the hardware prepass, and bit for bit against
-/// every triangle rasterized serially by its setup thread (records=0, the list-full
-/// path, which walks each triangle's box as the one-thread-per-triangle rasterizer did).
+/// rasterizer (setup's direct paths, tiles, bin, raster) against the hardware prepass,
+/// and bit for bit against every triangle rasterized serially by its setup thread
+/// (records=0 with the direct paths off: the list-full path, which walks each triangle's
+/// box as the one-thread-per-triangle rasterizer did).
 #[test]
 fn screen_filling_triangle_among_many_small_ones_is_exact() {
     if !has_atomics() {
@@ -713,7 +714,7 @@ fn screen_filling_triangle_among_many_small_ones_is_exact() {
             shown(1, 301) > 1000 && shown(301, 601) > 1000,
             "both fields show"
         );
-        let (serial, serial_report) = rasterize_limited(&s, w, h, "records=0");
+        let (serial, serial_report) = rasterize_limited(&s, w, h, "records=0,direct=0");
         assert!(serial_report.serial_triangles > 300, "{serial_report:?}");
         assert_eq!(bit_differences(&px, &serial), 0);
         // The huge triangle's fan triangles reserve their many tiles with a
