@@ -331,11 +331,15 @@ fn draw_fan(fan: Fan, local: u32) {
         raster_region(t, t.box);
     }
     let r = reserve_record(path, local);
-    if ((path == PATH_BLOCKS || path == PATH_TILES) && r >= list_capacity.x) {
-        // No room for a record: the whole box here, counted.
-        atomicAdd(&counters[SERIAL_TRIANGLES], 1u);
-        raster_region(t, t.box);
-        path = PATH_NONE;
+    if (path == PATH_BLOCKS || path == PATH_TILES) {
+        if (r < list_capacity.x) {
+            store_record(r, t);
+        } else {
+            // No room for a record: the whole box here, counted.
+            atomicAdd(&counters[SERIAL_TRIANGLES], 1u);
+            raster_region(t, t.box);
+            path = PATH_NONE;
+        }
     }
     let tile_span = vec2<u32>(t.box.zw) / TILE_PIXELS - vec2<u32>(t.box.xy) / TILE_PIXELS + vec2<u32>(1u);
     let tile_count = tile_span.x * tile_span.y;
@@ -345,7 +349,6 @@ fn draw_fan(fan: Fan, local: u32) {
         tiles = tile_count;
     }
     if (path == PATH_BLOCKS) {
-        store_record(r, t);
         blocks = countOneBits(fan.blocks);
     }
     let slots = reserve_entries(tiles, blocks, local);
@@ -353,7 +356,6 @@ fn draw_fan(fan: Fan, local: u32) {
         list_blocks(t, r, fan.blocks, slots.y);
     }
     if (path == PATH_TILES) {
-        store_record(r, t);
         var first = slots.x;
         if (tile_count > UNCHECKED_TILES) {
             first = reserve_many_tiles(tile_count);
