@@ -138,6 +138,20 @@ fn small_triangles_take_the_direct_paths_exactly() {
         "{tiled_report:?} vs {report:?}"
     );
 
+    // The small path's threshold moved (the hook's `small=N`): no small path (its
+    // triangles listed by block or tile instead), and four times the pixels.
+    for (limits, fewer) in [("small=0", true), ("small=64", false)] {
+        let (moved, r) = rasterize_limited(&s, w, h, limits);
+        eprintln!("{limits}: {r:?}");
+        let shifted = if fewer {
+            r.small_triangles == 0 && r.block_triangles > report.block_triangles
+        } else {
+            r.small_triangles > report.small_triangles
+        };
+        assert!(shifted, "{limits}: {r:?}");
+        assert_eq!(bit_differences(&px, &moved), 0, "{limits}");
+    }
+
     // No room for records: the small triangles are drawn as before, every other fan
     // triangle by its setup thread, counted. No room for blocks: setup's and bin's
     // blocks drawn by the thread that found the list full.

@@ -50,8 +50,8 @@
 #if RESOLVE
 @group(0) @binding(2) var<storage, read> vis: array<vec2<u32>>;
 #else
-// Capacities (entries) of the record, tile and block lists; 1 where setup's direct
-// paths are on (0 under the test hook's `direct=0`).
+// Capacities (entries) of the record, tile and block lists; setup's direct paths (see
+// its `blocks_direct` and `small_pixels`).
 @group(0) @binding(12) var<uniform> list_capacity: vec4<u32>;
 #if CLEAR
 @group(0) @binding(7) var<storage, read_write> vis: array<vec2<u32>>;

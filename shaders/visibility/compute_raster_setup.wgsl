@@ -2,7 +2,7 @@
 // visibility/compute_raster.wgsl (whose header tells the whole pass). A thread per
 // triangle clips, snaps and culls it, then draws each fan triangle by one of three
 // paths, chosen by its pixel box:
-// - PATH_SMALL, a box of at most SMALL_PIXELS pixels: covered here, in this thread, with
+// - PATH_SMALL, a box of at most `small_pixels()` (16) pixels: covered here, in this thread, with
 //   the per-pixel code every path runs (`cover`). No record, no list entry.
 // - PATH_BLOCKS, a box within 2×2 blocks: a record, and an entry per block of those its
 //   edges may reach appended to the block list here (no tile entry, no bin).
@@ -20,18 +20,6 @@ const PATH_NONE: u32 = 0u;
 const PATH_SMALL: u32 = 1u;
 const PATH_BLOCKS: u32 = 2u;
 const PATH_TILES: u32 = 3u;
-// Most pixels in the box of a fan triangle its setup thread covers itself. Listed, such a
-// triangle costs a 64-byte record, two or three same-address atomics and a 64-thread
-// raster block for each 8×8 block its box touches (one to four for a box of a few
-// pixels, 64 to 256 invocations for its 1 to 16 pixels), plus a 64-thread slice of a bin
-// workgroup on the tiled path. Here it costs at most 16 pixel tests in one thread. A
-// warp's lanes run together, so a warp of small triangles takes as long as its largest
-// box: 16 steps for 32 triangles where listing them costs at least 64 warp-steps of
-// raster (one block each). At 64 pixels (an 8×8 box) the serial walk would cost a warp
-// as much as the best case of listing, without its parallelism: 16 keeps a 4× margin for
-// warps whose boxes differ. The walk's loop runs at most 16 iterations a fan triangle,
-// far from lavapipe's loop limit (see `raster_region`).
-const SMALL_PIXELS: i32 = 16;
 // Tiles a fan triangle reserves without checking the count first (see `reserve_many_tiles`).
 const UNCHECKED_TILES: u32 = 16u;
 
@@ -79,10 +67,27 @@ fn within_linear_range(p: vec2<i32>) -> bool {
     return all(abs(p) < vec2<i32>(LINEAR_RANGE));
 }
 
-// Whether setup may draw small fan triangles itself and list the blocks of those within
-// 2×2 blocks (list_capacity.w: 0 under the test hook's `direct=0`).
-fn direct_paths() -> bool {
-    return list_capacity.w != 0u;
+// Whether setup lists the blocks of fan triangles within 2×2 blocks itself (bit 0 of
+// list_capacity.w; off under the test hook's `direct=0`).
+fn blocks_direct() -> bool {
+    return (list_capacity.w & 1u) != 0u;
+}
+
+// Most pixels in the box of a fan triangle its setup thread covers itself (the rest of
+// list_capacity.w): SMALL_PIXELS of compute_raster/prepare.rs, 16 (0 under `direct=0`;
+// the test hook's `small=N` sets it, to measure). Listed, such a triangle costs a
+// 64-byte record, two or three same-address atomics and a 64-thread raster block for
+// each 8×8 block its box touches (one to four for a box of a few pixels: 64 to 256
+// invocations for its 1 to 16 pixels), plus a 64-thread slice of a bin workgroup on the
+// tiled path. Here it costs at most 16 pixel tests in one thread. A warp's lanes run
+// together, so a warp of small triangles takes as long as its largest box: 16 steps for
+// 32 triangles where listing them costs at least 64 warp-steps of raster (one block
+// each). At 64 pixels (an 8×8 box) the serial walk would cost a warp as much as the best
+// case of listing, without its parallelism: 16 keeps a 4× margin for warps whose boxes
+// differ. The walk's loop runs at most 16 iterations a fan triangle (256 at the hook's
+// most), far from lavapipe's loop limit (see `raster_region`).
+fn small_pixels() -> i32 {
+    return i32(list_capacity.w >> 1u);
 }
 
 // The blocks of `t`'s 2×2 from its box's first block that lie in the box and that its
@@ -152,17 +157,16 @@ fn prepare_fan(ca: vec4<f32>, cb: vec4<f32>, cc: vec4<f32>, id: u32, cull_back: 
     t.id = id;
     fan.t = t;
     fan.path = PATH_TILES;
-    if (direct_paths()) {
-        // Width and height first: their product could wrap for a viewport-sized box.
-        let size = box.zw - box.xy + vec2<i32>(1);
-        let blocks = vec2<u32>(box.zw) / BLOCK - vec2<u32>(box.xy) / BLOCK;
-        if (all(size <= vec2<i32>(SMALL_PIXELS)) && size.x * size.y <= SMALL_PIXELS) {
-            fan.path = PATH_SMALL;
-        } else if (all(blocks <= vec2<u32>(1u))) {
-            fan.blocks = reached_blocks(t);
-            // No pixel centre inside: nothing to list.
-            fan.path = select(PATH_NONE, PATH_BLOCKS, fan.blocks != 0u);
-        }
+    // Width and height first: their product could wrap for a viewport-sized box.
+    let size = box.zw - box.xy + vec2<i32>(1);
+    let small = small_pixels();
+    let blocks = vec2<u32>(box.zw) / BLOCK - vec2<u32>(box.xy) / BLOCK;
+    if (all(size <= vec2<i32>(small)) && size.x * size.y <= small) {
+        fan.path = PATH_SMALL;
+    } else if (blocks_direct() && all(blocks <= vec2<u32>(1u))) {
+        fan.blocks = reached_blocks(t);
+        // No pixel centre inside: nothing to list.
+        fan.path = select(PATH_NONE, PATH_BLOCKS, fan.blocks != 0u);
     }
     return fan;
 }

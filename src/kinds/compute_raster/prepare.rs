@@ -57,11 +57,17 @@ const MAX_RECORDS: u64 = 1 << 22;
 const MAX_TRIANGLES: u32 = u32::MAX / 8;
 /// Words of the counter buffer (see the shader's `RECORDS`..`BLOCK_TRIANGLES`).
 const COUNTERS: usize = 8;
-/// Test hook: `records=N,tiles=N,blocks=N,groups=N,direct=0` (any of them) overrides the
-/// lists' capacities and the workgroups per dispatch dimension, so tests can fill the
-/// lists and fold small dispatches into y; `direct=0` turns setup's direct paths off
-/// (every fan triangle through tiles and bin), the reference they are tested against.
-/// Read when the pass is prepared.
+/// Most pixels in the box of a fan triangle that its setup thread covers itself (why 16:
+/// the setup shader's `small_pixels`).
+const SMALL_PIXELS: u32 = 16;
+/// The most the test hook's `small=N` may ask (a 16×16 box, 16 rows a thread).
+const MAX_SMALL_PIXELS: u32 = 256;
+/// Test hook: `records=N,tiles=N,blocks=N,groups=N,small=N,direct=0` (any of them)
+/// overrides the lists' capacities and the workgroups per dispatch dimension, so tests
+/// can fill the lists and fold small dispatches into y; `small=N` sets the most pixels of
+/// a box setup covers itself (0: none; to measure the threshold on a GPU); `direct=0`
+/// turns setup's direct paths off (every fan triangle through tiles and bin), the
+/// reference they are tested against. Read when the pass is prepared.
 pub const TEST_LIMITS_VAR: &str = "LIGHTGRAPH_COMPUTE_RASTER_TEST_LIMITS";
 
 /// What the rasterizer needs of the device: 64-bit integers and their atomic min on
@@ -141,6 +147,8 @@ struct TestLimits {
     tiles: Option<u32>,
     blocks: Option<u32>,
     groups: Option<u32>,
+    /// `small=N`: the small path's threshold instead of SMALL_PIXELS.
+    small: Option<u32>,
     /// `direct=0`: setup neither covers small fan triangles nor lists blocks itself.
     no_direct: bool,
 }
@@ -150,7 +158,7 @@ fn parse_test_limits(text: &str) -> Result<TestLimits, String> {
     for item in text.split(',').map(str::trim).filter(|i| !i.is_empty()) {
         let bad = || {
             format!(
-                "{TEST_LIMITS_VAR}: '{item}' is not NAME=COUNT (records, tiles, blocks, groups) or direct=0"
+                "{TEST_LIMITS_VAR}: '{item}' is not NAME=COUNT (records, tiles, blocks, groups, small up to {MAX_SMALL_PIXELS}) or direct=0"
             )
         };
         let (name, value) = item.split_once('=').ok_or_else(bad)?;
@@ -167,6 +175,7 @@ fn parse_test_limits(text: &str) -> Result<TestLimits, String> {
             "tiles" => &mut limits.tiles,
             "blocks" => &mut limits.blocks,
             "groups" if value >= 1 => &mut limits.groups,
+            "small" if value <= MAX_SMALL_PIXELS => &mut limits.small,
             _ => return Err(bad()),
         };
         *field = Some(value);
@@ -191,6 +200,15 @@ impl TestLimits {
             capacity,
             self.groups.map_or(max_groups, |g| g.min(max_groups)),
         )
+    }
+    /// The setup shader's `list_capacity.w`: bit 0, setup lists the blocks of fan
+    /// triangles within 2×2 blocks; above it, the most pixels of a box it covers itself.
+    fn direct_paths(self) -> u32 {
+        if self.no_direct {
+            0
+        } else {
+            (self.small.unwrap_or(SMALL_PIXELS) << 1) | 1
+        }
     }
 }
 
@@ -328,7 +346,7 @@ pub(super) fn prepare_compute(
             capacity.records,
             capacity.tiles,
             capacity.blocks,
-            u32::from(!test_limits.no_direct),
+            test_limits.direct_paths(),
         ]),
         wgpu::BufferUsages::UNIFORM,
     );
@@ -572,10 +590,15 @@ mod tests {
                 tiles: None,
                 blocks: Some(7),
                 groups: Some(3),
+                small: None,
                 no_direct: false,
             }
         );
-        assert!(parse_test_limits("direct=0").unwrap().no_direct);
+        assert_eq!(t.direct_paths(), (SMALL_PIXELS << 1) | 1);
+        let small = parse_test_limits("small=0").unwrap();
+        assert_eq!((small.small, small.direct_paths()), (Some(0), 1));
+        let off = parse_test_limits("direct=0,small=64").unwrap();
+        assert_eq!((off.no_direct, off.direct_paths()), (true, 0));
         let full = ListCapacity {
             records: 10,
             tiles: 20,
@@ -593,7 +616,14 @@ mod tests {
                 3
             )
         );
-        for bad in ["records", "tiles=x", "groups=0", "pixels=3", "direct=1"] {
+        for bad in [
+            "records",
+            "tiles=x",
+            "groups=0",
+            "pixels=3",
+            "direct=1",
+            "small=257",
+        ] {
             let e = parse_test_limits(bad).unwrap_err();
             assert!(e.contains(TEST_LIMITS_VAR) && e.contains(bad), "{e}");
         }
