@@ -4,147 +4,15 @@
 //! large triangles, and depth ties (the later triangle wins, as LessEqual keeps it).
 
 mod common;
+use common::compute_raster::*;
 use common::textured::*;
 use common::*;
 use glam::{Vec2, Vec3};
 use lightgraph::graph::{self, FrameSize};
-use lightgraph::render::{RasterReport, SceneGpu};
-use lightgraph::scene::{AlphaMode, Camera, Light, Mesh, Scene};
+use lightgraph::render::SceneGpu;
+use lightgraph::scene::{AlphaMode, Mesh, Scene};
 use lightgraph::shader::ShaderLibrary;
 use std::path::Path;
-
-const NO_TRIANGLE: u32 = u32::MAX;
-
-/// Both rasterizers into one image: compute depth, prepass depth, the id's two halves.
-const COMPARE: &str = r#"Graph(
-    name: "compute_raster_compare",
-    resources: [
-        Texture(name: "depth_cr", format: Depth32Float),
-        Texture(name: "depth_hw", format: Depth32Float),
-        Texture(name: "visibility", format: R32Uint),
-        Texture(name: "out", format: Rgba32Float),
-        Import(name: "geometry", from: Geometry),
-        Import(name: "vertices", from: Vertices),
-        Import(name: "triangles", from: Triangles),
-        Import(name: "material_triangles", from: MaterialTriangles),
-    ],
-    passes: [
-        Pass(name: "cr", kind: ComputeRaster, reads: ["vertices", "triangles", "material_triangles"], writes: ["depth=depth_cr", "visibility"]),
-        Pass(name: "pre", kind: DepthPrepass, reads: ["geometry"], writes: ["depth_hw"]),
-        Pass(name: "compare", kind: Fullscreen(shader: "visibility/compute_raster_compare.wgsl"), reads: ["depth_cr", "depth_hw", "visibility"], writes: ["out"]),
-    ],
-    output: "out",
-)"#;
-
-struct Pixel {
-    cr: f32,
-    hw: f32,
-    id: u32,
-}
-
-/// What the two rasterizers differ in over a frame.
-#[derive(Debug, Default)]
-struct Diff {
-    pixels: usize,
-    covered: usize,
-    /// Covered by one rasterizer only.
-    coverage: usize,
-    /// Largest depth difference where both cover.
-    depth: f32,
-    /// Ids past the scene's triangles, or a depth without an id.
-    bad_ids: usize,
-}
-
-fn rasterize(scene: &Scene, width: u32, height: u32) -> Vec<Pixel> {
-    rasterize_limited(scene, width, height, "").0
-}
-
-/// The compute rasterizer's test hook (`compute_raster.rs`): list capacities and
-/// workgroups per dispatch dimension, read when the pass is prepared.
-const TEST_LIMITS: &str = "LIGHTGRAPH_COMPUTE_RASTER_TEST_LIMITS";
-
-/// Sets the test hook while alive.
-struct Limits;
-impl Limits {
-    fn set(limits: &str) -> Self {
-        std::env::set_var(TEST_LIMITS, limits);
-        Limits
-    }
-}
-impl Drop for Limits {
-    fn drop(&mut self) {
-        std::env::remove_var(TEST_LIMITS);
-    }
-}
-
-/// As `rasterize`, under the test hook's `limits` ("" for none), with the pass's report.
-fn rasterize_limited(
-    scene: &Scene,
-    width: u32,
-    height: u32,
-    limits: &str,
-) -> (Vec<Pixel>, RasterReport) {
-    // The renderer's lock keeps the other tests of this binary from preparing while the
-    // variable is set (dropped after `_limits`).
-    let mut r = renderer();
-    let _limits = Limits::set(limits);
-    let out = render_text(&mut r, COMPARE, scene, width, height);
-    assert_eq!(out.image.len(), (width * height) as usize);
-    assert_eq!(out.rasters.len(), 1, "one ComputeRaster report");
-    let px = out
-        .image
-        .iter()
-        .map(|p| Pixel {
-            cr: p[0],
-            hw: p[1],
-            id: p[2] as u32 | (p[3] as u32) << 16,
-        })
-        .collect();
-    (px, out.rasters[0].clone())
-}
-
-/// Pixels whose compute depth bits or id differ between two runs.
-fn bit_differences(a: &[Pixel], b: &[Pixel]) -> usize {
-    assert_eq!(a.len(), b.len());
-    a.iter()
-        .zip(b)
-        .filter(|(p, q)| p.cr.to_bits() != q.cr.to_bits() || p.id != q.id)
-        .count()
-}
-
-fn triangles(scene: &Scene) -> u32 {
-    scene
-        .meshes
-        .iter()
-        .filter(|m| scene.materials[m.material].alpha_mode != AlphaMode::Blend)
-        .map(|m| m.indices.len() as u32 / 3)
-        .sum()
-}
-
-fn diff(scene: &Scene, px: &[Pixel]) -> Diff {
-    let n = triangles(scene);
-    let mut d = Diff {
-        pixels: px.len(),
-        ..Default::default()
-    };
-    for p in px {
-        let cr = p.id != NO_TRIANGLE;
-        let hw = p.hw < 1.0;
-        d.bad_ids += (cr && p.id >= n) as usize + (!cr && p.cr != 1.0) as usize;
-        if cr && hw {
-            d.covered += 1;
-            d.depth = d.depth.max((p.cr - p.hw).abs());
-        } else if cr != hw {
-            d.coverage += 1;
-        }
-    }
-    d
-}
-
-fn load(rel: &str) -> Scene {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
-    lightgraph::scene::load(&path).unwrap().scene
-}
 
 #[test]
 fn lavapipe_has_the_64_bit_atomics() {
@@ -174,22 +42,6 @@ fn lavapipe_has_the_64_bit_atomics() {
     }
 }
 
-fn has_atomics() -> bool {
-    let r = renderer();
-    let ok = r
-        .ctx
-        .device
-        .features()
-        .contains(wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX);
-    if !ok {
-        eprintln!(
-            "!!!!! no 64-bit atomics on {}: skipped !!!!!",
-            r.ctx.adapter_name()
-        );
-    }
-    ok
-}
-
 #[test]
 fn shipped_scenes_match_the_depth_prepass() {
     if !has_atomics() {
@@ -210,76 +62,6 @@ fn shipped_scenes_match_the_depth_prepass() {
         assert!(d.covered > d.pixels / 4, "{rel}: {d:?}");
         assert_matches(rel, &d);
     }
-}
-
-/// Coverage may differ only where float rounding of a vertex's transform (the vertex
-/// stage and this compute shader may contract multiply-adds differently) moves its
-/// snapped 1/256-pixel position, which flips only pixel centres within 1/256 pixel of
-/// an edge: at most one pixel in 5000 (lavapipe: none on every scene here). Depth where
-/// both cover: the plane evaluated in another order, a few ulps of 1.0 (lavapipe: at
-/// most 4.2e-7, cornell box).
-const MAX_COVERAGE_DIFF: usize = 5000;
-const DEPTH_TOLERANCE: f32 = 1e-6;
-
-fn assert_matches(what: &str, d: &Diff) {
-    assert_eq!(d.bad_ids, 0, "{what}: {d:?}");
-    assert!(d.coverage <= d.pixels / MAX_COVERAGE_DIFF, "{what}: {d:?}");
-    assert!(d.depth <= DEPTH_TOLERANCE, "{what}: {d:?}");
-}
-
-/// A camera at the origin looking down -Z with a 90° field of view: at distance d the
-/// view spans [-d, d] in x and y (square frames).
-fn camera(near: f32) -> Camera {
-    Camera {
-        eye: Vec3::ZERO,
-        target: Vec3::NEG_Z,
-        up: Vec3::Y,
-        fov_y: 90f32.to_radians(),
-        near,
-        far: 100.0,
-    }
-}
-
-fn scene(
-    meshes: Vec<Mesh>,
-    materials: Vec<lightgraph::scene::SurfaceMaterial>,
-    camera: Camera,
-) -> Scene {
-    Scene {
-        name: "compute_raster".into(),
-        meshes,
-        materials,
-        lights: vec![Light::point(
-            Vec3::new(0.0, 2.0, -3.0),
-            20.0,
-            Vec3::ONE,
-            10.0,
-        )],
-        camera,
-        output_size: None,
-        ambient: Vec3::ZERO,
-        ..Default::default()
-    }
-}
-
-/// One triangle (normals towards +Z), material `material`.
-fn triangle(name: &str, p: [Vec3; 3], material: usize) -> Mesh {
-    Mesh {
-        name: name.into(),
-        material,
-        positions: p.to_vec(),
-        normals: vec![Vec3::Z; 3],
-        uvs: vec![Vec2::ZERO; 3],
-        tangents: vec![Vec3::X.extend(1.0); 3],
-        indices: vec![0, 1, 2],
-        ..Default::default()
-    }
-}
-
-fn double_sided(name: &str, albedo: Vec3) -> lightgraph::scene::SurfaceMaterial {
-    let mut m = lambert(name, albedo);
-    m.double_sided = true;
-    m
 }
 
 /// The screen split along its diagonal into two triangles at different depths whose
@@ -639,9 +421,10 @@ fn masked_materials_match_the_prepass_alpha_test() {
 
 /// A triangle covering the whole viewport behind a field of small triangles (some under
 /// a pixel, some single-sided and facing away, many across tile and block borders): the
-/// tiled path (setup, bin, raster) against the hardware prepass, and bit for bit against
-/// every triangle rasterized serially by its setup thread (records=0, the list-full
-/// path, which walks each triangle's box as the one-thread-per-triangle rasterizer did).
+/// rasterizer (setup's direct paths, tiles, bin, raster) against the hardware prepass,
+/// and bit for bit against every triangle rasterized serially by its setup thread
+/// (records=0 with the direct paths off: the list-full path, which walks each triangle's
+/// box as the one-thread-per-triangle rasterizer did).
 #[test]
 fn screen_filling_triangle_among_many_small_ones_is_exact() {
     if !has_atomics() {
@@ -713,7 +496,7 @@ fn screen_filling_triangle_among_many_small_ones_is_exact() {
             shown(1, 301) > 1000 && shown(301, 601) > 1000,
             "both fields show"
         );
-        let (serial, serial_report) = rasterize_limited(&s, w, h, "records=0");
+        let (serial, serial_report) = rasterize_limited(&s, w, h, "records=0,direct=0");
         assert!(serial_report.serial_triangles > 300, "{serial_report:?}");
         assert_eq!(bit_differences(&px, &serial), 0);
         // The huge triangle's fan triangles reserve their many tiles with a

@@ -12,9 +12,12 @@
 // Four dispatches, each spreading its work over threads so that no thread walks many
 // pixels (the GPU waits for its slowest thread):
 // - `clear` (CLEAR): the buffer to all ones; list counters and indirect arguments reset.
-// - `setup` (SETUP), one thread per triangle: clip, snap, cull, and per fan triangle of
-//   the clipped polygon one 64-byte record (snapped vertices, top-left biases, depth
-//   plane, pixel box, id) and one entry per TILE_PIXELS² tile of its box.
+// - `setup` (SETUP, visibility/compute_raster_setup.wgsl), one thread per triangle:
+//   clip, snap, cull, then per fan triangle of the clipped polygon by its pixel box: a
+//   box of at most 16 pixels covered in the thread; else one 64-byte record (snapped
+//   vertices, top-left biases, depth plane, pixel box, id) and, for a box within 2×2
+//   blocks, an entry per block its edges may reach, or else one entry per TILE_PIXELS²
+//   tile of its box. Reserved a workgroup at a time (one global atomic a workgroup).
 // - `bin` (BIN), a thread per BLOCK² block of a tile entry (TILES_PER_GROUP a workgroup):
 //   blocks inside the box that no edge rejects (tested at the block's corner where the
 //   edge function is largest: exact, as the function is linear) become block entries.
@@ -24,8 +27,9 @@
 // (510 at 1080p) for a screen-filling triangle instead of its 32,400 blocks. Both are
 // dispatched indirectly over x and y (flattened here), the arguments grown with atomicMax
 // as entries are appended. A list that is full loses nothing: setup rasterizes a fan
-// triangle without a record, or a tile without an entry, in its own thread; bin a block
-// without an entry. Each is counted (`counters`), read back for the pass's report. Every
+// triangle without a record, or a tile or block without an entry, in its own thread; bin
+// a block without an entry. Each is counted (`counters`), as are the fan triangles of
+// setup's direct paths, read back for the pass's report. Every
 // path runs the same per-pixel code (`cover`), and an atomic min is order-independent,
 // so the image does not depend on which path drew a pixel.
 // RESOLVE: the full-screen draw writing the id and frag_depth.
@@ -46,7 +50,8 @@
 #if RESOLVE
 @group(0) @binding(2) var<storage, read> vis: array<vec2<u32>>;
 #else
-// Capacities (entries) of the record, tile and block lists; unused.
+// Capacities (entries) of the record, tile and block lists; setup's direct paths (see
+// its `blocks_direct` and `small_pixels`).
 @group(0) @binding(12) var<uniform> list_capacity: vec4<u32>;
 #if CLEAR
 @group(0) @binding(7) var<storage, read_write> vis: array<vec2<u32>>;
@@ -90,6 +95,9 @@
 // The bin dispatch's arguments (so the bin dispatch, which reads them, binds nothing it
 // could write them with).
 @group(0) @binding(9) var<storage, read_write> tile_args: array<atomic<u32>, 4>;
+// Setup lists the blocks of fan triangles within 2×2 blocks itself.
+@group(0) @binding(11) var<storage, read_write> blocks: array<vec2<u32>>;
+@group(0) @binding(10) var<storage, read_write> block_args: array<atomic<u32>, 4>;
 #endif
 #if BIN
 @group(0) @binding(6) var<storage, read> tiles: array<vec2<u32>>;
@@ -103,18 +111,19 @@ const NO_TRIANGLE: u32 = 0xffffffffu;
 // Half a pixel in snapped (1/SUBPIXEL) units: pixel centres.
 const HALF_PIXEL: i32 = 128;
 // Counter slots: entries appended to each list (past the capacity too), then fan
-// triangles, tiles and blocks rasterized serially because their list was full.
+// triangles, tiles and blocks rasterized serially because their list was full, then
+// fan triangles setup drew itself (small ones) and whose blocks it listed itself.
 const RECORDS: u32 = 0u;
 const TILES: u32 = 1u;
 const BLOCKS: u32 = 2u;
 const SERIAL_TRIANGLES: u32 = 3u;
 const SERIAL_TILES: u32 = 4u;
 const SERIAL_BLOCKS: u32 = 5u;
+const SMALL_TRIANGLES: u32 = 6u;
+const BLOCK_TRIANGLES: u32 = 7u;
 // Record flags: bits 0-2, edge k is not a top or left edge (bias -1); RECORD_LINEAR, the
 // snapped coordinates are small enough for the edge functions to be exactly linear.
 const RECORD_LINEAR: u32 = 8u;
-// Tiles a fan triangle reserves without checking the count first (see `reserve_tiles`).
-const SMALL_BOX: u32 = 16u;
 // Snapped coordinates up to this (2^29 fixed point, 2^21 pixels) keep every difference
 // the edge functions take within i32 (pixel centres are under 2^22 for viewports up to
 // 16,384 pixels), so an edge function is exactly the linear function of the pixel.
@@ -306,195 +315,6 @@ fn load_record(r: u32) -> Tri {
     return t;
 }
 
-#if SETUP
-
-fn store_record(r: u32, t: Tri) {
-    let i = 4u * r;
-    records[i] = bitcast<vec4<u32>>(vec4<i32>(t.a, t.b));
-    records[i + 1u] = vec4<u32>(bitcast<vec2<u32>>(t.c), pack_point(t.box.xy), pack_point(t.box.zw));
-    records[i + 2u] = vec4<u32>(bitcast<vec3<u32>>(t.sa), bitcast<u32>(t.dz.x));
-    records[i + 3u] = vec4<u32>(bitcast<u32>(t.dz.y), t.id, t.flags, 0u);
-}
-
-fn clip_position(v: u32) -> vec4<f32> {
-    let b = 12u * v;
-    let p = vec3<f32>(vertices[b], vertices[b + 1u], vertices[b + 2u]);
-    return frame.view_proj * vec4<f32>(p, 1.0);
-}
-
-
-
-// Framebuffer position (x right, y down, pixels) and depth, as the viewport transform.
-fn to_screen(c: vec4<f32>) -> vec3<f32> {
-    let ndc = c.xyz * (1.0 / c.w);
-    let half = vec2<f32>(raster_params.zw) * 0.5;
-    return vec3<f32>(ndc.x * half.x + half.x, ndc.y * -half.y + half.y, ndc.z);
-}
-
-// Pixels whose centres lie in [lo, hi] (fixed point), clamped to the viewport; empty
-// when x > z or y > w.
-fn pixel_box(lo: vec2<i32>, hi: vec2<i32>) -> vec4<i32> {
-    // ceil((lo - 128) / 256) and floor((hi - 128) / 256), with arithmetic shifts.
-    let first = -((vec2<i32>(HALF_PIXEL) - lo) >> vec2<u32>(8u));
-    let last = (hi - vec2<i32>(HALF_PIXEL)) >> vec2<u32>(8u);
-    let size = vec2<i32>(raster_params.zw);
-    return vec4<i32>(max(first, vec2<i32>(0)), min(last, size - 1));
-}
-
-fn within_linear_range(p: vec2<i32>) -> bool {
-    return all(abs(p) < vec2<i32>(LINEAR_RANGE));
-}
-
-// Entries [first, first + n) of the tile list reserved (a slot at or past the capacity
-// has no room): returns the first slot. One reservation per fan triangle: a returned
-// atomic is a round trip to L2, and setup's slowest thread bounds the dispatch.
-// The counter never wraps: a box of up to SMALL_BOX tiles adds without checking (at most
-// SMALL_BOX x 2^22 records = 2^26 in all), a larger one only while the count is below
-// capacity (compare-exchange), adding at most 2^20 tiles (65,536² pixels) to under 2^24.
-fn reserve_tiles(n: u32) -> u32 {
-    let capacity = list_capacity.y;
-    var first = capacity;
-    if (n <= SMALL_BOX) {
-        first = atomicAdd(&counters[TILES], n);
-    } else {
-        var old = atomicLoad(&counters[TILES]);
-        loop {
-            if (old >= capacity) {
-                break;
-            }
-            let swap = atomicCompareExchangeWeak(&counters[TILES], old, old + n);
-            if (swap.exchanged) {
-                first = old;
-                break;
-            }
-            old = swap.old_value;
-        }
-    }
-    let end = min(first + n, capacity);
-    if (end > first) {
-        // Enough bin workgroups for every entry below `end`.
-        let size = dispatch_size(end, TILES_PER_GROUP);
-        atomicMax(&tile_args[0], size.x);
-        atomicMax(&tile_args[1], size.y);
-    }
-    return first;
-}
-
-// One fan triangle: rejected, or recorded with its tiles listed (or drawn here where a
-// list is full).
-fn setup_triangle(ca: vec4<f32>, cb: vec4<f32>, cc: vec4<f32>, id: u32, cull_back: bool) {
-    let sa = to_screen(ca);
-    var sb = to_screen(cb);
-    var sc = to_screen(cc);
-    let a = snap(sa);
-    var b = snap(sb);
-    var c = snap(sc);
-    var area = edge(a, b, c);
-    if (area == 0) {
-        return;
-    }
-    // Positive area is clockwise on screen: clockwise in NDC too, a back face.
-    if (area > 0 && cull_back) {
-        return;
-    }
-    if (area < 0) {
-        let t = b;
-        b = c;
-        c = t;
-        let s = sb;
-        sb = sc;
-        sc = s;
-        area = -area;
-    }
-    let box = pixel_box(min(a, min(b, c)), max(a, max(b, c)));
-    if (box.x > box.z || box.y > box.w) {
-        return;
-    }
-    // Depth plane from the unsnapped positions.
-    let e1 = sb - sa;
-    let e2 = sc - sa;
-    let det = e1.x * e2.y - e1.y * e2.x;
-    let dzdx = (e1.z * e2.y - e2.z * e1.y) / det;
-    let dzdy = (e2.z * e1.x - e1.z * e2.x) / det;
-    var t: Tri;
-    t.a = a;
-    t.b = b;
-    t.c = c;
-    // Edge biases: a centre exactly on an edge counts only on top and left edges.
-    t.flags = select(1u, 0u, top_left(b, c)) | select(2u, 0u, top_left(c, a)) | select(4u, 0u, top_left(a, b));
-    if (within_linear_range(a) && within_linear_range(b) && within_linear_range(c)) {
-        t.flags |= RECORD_LINEAR;
-    }
-    t.bias = -vec3<i32>(vec3<u32>(t.flags, t.flags >> 1u, t.flags >> 2u) & vec3<u32>(1u));
-    t.sa = sa;
-    t.dz = vec2<f32>(dzdx, dzdy);
-    t.box = box;
-    t.id = id;
-    // At most 6 fan triangles per triangle, and compute_raster.rs refuses scenes of
-    // over 2^32 / 8 triangles: the counter never wraps.
-    let r = atomicAdd(&counters[RECORDS], 1u);
-    if (r >= list_capacity.x) {
-        atomicAdd(&counters[SERIAL_TRIANGLES], 1u);
-        raster_region(t, box);
-        return;
-    }
-    store_record(r, t);
-    let first = vec2<u32>(box.xy) / TILE_PIXELS;
-    let last = vec2<u32>(box.zw) / TILE_PIXELS;
-    let capacity = list_capacity.y;
-    var serial = 0u;
-    var slot = reserve_tiles((last.x - first.x + 1u) * (last.y - first.y + 1u));
-    for (var ty = first.y; ty <= last.y; ty++) {
-        for (var tx = first.x; tx <= last.x; tx++) {
-            if (slot < capacity) {
-                tiles[slot] = vec2<u32>(r, tx | (ty << 16u));
-                slot++;
-            } else {
-                serial++;
-                raster_region(t, cell_region(box, vec2<u32>(tx, ty), TILE_PIXELS));
-            }
-        }
-    }
-    if (serial > 0u) {
-        atomicAdd(&counters[SERIAL_TILES], serial);
-    }
-}
-
-@compute @workgroup_size(GROUP)
-fn setup(
-    @builtin(workgroup_id) wg: vec3<u32>,
-    @builtin(num_workgroups) groups: vec3<u32>,
-    @builtin(local_invocation_index) local: u32,
-) {
-#if ALPHA_TEST
-    let range = material_triangles[MATERIAL_INDEX];
-    let id = range.x + flat_index(wg, groups, local, GROUP);
-    if (id >= range.y) {
-        return;
-    }
-#else
-    let id = flat_index(wg, groups, local, GROUP);
-    if (id >= raster_params.x || (alpha_tested[id / 32u] & (1u << (id % 32u))) != 0u) {
-        return;
-    }
-#endif
-    let t = 3u * id;
-    let a = clip_position(triangles[t]);
-    let b = clip_position(triangles[t + 1u]);
-    let c = clip_position(triangles[t + 2u]);
-    let cull_back = (single_sided[id / 32u] & (1u << (id % 32u))) != 0u;
-    if (!needs_clipping(a, b, c)) {
-        setup_triangle(a, b, c, id, cull_back);
-        return;
-    }
-    let poly = clip_triangle(a, b, c);
-    for (var k = 1u; k + 1u < poly.n; k++) {
-        setup_triangle(poly.v[0], poly.v[k], poly.v[k + 1u], id, cull_back);
-    }
-}
-#endif
-#if BIN
-
 // Whether some pixel centre of `region` may lie inside edge a -> b: its edge function
 // (plus bias) is not negative at the corner where the function is largest, the one its
 // gradient (-(b.y - a.y), b.x - a.x) points to.
@@ -513,6 +333,11 @@ fn may_cover(t: Tri, region: vec4<i32>) -> bool {
     let hi = region.zw * 256 + vec2<i32>(HALF_PIXEL);
     return edge_reaches(t.b, t.c, t.bias.x, lo, hi) && edge_reaches(t.c, t.a, t.bias.y, lo, hi) && edge_reaches(t.a, t.b, t.bias.z, lo, hi);
 }
+
+#if SETUP
+#include "visibility/compute_raster_setup.wgsl"
+#endif
+#if BIN
 
 var<workgroup> kept: atomic<u32>;
 var<workgroup> kept_first: u32;

@@ -429,6 +429,12 @@ pub struct RasterReport {
     pub serial_tiles: u32,
     /// Blocks rasterized serially because the block list was full.
     pub serial_blocks: u32,
+    /// Fan triangles of at most 16 pixels (their box) covered by their setup thread
+    /// itself, without a record or a list entry (all runs').
+    pub small_triangles: u32,
+    /// Fan triangles within 2×2 blocks whose blocks setup listed itself, without a tile
+    /// entry or bin (all runs').
+    pub block_triangles: u32,
 }
 
 impl RasterReport {
@@ -440,14 +446,16 @@ impl RasterReport {
     pub fn lines(&self) -> Vec<String> {
         let r = self;
         let mut lines = vec![format!(
-            "{}: {} of {} triangle records, {} of {} tiles, {} of {} blocks",
+            "{}: {} of {} triangle records, {} of {} tiles, {} of {} blocks; {} small fan triangles drawn in setup, {} listed by block",
             r.pass,
             r.records,
             r.records_capacity,
             r.tiles,
             r.tiles_capacity,
             r.blocks,
-            r.blocks_capacity
+            r.blocks_capacity,
+            r.small_triangles,
+            r.block_triangles
         )];
         if r.serial() > 0 {
             lines.push(format!(

@@ -2,6 +2,7 @@
 //! file on the real adapter (lavapipe on CI).
 #![allow(dead_code)]
 
+pub mod compute_raster;
 pub mod cornell;
 pub mod glass;
 pub mod msaa;

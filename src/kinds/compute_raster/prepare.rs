@@ -1,9 +1,10 @@
 //! `ComputeRaster`: the merged opaque triangles rasterized in compute into a per-pixel
 //! `u64` buffer with a 64-bit atomic min of (depth bits, inverted id). One compute pass of
-//! four dispatches: `clear`; `setup`, a thread per triangle, appends a record per (clipped)
-//! fan triangle and its 64×64-pixel tiles to lists; `bin` (indirect), a thread per block
-//! of a tile, appends the tile's 8×8-pixel blocks the triangle may cover; `raster`
-//! (indirect), a thread per pixel of a block. A resolve then writes the buffer into the
+//! four dispatches: `clear`; `setup`, a thread per triangle, covers a (clipped) fan
+//! triangle of at most 16 pixels itself, else appends a record and either the 8×8-pixel
+//! blocks it may cover (a box within 2×2 blocks) or its 64×64-pixel tiles to lists;
+//! `bin` (indirect), a thread per block of a tile, appends the tile's blocks the triangle
+//! may cover; `raster` (indirect), a thread per pixel of a block. A resolve then writes the buffer into the
 //! depth texture and the R32Uint visibility texture (a draw or a dispatch, by the depth's
 //! format: `resolve.rs`). Alpha-masked materials: setup, bin and raster
 //! run again per masked material, with its material code testing alpha per pixel; the
@@ -46,19 +47,27 @@ const TILE_PIXELS: u32 = BLOCK * TILE_BLOCKS;
 const RECORD_BYTES: u64 = 64;
 const ENTRY_BYTES: u64 = 8;
 /// Most entries a list holds: the block counter, which grows by at most TILE_BLOCKS² per
-/// tile entry without checking, then stays under 2^30 (no wrap).
+/// tile entry and 4 per record without checking, then stays under 2^31 (no wrap).
 const MAX_ENTRIES: u64 = 1 << 24;
 /// Most records: the tile counter, which grows by up to 16 tiles per record without
-/// checking, then stays under 2^26 (see the shader's `reserve_tiles`).
+/// checking, then stays under 2^27 (see the setup shader's `reserve_entries`).
 const MAX_RECORDS: u64 = 1 << 22;
 /// Most triangles: the record counter grows by up to 6 per triangle (a triangle clipped
 /// by five planes is a fan of six) without checking, so this keeps it from wrapping.
 const MAX_TRIANGLES: u32 = u32::MAX / 8;
-/// Words of the counter buffer (see the shader's `RECORDS`..`SERIAL_BLOCKS`).
+/// Words of the counter buffer (see the shader's `RECORDS`..`BLOCK_TRIANGLES`).
 const COUNTERS: usize = 8;
-/// Test hook: `records=N,tiles=N,blocks=N,groups=N` (any of them) overrides the lists'
-/// capacities and the workgroups per dispatch dimension, so tests can fill the lists and
-/// fold small dispatches into y. Read when the pass is prepared.
+/// Most pixels in the box of a fan triangle that its setup thread covers itself (why 16:
+/// the setup shader's `small_pixels`).
+const SMALL_PIXELS: u32 = 16;
+/// The most the test hook's `small=N` may ask (a 16×16 box, 16 rows a thread).
+const MAX_SMALL_PIXELS: u32 = 256;
+/// Test hook: `records=N,tiles=N,blocks=N,groups=N,small=N,direct=0` (any of them)
+/// overrides the lists' capacities and the workgroups per dispatch dimension, so tests
+/// can fill the lists and fold small dispatches into y; `small=N` sets the most pixels of
+/// a box setup covers itself (0: none; to measure the threshold on a GPU); `direct=0`
+/// turns setup's direct paths off (every fan triangle through tiles and bin), the
+/// reference they are tested against. Read when the pass is prepared.
 pub const TEST_LIMITS_VAR: &str = "LIGHTGRAPH_COMPUTE_RASTER_TEST_LIMITS";
 
 /// What the rasterizer needs of the device: 64-bit integers and their atomic min on
@@ -138,6 +147,10 @@ struct TestLimits {
     tiles: Option<u32>,
     blocks: Option<u32>,
     groups: Option<u32>,
+    /// `small=N`: the small path's threshold instead of SMALL_PIXELS.
+    small: Option<u32>,
+    /// `direct=0`: setup neither covers small fan triangles nor lists blocks itself.
+    no_direct: bool,
 }
 
 fn parse_test_limits(text: &str) -> Result<TestLimits, String> {
@@ -145,16 +158,24 @@ fn parse_test_limits(text: &str) -> Result<TestLimits, String> {
     for item in text.split(',').map(str::trim).filter(|i| !i.is_empty()) {
         let bad = || {
             format!(
-                "{TEST_LIMITS_VAR}: '{item}' is not NAME=COUNT (records, tiles, blocks, groups)"
+                "{TEST_LIMITS_VAR}: '{item}' is not NAME=COUNT (records, tiles, blocks, groups, small up to {MAX_SMALL_PIXELS}) or direct=0"
             )
         };
         let (name, value) = item.split_once('=').ok_or_else(bad)?;
         let value: u32 = value.trim().parse().map_err(|_| bad())?;
+        if name.trim() == "direct" {
+            if value != 0 {
+                return Err(bad());
+            }
+            limits.no_direct = true;
+            continue;
+        }
         let field = match name.trim() {
             "records" => &mut limits.records,
             "tiles" => &mut limits.tiles,
             "blocks" => &mut limits.blocks,
             "groups" if value >= 1 => &mut limits.groups,
+            "small" if value <= MAX_SMALL_PIXELS => &mut limits.small,
             _ => return Err(bad()),
         };
         *field = Some(value);
@@ -179,6 +200,15 @@ impl TestLimits {
             capacity,
             self.groups.map_or(max_groups, |g| g.min(max_groups)),
         )
+    }
+    /// The setup shader's `list_capacity.w`: bit 0, setup lists the blocks of fan
+    /// triangles within 2×2 blocks; above it, the most pixels of a box it covers itself.
+    fn direct_paths(self) -> u32 {
+        if self.no_direct {
+            0
+        } else {
+            (self.small.unwrap_or(SMALL_PIXELS) << 1) | 1
+        }
     }
 }
 
@@ -312,7 +342,12 @@ pub(super) fn prepare_compute(
     );
     let list_capacity = init(
         "compute raster list capacity",
-        bytemuck::cast_slice(&[capacity.records, capacity.tiles, capacity.blocks, 0]),
+        bytemuck::cast_slice(&[
+            capacity.records,
+            capacity.tiles,
+            capacity.blocks,
+            test_limits.direct_paths(),
+        ]),
         wgpu::BufferUsages::UNIFORM,
     );
     let sides = init(
@@ -480,6 +515,8 @@ impl ComputeRasterPass {
             serial_triangles: 0,
             serial_tiles: 0,
             serial_blocks: 0,
+            small_triangles: 0,
+            block_triangles: 0,
         };
         for run in &self.runs {
             let bytes = read_buffer(&r.ctx.device, &r.ctx.queue, &run.counters)?;
@@ -490,6 +527,8 @@ impl ComputeRasterPass {
             report.serial_triangles += c[3];
             report.serial_tiles += c[4];
             report.serial_blocks += c[5];
+            report.small_triangles += c[6];
+            report.block_triangles += c[7];
         }
         Ok(report)
     }
@@ -550,9 +589,16 @@ mod tests {
                 records: Some(0),
                 tiles: None,
                 blocks: Some(7),
-                groups: Some(3)
+                groups: Some(3),
+                small: None,
+                no_direct: false,
             }
         );
+        assert_eq!(t.direct_paths(), (SMALL_PIXELS << 1) | 1);
+        let small = parse_test_limits("small=0").unwrap();
+        assert_eq!((small.small, small.direct_paths()), (Some(0), 1));
+        let off = parse_test_limits("direct=0,small=64").unwrap();
+        assert_eq!((off.no_direct, off.direct_paths()), (true, 0));
         let full = ListCapacity {
             records: 10,
             tiles: 20,
@@ -570,7 +616,14 @@ mod tests {
                 3
             )
         );
-        for bad in ["records", "tiles=x", "groups=0", "pixels=3"] {
+        for bad in [
+            "records",
+            "tiles=x",
+            "groups=0",
+            "pixels=3",
+            "direct=1",
+            "small=257",
+        ] {
             let e = parse_test_limits(bad).unwrap_err();
             assert!(e.contains(TEST_LIMITS_VAR) && e.contains(bad), "{e}");
         }
