@@ -7,7 +7,8 @@
 // pixel centre and shades it with the same material code and light loop as forward
 // shading. Ids: src/render/visibility_geometry.rs (NO_TRIANGLE where nothing was drawn).
 // Defines: SHADING_GROUP (the workgroup's side in pixels; 8 with STAGED_LIGHTS),
-// MEMBERS_FIRST and MEMBERS_COUNT (the group's entries in `shading_members`), CLEARS
+// MEMBERS_FIRST and MEMBERS_COUNT (the group's entries in `shading_members`), SHARED_CODE
+// (the group's code reads its constants from a buffer), CLEARS
 // (this dispatch stores black where nothing was drawn), CLASSIFIED with MATERIAL_SLOT and
 // TILES (the group's tiles are the workgroups: `material_tiles[MATERIAL_SLOT * TILES + n]`,
 // n from the workgroup id, folded into y past 65,535),
@@ -73,10 +74,11 @@
 #include "common/shadows.wgsl"
 #endif
 
-// Material code generated with WgslOptions::constants_binding (its constants read from
-// material_constants at material_constant_base, set here per pixel) and, when it has
-// textures, sample_grad: it samples with material_uv_ddx / material_uv_ddy, set by
-// surface_point before material_setup.
+// Material code generated with WgslOptions::sample_grad when it has textures (it samples
+// with material_uv_ddx / material_uv_ddy, set by surface_point before material_setup);
+// with SHARED_CODE (a group of several materials) also with constants_binding: its
+// per-pixel constants read from material_constants at material_constant_base, set here
+// per pixel. A group of one has its constants written into its code.
 #include <material>
 #include "common/light_loop.wgsl"
 #include "visibility/staged_lights.wgsl"
@@ -191,7 +193,9 @@ fn main(
     // any pixel of this group pays for the rebuild anyway.
     let shown = shading_members[select(MEMBERS_FIRST, member, shades)];
     let surface_tri = select(shown.x, tri, shades);
+#if SHARED_CODE
     material_constant_base = shown.z;
+#endif
 #if SHADOWS
     shadow_pixel = id.y * frame.size.x + id.x;
 #endif
@@ -238,7 +242,9 @@ fn main(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group
     if (member == NO_MEMBER) {
         return;
     }
+#if SHARED_CODE
     material_constant_base = shading_members[member].z;
+#endif
 #if SHADOWS
     shadow_pixel = id.y * frame.size.x + id.x;
 #endif

@@ -15,19 +15,15 @@ pub(crate) const CONSTANTS_BINDING: u32 = 20;
 
 /// The materials of `shaded` (indices into `materials`, ascending) in groups that one
 /// visibility-shading dispatch shades together, in the order of their first material,
-/// each ascending. With `share`, materials whose `shared_wgsl` is the same text (they
-/// differ only in constants) form one group; a textured material stays alone, as its
-/// textures are bound per dispatch. Without, every material is a group of its own.
-pub fn shared_code_groups(
-    materials: &[MaterialProgram],
-    shaded: &[usize],
-    share: bool,
-) -> Vec<Vec<usize>> {
+/// each ascending: materials whose `shared_wgsl` is the same text (they differ only in
+/// constants) form one group; a textured material stays alone, as its textures are bound
+/// per dispatch.
+pub fn shared_code_groups(materials: &[MaterialProgram], shaded: &[usize]) -> Vec<Vec<usize>> {
     let mut groups: Vec<Vec<usize>> = Vec::new();
     let mut by_code: std::collections::HashMap<&str, usize> = Default::default();
     for &i in shaded {
         let m = &materials[i];
-        let shares = share && m.textures.is_none();
+        let shares = m.textures.is_none();
         match by_code.get(m.shared_wgsl.as_str()) {
             Some(&g) if shares => groups[g].push(i),
             _ => {

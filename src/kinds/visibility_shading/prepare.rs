@@ -75,9 +75,21 @@ pub(super) fn prepare(
         cx.size.height.div_ceil(side),
         1,
     ];
-    let share = p.materials != MaterialDispatch::PerMaterial;
-    let shader_groups =
-        crate::render::materials::shared_code_groups(&cx.gpu.materials, &shaded, share);
+    // Which materials share their code decides each material's code (shared, with its
+    // constants from the buffer, or its own with them written in) whatever the dispatch
+    // mode, so the three modes run the same code and give the same bits; `PerMaterial`
+    // then gives each material its own dispatch.
+    let sharing = crate::render::materials::shared_code_groups(&cx.gpu.materials, &shaded);
+    let shares: std::collections::HashSet<usize> = sharing
+        .iter()
+        .filter(|g| g.len() > 1)
+        .flatten()
+        .copied()
+        .collect();
+    let shader_groups = match p.materials {
+        MaterialDispatch::PerMaterial => shaded.iter().map(|&i| vec![i]).collect(),
+        MaterialDispatch::PerShader | MaterialDispatch::Classified => sharing,
+    };
     let members = Members::new(&cx.gpu.materials, &shader_groups, &ranges);
     offer_members(cx, &members, &mut offered);
     let classified = p.materials == MaterialDispatch::Classified && shader_groups.len() > 1;
@@ -112,6 +124,14 @@ pub(super) fn prepare(
         if m.textures.is_some() {
             d.push(("MATERIAL_TEXTURED", "1".into()));
         }
+        // A material that shares its code with none keeps its constants in its code:
+        // literals let the compiler fold what they feed (harada pays nothing for grouping).
+        let code = if shares.contains(&group[0]) {
+            d.push(("SHARED_CODE", "1".into()));
+            m.shared_wgsl.clone()
+        } else {
+            m.wgsl_for_compute().to_string()
+        };
         d.extend(lists.define());
         d.extend(loop_define(light_loop));
         d.extend(crate::render::draws::shadow_defines(shadows));
@@ -125,7 +145,7 @@ pub(super) fn prepare(
         let key = PipelineKey {
             shader: "visibility/visibility_shading.wgsl".into(),
             defines: defines(&d),
-            virtual_code: BTreeMap::from([("material".to_string(), m.shared_wgsl.clone())]),
+            virtual_code: BTreeMap::from([("material".to_string(), code)]),
             state: String::new(),
         };
         let label = match group.len() {
