@@ -172,12 +172,29 @@ fn render_plot(
     Ok(())
 }
 
-/// Plot median frame time (p10–p90 bars) against light count (log x), one line per technique.
-pub fn plot_time_vs_lights(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(), ReportError> {
+/// Whether `rows` hold more than one scene: each scene's points are then series of their
+/// own, so no line joins points of two scenes.
+fn several_scenes(rows: &[BenchRow]) -> bool {
+    rows.iter().any(|r| r.scene != rows[0].scene)
+}
+
+/// A row's series name: its technique, after its scene where the rows hold several.
+fn series_name(r: &BenchRow, several_scenes: bool) -> String {
+    if several_scenes {
+        format!("{}: {}", r.scene, r.technique)
+    } else {
+        r.technique.clone()
+    }
+}
+
+/// The series of frame time against light count: one per technique (per scene and
+/// technique where the rows hold several scenes), each sorted by light count.
+fn time_vs_lights_series(rows: &[BenchRow]) -> Series {
+    let scenes = several_scenes(rows);
     let mut series: BTreeMap<String, Vec<Point>> = BTreeMap::new();
     for r in rows.iter().filter(|r| r.light_count > 0) {
         if let Some(t) = r.frame_ms {
-            series.entry(r.technique.clone()).or_default().push((
+            series.entry(series_name(r, scenes)).or_default().push((
                 r.light_count as f64,
                 t.median,
                 t.p10,
@@ -185,13 +202,19 @@ pub fn plot_time_vs_lights(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<
             ));
         }
     }
-    let series: Series = series
+    series
         .into_iter()
         .map(|(name, mut points)| {
             points.sort_by(|a, b| a.0.total_cmp(&b.0));
             (name, points)
         })
-        .collect();
+        .collect()
+}
+
+/// Plot median frame time (p10–p90 bars) against light count (log x), one line per technique
+/// (and scene, where the rows hold several).
+pub fn plot_time_vs_lights(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(), ReportError> {
+    let series = time_vs_lights_series(rows);
     render_plot(
         path.as_ref(),
         "Frame time vs light count",
@@ -204,8 +227,9 @@ pub fn plot_time_vs_lights(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<
 /// Plot median frame time (p10–p90 bars) against RMSE (linear x from 0; rows without RMSE are
 /// left out), one series per technique, points joined in order of RMSE (a parameter sweep then
 /// draws its time/error trade-off curve). If the rows hold several light counts, each
-/// (technique, light count) pair is its own series, labelled `technique @ N lights`, so points
-/// of different scene sizes are never joined.
+/// (technique, light count) pair is its own series, labelled `technique @ N lights`, and
+/// several scenes put the scene before it, so points of different scenes or sizes are
+/// never joined.
 pub fn plot_time_vs_error(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(), ReportError> {
     let with_error = || {
         rows.iter()
@@ -213,11 +237,12 @@ pub fn plot_time_vs_error(path: impl AsRef<Path>, rows: &[BenchRow]) -> Result<(
     };
     let first_count = with_error().next().map(|r| r.light_count);
     let several_counts = with_error().any(|r| Some(r.light_count) != first_count);
+    let scenes = several_scenes(rows);
     let mut series: BTreeMap<(String, u32), Vec<Point>> = BTreeMap::new();
     for r in with_error() {
         if let (Some(e), Some(t)) = (r.rmse, r.frame_ms) {
             let key = (
-                r.technique.clone(),
+                series_name(r, scenes),
                 if several_counts { r.light_count } else { 0 },
             );
             series
@@ -346,7 +371,65 @@ pub fn plot_time_vs_error_points(
 
 #[cfg(test)]
 mod tests {
-    use super::{axis_label, family};
+    use super::{axis_label, family, time_vs_lights_series};
+    use crate::bench::report::{BenchRow, TimingSummary};
+
+    fn row(scene: &str, technique: &str, lights: u32, ms: f64) -> BenchRow {
+        BenchRow {
+            scene: scene.into(),
+            technique: technique.into(),
+            light_count: lights,
+            frame_ms: Some(TimingSummary {
+                median: ms,
+                p10: ms,
+                p90: ms,
+            }),
+            ..Default::default()
+        }
+    }
+
+    /// A sweep over two scenes draws each scene's light-count curve apart: a line that
+    /// joined the gallery's 1,024-light point to the chairs' would be no curve at all.
+    #[test]
+    fn each_scene_has_its_own_light_count_curves() {
+        let mut rows = Vec::new();
+        for (scene, ms) in [("gallery", 1.0), ("chairs", 2.0)] {
+            for technique in ["exact", "sampled"] {
+                for lights in [4096, 1024] {
+                    rows.push(row(scene, technique, lights, ms + f64::from(lights) / 1e4));
+                }
+            }
+        }
+        let series = time_vs_lights_series(&rows);
+        let names: Vec<&str> = series.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "chairs: exact",
+                "chairs: sampled",
+                "gallery: exact",
+                "gallery: sampled"
+            ]
+        );
+        for (name, points) in &series {
+            let xs: Vec<f64> = points.iter().map(|p| p.0).collect();
+            assert_eq!(xs, [1024.0, 4096.0], "{name}");
+            let base = if name.starts_with("chairs") { 2.0 } else { 1.0 };
+            assert!(
+                points
+                    .iter()
+                    .all(|p| (p.1 - base - p.0 / 1e4).abs() < 1e-12),
+                "{name}"
+            );
+        }
+        // One scene: the techniques alone name the series.
+        let one: Vec<BenchRow> = rows.into_iter().filter(|r| r.scene == "gallery").collect();
+        let names: Vec<String> = time_vs_lights_series(&one)
+            .into_iter()
+            .map(|(n, _)| n)
+            .collect();
+        assert_eq!(names, ["exact", "sampled"]);
+    }
 
     #[test]
     fn sample_counts_are_dropped_from_the_series_name() {
