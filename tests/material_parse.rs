@@ -371,6 +371,13 @@ fn materials_that_differ_only_in_constants_share_their_code() {
     let other_ior = text.replace("ior: Some(1.5)", "ior: Some(1.4)");
     let d = Material::parse(&other_ior, "d.ron").unwrap();
     assert_ne!(d.wgsl_with_constants(&opts).unwrap().0, code_a);
+    // What only the rasterizing passes read is left out, so sidedness and the alpha
+    // cutoff do not split a group; a material's own code keeps them.
+    assert!(!code_a.contains("MATERIAL_DOUBLE_SIDED") && !code_a.contains("MATERIAL_ALPHA_CUTOFF"));
+    assert!(a
+        .wgsl()
+        .unwrap()
+        .contains("const MATERIAL_DOUBLE_SIDED: bool = false;"));
     // Literal code is unchanged: the material's own constants written in.
     assert!(a.wgsl().unwrap().contains("0.5"));
     let two_lobes = text.replace(

@@ -39,13 +39,18 @@ pub struct WgslOptions {
     /// material's pipelines. Standalone code (validation, `material --wgsl`, tests)
     /// leaves it off.
     pub include_library: bool,
-    /// Read the material's constants (colours, roughness, weights, scales, IORs) from a
-    /// storage buffer instead of writing them into the code: `Some(b)` declares
+    /// Read the material's per-pixel constants (colours, roughness, metalness, emission,
+    /// alpha, texture and normal scales) from a storage buffer instead of writing them
+    /// into the code: `Some(b)` declares
     /// `material_constants` (`array<f32>`) at `@group(0) @binding(b)` and a private
     /// `material_constant_base` the including shader sets to the material's first
     /// constant before `material_setup`. Materials that differ only in their constants
     /// then generate the same code, so one pipeline and one dispatch shade them all
-    /// (visibility shading); [`generate_with_constants`] returns the values.
+    /// (visibility shading); [`generate_with_constants`] returns the values. Such code
+    /// declares neither `MATERIAL_ALPHA_CUTOFF` nor `MATERIAL_DOUBLE_SIDED` (only the
+    /// rasterizing passes read them, with a material's own code), so materials that
+    /// differ only in alpha cutoff or sidedness share it too. `material_eval`'s constants
+    /// stay literals.
     pub constants_binding: Option<u32>,
 }
 
@@ -226,12 +231,18 @@ pub(crate) fn generate_with_constants(m: &Material, opts: &WgslOptions) -> (Stri
         AlphaMode::Mask(c) => c,
         _ => 0.0,
     };
-    let _ = writeln!(o, "const MATERIAL_ALPHA_CUTOFF: f32 = {};", lit(cutoff));
-    let _ = writeln!(
-        o,
-        "const MATERIAL_DOUBLE_SIDED: bool = {};\n",
-        desc.double_sided
-    );
+    // Shared code leaves out what only the rasterizing passes read (the alpha test's
+    // cutoff, the faces drawn): visibility shading, which takes it, reads neither, so
+    // materials that differ only in them share their code.
+    if g.constants.is_none() {
+        let _ = writeln!(o, "const MATERIAL_ALPHA_CUTOFF: f32 = {};", lit(cutoff));
+        let _ = writeln!(
+            o,
+            "const MATERIAL_DOUBLE_SIDED: bool = {};",
+            desc.double_sided
+        );
+    }
+    o.push('\n');
 
     // MaterialSample: frame, view, and the resolved parameters of every lobe.
     o.push_str("struct MaterialSample {\n    n: vec3<f32>,\n    ng: vec3<f32>,\n    t: vec3<f32>,\n    b: vec3<f32>,\n    v: vec3<f32>,\n    emission: vec3<f32>,\n    alpha: f32,\n    occlusion: f32,\n");
