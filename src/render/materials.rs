@@ -16,25 +16,40 @@ pub(crate) const CONSTANTS_BINDING: u32 = 20;
 /// The materials of `shaded` (indices into `materials`, ascending) in groups that one
 /// visibility-shading dispatch shades together, in the order of their first material,
 /// each ascending: materials whose `shared_wgsl` is the same text (they differ only in
-/// constants) form one group; a textured material stays alone, as its textures are bound
-/// per dispatch.
+/// constants) and whose textures are the same images through the same samplers (none,
+/// or glTF materials that read one texture with other factors) form one group; a
+/// dispatch binds one material's textures.
 pub fn shared_code_groups(materials: &[MaterialProgram], shaded: &[usize]) -> Vec<Vec<usize>> {
     let mut groups: Vec<Vec<usize>> = Vec::new();
-    let mut by_code: std::collections::HashMap<&str, usize> = Default::default();
+    let mut by_code: std::collections::HashMap<(&str, Option<&str>), usize> = Default::default();
     for &i in shaded {
         let m = &materials[i];
-        let shares = m.textures.is_none();
-        match by_code.get(m.shared_wgsl.as_str()) {
-            Some(&g) if shares => groups[g].push(i),
-            _ => {
-                if shares {
-                    by_code.insert(&m.shared_wgsl, groups.len());
-                }
+        let key = (m.shared_wgsl.as_str(), m.texture_key.as_deref());
+        match by_code.get(&key) {
+            Some(&g) => groups[g].push(i),
+            None => {
+                by_code.insert(key, groups.len());
                 groups.push(vec![i]);
             }
         }
     }
     groups
+}
+
+/// Each texture slot's image (a file and its encoding, or the decoded image itself:
+/// a glTF importer hands materials that read one image the same one) and sampler.
+fn texture_key(slots: &[crate::material::TextureSlot]) -> String {
+    slots
+        .iter()
+        .map(|slot| {
+            let image = match &slot.source {
+                TextureSource::File { path, srgb } => format!("{}:{srgb}", path.display()),
+                TextureSource::Image(image) => format!("{:p}", std::sync::Arc::as_ptr(image)),
+            };
+            format!("{}={image}/{:?}", slot.binding, slot.sampler)
+        })
+        .collect::<Vec<_>>()
+        .join(";")
 }
 
 /// One scene material compiled for the GPU: its generated WGSL, its textures uploaded and
@@ -55,6 +70,10 @@ pub struct MaterialProgram {
     pub shared_wgsl: String,
     /// The constants `shared_wgsl` reads, in its order.
     pub constants: Vec<f32>,
+    /// What the textures are (each slot's image and sampler): materials whose shared code
+    /// and textures are the same can share one dispatch and its bind group. None
+    /// without textures.
+    pub texture_key: Option<String>,
     /// How the material blends: opaque, alpha-masked or blended.
     pub alpha_mode: AlphaMode,
     /// Whether back faces are drawn (and lit) too.
@@ -98,6 +117,7 @@ impl MaterialProgram {
                 constants_binding: Some(CONSTANTS_BINDING),
                 ..Default::default()
             })?;
+        let texture_key = (!slots.is_empty()).then(|| texture_key(&slots));
         // Offered by the names the generated WGSL declares (`material_sampler`,
         // `material_tex{i}`); the layout comes from reflecting the composed shader.
         let mut texture_bytes = 0u64;
@@ -184,6 +204,7 @@ impl MaterialProgram {
             compute_wgsl,
             shared_wgsl,
             constants,
+            texture_key,
             alpha_mode,
             double_sided,
             textures,
