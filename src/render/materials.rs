@@ -117,7 +117,7 @@ impl MaterialProgram {
                 constants_binding: Some(CONSTANTS_BINDING),
                 ..Default::default()
             })?;
-        let texture_key = (!slots.is_empty()).then(|| texture_key(&slots));
+        let texture_key = (!slots.is_empty()).then(|| texture_key(slots));
         // Offered by the names the generated WGSL declares (`material_sampler`,
         // `material_tex{i}`); the layout comes from reflecting the composed shader.
         let mut texture_bytes = 0u64;
