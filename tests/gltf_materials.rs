@@ -768,3 +768,39 @@ fn ron_material_textures_take_a_sampler_and_a_transform() {
         "{code}"
     );
 }
+
+/// Materials that read one image share its GPU copy: AlphaBlendModeTest's glass and four
+/// label materials read one image, uploaded once (by the first of them in the scene's
+/// order), the others binding that copy; the bed's own three textures are uploaded for
+/// it.
+#[test]
+fn materials_that_read_one_image_upload_it_once() {
+    let r = renderer();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let path = root.join("tests/assets/khronos/AlphaBlendModeTest/AlphaBlendModeTest.gltf");
+    let s = scene::load(&path).unwrap().scene;
+    let programs =
+        lightgraph::render::MaterialProgram::for_scene(&r.ctx.device, &r.ctx.queue, &s).unwrap();
+    let bytes = |name: &str| {
+        programs
+            .iter()
+            .find(|p| p.name == name)
+            .unwrap_or_else(|| panic!("material {name}"))
+            .texture_bytes
+    };
+    assert!(bytes("MatBed") > 0);
+    let labels = [
+        "MatBlend",
+        "MatCutoff25",
+        "MatCutoff75",
+        "MatCutoffDefault",
+        "MatOpaque",
+    ];
+    let uploaded: Vec<u64> = labels.iter().map(|n| bytes(n)).filter(|&b| b > 0).collect();
+    assert_eq!(
+        uploaded.len(),
+        1,
+        "the labels uploaded {} times",
+        uploaded.len()
+    );
+}

@@ -179,9 +179,12 @@ fn upload_scene(
     }
     let mut programs = Vec::new();
     let mut files = Vec::new();
+    // Materials that read one image share its GPU copy.
+    let mut uploads = crate::render::materials::TextureUploads::default();
     for surface in &scene.materials {
-        let (program, used) = MaterialProgram::for_surface(device, queue, scene, surface)
-            .map_err(|e| e.to_string())?;
+        let (program, used) =
+            MaterialProgram::for_surface(device, queue, scene, surface, &mut uploads)
+                .map_err(|e| e.to_string())?;
         if !used.is_empty() {
             files.push((surface.name.clone(), used));
         }
@@ -443,9 +446,17 @@ impl ReloadSession {
                     if surface.name != name {
                         continue;
                     }
-                    let (program, used) =
-                        MaterialProgram::for_surface(&device, &queue, &self.scene, surface)
-                            .map_err(|e| e.to_string())?;
+                    // A reloaded material uploads its textures afresh (its files may
+                    // have changed).
+                    let mut uploads = crate::render::materials::TextureUploads::default();
+                    let (program, used) = MaterialProgram::for_surface(
+                        &device,
+                        &queue,
+                        &self.scene,
+                        surface,
+                        &mut uploads,
+                    )
+                    .map_err(|e| e.to_string())?;
                     gpu.get_or_insert_with(|| self.gpu.clone()).materials[i] = program;
                     files = used;
                 }

@@ -36,17 +36,33 @@ pub fn shared_code_groups(materials: &[MaterialProgram], shaded: &[usize]) -> Ve
     groups
 }
 
-/// Each texture slot's image (a file and its encoding, or the decoded image itself:
-/// a glTF importer hands materials that read one image the same one) and sampler.
+/// Which image a texture slot reads: a file and its encoding, or the decoded image itself
+/// (a glTF importer hands materials that read one image the same one).
+fn image_key(source: &TextureSource) -> String {
+    match source {
+        TextureSource::File { path, srgb } => format!("{}:{srgb}", path.display()),
+        TextureSource::Image(image) => format!("{:p}", std::sync::Arc::as_ptr(image)),
+    }
+}
+
+/// The GPU textures uploaded for a scene's materials, by [`image_key`]: materials that
+/// read one image share one copy.
+#[derive(Default)]
+pub(crate) struct TextureUploads {
+    views: std::collections::HashMap<String, wgpu::TextureView>,
+}
+
+/// Each texture slot's image ([`image_key`]) and sampler.
 fn texture_key(slots: &[crate::material::TextureSlot]) -> String {
     slots
         .iter()
         .map(|slot| {
-            let image = match &slot.source {
-                TextureSource::File { path, srgb } => format!("{}:{srgb}", path.display()),
-                TextureSource::Image(image) => format!("{:p}", std::sync::Arc::as_ptr(image)),
-            };
-            format!("{}={image}/{:?}", slot.binding, slot.sampler)
+            format!(
+                "{}={}/{:?}",
+                slot.binding,
+                image_key(&slot.source),
+                slot.sampler
+            )
         })
         .collect::<Vec<_>>()
         .join(";")
@@ -80,7 +96,8 @@ pub struct MaterialProgram {
     pub double_sided: bool,
     /// Group 2's sampler and textures by binding name; None without textures.
     pub(super) textures: Option<BindingSet>,
-    /// GPU bytes of the material's textures, every mip level included (4/3 of level 0).
+    /// GPU bytes of the textures this material uploaded, every mip level included (4/3 of
+    /// level 0); an image an earlier material of the scene uploaded counts there only.
     pub texture_bytes: u64,
     /// Whether shading reads the uv or the tangent ([`Material::reads_uv_or_tangent`]).
     pub reads_uv_or_tangent: bool,
@@ -100,6 +117,28 @@ impl MaterialProgram {
         material: &Material,
         alpha_mode: AlphaMode,
         double_sided: bool,
+    ) -> Result<Self, MaterialError> {
+        let mut uploads = TextureUploads::default();
+        Self::new_sharing(
+            device,
+            queue,
+            material,
+            alpha_mode,
+            double_sided,
+            &mut uploads,
+        )
+    }
+
+    /// [`Self::new`], with the textures that `uploads` already holds (an image another
+    /// material of the scene read) bound instead of uploaded again; those it uploads
+    /// are added.
+    pub(crate) fn new_sharing(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        material: &Material,
+        alpha_mode: AlphaMode,
+        double_sided: bool,
+        uploads: &mut TextureUploads,
     ) -> Result<Self, MaterialError> {
         let wgsl = material.renderer_wgsl(&Default::default())?;
         let slots = material.texture_slots();
@@ -136,6 +175,12 @@ impl MaterialProgram {
                 );
             }
             for (i, slot) in slots.iter().enumerate() {
+                let name = format!("material_tex{i}");
+                let key = image_key(&slot.source);
+                if let Some(view) = uploads.views.get(&key) {
+                    set.offer(&name, Bound::View(view.clone()));
+                    continue;
+                }
                 let image = slot.source.load()?;
                 let max = device.limits().max_texture_dimension_2d;
                 let fitted = super::texture_fit::fit_to_device(&image, max, material.path())
@@ -191,10 +236,9 @@ impl MaterialProgram {
                     wgpu::util::TextureDataOrder::LayerMajor,
                     &chain.rgba8,
                 );
-                set.offer(
-                    &format!("material_tex{i}"),
-                    Bound::View(texture.create_view(&Default::default())),
-                );
+                let view = texture.create_view(&Default::default());
+                uploads.views.insert(key, view.clone());
+                set.offer(&name, Bound::View(view));
             }
             Some(set)
         };
@@ -226,9 +270,12 @@ impl MaterialProgram {
         } else {
             &scene.materials[..]
         };
+        let mut uploads = TextureUploads::default();
         surfaces
             .iter()
-            .map(|surface| Self::for_surface(device, queue, scene, surface).map(|(p, _)| p))
+            .map(|surface| {
+                Self::for_surface(device, queue, scene, surface, &mut uploads).map(|(p, _)| p)
+            })
             .collect()
     }
 
@@ -239,6 +286,7 @@ impl MaterialProgram {
         queue: &wgpu::Queue,
         scene: &Scene,
         surface: &SurfaceMaterial,
+        uploads: &mut TextureUploads,
     ) -> Result<(Self, Vec<PathBuf>), MaterialError> {
         let (material, files) = match override_path(scene, &surface.name) {
             Some(path) => {
@@ -258,12 +306,13 @@ impl MaterialProgram {
             }
             None => (Material::from_surface(surface), Vec::new()),
         };
-        let program = Self::new(
+        let program = Self::new_sharing(
             device,
             queue,
             &material,
             surface.alpha_mode,
             surface.double_sided,
+            uploads,
         )?;
         Ok((program, files))
     }
