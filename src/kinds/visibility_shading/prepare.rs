@@ -1,10 +1,14 @@
-//! `VisibilityShading`: one compute dispatch per material with triangles, rebuilding each
-//! pixel's surface from its triangle id (shaders/visibility/visibility_shading.wgsl).
-//! Textured materials sample with explicit derivatives (`MaterialProgram::compute_wgsl`)
-//! and bind their textures in group 2. With `materials: Classified` and more than one
-//! material a classification dispatch first lists every tile under the materials it
-//! holds (shaders/visibility/classify_materials.wgsl) and each material's dispatch is
-//! indirect, over its own tiles; otherwise each covers the whole frame. A read
+//! `VisibilityShading`: one compute dispatch per group of materials that share their code
+//! (`render::materials::shared_code_groups`: the same shared code and, if textured, the
+//! same images; `PerMaterial` splits the groups into one dispatch a material), rebuilding
+//! each pixel's surface from its triangle id (shaders/visibility/visibility_shading.wgsl)
+//! and finding its material among the group's (`shading_members`). A material in a group
+//! of several runs `MaterialProgram::shared_wgsl`, its per-pixel constants read from
+//! `material_constants`; one alone runs its own code. Textured materials sample with
+//! explicit derivatives and bind their textures in group 2. With `materials: Classified`
+//! and more than one group a classification dispatch first lists every tile under the
+//! groups it holds (shaders/visibility/classify_materials.wgsl) and each group's
+//! dispatch is indirect, over its own tiles; otherwise each covers the whole frame. A read
 //! `shadow_mask` shadows the casters (`SHADOWS`, `SHADOW_MASK`), a read `shadow_atlas`
 //! with its `shadow_views` samples their maps (`SHADOW_ATLAS`, as forward shading).
 
