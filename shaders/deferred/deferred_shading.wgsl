@@ -1,14 +1,17 @@
-// Deferred shading in a compute shader: one dispatch per material over the whole frame;
-// each invocation shades the pixel if the G-buffer holds this material there, with the
-// same material code and light loop as forward shading. On GPUs where few SMs run
+// Deferred shading in a compute shader: one dispatch per group of materials that share
+// their code (one per material with a multisampled G-buffer) over the whole frame; each
+// invocation shades the pixel if the G-buffer holds one of the group's materials there,
+// with the same material code and light loop as forward shading. On GPUs where few SMs run
 // fragment work (GH100) this is where the lighting throughput is.
 // With G_PACKED the G-buffer is one texture: view depth, octahedral normal, material;
 // the position is rebuilt on the pixel's view ray.
 // With G_SURFACE the G-buffer also holds the material's surface (deferred/g_surface.wgsl:
 // uv and tangent) and the uv's screen derivatives, which textured materials
 // (MATERIAL_TEXTURED, code generated with explicit derivatives) sample with.
-// Defines: MATERIAL_INDEX, LIGHT_LISTS (tile lists) or LINKED_LISTS (a light linked
-// list), G_PACKED, G_SAMPLES (a multisampled G-buffer of that many samples: the main of
+// Defines: GROUP_INDEX (the group: `material_groups` gives each material's group and
+// first constant; SHARED_CODE where the group's code reads its constants from
+// `material_constants`) or, with G_SAMPLES, MATERIAL_INDEX; LIGHT_LISTS (tile lists) or
+// LINKED_LISTS (a light linked list), G_PACKED, G_SAMPLES (a multisampled G-buffer of that many samples: the main of
 // deferred/deferred_msaa.wgsl), SHADOWS with SHADOW_MASK (ray-cast shadows from
 // shadow/shadow_ray_cast.wgsl) or SHADOW_ATLAS (a ShadowAtlas pass's maps),
 // VPL_VISIBILITY (VPLs hidden from the pixel's block add nothing: indirect/vpl_lookup.wgsl).
@@ -18,6 +21,11 @@
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 #include "common/light_inputs.wgsl"
+#if G_SAMPLES
+#else
+// Per material index: (its group, its first constant in material_constants).
+@group(0) @binding(15) var<storage, read> material_groups: array<vec2<u32>>;
+#endif
 #if G_SAMPLES
 // A multisampled G-buffer (see deferred/deferred_msaa.wgsl): `hdr` holds partial sums
 // between the materials' dispatches.
@@ -115,15 +123,19 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let g = textureLoad(g_position, id.xy, 0);
     let here = i32(round(g.w));
     if (here < 0) {
-        // Nothing drawn: the first material's dispatch clears the pixel.
-        if (MATERIAL_INDEX == 0) {
+        // Nothing drawn: the first group's dispatch clears the pixel.
+        if (GROUP_INDEX == 0u) {
             textureStore(hdr, id.xy, vec4<f32>(0.0));
         }
         return;
     }
-    if (here != MATERIAL_INDEX) {
+    let group = material_groups[u32(here)];
+    if (group.x != GROUP_INDEX) {
         return;
     }
+#if SHARED_CODE
+    material_constant_base = group.y;
+#endif
     var p: ShadingPoint;
 #if G_PACKED
     p.position = position_on_view_ray(vec2<f32>(id.xy) + 0.5, g.x);

@@ -1,6 +1,9 @@
-//! `DeferredShading`: one compute dispatch per material over the frame, reading the
-//! G-buffer and storing lit colour; from a multisampled G-buffer, the mean of every
-//! sample's colour (shaders/deferred/deferred_msaa.wgsl). Textured materials sample
+//! `DeferredShading`: one compute dispatch per group of materials that share their code
+//! (`render::materials::shared_code_groups`, as visibility shading groups them) over the
+//! frame, reading the G-buffer and storing lit colour; each pixel's material index finds
+//! its group and first constant in `material_groups`. From a multisampled G-buffer, one
+//! dispatch per material, the mean of every sample's colour
+//! (shaders/deferred/deferred_msaa.wgsl, which orders samples by material index). Textured materials sample
 //! their textures at the G-buffer's uv with its uv derivatives (group 2, as visibility
 //! shading binds them).
 
@@ -72,16 +75,43 @@ pub(super) fn prepare(
             ));
         }
     }
+    if let Some(m) = cx
+        .gpu
+        .materials
+        .iter()
+        .find(|m| m.reads_uv_or_tangent && !surface)
+    {
+        return Err(pass_error(
+            &sp.name,
+            format!("material '{}' has textures: its G-buffer needs the surface targets '{G_SURFACE}' and 'g_uv_grad' (uv, tangent and uv derivatives), which this pass does not read", m.name),
+        ));
+    }
+    let all: Vec<usize> = (0..cx.gpu.materials.len()).collect();
+    // The multisampled shader sums samples material by material: one dispatch each.
+    let groups = if msaa {
+        all.iter().map(|&i| vec![i]).collect()
+    } else {
+        let groups = crate::render::materials::shared_code_groups(&cx.gpu.materials, &all);
+        offer_material_groups(cx, &groups, &mut offered);
+        groups
+    };
     let mut dispatches = Vec::new();
-    for (index, m) in cx.gpu.materials.iter().enumerate() {
+    for (slot, group) in groups.iter().enumerate() {
+        let m = &cx.gpu.materials[group[0]];
         let textured = m.textures.is_some();
-        if m.reads_uv_or_tangent && !surface {
-            return Err(pass_error(
-                &sp.name,
-                format!("material '{}' has textures: its G-buffer needs the surface targets '{G_SURFACE}' and 'g_uv_grad' (uv, tangent and uv derivatives), which this pass does not read", m.name),
-            ));
-        }
-        let mut d = vec![("MATERIAL_INDEX", index.to_string())];
+        let mut d = if msaa {
+            vec![("MATERIAL_INDEX", group[0].to_string())]
+        } else {
+            vec![("GROUP_INDEX", format!("{slot}u"))]
+        };
+        // A group of several runs the shared code (constants from the buffer); a
+        // material alone its own code.
+        let code = if group.len() > 1 {
+            d.push(("SHARED_CODE", "1".into()));
+            m.shared_wgsl.clone()
+        } else {
+            m.wgsl_for_compute().to_string()
+        };
         if packed {
             d.push(("G_PACKED", "1".into()));
         }
@@ -100,13 +130,18 @@ pub(super) fn prepare(
         let key = PipelineKey {
             shader: "deferred/deferred_shading.wgsl".into(),
             defines: defines(&d),
-            virtual_code: BTreeMap::from([(
-                "material".to_string(),
-                m.wgsl_for_compute().to_string(),
-            )]),
+            virtual_code: BTreeMap::from([("material".to_string(), code)]),
             state: String::new(),
         };
-        let label = format!("{} (material '{}')", sp.name, m.name);
+        let label = match group.len() {
+            1 => format!("{} (material '{}')", sp.name, m.name),
+            n => format!(
+                "{} (material '{}' and {} sharing its code)",
+                sp.name,
+                m.name,
+                n - 1
+            ),
+        };
         let (pipeline, bind, textures) =
             cx.compute_pipeline_with_material(&label, key, "main", &offered, m.textures.as_ref())?;
         dispatches.push(ShadeDispatch {
@@ -120,6 +155,45 @@ pub(super) fn prepare(
         dispatches,
         groups: [cx.size.width.div_ceil(8), cx.size.height.div_ceil(8), 1],
     })
+}
+
+/// Offers `material_groups` (per material index: its group and first constant) and
+/// `material_constants` (every material's shared-code constants) to the dispatches.
+fn offer_material_groups(
+    cx: &PrepareCtx,
+    groups: &[Vec<usize>],
+    offered: &mut crate::render::bind::BindingSet,
+) {
+    let materials = &cx.gpu.materials;
+    let mut table = vec![[0u32; 2]; materials.len().max(1)];
+    let mut constants: Vec<f32> = Vec::new();
+    for (g, group) in groups.iter().enumerate() {
+        for &i in group {
+            table[i] = [g as u32, constants.len() as u32];
+            constants.extend_from_slice(&materials[i].constants);
+        }
+    }
+    // A binding is never empty.
+    if constants.is_empty() {
+        constants.push(0.0);
+    }
+    let device = cx.device();
+    let usage = wgpu::BufferUsages::empty();
+    let storage = crate::render::scene_gpu::storage_buffer;
+    let table = storage(
+        &device,
+        "material groups",
+        bytemuck::cast_slice(&table),
+        usage,
+    );
+    let constants = storage(
+        &device,
+        "material constants",
+        bytemuck::cast_slice(&constants),
+        usage,
+    );
+    offered.buffer("material_groups", &table);
+    offered.buffer("material_constants", &constants);
 }
 
 impl PreparedPass for DeferredShadingPass {
