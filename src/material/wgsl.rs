@@ -46,7 +46,7 @@ pub struct WgslOptions {
     /// `material_constant_base` the including shader sets to the material's first
     /// constant before `material_setup`. Materials that differ only in their constants
     /// then generate the same code, so one pipeline and one dispatch shade them all
-    /// (visibility shading); [`generate_with_constants`] returns the values. Such code
+    /// (visibility shading); `Material::wgsl_with_constants` returns the values. Such code
     /// declares neither `MATERIAL_ALPHA_CUTOFF` nor `MATERIAL_DOUBLE_SIDED` (only the
     /// rasterizing passes read them, with a material's own code), so materials that
     /// differ only in alpha cutoff or sidedness share it too. `material_eval`'s constants

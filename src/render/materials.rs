@@ -80,7 +80,7 @@ pub struct MaterialProgram {
     /// `WgslOptions::sample_grad`); None when `wgsl` has no textures, so serves as is.
     pub compute_wgsl: Option<String>,
     /// The compute code with its constants read from a buffer (`WgslOptions::
-    /// constants_binding` at [`CONSTANTS_BINDING`]): the same text for every material
+    /// constants_binding` at `CONSTANTS_BINDING`): the same text for every material
     /// that differs from this one only in its constants, so visibility shading shades
     /// them in one dispatch.
     pub shared_wgsl: String,

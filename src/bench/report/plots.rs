@@ -290,7 +290,7 @@ fn family(technique: &str) -> String {
 /// of a stochastic graph without the luck of one frame. Both axes are logarithmic (errors
 /// and times span decades: the atlas beside one-sample frames); errors of 0 or below are
 /// drawn at the left edge, a third of the smallest positive one. Graphs that differ
-/// only in a `k<N>` token of their name form one series ([`family`]), joined in order of
+/// only in a `k<N>` token of their name form one series (`family`), joined in order of
 /// error: a sample-count sweep draws its trade-off curve. Where the rows hold several
 /// scenes or light counts, those are part of the series, as in [`plot_time_vs_error`].
 pub fn plot_time_vs_seed_error(

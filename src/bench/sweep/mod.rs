@@ -71,7 +71,7 @@ pub struct Sweep {
     /// The spread over seeds: each graph's frame is rendered this many more times with
     /// other seeds (passes that take one, `LightSampling`, get seed + 1 ..= seed + S;
     /// other graphs render the same frame again), and the row gets the sample variance
-    /// and squared bias over them on rel_mse's scale ([`crate::bench::seed_spread`]).
+    /// and squared bias over them on rel_mse's scale ([`crate::bench::seed_spread()`]).
     /// 0, the default, is off; else 2..=[`MAX_SEEDS`]. Needs a reference image; not with
     /// `animate`.
     #[serde(default)]

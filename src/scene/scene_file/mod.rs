@@ -48,7 +48,7 @@ pub(crate) use build::load_scene_file;
 pub(crate) const MAX_SCENE_LIGHTS: u64 = 1 << 20;
 
 /// A scene file (`scenes/*.ron`, written `Scene(...)`) as parsed; [`build_scene`] turns it
-/// into a [`Scene`]. docs/format.md describes every field.
+/// into a [`Scene`](crate::scene::Scene). docs/format.md describes every field.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, rename = "Scene")]
 pub struct SceneFile {
