@@ -36,6 +36,55 @@ pub fn shared_code_groups(materials: &[MaterialProgram], shaded: &[usize]) -> Ve
     groups
 }
 
+/// The constants of a pass's shading groups in one buffer (`material_constants`, where
+/// `shared_wgsl` reads them) and where each material's begin: one table for visibility
+/// and deferred shading.
+pub(crate) struct GroupConstants {
+    /// Per material index: its first constant (0 for a material in no group).
+    pub first: Vec<u32>,
+    /// Every grouped material's constants, group by group.
+    pub values: Vec<f32>,
+}
+
+impl GroupConstants {
+    pub(crate) fn new(materials: &[MaterialProgram], groups: &[Vec<usize>]) -> Self {
+        let mut first = vec![0u32; materials.len()];
+        let mut values = Vec::new();
+        for &i in groups.iter().flatten() {
+            first[i] = values.len() as u32;
+            values.extend_from_slice(&materials[i].constants);
+        }
+        Self { first, values }
+    }
+
+    /// Offers the constants as `material_constants` (one zero where there are none: a
+    /// binding is never empty).
+    pub(in crate::render) fn offer(&self, device: &wgpu::Device, offered: &mut BindingSet) {
+        let values: &[f32] = if self.values.is_empty() {
+            &[0.0]
+        } else {
+            &self.values
+        };
+        let buffer = super::scene_gpu::storage_buffer(
+            device,
+            "material constants",
+            bytemuck::cast_slice(values),
+            wgpu::BufferUsages::empty(),
+        );
+        offered.buffer("material_constants", &buffer);
+    }
+}
+
+/// The pipeline label of a shading group's dispatch in pass `pass`: its first material,
+/// and how many more share its code.
+pub(crate) fn group_label(pass: &str, materials: &[MaterialProgram], group: &[usize]) -> String {
+    let name = &materials[group[0]].name;
+    match group.len() {
+        1 => format!("{pass} (material '{name}')"),
+        n => format!("{pass} (material '{name}' and {} sharing its code)", n - 1),
+    }
+}
+
 /// Which image a texture slot reads: a file and its encoding, or the decoded image itself
 /// (a glTF importer hands materials that read one image the same one).
 fn image_key(source: &TextureSource) -> String {
@@ -107,6 +156,17 @@ impl MaterialProgram {
     /// The material code a compute shader includes.
     pub(crate) fn wgsl_for_compute(&self) -> &str {
         self.compute_wgsl.as_deref().unwrap_or(&self.wgsl)
+    }
+
+    /// The code a shading group's dispatch includes: `shared_wgsl` (its constants read
+    /// from `material_constants`, the shader told so by `SHARED_CODE`) where the material
+    /// shares its code, else its own.
+    pub(crate) fn group_code(&self, shared: bool) -> &str {
+        if shared {
+            &self.shared_wgsl
+        } else {
+            self.wgsl_for_compute()
+        }
     }
 
     /// Generates `material`'s WGSL and uploads its textures (with mip levels) for bind

@@ -106,12 +106,10 @@ pub(super) fn prepare(
         };
         // A group of several runs the shared code (constants from the buffer); a
         // material alone its own code.
-        let code = if group.len() > 1 {
+        let shared = group.len() > 1;
+        if shared {
             d.push(("SHARED_CODE", "1".into()));
-            m.shared_wgsl.clone()
-        } else {
-            m.wgsl_for_compute().to_string()
-        };
+        }
         if packed {
             d.push(("G_PACKED", "1".into()));
         }
@@ -130,18 +128,13 @@ pub(super) fn prepare(
         let key = PipelineKey {
             shader: "deferred/deferred_shading.wgsl".into(),
             defines: defines(&d),
-            virtual_code: BTreeMap::from([("material".to_string(), code)]),
+            virtual_code: BTreeMap::from([(
+                "material".to_string(),
+                m.group_code(shared).to_string(),
+            )]),
             state: String::new(),
         };
-        let label = match group.len() {
-            1 => format!("{} (material '{}')", sp.name, m.name),
-            n => format!(
-                "{} (material '{}' and {} sharing its code)",
-                sp.name,
-                m.name,
-                n - 1
-            ),
-        };
+        let label = crate::render::materials::group_label(&sp.name, &cx.gpu.materials, group);
         let (pipeline, bind, textures) =
             cx.compute_pipeline_with_material(&label, key, "main", &offered, m.textures.as_ref())?;
         dispatches.push(ShadeDispatch {
@@ -158,42 +151,29 @@ pub(super) fn prepare(
 }
 
 /// Offers `material_groups` (per material index: its group and first constant) and
-/// `material_constants` (every material's shared-code constants) to the dispatches.
+/// `material_constants` (every grouped material's shared-code constants) to the dispatches.
 fn offer_material_groups(
     cx: &PrepareCtx,
     groups: &[Vec<usize>],
     offered: &mut crate::render::bind::BindingSet,
 ) {
     let materials = &cx.gpu.materials;
+    let constants = crate::render::materials::GroupConstants::new(materials, groups);
     let mut table = vec![[0u32; 2]; materials.len().max(1)];
-    let mut constants: Vec<f32> = Vec::new();
     for (g, group) in groups.iter().enumerate() {
         for &i in group {
-            table[i] = [g as u32, constants.len() as u32];
-            constants.extend_from_slice(&materials[i].constants);
+            table[i] = [g as u32, constants.first[i]];
         }
     }
-    // A binding is never empty.
-    if constants.is_empty() {
-        constants.push(0.0);
-    }
     let device = cx.device();
-    let usage = wgpu::BufferUsages::empty();
-    let storage = crate::render::scene_gpu::storage_buffer;
-    let table = storage(
+    constants.offer(&device, offered);
+    let table = crate::render::scene_gpu::storage_buffer(
         &device,
         "material groups",
         bytemuck::cast_slice(&table),
-        usage,
-    );
-    let constants = storage(
-        &device,
-        "material constants",
-        bytemuck::cast_slice(&constants),
-        usage,
+        wgpu::BufferUsages::empty(),
     );
     offered.buffer("material_groups", &table);
-    offered.buffer("material_constants", &constants);
 }
 
 impl PreparedPass for DeferredShadingPass {

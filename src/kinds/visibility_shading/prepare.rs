@@ -17,6 +17,7 @@ use crate::graph::kinds::visibility_shading::{LightLoop, MaterialDispatch};
 use crate::graph::Name;
 use crate::graph::{ListLayout, ScheduledPass, VisibilityShading};
 use crate::render::device_limits::create_internal_buffer;
+use crate::render::materials::{group_label, GroupConstants};
 use crate::render::pipelines::PipelineKey;
 use crate::render::scene_gpu::storage_buffer;
 use crate::render::RenderError;
@@ -94,8 +95,18 @@ pub(super) fn prepare(
         MaterialDispatch::PerMaterial => shaded.iter().map(|&i| vec![i]).collect(),
         MaterialDispatch::PerShader | MaterialDispatch::Classified => sharing,
     };
-    let members = Members::new(&cx.gpu.materials, &shader_groups, &ranges);
-    offer_members(cx, &members, &mut offered);
+    let constants = GroupConstants::new(&cx.gpu.materials, &shader_groups);
+    let members = Members::new(&shader_groups, &ranges, &constants);
+    constants.offer(&cx.device(), &mut offered);
+    offered.buffer(
+        "shading_members",
+        &storage_buffer(
+            &cx.device(),
+            "shading members",
+            bytemuck::cast_slice(&members.table),
+            wgpu::BufferUsages::empty(),
+        ),
+    );
     let classified = p.materials == MaterialDispatch::Classified && shader_groups.len() > 1;
     let tiles = groups[0] * groups[1];
     let classification = if classified {
@@ -130,12 +141,10 @@ pub(super) fn prepare(
         }
         // A material that shares its code with none keeps its constants in its code:
         // literals let the compiler fold what they feed (harada pays nothing for grouping).
-        let code = if shares.contains(&group[0]) {
+        let shared = shares.contains(&group[0]);
+        if shared {
             d.push(("SHARED_CODE", "1".into()));
-            m.shared_wgsl.clone()
-        } else {
-            m.wgsl_for_compute().to_string()
-        };
+        }
         d.extend(lists.define());
         d.extend(loop_define(light_loop));
         d.extend(crate::render::draws::shadow_defines(shadows));
@@ -149,18 +158,13 @@ pub(super) fn prepare(
         let key = PipelineKey {
             shader: "visibility/visibility_shading.wgsl".into(),
             defines: defines(&d),
-            virtual_code: BTreeMap::from([("material".to_string(), code)]),
+            virtual_code: BTreeMap::from([(
+                "material".to_string(),
+                m.group_code(shared).to_string(),
+            )]),
             state: String::new(),
         };
-        let label = match group.len() {
-            1 => format!("{} (material '{}')", sp.name, m.name),
-            n => format!(
-                "{} (material '{}' and {} sharing its code)",
-                sp.name,
-                m.name,
-                n - 1
-            ),
-        };
+        let label = group_label(&sp.name, &cx.gpu.materials, group);
         let textures = m.textures.clone();
         let (pipeline, bind, textures) =
             cx.compute_pipeline_with_material(&label, key, "main", &offered, textures.as_ref())?;
@@ -178,65 +182,31 @@ pub(super) fn prepare(
     })
 }
 
-/// The shading groups' materials as the shader finds them: per material
-/// (group by group) its triangle range and first constant, and the constants.
+/// The shading groups' materials as the shader finds them: per material (group by group)
+/// its triangle range and first constant (`shading_members`), and each group's first
+/// entry.
 struct Members {
     /// (first triangle, end, first constant, 0) per material, group by group.
     table: Vec<[u32; 4]>,
     /// Each group's first entry in `table`.
     first: Vec<u32>,
-    /// Every shaded material's constants, one after another.
-    constants: Vec<f32>,
 }
 
 impl Members {
-    fn new(
-        materials: &[crate::render::materials::MaterialProgram],
-        groups: &[Vec<usize>],
-        ranges: &[[u32; 2]],
-    ) -> Self {
+    fn new(groups: &[Vec<usize>], ranges: &[[u32; 2]], constants: &GroupConstants) -> Self {
         let mut out = Members {
             table: Vec::new(),
             first: Vec::new(),
-            constants: Vec::new(),
         };
         for group in groups {
             out.first.push(out.table.len() as u32);
             for &i in group {
                 let [first, end] = ranges.get(i).copied().unwrap_or([0, 0]);
-                out.table.push([first, end, out.constants.len() as u32, 0]);
-                out.constants.extend_from_slice(&materials[i].constants);
+                out.table.push([first, end, constants.first[i], 0]);
             }
-        }
-        // A binding is never empty.
-        if out.constants.is_empty() {
-            out.constants.push(0.0);
         }
         out
     }
-}
-
-/// Offers the members' table and constants to the shading dispatches.
-fn offer_members(
-    cx: &PrepareCtx,
-    members: &Members,
-    offered: &mut crate::render::bind::BindingSet,
-) {
-    let device = cx.device();
-    let table = storage_buffer(
-        &device,
-        "shading members",
-        bytemuck::cast_slice(&members.table),
-        wgpu::BufferUsages::empty(),
-    );
-    let constants = storage_buffer(
-        &device,
-        "material constants",
-        bytemuck::cast_slice(&members.constants),
-        wgpu::BufferUsages::empty(),
-    );
-    offered.buffer("shading_members", &table);
-    offered.buffer("material_constants", &constants);
 }
 
 /// The light loop's defines for a read `light_samples` buffer (common/light_samples.wgsl):
