@@ -214,24 +214,12 @@ fn the_surface_pair_is_written_only_for_materials_that_read_it() {
 /// constants written into its code) shades it.
 #[test]
 fn deferred_shading_shades_materials_that_share_their_code_in_one_dispatch() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let path = root
-        .join("tests/assets/khronos/MetalRoughSpheresNoTextures/MetalRoughSpheresNoTextures.gltf");
-    let spheres = scene::load(&path).unwrap().scene;
+    let spheres = khronos_model("MetalRoughSpheresNoTextures");
     let spheres = lightgraph::bench::sweep::with_light_count(&spheres, 256);
     let text = std::fs::read_to_string(graph_path("tiled_deferred.ron")).unwrap();
-    let mut fresh = lightgraph::render::Renderer::headless().expect("a wgpu adapter");
-    let prepared = prepare_text(&mut fresh, &text, &spheres, 64, 48, false).expect("prepare");
-    let shading: Vec<&String> = prepared
-        .stats()
-        .pipelines_built
-        .iter()
-        .filter(|l| l.starts_with("deferred/deferred_shading.wgsl"))
-        .collect();
+    let shading = pipelines_built_from("deferred/deferred_shading.wgsl", &text, &spheres);
     assert_eq!(shading.len(), 1, "{shading:?}");
     assert!(shading[0].contains("SHARED_CODE"), "{shading:?}");
-    drop(prepared);
-    drop(fresh);
     let mut r = renderer();
     let reference = render_file(&mut r, "forward_plus.ron", &spheres, W, H);
     let out = render_text(&mut r, &text, &spheres, W, H);

@@ -629,10 +629,7 @@ fn with_materials(graph_text: &str, how: &str) -> String {
 #[test]
 fn grouped_and_classified_shading_equal_per_material_dispatches_to_the_bit() {
     let mut r = renderer();
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let spheres_path = root
-        .join("tests/assets/khronos/MetalRoughSpheresNoTextures/MetalRoughSpheresNoTextures.gltf");
-    let spheres = scene::load(&spheres_path).unwrap().scene;
+    let spheres = khronos_model("MetalRoughSpheresNoTextures");
     assert!(
         spheres.materials.len() >= 98,
         "{} materials",
@@ -684,26 +681,15 @@ fn grouped_and_classified_shading_equal_per_material_dispatches_to_the_bit() {
 /// constants, as forward brute force (its constants written into its own code) shades it.
 #[test]
 fn materials_that_differ_only_in_constants_share_one_dispatch() {
-    let mut r = lightgraph::render::Renderer::headless().expect("a wgpu adapter");
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let path = root
-        .join("tests/assets/khronos/MetalRoughSpheresNoTextures/MetalRoughSpheresNoTextures.gltf");
-    let spheres = scene::load(&path).unwrap().scene;
+    let spheres = khronos_model("MetalRoughSpheresNoTextures");
     let spheres = lightgraph::bench::sweep::with_light_count(&spheres, 64);
     let text = std::fs::read_to_string(graph_path("visibility_compute_raster.ron")).unwrap();
-    let prepared = prepare_text(&mut r, &text, &spheres, 64, 48, false).expect("prepare");
     // The spheres' 98 and the default material of their primitives without one (it is
     // single-sided, they are double-sided: shared code leaves sidedness out) in one
     // group.
-    let shading: Vec<&String> = prepared
-        .stats()
-        .pipelines_built
-        .iter()
-        .filter(|l| l.starts_with("visibility/visibility_shading.wgsl"))
-        .collect();
+    let shading = pipelines_built_from("visibility/visibility_shading.wgsl", &text, &spheres);
     assert_eq!(shading.len(), 1, "{shading:?}");
     assert!(shading[0].contains("MEMBERS_COUNT=99u"), "{shading:?}");
-    drop(r);
     let spheres = lightgraph::bench::sweep::with_light_count(&spheres, 512);
     let graphs = [("visibility_compute_raster.ron".to_string(), text)];
     let failures = check_graph_texts(&spheres, "brute_force.ron", BOUND_SPHERES, &graphs);
@@ -719,7 +705,6 @@ fn materials_that_differ_only_in_constants_share_one_dispatch() {
 /// matches forward brute force, whose code has each material's constants written in.
 #[test]
 fn textured_materials_that_read_the_same_images_share_one_dispatch() {
-    let mut fresh = lightgraph::render::Renderer::headless().expect("a wgpu adapter");
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let khronos = root.join("tests/assets/khronos");
     let dir = tempfile::tempdir().unwrap();
@@ -750,13 +735,7 @@ fn textured_materials_that_read_the_same_images_share_one_dispatch() {
     }
     let s = lightgraph::bench::sweep::with_light_count(&s, 256);
     let text = std::fs::read_to_string(graph_path("visibility_compute_raster.ron")).unwrap();
-    let prepared = prepare_text(&mut fresh, &text, &s, 64, 48, false).expect("prepare");
-    let shading: Vec<&String> = prepared
-        .stats()
-        .pipelines_built
-        .iter()
-        .filter(|l| l.starts_with("visibility/visibility_shading.wgsl"))
-        .collect();
+    let shading = pipelines_built_from("visibility/visibility_shading.wgsl", &text, &s);
     assert_eq!(shading.len(), 3, "{shading:?}");
     assert!(
         shading
@@ -764,8 +743,6 @@ fn textured_materials_that_read_the_same_images_share_one_dispatch() {
             .any(|l| l.contains("MEMBERS_COUNT=4u") && l.contains("SHARED_CODE")),
         "{shading:?}"
     );
-    drop(prepared);
-    drop(fresh);
     let mut r = renderer();
     let grouped = render_text(&mut r, &with_materials(&text, "PerShader"), &s, W, H);
     let whole = render_text(&mut r, &with_materials(&text, "PerMaterial"), &s, W, H);

@@ -260,6 +260,32 @@ pub fn graph_with_culling(name: &str, kind: &str) -> String {
     with_culling(&std::fs::read_to_string(graph_path(name)).unwrap(), kind)
 }
 
+/// Khronos sample model `name` (tests/assets/khronos/`name`/`name`.gltf), loaded.
+pub fn khronos_model(name: &str) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/assets/khronos")
+        .join(name)
+        .join(format!("{name}.gltf"));
+    lightgraph::scene::load(&path)
+        .expect("a Khronos sample model")
+        .scene
+}
+
+/// The pipelines a fresh renderer (nothing from a pipeline cache) builds from `shader`
+/// (e.g. `visibility/visibility_shading.wgsl`) to prepare `graph_text` for `scene` at
+/// 64×48: each one's description (`PipelineKey::describe`: shader, defines, material).
+pub fn pipelines_built_from(shader: &str, graph_text: &str, scene: &Scene) -> Vec<String> {
+    let mut fresh = Renderer::headless().expect("a wgpu adapter");
+    let prepared = prepare_text(&mut fresh, graph_text, scene, 64, 48, false).expect("prepare");
+    prepared
+        .stats()
+        .pipelines_built
+        .iter()
+        .filter(|l| l.starts_with(shader))
+        .cloned()
+        .collect()
+}
+
 pub fn graph_path(name: &str) -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("graphs")
