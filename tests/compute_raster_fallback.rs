@@ -146,6 +146,36 @@ fn draws_the_hardware_visibility_buffer(scene: &Scene) {
     }
 }
 
+/// Without the atomics, `TransparentDepth` into R32Float draws the blended meshes with
+/// the raster units and copies them: bit for bit the Depth32Float the same draws give,
+/// and the report says so. On the built-in glass scene.
+#[test]
+fn without_the_atomics_the_transparent_depth_is_drawn_and_copied() {
+    let mut r = masked_renderer();
+    let adapter = r.ctx.adapter_name();
+    let scene = lightgraph::scene::builtin::by_name("glass").expect("the glass scene");
+    let (frame, bits) = render_reading(
+        &mut r,
+        common::compute_raster::TRANSPARENT_COMPARE,
+        &scene,
+        &["transparent_cr", "transparent_hw"],
+    )
+    .unwrap();
+    let covered = bits[1].iter().filter(|&&d| f32::from_bits(d) < 1.0).count();
+    assert!(
+        covered > 5_000,
+        "{covered} blended pixels: nothing compared"
+    );
+    assert!(bits[0] == bits[1], "the copied depth's bits differ");
+    let lines: Vec<String> = frame.fallbacks.iter().map(|f| f.line()).collect();
+    assert_eq!(
+        lines,
+        [format!(
+            "cr: adapter {adapter} lacks SHADER_INT64_ATOMIC_MIN_MAX (offered by the adapter, disabled on request); drawn with the hardware rasterizer and copied"
+        )]
+    );
+}
+
 /// With the atomics the compute rasterizer runs and nothing is reported.
 #[test]
 fn with_the_atomics_nothing_falls_back() {

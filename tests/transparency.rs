@@ -173,6 +173,15 @@ fn glass_over_the_compute_first_frame_equals_brute_force() {
         opaque_err <= 1e-4 * peak,
         "the opaque compute-first frame differs from brute force by {opaque_err:e} (peak {peak})"
     );
+    // Its depth rasterized in compute too (an R32Float transparent depth).
+    assert!(
+        frame
+            .rasters
+            .iter()
+            .any(|r| r.pass == "transparent_prepass"),
+        "the transparent depth was not rasterized in compute: {:?}",
+        frame.rasters
+    );
     // The glass was culled into its own lists, on the compute rasterizer's depth.
     let t = frame
         .culling

@@ -10,8 +10,8 @@
 // so the tiles' lists are exactly those without it.
 // MSAA: the depth is multisampled and every one of its SAMPLES samples bounds the tile.
 // FLOAT_DEPTH: the depth is single-sample R32Float (a compute resolve's; the same values
-// a depth texture holds), read as texture_2d<f32>. Not with MSAA; with TRANSPARENT the
-// transparent depth stays a depth texture.
+// a depth texture holds), read as texture_2d<f32>. Not with MSAA. FLOAT_TRANSPARENT: the
+// same for the transparent depth (TransparentDepth rasterized in compute).
 // TRANSPARENT: lists for transparent surfaces (AMD's TiledLighting11 sample). A sample where a transparent
 // surface lies in front of the opaque one contributes the range from the nearest
 // transparent depth to the opaque depth (the far plane over the background): every
@@ -60,7 +60,11 @@
 #if MSAA
 @group(0) @binding(6) var transparent_depth: texture_depth_multisampled_2d;
 #else
+#if FLOAT_TRANSPARENT
+@group(0) @binding(6) var transparent_depth: texture_2d<f32>;
+#else
 @group(0) @binding(6) var transparent_depth: texture_depth_2d;
+#endif
 #endif
 #endif
 // What the tile tests need of the lights, in view space (`bounds` writes it, the tests
@@ -148,7 +152,11 @@ fn sample_range(pixel: vec2<u32>, s: u32) -> vec2<f32> {
     let d = textureLoad(depth, pixel, s);
 #endif
 #if TRANSPARENT
+#if FLOAT_TRANSPARENT
+    let t = textureLoad(transparent_depth, pixel, s).x;
+#else
     let t = textureLoad(transparent_depth, pixel, s);
+#endif
     // No transparent surface here, or every one is behind the opaque surface.
     if (t >= 1.0 || t > d) {
         return none;

@@ -3,7 +3,8 @@
 // depth and id textures: the depth's bits unchanged and the id, or 1.0 and NO_TRIANGLE
 // where nothing was drawn, as the full-screen draw resolve writes a Depth32Float depth.
 // A frame resolved here runs no vertex or fragment work. One invocation a pixel, in 8×8
-// tiles (storage textures are tiled in memory).
+// tiles (storage textures are tiled in memory). DEPTH_ONLY: the depth alone (the blended
+// triangles' transparent depth, whose ids nothing reads).
 
 #include "common/types.wgsl"
 
@@ -11,7 +12,10 @@
 // Little-endian: x holds ~id, y the depth bits; all ones where nothing was drawn.
 @group(0) @binding(1) var<storage, read> vis: array<vec2<u32>>;
 @group(0) @binding(2) var depth: texture_storage_2d<r32float, write>;
+#if DEPTH_ONLY
+#else
 @group(0) @binding(3) var visibility: texture_storage_2d<r32uint, write>;
+#endif
 
 const NO_TRIANGLE: u32 = 0xffffffffu;
 const EMPTY: u32 = 0xffffffffu;
@@ -29,5 +33,8 @@ fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
         triangle = ~v.x;
     }
     textureStore(depth, id.xy, vec4<f32>(z, 0.0, 0.0, 0.0));
+#if DEPTH_ONLY
+#else
     textureStore(visibility, id.xy, vec4<u32>(triangle, 0u, 0u, 0u));
+#endif
 }

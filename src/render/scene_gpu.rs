@@ -61,6 +61,9 @@ pub struct SceneGpu {
     /// The opaque meshes merged for vertex fetching, built the first time a pass binds
     /// them (see [`SceneGpu::visibility_geometry`]).
     visibility: std::sync::Arc<std::sync::OnceLock<Result<VisibilityGeometry, String>>>,
+    /// The blended meshes merged the same way, built the first time a pass rasterizes
+    /// them in compute (see [`SceneGpu::transparent_geometry`]).
+    transparent: std::sync::Arc<std::sync::OnceLock<Result<VisibilityGeometry, String>>>,
 }
 
 /// The shadow BVH's two storage buffers and what building it found.
@@ -198,6 +201,20 @@ impl SceneGpu {
             .map_err(Clone::clone)
     }
 
+    /// The blended meshes merged into storage buffers (their own triangle ids), or why
+    /// they cannot be: built on first use. `scene` must be the scene this was uploaded
+    /// from.
+    pub fn transparent_geometry(
+        &self,
+        device: &wgpu::Device,
+        scene: &Scene,
+    ) -> Result<&VisibilityGeometry, String> {
+        self.transparent
+            .get_or_init(|| VisibilityGeometry::build_transparent(device, self, scene))
+            .as_ref()
+            .map_err(Clone::clone)
+    }
+
     /// The merged geometry, if a pass has built it.
     pub fn built_visibility_geometry(&self) -> Option<&VisibilityGeometry> {
         self.visibility.get().and_then(|b| b.as_ref().ok())
@@ -253,6 +270,7 @@ impl SceneGpu {
             // A new upload (hot reload of geometry) builds its own when first bound.
             bvh: Default::default(),
             visibility: Default::default(),
+            transparent: Default::default(),
         };
         gpu.number_triangles();
         gpu
@@ -311,6 +329,7 @@ impl SceneGpu {
         self.number_triangles();
         self.bvh = Default::default();
         self.visibility = Default::default();
+        self.transparent = Default::default();
     }
 
     /// Mesh indices to draw for opaque and alpha-masked geometry, sorted by material so

@@ -1,6 +1,8 @@
 //! Every opaque and alpha-masked mesh merged into two storage buffers, for passes that
 //! fetch vertices themselves: the visibility buffer's shading (which rebuilds a pixel's
-//! attributes from its triangle id) and the compute rasterizer.
+//! attributes from its triangle id) and the compute rasterizer. The blended meshes are
+//! merged the same way apart ([`VisibilityGeometry::build_transparent`]), for the
+//! compute rasterizer's transparent depth.
 //!
 //! A triangle's id is its index in `triangles`: the meshes in [`SceneGpu::opaque_draws`]
 //! order (sorted by material), each mesh's triangles in its index order. So one
@@ -46,14 +48,45 @@ impl VisibilityGeometry {
     /// Merges `gpu`'s opaque meshes (uploaded from `scene`) in draw order. Refuses what
     /// the device cannot bind or a 32-bit id cannot name.
     pub fn build(device: &wgpu::Device, gpu: &SceneGpu, scene: &Scene) -> Result<Self, String> {
+        Self::merge(device, gpu, scene, &gpu.opaque_draws(), "opaque", true)
+    }
+
+    /// Merges `gpu`'s blended meshes in scene order: triangle ids index these buffers
+    /// alone (no visibility buffer holds them), and each blended material's range is
+    /// its meshes' (adjacent only where its meshes are).
+    pub fn build_transparent(
+        device: &wgpu::Device,
+        gpu: &SceneGpu,
+        scene: &Scene,
+    ) -> Result<Self, String> {
+        Self::merge(
+            device,
+            gpu,
+            scene,
+            &gpu.transparent_draws(),
+            "blended",
+            false,
+        )
+    }
+
+    /// `draws` merged in order; `numbered`: their ids must be the visibility ids the
+    /// upload numbered (the opaque draws').
+    fn merge(
+        device: &wgpu::Device,
+        gpu: &SceneGpu,
+        scene: &Scene,
+        draws: &[usize],
+        what: &str,
+        numbered: bool,
+    ) -> Result<Self, String> {
         let mut vertices: Vec<GpuVertex> = Vec::new();
         let mut triangles: Vec<u32> = Vec::new();
         let mut material_ranges = vec![[0u32, 0u32]; gpu.materials.len()];
-        for mesh in gpu.opaque_draws() {
+        for &mesh in draws {
             let gm = &gpu.meshes[mesh];
             let m = &scene.meshes[gm.scene_mesh];
             let first = (triangles.len() / 3) as u64;
-            if first != u64::from(gm.first_triangle) {
+            if numbered && first != u64::from(gm.first_triangle) {
                 return Err(format!(
                     "mesh '{}' starts at triangle {first}, its draws say {}",
                     m.name, gm.first_triangle
@@ -66,7 +99,7 @@ impl VisibilityGeometry {
             let end = (triangles.len() / 3) as u64;
             if end >= u64::from(NO_TRIANGLE) {
                 return Err(format!(
-                    "the scene has {end} opaque triangles; a 32-bit visibility id names at most {}",
+                    "the scene has {end} {what} triangles; a 32-bit visibility id names at most {}",
                     NO_TRIANGLE - 1
                 ));
             }
@@ -81,10 +114,10 @@ impl VisibilityGeometry {
         let limit = device.limits().max_storage_buffer_binding_size;
         let vertex_bytes = std::mem::size_of_val(&vertices[..]) as u64;
         let triangle_bytes = std::mem::size_of_val(&triangles[..]) as u64;
-        for (what, bytes) in [("vertices", vertex_bytes), ("triangles", triangle_bytes)] {
+        for (part, bytes) in [("vertices", vertex_bytes), ("triangles", triangle_bytes)] {
             if bytes > limit {
                 return Err(format!(
-                    "the scene's merged {what} take {bytes} bytes; this device binds at most {limit} bytes of storage"
+                    "the scene's merged {what} {part} take {bytes} bytes; this device binds at most {limit} bytes of storage"
                 ));
             }
         }

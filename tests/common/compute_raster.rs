@@ -33,6 +33,31 @@ pub const COMPARE: &str = r#"Graph(
     output: "out",
 )"#;
 
+/// `TransparentDepth` both ways, into `transparent_cr` (R32Float: the compute rasterizer)
+/// and `transparent_hw` (Depth32Float: the raster units), after a forward frame that
+/// gives the graph its output (their passes kept by `side_effects`; last, so no later
+/// pass reuses their memory).
+pub const TRANSPARENT_COMPARE: &str = r#"Graph(
+    name: "transparent_depth_compare",
+    resources: [
+        Texture(name: "depth", format: Depth32Float),
+        Texture(name: "transparent_cr", format: R32Float),
+        Texture(name: "transparent_hw", format: Depth32Float),
+        Texture(name: "hdr", format: Rgba32Float),
+        Import(name: "geometry", from: Geometry),
+        Import(name: "light_geometry", from: LightGeometry),
+        Import(name: "light_properties", from: LightProperties),
+    ],
+    passes: [
+        Pass(name: "pre", kind: DepthPrepass, reads: ["geometry"], writes: ["depth"]),
+        Pass(name: "shade", kind: ForwardShading(lights: AllLights), reads: ["geometry", "depth", "light_geometry", "light_properties"], writes: ["hdr"]),
+        Pass(name: "cr", kind: TransparentDepth, reads: ["geometry"], writes: ["depth=transparent_cr"]),
+        Pass(name: "hw", kind: TransparentDepth, reads: ["geometry"], writes: ["depth=transparent_hw"]),
+    ],
+    output: "hdr",
+    side_effects: ["cr", "hw"],
+)"#;
+
 pub struct Pixel {
     pub cr: f32,
     pub hw: f32,

@@ -516,6 +516,7 @@ pub(crate) mod test_support {
         Texture(name: "ids4", format: R32Uint, samples: 4),
         Texture(name: "fdepth", format: R32Float),
         Texture(name: "fdepth4", format: R32Float, samples: 4),
+        Texture(name: "tdepth_f", format: R32Float),
         Buffer(name: "lists"),
         Buffer(name: "links"),
         Import(name: "geometry", from: Geometry),

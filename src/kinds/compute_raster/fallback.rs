@@ -143,30 +143,41 @@ pub(super) fn depth_copy(
     Ok((drawn, (pipeline, bind, groups)))
 }
 
+/// The timestamps of draws that a depth copy follows: the draws open the pair.
+pub(super) fn draws_opening(ts: Timestamps<'_>) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+    ts.render().map(|t| wgpu::RenderPassTimestampWrites {
+        end_of_pass_write_index: None,
+        ..t
+    })
+}
+
+/// The copy after the draws into the internal depth, closing the timestamp pair.
+pub(super) fn record_depth_copy(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    (pipeline, bind, groups): &DepthCopy,
+    ts: Timestamps<'_>,
+) {
+    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(label),
+        timestamp_writes: ts.compute().map(|t| wgpu::ComputePassTimestampWrites {
+            beginning_of_pass_write_index: None,
+            ..t
+        }),
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, bind, &[]);
+    pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
+}
+
 impl PreparedPass for HardwareRaster {
     fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
-        let Some((pipeline, bind, groups)) = &self.copy else {
+        let Some(copy) = &self.copy else {
             self.draws.record_with(encoder, ts.render());
             return;
         };
-        // One timestamp pair: the draws open it, the copy closes it.
-        self.draws.record_with(
-            encoder,
-            ts.render().map(|t| wgpu::RenderPassTimestampWrites {
-                end_of_pass_write_index: None,
-                ..t
-            }),
-        );
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(&self.name),
-            timestamp_writes: ts.compute().map(|t| wgpu::ComputePassTimestampWrites {
-                beginning_of_pass_write_index: None,
-                ..t
-            }),
-        });
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, bind, &[]);
-        pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
+        self.draws.record_with(encoder, draws_opening(ts));
+        record_depth_copy(encoder, &self.name, copy, ts);
     }
 
     fn report(&self, _r: &Renderer) -> Result<Option<PassReport>, RenderError> {

@@ -222,19 +222,48 @@ pub(super) fn prepare_compute(
     cx: &mut PrepareCtx,
     sp: &ScheduledPass,
 ) -> Result<ComputeRasterPass, RenderError> {
+    prepare_source(cx, sp, RasterSource::Opaque)
+}
+
+/// The triangles a compute raster pass draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum RasterSource {
+    /// The opaque and alpha-masked meshes (`ComputeRaster`): the visibility ids, back
+    /// faces of single-sided materials culled, masked materials alpha-tested, resolved
+    /// into the depth and the visibility texture.
+    Opaque,
+    /// The blended meshes (`TransparentDepth` into an R32Float depth): both faces, as
+    /// the transparent depth prepass draws them, resolved into the depth alone.
+    Blended,
+}
+
+/// The compute rasterizer over `source`'s triangles, into the pass's `depth` (and, for
+/// the opaque triangles, `visibility`).
+pub(super) fn prepare_source(
+    cx: &mut PrepareCtx,
+    sp: &ScheduledPass,
+    source: RasterSource,
+) -> Result<ComputeRasterPass, RenderError> {
     let device = cx.device();
-    let geometry = cx
-        .gpu
-        .visibility_geometry(&device, cx.scene)
-        .map_err(|m| pass_error(&sp.name, m))?;
+    let opaque = source == RasterSource::Opaque;
+    let geometry = match source {
+        RasterSource::Opaque => cx.gpu.visibility_geometry(&device, cx.scene),
+        RasterSource::Blended => cx.gpu.transparent_geometry(&device, cx.scene),
+    }
+    .map_err(|m| pass_error(&sp.name, m))?;
     // Bit t set: triangle t is culled when it faces away (its material is single-sided);
-    // in `alpha_tested`, its masked material's run draws it.
+    // in `alpha_tested`, its masked material's run draws it. Blended triangles: neither.
     let words = (geometry.triangle_count.div_ceil(32)).max(1) as usize;
     let mut single_sided = vec![0u32; words];
     let mut alpha_tested = vec![0u32; words];
     // (material, triangles) of each masked material's run.
     let mut masked = Vec::new();
-    for (m, &[first, end]) in geometry.material_ranges.iter().enumerate() {
+    let ranges = if opaque {
+        &geometry.material_ranges[..]
+    } else {
+        &[]
+    };
+    for (m, &[first, end]) in ranges.iter().enumerate() {
         let material = &cx.gpu.materials[m];
         if first == end {
             continue;
@@ -361,6 +390,12 @@ pub(super) fn prepare_compute(
         wgpu::BufferUsages::STORAGE,
     );
     let mut offered = cx.declared(sp)?;
+    if !opaque {
+        // The graph imports the opaque merge under these names; the blended pass reads
+        // its own.
+        offered.buffer("vertices", &geometry.vertices);
+        offered.buffer("triangles", &geometry.triangles);
+    }
     offered.buffer("raster_params", &params);
     offered.buffer("list_capacity", &list_capacity);
     offered.buffer("single_sided", &sides);
@@ -473,6 +508,7 @@ pub(super) fn prepare_compute(
         sp,
         key(&[("RESOLVE", "1".into())], "resolve", None),
         &offered,
+        opaque,
     )?;
     Ok(ComputeRasterPass {
         name: sp.name.clone(),

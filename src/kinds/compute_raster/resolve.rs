@@ -40,18 +40,25 @@ pub(super) enum Resolve {
 impl Resolve {
     /// The resolve the pass's depth format asks for; `draw_key` is the rasterizer
     /// shader's full-screen resolve (`RESOLVE`). `offered` holds the pass's slots, the
-    /// frame uniform and the `vis` buffer.
+    /// frame uniform and the `vis` buffer. Without `ids` (the blended triangles' depth)
+    /// only the depth is written, and it must be R32Float.
     pub fn prepare(
         cx: &mut PrepareCtx,
         sp: &ScheduledPass,
         draw_key: PipelineKey,
         offered: &BindingSet,
+        ids: bool,
     ) -> Result<Self, RenderError> {
         let depth = sp.required(slot::DEPTH);
         if cx.float_depth(depth) {
+            let depth_only: &[(&str, String)] = if ids {
+                &[]
+            } else {
+                &[("DEPTH_ONLY", "1".to_string())]
+            };
             let key = PipelineKey {
                 shader: COMPUTE_SHADER.into(),
-                defines: defines(&[]),
+                defines: defines(depth_only),
                 virtual_code: BTreeMap::new(),
                 state: "resolve".into(),
             };
@@ -65,6 +72,12 @@ impl Resolve {
                     1,
                 ],
             });
+        }
+        if !ids {
+            return Err(pass_error(
+                &sp.name,
+                format!("the compute rasterizer resolves a depth of its own into R32Float only, and '{depth}' is a depth format"),
+            ));
         }
         let (pipeline, bind) = draw_pipeline(cx, sp, draw_key, offered)?;
         Ok(Resolve::Draw {

@@ -27,6 +27,20 @@ pub(super) fn prepare_meshes(
     set: MeshSet,
 ) -> Result<DepthPrepass, RenderError> {
     let depth = sp.required(slot::DEPTH);
+    let target = cx.view(&sp.name, depth)?;
+    let clear = sp.clears(depth);
+    prepare_meshes_into(cx, sp, set, target, clear)
+}
+
+/// The depth-only draw of one mesh set into `depth` (cleared first where `clear`): the
+/// pass's own depth, or a fallback's internal Depth32Float.
+pub(super) fn prepare_meshes_into(
+    cx: &mut PrepareCtx,
+    sp: &ScheduledPass,
+    set: MeshSet,
+    depth: wgpu::TextureView,
+    clear: bool,
+) -> Result<DepthPrepass, RenderError> {
     let offered = cx.declared(sp)?;
     let draws = cx.renderer.mesh_draws(
         cx.gpu,
@@ -38,22 +52,33 @@ pub(super) fn prepare_meshes(
     )?;
     Ok(DepthPrepass {
         name: sp.name.clone(),
-        depth: cx.view(&sp.name, depth)?,
-        clear: sp.clears(depth),
+        depth,
+        clear,
         draws,
     })
 }
 
-impl PreparedPass for DepthPrepass {
-    fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
+impl DepthPrepass {
+    /// The draws, in one render pass with `timestamps`.
+    pub(super) fn record_with(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(&self.name),
             color_attachments: &[],
             depth_stencil_attachment: Some(depth_attachment(&self.depth, self.clear)),
-            timestamp_writes: ts.render(),
+            timestamp_writes: timestamps,
             occlusion_query_set: None,
             multiview_mask: None,
         });
         self.draws.record(&mut pass);
+    }
+}
+
+impl PreparedPass for DepthPrepass {
+    fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
+        self.record_with(encoder, ts.render());
     }
 }

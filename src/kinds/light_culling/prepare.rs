@@ -129,8 +129,12 @@ pub(super) fn prepare(
     if cx.float_depth(sp.required(slot::DEPTH)) {
         d.push(("FLOAT_DEPTH", "1".into()));
     }
-    if sp.roles.slot(slot::TRANSPARENT_DEPTH).is_some() {
+    if let Some(t) = sp.roles.slot(slot::TRANSPARENT_DEPTH) {
         d.push(("TRANSPARENT", "1".into()));
+        // A compute-rasterized transparent depth (TransparentDepth into R32Float).
+        if cx.float_depth(t) {
+            d.push(("FLOAT_TRANSPARENT", "1".into()));
+        }
     }
     let blocks = layout.scan_blocks();
     if let ListStorage::Fixed { capacity } = layout.storage {

@@ -2,10 +2,11 @@
 //! DepthMask, Clustered), with an optional coarse stage. Runs `shaders/cull/light_culling.wgsl`.
 //! A multisampled depth is read sample by sample. The depth may also be a single-sample
 //! R32Float texture (ComputeRaster's compute resolve), read as `texture_2d<f32>`
-//! (`FLOAT_DEPTH`). With a `transparent_depth` (a TransparentDepth pass's, always a
-//! depth format) the lists are for transparent surfaces: a tile spans, over its pixels
-//! that hold one, from the nearest transparent depth to the opaque depth behind it (AMD's
-//! TiledLighting11 sample); the opaque depth may be either format there too.
+//! (`FLOAT_DEPTH`). With a `transparent_depth` (a TransparentDepth pass's) the lists are
+//! for transparent surfaces: a tile spans, over its pixels that hold one, from the
+//! nearest transparent depth to the opaque depth behind it (AMD's TiledLighting11
+//! sample); either depth may be a depth format or single-sample R32Float there
+//! (`FLOAT_TRANSPARENT` for the transparent one).
 //!
 //! Two list layouts (`lists:`), read alike through `shaders/common/light_lists.wgsl`:
 //! `Fixed` gives every list room for `capacity` lights (a longer list is cut, counted
@@ -264,7 +265,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     ),
     SlotSpec::new(
         slot::TRANSPARENT_DEPTH,
-        SlotType::DepthTexture,
+        SlotType::DepthValues,
         Access::Read,
         Usage::Sampled,
     )
@@ -273,6 +274,14 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
 
 pub(crate) fn check(p: &LightCulling, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     super::check_float_depth_samples(ctx, errors);
+    if let Some(t) = ctx.slot(slot::TRANSPARENT_DEPTH) {
+        if ctx.is_float_depth(t) && ctx.samples(t) > 1 {
+            errors.push(ctx.mismatch(
+                t,
+                format!("an R32Float transparent depth is single-sample (compute stores one depth a pixel); it has {} samples: use a multisampled Depth32Float for MSAA", ctx.samples(t)),
+            ));
+        }
+    }
     if let (Some(depth), Some(t)) = (ctx.slot(slot::DEPTH), ctx.slot(slot::TRANSPARENT_DEPTH)) {
         let (ds, ts) = (ctx.samples(depth), ctx.samples(t));
         if ds != ts {
@@ -471,7 +480,16 @@ mod tests {
             Pass(name: "s", kind: VisibilityShading(lights: Culled), reads: ["visibility", "vertices", "triangles", "material_triangles", "lg", "lp", "lists"], writes: ["hdr"])"#;
         crate::graph::kinds::test_support::validate(FLOAT_FRAME, "hdr")
             .expect("an R32Float opaque depth with a Depth32Float transparent depth is valid");
-        // The transparent depth itself stays a depth texture.
+        // A compute-rasterized transparent depth: R32Float too.
+        let float_transparent = FLOAT_FRAME
+            .replace(r#"writes: ["depth"]"#, r#"writes: ["tdepth_f"]"#)
+            .replace(
+                r#""transparent_depth=depth""#,
+                r#""transparent_depth=tdepth_f""#,
+            );
+        crate::graph::kinds::test_support::validate(&float_transparent, "hdr")
+            .expect("R32Float opaque and transparent depths are valid");
+        // But single-sample, as the opaque one.
         let e = errors(
             &FLOAT_FRAME.replace(
                 r#""transparent_depth=depth""#,
