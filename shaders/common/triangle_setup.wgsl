@@ -1,7 +1,7 @@
 // What the two compute rasterizers (visibility/compute_raster.wgsl for the frame,
 // shadow/atlas_raster.wgsl for the shadow atlas's views) set a triangle up with, as the
-// raster pipeline does: near and side clipping in clip space, 1/256-pixel snapping, exact
-// 64-bit edge functions and the top-left fill rule.
+// raster pipeline does: near and side clipping in clip space, 1/256-pixel snapping and
+// ordering (`snap_triangle`), exact 64-bit edge functions and the top-left fill rule.
 
 // Subpixel steps a pixel (or texel): positions snap to 1/256, as the raster pipeline's.
 const SUBPIXEL: f32 = 256.0;
@@ -34,6 +34,47 @@ fn snap(p: vec3<f32>) -> vec2<i32> {
 fn top_left(a: vec2<i32>, b: vec2<i32>) -> bool {
     let d = b - a;
     return d.y < 0 || (d.y == 0 && d.x > 0);
+}
+
+// A screen triangle snapped and ordered for the edge tests: clockwise on screen (positive
+// snapped area), its unsnapped vertices (x, y, depth) in the same order. `facing` is the
+// snapped area's sign before ordering (0: degenerate, no pixel; positive: clockwise,
+// which is clockwise in NDC too, a back face).
+struct Snapped {
+    a: vec2<i32>,
+    b: vec2<i32>,
+    c: vec2<i32>,
+    sa: vec3<f32>,
+    sb: vec3<f32>,
+    sc: vec3<f32>,
+    facing: i32,
+}
+
+fn snap_triangle(sa: vec3<f32>, sb: vec3<f32>, sc: vec3<f32>) -> Snapped {
+    var t: Snapped;
+    t.a = snap(sa);
+    t.b = snap(sb);
+    t.c = snap(sc);
+    t.sa = sa;
+    t.sb = sb;
+    t.sc = sc;
+    let area = edge(t.a, t.b, t.c);
+    t.facing = select(select(-1, 1, area > 0), 0, area == 0);
+    if (area < 0) {
+        t.b = snap(sc);
+        t.c = snap(sb);
+        t.sb = sc;
+        t.sc = sb;
+    }
+    return t;
+}
+
+// The depth's slopes (per pixel in x and y) of the plane through the unsnapped vertices.
+fn depth_slopes(t: Snapped) -> vec2<f32> {
+    let e1 = t.sb - t.sa;
+    let e2 = t.sc - t.sa;
+    let det = e1.x * e2.y - e1.y * e2.x;
+    return vec2<f32>((e1.z * e2.y - e2.z * e1.y) / det, (e2.z * e1.x - e1.z * e2.x) / det);
 }
 
 // Whether `clip_triangle` would change the triangle: some vertex outside some plane.

@@ -257,40 +257,26 @@ fn depth_bias(z: vec3<f32>, dz: vec2<f32>) -> f32 {
 }
 
 fn setup_triangle(ca: vec4<f32>, cb: vec4<f32>, cc: vec4<f32>, rect: vec4<u32>, id: u32) {
-    let sa = to_screen(ca, rect);
-    var sb = to_screen(cb, rect);
-    var sc = to_screen(cc, rect);
-    let a = snap(sa);
-    var b = snap(sb);
-    var c = snap(sc);
-    var area = edge(a, b, c);
-    if (area == 0) {
+    // Both faces: either facing is drawn, ordered clockwise for the edge tests.
+    let s = snap_triangle(to_screen(ca, rect), to_screen(cb, rect), to_screen(cc, rect));
+    if (s.facing == 0) {
         return;
     }
-    // Both faces: orient clockwise (positive area) for the edge tests.
-    if (area < 0) {
-        let t = b;
-        b = c;
-        c = t;
-        let s = sb;
-        sb = sc;
-        sc = s;
-    }
+    let a = s.a;
+    let b = s.b;
+    let c = s.c;
     let box = texel_box(min(a, min(b, c)), max(a, max(b, c)), rect);
     if (box.x > box.z || box.y > box.w) {
         return;
     }
-    let e1 = sb - sa;
-    let e2 = sc - sa;
-    let det = e1.x * e2.y - e1.y * e2.x;
     var t: Tri;
     t.a = a;
     t.b = b;
     t.c = c;
     t.bias = -vec3<i32>(select(1, 0, top_left(b, c)), select(1, 0, top_left(c, a)), select(1, 0, top_left(a, b)));
-    t.sa = sa;
-    t.dz = vec2<f32>((e1.z * e2.y - e2.z * e1.y) / det, (e2.z * e1.x - e1.z * e2.x) / det);
-    t.offset = depth_bias(vec3<f32>(sa.z, sb.z, sc.z), t.dz);
+    t.sa = s.sa;
+    t.dz = depth_slopes(s);
+    t.offset = depth_bias(vec3<f32>(s.sa.z, s.sb.z, s.sc.z), t.dz);
     t.box = box;
     t.id = id;
     let size = box.zw - box.xy + vec2<i32>(1);

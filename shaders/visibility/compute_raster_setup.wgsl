@@ -108,39 +108,17 @@ fn reached_blocks(t: Tri) -> u32 {
 fn prepare_fan(ca: vec4<f32>, cb: vec4<f32>, cc: vec4<f32>, id: u32, cull_back: bool) -> Fan {
     var fan: Fan;
     fan.path = PATH_NONE;
-    let sa = to_screen(ca);
-    var sb = to_screen(cb);
-    var sc = to_screen(cc);
-    let a = snap(sa);
-    var b = snap(sb);
-    var c = snap(sc);
-    var area = edge(a, b, c);
-    if (area == 0) {
+    let s = snap_triangle(to_screen(ca), to_screen(cb), to_screen(cc));
+    if (s.facing == 0 || (s.facing > 0 && cull_back)) {
         return fan;
     }
-    // Positive area is clockwise on screen: clockwise in NDC too, a back face.
-    if (area > 0 && cull_back) {
-        return fan;
-    }
-    if (area < 0) {
-        let t = b;
-        b = c;
-        c = t;
-        let s = sb;
-        sb = sc;
-        sc = s;
-        area = -area;
-    }
+    let a = s.a;
+    let b = s.b;
+    let c = s.c;
     let box = pixel_box(min(a, min(b, c)), max(a, max(b, c)));
     if (box.x > box.z || box.y > box.w) {
         return fan;
     }
-    // Depth plane from the unsnapped positions.
-    let e1 = sb - sa;
-    let e2 = sc - sa;
-    let det = e1.x * e2.y - e1.y * e2.x;
-    let dzdx = (e1.z * e2.y - e2.z * e1.y) / det;
-    let dzdy = (e2.z * e1.x - e1.z * e2.x) / det;
     var t: Tri;
     t.a = a;
     t.b = b;
@@ -151,8 +129,9 @@ fn prepare_fan(ca: vec4<f32>, cb: vec4<f32>, cc: vec4<f32>, id: u32, cull_back: 
         t.flags |= RECORD_LINEAR;
     }
     t.bias = -vec3<i32>(vec3<u32>(t.flags, t.flags >> 1u, t.flags >> 2u) & vec3<u32>(1u));
-    t.sa = sa;
-    t.dz = vec2<f32>(dzdx, dzdy);
+    t.sa = s.sa;
+    // Depth plane from the unsnapped positions.
+    t.dz = depth_slopes(s);
     t.box = box;
     t.id = id;
     fan.t = t;
