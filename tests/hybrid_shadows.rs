@@ -10,7 +10,9 @@
 //! - lights an atlas too small for all drops are ray-cast, and every ray's bit equals the
 //!   CPU twin's ray from the surface rebuilt in f64 (rays within 1e-4 of an edge counted);
 //! - the policy picks the lights it names (the nearest, here), and follows lights that
-//!   move (a frame after `update_lights` is the frame prepared for the moved lights).
+//!   move (a frame after `update_lights` is the frame prepared for the moved lights);
+//! - Forward+ and tiled deferred take the hybrid alike, against their own ray-cast and
+//!   atlas frames.
 
 mod common;
 
@@ -94,12 +96,37 @@ fn darkened(scene: &Scene, dark: &BTreeSet<u32>, casting: bool) -> Scene {
     s
 }
 
-/// Runs the hybrid graph `text` on `scene` and checks it against the ray-cast and atlas
-/// frames (see the module doc); returns its atlas report and its jobs.
+/// The compute-first frame's ray-cast and atlas graphs, which its hybrid combines.
+const VISIBILITY_PARTS: Parts = Parts {
+    rays: "visibility_raycast_shadows.ron",
+    atlas: "visibility_shadow_atlas.ron",
+};
+
+/// The graphs of one frame kind that shadow one way each: all rays, all atlas.
+struct Parts {
+    rays: &'static str,
+    atlas: &'static str,
+}
+
+/// Runs the hybrid graph `text` on `scene` and checks it against the compute-first
+/// frame's ray-cast and atlas frames (see the module doc); returns its atlas report and
+/// its jobs.
 fn check_hybrid(
     r: &mut Renderer,
     text: &str,
     scene: &Scene,
+) -> (AtlasReport, Vec<BTreeMap<u32, bool>>) {
+    check_hybrid_against(r, text, scene, &VISIBILITY_PARTS)
+}
+
+/// `check_hybrid` against the ray-cast and atlas frames of `parts` (its frame kind's);
+/// the rays against the CPU twin where the frame has a visibility buffer to rebuild
+/// surfaces from.
+fn check_hybrid_against(
+    r: &mut Renderer,
+    text: &str,
+    scene: &Scene,
+    parts: &Parts,
 ) -> (AtlasReport, Vec<BTreeMap<u32, bool>>) {
     let (prepared, result) = run(r, text, scene);
     let atlas = result.atlases[0].clone();
@@ -115,7 +142,7 @@ fn check_hybrid(
         bytemuck::cast_slice(&prepared.read_buffer(r, "shadow_mask").unwrap()).to_vec();
 
     // Rays: the ray-cast frame's jobs and bits, less the mapped lights'.
-    let (ray_prepared, _) = run(r, &graph_text("visibility_raycast_shadows.ron"), scene);
+    let (ray_prepared, _) = run(r, &graph_text(parts.rays), scene);
     let all_rays = pixel_jobs(r, &ray_prepared, W * H);
     let ray_mask: Vec<u32> =
         bytemuck::cast_slice(&ray_prepared.read_buffer(r, "shadow_mask").unwrap()).to_vec();
@@ -145,32 +172,34 @@ fn check_hybrid(
     }
     assert!(jobs > 1_000 && hidden > 100, "{jobs} jobs, {hidden} hidden");
 
-    // Every ray against the CPU twin from the surface rebuilt in f64.
-    let ids = prepared.read_texture_bits(r, "visibility").unwrap();
-    let surfaces = Surfaces::new(r, scene, W, H);
-    let (agree, grazing, failures) = compare_with_cpu_twin(scene, &surfaces, &ids, &hybrid, OFFSET);
+    // Every ray against the CPU twin from the surface rebuilt in f64 (the other frame
+    // kinds' ray-cast frames are checked against it in tests/raycast_shadows.rs, and
+    // their jobs and bits are those frames' here).
     eprintln!(
-        "{} mapped, {} to rays; {jobs} jobs, {hidden} hidden; CPU twin: {agree} agree, {grazing} graze an edge",
+        "{}: {} mapped, {} to rays; {jobs} jobs, {hidden} hidden",
+        parts.rays,
         mapped.len(),
         rays.len()
     );
-    assert!(failures.is_empty(), "{failures:?}");
-    assert!(grazing * 100 < agree, "{grazing} grazing of {agree}");
+    if parts.rays == VISIBILITY_PARTS.rays {
+        let ids = prepared.read_texture_bits(r, "visibility").unwrap();
+        let surfaces = Surfaces::new(r, scene, W, H);
+        let (agree, grazing, failures) =
+            compare_with_cpu_twin(scene, &surfaces, &ids, &hybrid, OFFSET);
+        eprintln!("CPU twin: {agree} agree, {grazing} graze an edge");
+        assert!(failures.is_empty(), "{failures:?}");
+        assert!(grazing * 100 < agree, "{grazing} grazing of {agree}");
+    }
 
     // The image: ray-cast frame with the mapped lights dark, plus the atlas frame with
     // the others dark and casting none (so its allocation is the hybrid's: the same
     // lights, ranked alike, in the same tiles), less what neither lights.
     let all: BTreeSet<u32> = (0..scene.lights.len() as u32).collect();
-    let ray_part = run(
-        r,
-        &graph_text("visibility_raycast_shadows.ron"),
-        &darkened(scene, &mapped, true),
-    )
-    .1;
+    let ray_part = run(r, &graph_text(parts.rays), &darkened(scene, &mapped, true)).1;
     let others: BTreeSet<u32> = all.difference(&mapped).copied().collect();
     let atlas_run = run(
         r,
-        &graph_text("visibility_shadow_atlas.ron"),
+        &graph_text(parts.atlas),
         &darkened(scene, &others, false),
     )
     .1;
@@ -178,12 +207,7 @@ fn check_hybrid(
         atlas_run.atlases[0].shadowed, atlas.shadowed,
         "the atlas frame allocates alike"
     );
-    let dark = run(
-        r,
-        &graph_text("visibility_raycast_shadows.ron"),
-        &darkened(scene, &all, true),
-    )
-    .1;
+    let dark = run(r, &graph_text(parts.rays), &darkened(scene, &all, true)).1;
     let sum: Vec<[f32; 4]> = ray_part
         .image
         .iter()
@@ -208,7 +232,7 @@ fn check_hybrid(
     for l in &mut open.lights {
         l.flags &= !light_flags::CASTS_SHADOW;
     }
-    let open_part = run(r, &graph_text("visibility_shadow_atlas.ron"), &open).1;
+    let open_part = run(r, &graph_text(parts.atlas), &open).1;
     assert_ne!(
         open_part.image, atlas_run.image,
         "the atlas shadows nothing"
@@ -339,4 +363,36 @@ fn the_policy_follows_lights_that_move() {
     let (worst, at) = max_rel_diff(&after.image, &fresh.image);
     assert!(worst < 3e-7, "{worst} of the peak at pixel {at}");
     assert_ne!(after.image, before.image);
+}
+
+/// Forward+ (graphs/hybrid_shadows.ron) and tiled deferred
+/// (graphs/tiled_deferred_hybrid_shadows.ron) take the hybrid as the compute-first frame
+/// does: their own ray-cast frame's jobs and bits for the lights the policy leaves to
+/// rays, none for the mapped ones, and an image that is their ray-cast frame's plus their
+/// atlas frame's (raycast_shadows.ron and shadow_atlas.ron, and the tiled deferred ones).
+#[test]
+fn forward_and_deferred_hybrids_equal_their_ray_cast_and_atlas_frames() {
+    let mut r = renderer();
+    let scene = scene(14, 7);
+    for (hybrid, parts) in [
+        (
+            "hybrid_shadows.ron",
+            Parts {
+                rays: "raycast_shadows.ron",
+                atlas: "shadow_atlas.ron",
+            },
+        ),
+        (
+            "tiled_deferred_hybrid_shadows.ron",
+            Parts {
+                rays: "tiled_deferred_raycast_shadows.ron",
+                atlas: "tiled_deferred_shadow_atlas.ron",
+            },
+        ),
+    ] {
+        let text = graph_text(hybrid).replace("policy: Nearest(16)", "policy: Nearest(4)");
+        assert!(text.contains("policy: Nearest(4)"), "{hybrid}");
+        let (atlas, _) = check_hybrid_against(&mut r, &text, &scene, &parts);
+        assert_eq!(atlas.shadowed.len(), 4, "{hybrid}: {atlas:?}");
+    }
 }

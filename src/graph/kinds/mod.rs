@@ -385,11 +385,37 @@ pub(crate) fn check_shadow_atlas(ctx: &KindCtx, errors: &mut Vec<GraphError>, wi
             if let Some(other) = other {
                 errors.push(ctx.mismatch(
                     other,
-                    "a pass shadows its lights one way: from the atlas, the ray-cast mask or the BVH (VisibilityShading reads the atlas and the mask together)",
+                    "a pass shadows its lights one way: from the atlas, the ray-cast mask or the BVH (forward, deferred and visibility shading read the atlas and the mask together)",
                 ));
             }
         }
         (None, None) => {}
+    }
+}
+
+/// The hybrid (the atlas and the mask read together): the jobs pass that writes the mask
+/// reads the same view table, so it casts rays only for the lights without a map.
+pub(crate) fn check_hybrid_jobs(ctx: &contracts::InputsCtx, errors: &mut Vec<GraphError>) {
+    let (Some(mask), Some(views)) = (
+        ctx.slot(shadow_ray_jobs::SHADOW_MASK),
+        ctx.slot(shadow_atlas::SHADOW_VIEWS),
+    ) else {
+        return;
+    };
+    for (p, r) in ctx.passes() {
+        let writes_mask = p.writes.iter().any(|w| w == mask);
+        if writes_mask
+            && matches!(p.kind, PassKind::ShadowRayJobs(_))
+            && r.slot(shadow_atlas::SHADOW_VIEWS) != Some(views)
+        {
+            errors.push(ctx.mismatch(
+                mask,
+                format!(
+                    "the pass samples the atlas for lights with a map in '{views}' and reads the mask for the rest, but jobs pass '{}' does not read '{views}': it would cast rays for every caster; add '{views}' to its reads",
+                    p.name
+                ),
+            ));
+        }
     }
 }
 

@@ -55,7 +55,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
 pub(crate) fn check(p: &DeferredShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     check_light_source(ctx, p.lights, errors);
     super::check_shadow_mask(ctx, errors);
-    super::check_shadow_atlas(ctx, errors, false);
+    super::check_shadow_atlas(ctx, errors, true);
     ctx.require_single_rgba32f(
         &[HDR],
         "deferred shading stores into a single-sample Rgba32Float texture",
@@ -102,6 +102,9 @@ impl KindRules for DeferredShading {
     }
     fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         check(self, ctx, errors)
+    }
+    fn check_inputs(&self, ctx: &super::contracts::InputsCtx, errors: &mut Vec<GraphError>) {
+        super::check_hybrid_jobs(ctx, errors)
     }
 }
 

@@ -112,7 +112,7 @@ pub(crate) fn check(p: &ForwardShading, ctx: &KindCtx, errors: &mut Vec<GraphErr
         ));
     }
     super::check_shadow_mask(ctx, errors);
-    super::check_shadow_atlas(ctx, errors, false);
+    super::check_shadow_atlas(ctx, errors, true);
     if let (Some(c), Some(d)) = (ctx.slot(slot::COLOR), ctx.slot(slot::DEPTH)) {
         let (cs, ds) = (ctx.samples(c), ctx.samples(d));
         if cs != ds {
@@ -131,11 +131,35 @@ impl KindRules for ForwardShading {
     fn check(&self, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         check(self, ctx, errors)
     }
+    fn check_inputs(&self, ctx: &super::contracts::InputsCtx, errors: &mut Vec<GraphError>) {
+        super::check_hybrid_jobs(ctx, errors)
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use crate::graph::kinds::test_support::{errors, validate, CULL, PREPASS};
+
+    /// The hybrid: the atlas for lights with a map, the mask of jobs that skip them.
+    #[test]
+    fn takes_the_atlas_and_the_mask_of_jobs_that_skip_mapped_lights() {
+        let graph = |job_views: &str| {
+            format!(
+                r#"Pass(name: "a", kind: ShadowAtlas(policy: Nearest(4)), reads: ["geometry"], writes: ["atlas", "views"]),
+                {PREPASS} {CULL}
+                Pass(name: "g", kind: GBuffer, reads: ["geometry", "depth"], writes: ["g_position=pos", "g_geometric=geo"]),
+                Pass(name: "j", kind: ShadowRayJobs(), reads: ["g_position=pos", "g_geometric=geo", "lg", "lp", "lists"{job_views}], writes: ["jobs", "mask"]),
+                Pass(name: "r", kind: ShadowRayCast(), reads: ["jobs", "g_position=pos", "g_geometric=geo", "lg", "bn", "bt"], writes: ["mask"]),
+                Pass(name: "s", kind: ForwardShading(lights: Culled), reads: ["geometry", "depth", "lg", "lp", "lists", "shadow_mask=mask", "atlas", "shadow_views=views"], writes: ["hdr"])"#
+            )
+        };
+        validate(&graph(r#", "shadow_views=views""#), "hdr").unwrap();
+        let e = errors(&graph(""), "hdr");
+        assert!(
+            e.contains("pass 's', resource 'mask': the pass samples the atlas for lights with a map in 'views' and reads the mask for the rest, but jobs pass 'j' does not read 'views'"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn culled_needs_lists_and_all_lights_takes_none() {

@@ -249,7 +249,8 @@ pub(crate) fn jobs_reading_views<'a>(
 }
 
 /// A mask whose jobs skip the atlas's lights holds no answer for them: every pass that
-/// reads it must be a `VisibilityShading` pass sampling the same atlas for those lights.
+/// reads it must be a shading pass sampling the same atlas for those lights (forward,
+/// deferred or visibility shading: the hybrid).
 fn check_mask_readers(ctx: &InputsCtx, errors: &mut Vec<GraphError>) {
     let (Some(views), Some(mask)) = (ctx.slot(SHADOW_VIEWS), ctx.slot(SHADOW_MASK)) else {
         return;
@@ -258,9 +259,15 @@ fn check_mask_readers(ctx: &InputsCtx, errors: &mut Vec<GraphError>) {
         if r.slot(SHADOW_MASK) != Some(mask) || p.writes.iter().any(|w| w == mask) {
             continue;
         }
-        let problem = if !matches!(p.kind, PassKind::VisibilityShading(_)) {
+        let hybrid_reader = matches!(
+            p.kind,
+            PassKind::VisibilityShading(_)
+                | PassKind::ForwardShading(_)
+                | PassKind::DeferredShading(_)
+        );
+        let problem = if !hybrid_reader {
             format!(
-                "'{}' ({}) reads '{mask}', whose jobs pass '{}' casts no rays for lights with a map in '{views}'; only VisibilityShading reads such a mask (sampling the atlas for those lights)",
+                "'{}' ({}) reads '{mask}', whose jobs pass '{}' casts no rays for lights with a map in '{views}'; only forward, deferred and visibility shading read such a mask (sampling the atlas for those lights)",
                 p.name,
                 p.kind.label(),
                 ctx.pass().name

@@ -13,13 +13,13 @@
 use super::contracts::InputsCtx;
 use super::deferred_shading::HDR;
 use super::light_sampling::LIGHT_SAMPLES;
-use super::shadow_atlas::{SHADOW_ATLAS, SHADOW_VIEWS};
+use super::shadow_atlas::SHADOW_ATLAS;
 use super::shadow_ray_cast::{BVH_NODES, BVH_TRIANGLES};
 use super::shadow_ray_jobs::SHADOW_MASK;
 use super::visibility_buffer::VISIBILITY;
 use super::{check_light_source, Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
-use crate::graph::model::{LightSource, PassKind, SceneResource};
+use crate::graph::model::{LightSource, SceneResource};
 use serde::{Deserialize, Serialize};
 
 /// `VisibilityShading(lights: Culled, light_loop: RangeFirst, workgroup: 16, materials: PerShader)`.
@@ -204,29 +204,6 @@ pub(crate) fn check(p: &VisibilityShading, ctx: &KindCtx, errors: &mut Vec<Graph
     }
 }
 
-/// The hybrid (the atlas and the mask read together): the jobs pass that writes the mask
-/// reads the same view table, so it casts rays only for the lights without a map.
-fn check_hybrid_jobs(ctx: &InputsCtx, errors: &mut Vec<GraphError>) {
-    let (Some(mask), Some(views)) = (ctx.slot(SHADOW_MASK), ctx.slot(SHADOW_VIEWS)) else {
-        return;
-    };
-    for (p, r) in ctx.passes() {
-        let writes_mask = p.writes.iter().any(|w| w == mask);
-        if writes_mask
-            && matches!(p.kind, PassKind::ShadowRayJobs(_))
-            && r.slot(SHADOW_VIEWS) != Some(views)
-        {
-            errors.push(ctx.mismatch(
-                mask,
-                format!(
-                    "the pass samples the atlas for lights with a map in '{views}' and reads the mask for the rest, but jobs pass '{}' does not read '{views}': it would cast rays for every caster; add '{views}' to its reads",
-                    p.name
-                ),
-            ));
-        }
-    }
-}
-
 impl KindRules for VisibilityShading {
     fn slots(&self) -> &'static [SlotSpec] {
         SLOTS
@@ -235,7 +212,7 @@ impl KindRules for VisibilityShading {
         check(self, ctx, errors)
     }
     fn check_inputs(&self, ctx: &InputsCtx, errors: &mut Vec<GraphError>) {
-        check_hybrid_jobs(ctx, errors)
+        super::check_hybrid_jobs(ctx, errors)
     }
 }
 
