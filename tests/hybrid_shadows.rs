@@ -373,7 +373,25 @@ fn the_policy_follows_lights_that_move() {
 #[test]
 fn forward_and_deferred_hybrids_equal_their_ray_cast_and_atlas_frames() {
     let mut r = renderer();
-    let scene = scene(14, 7);
+    let mut scene = scene(14, 7);
+    // A pane of glass over the room: tiled deferred's glass is hybrid too (the atlas for
+    // the mapped lights, its own traced rays for the rest), so its parts are the glass of
+    // tiled_deferred_raycast_shadows.ron (traced) and tiled_deferred_shadow_atlas.ron
+    // (the atlas); Forward+'s graphs have no glass passes and skip it.
+    scene.materials.push(lightgraph::scene::SurfaceMaterial {
+        name: "glass".into(),
+        base_color: glam::Vec4::new(0.6, 0.8, 1.0, 0.5),
+        alpha_mode: lightgraph::scene::AlphaMode::Blend,
+        ..Default::default()
+    });
+    let mut pane = lightgraph::scene::geometry::MeshBuilder::new("pane", 2);
+    pane.quad(
+        Vec3::new(-5.0, 2.5, -9.0),
+        Vec3::new(0.0, 0.0, 8.0),
+        Vec3::new(10.0, 0.0, 0.0),
+        glam::Vec2::ONE,
+    );
+    scene.meshes.push(pane.build());
     for (hybrid, parts) in [
         (
             "hybrid_shadows.ron",
@@ -395,4 +413,18 @@ fn forward_and_deferred_hybrids_equal_their_ray_cast_and_atlas_frames() {
         let (atlas, _) = check_hybrid_against(&mut r, &text, &scene, &parts);
         assert_eq!(atlas.shadowed.len(), 4, "{hybrid}: {atlas:?}");
     }
+    // The pane shows in the tiled deferred frame (so its glass was checked above).
+    let text = graph_text("tiled_deferred_hybrid_shadows.ron");
+    let with_pane = run(&mut r, &text, &scene).1;
+    let mut without = scene.clone();
+    without.meshes.pop();
+    let no_pane = run(&mut r, &text, &without).1;
+    let changed = with_pane
+        .image
+        .iter()
+        .zip(&no_pane.image)
+        .filter(|(a, b)| a != b)
+        .count();
+    // 462 pixels on lavapipe (the room's boxes and column hide part of it).
+    assert!(changed > 300, "the pane changes {changed} pixels");
 }

@@ -13,9 +13,9 @@
 // SHADOW_ATLAS (sample a ShadowAtlas pass's depth atlas, with SHADOW_PCF5 for the 5×5
 // filter, else one 2×2 hardware-comparison tap; SHADOW_ATLAS_FLOAT: the atlas is the
 // compute raster's R32Float, compared by hand with the same weights), or SHADOW_HYBRID
-// with both SHADOW_MASK and SHADOW_ATLAS (the atlas for lights with a map this frame, the
-// mask for the rest). SHADOW_ATLAS_LIGHTS alone (job creation) reads only which lights
-// have a map.
+// with SHADOW_ATLAS and SHADOW_MASK or SHADOW_TRACE (the atlas for lights with a map this
+// frame, the mask or the tracer for the rest: the tracer for glass, which no job
+// covers). SHADOW_ATLAS_LIGHTS alone (job creation) reads only which lights have a map.
 //
 // The light loop asks `shadow_visibility` for the fraction of light that reaches p:
 // 0 or 1 from the mask and the tracer, filtered from the atlas.
@@ -74,9 +74,12 @@ fn shadow_visible(pixel_index: u32, caster: u32, light_pos: vec3<f32>, p: vec3<f
 // The fragment's geometric normal, set by the fragment shader before shading.
 var<private> shadow_ng: vec3<f32>;
 
+#if SHADOW_HYBRID
+#else
 fn shadow_visibility(pixel_index: u32, caster: u32, light: u32, light_pos: vec3<f32>, p: ShadingPoint) -> f32 {
     return select(0.0, 1.0, shadow_visible(pixel_index, caster, light_pos, p.position));
 }
+#endif
 
 fn shadow_visible(pixel_index: u32, caster: u32, light_pos: vec3<f32>, p: vec3<f32>) -> bool {
     if (!shadow_faces(p, shadow_ng, light_pos)) {
@@ -246,7 +249,8 @@ fn shadow_atlas_visibility(light: u32, light_pos: vec3<f32>, p: ShadingPoint) ->
 
 #if SHADOW_HYBRID
 // A light with a map this frame samples it; the others were ray-cast by job creation,
-// which skipped the mapped ones (shadow/shadow_ray_jobs.wgsl) and numbered casters alike.
+// which skipped the mapped ones (shadow/shadow_ray_jobs.wgsl) and numbered casters alike
+// (SHADOW_MASK), or are traced here (SHADOW_TRACE).
 fn shadow_visibility(pixel_index: u32, caster: u32, light: u32, light_pos: vec3<f32>, p: ShadingPoint) -> f32 {
     if (shadow_atlas_entry(light) != 0u) {
         return shadow_atlas_visibility(light, light_pos, p);

@@ -362,10 +362,14 @@ pub(crate) fn check_bvh_trace(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     }
 }
 
-/// A shading pass samples an atlas through its view table, and shadows one way only;
-/// with `with_mask`, the atlas and the ray-cast mask together (the hybrid: the atlas for
-/// lights with a map, the mask for the rest).
-pub(crate) fn check_shadow_atlas(ctx: &KindCtx, errors: &mut Vec<GraphError>, with_mask: bool) {
+/// A shading pass samples an atlas through its view table, and shadows one way only, or
+/// the atlas and `hybrid` together (the hybrid: the atlas for lights with a map, the
+/// ray-cast mask, or the BVH traced in the light loop, for the rest).
+pub(crate) fn check_shadow_atlas(
+    ctx: &KindCtx,
+    errors: &mut Vec<GraphError>,
+    hybrid: Option<&str>,
+) {
     use shadow_atlas::{SHADOW_ATLAS, SHADOW_VIEWS};
     match (ctx.slot(SHADOW_ATLAS), ctx.slot(SHADOW_VIEWS)) {
         (Some(atlas), None) => errors.push(ctx.mismatch(
@@ -380,12 +384,12 @@ pub(crate) fn check_shadow_atlas(ctx: &KindCtx, errors: &mut Vec<GraphError>, wi
             check_shadow_atlas_texture(ctx, errors);
             let other = [shadow_ray_jobs::SHADOW_MASK, shadow_ray_cast::BVH_NODES]
                 .into_iter()
-                .filter(|s| !(with_mask && *s == shadow_ray_jobs::SHADOW_MASK))
+                .filter(|s| hybrid != Some(*s))
                 .find_map(|s| ctx.slot(s));
             if let Some(other) = other {
                 errors.push(ctx.mismatch(
                     other,
-                    "a pass shadows its lights one way: from the atlas, the ray-cast mask or the BVH (forward, deferred and visibility shading read the atlas and the mask together)",
+                    "a pass shadows its lights one way: from the atlas, the ray-cast mask or the BVH (the hybrid: forward, deferred and visibility shading read the atlas and the mask together, glass shading the atlas and the BVH)",
                 ));
             }
         }

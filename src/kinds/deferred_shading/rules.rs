@@ -55,7 +55,7 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
 pub(crate) fn check(p: &DeferredShading, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     check_light_source(ctx, p.lights, errors);
     super::check_shadow_mask(ctx, errors);
-    super::check_shadow_atlas(ctx, errors, true);
+    super::check_shadow_atlas(ctx, errors, Some(super::shadow_ray_jobs::SHADOW_MASK));
     ctx.require_single_rgba32f(
         &[HDR],
         "deferred shading stores into a single-sample Rgba32Float texture",

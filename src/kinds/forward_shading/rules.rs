@@ -66,8 +66,14 @@ pub enum Shadows {
         super::shadow_atlas::AtlasRaster,
     ),
     /// Samples the atlas for lights with a map this frame and reads the ray-cast mask
-    /// for the rest (VisibilityShading only).
+    /// for the rest (forward, deferred and visibility shading).
     Hybrid(
+        super::shadow_atlas::ShadowFilter,
+        super::shadow_atlas::AtlasRaster,
+    ),
+    /// Samples the atlas for lights with a map this frame and casts a ray in the light
+    /// loop for the rest (glass: no job covers its fragments).
+    HybridTrace(
         super::shadow_atlas::ShadowFilter,
         super::shadow_atlas::AtlasRaster,
     ),
@@ -93,6 +99,10 @@ pub fn shadows(roles: &crate::graph::PassRoles, plan: &crate::graph::ResourcePla
             Shadows::Hybrid(filter, raster)
         }
         (Some(_), None) => Shadows::Mask,
+        (None, Some(views)) if roles.slot(BVH_NODES).is_some() => {
+            let (filter, raster) = atlas(views);
+            Shadows::HybridTrace(filter, raster)
+        }
         _ if roles.slot(BVH_NODES).is_some() => Shadows::Trace,
         (None, Some(views)) => {
             let (filter, raster) = atlas(views);
@@ -112,7 +122,7 @@ pub(crate) fn check(p: &ForwardShading, ctx: &KindCtx, errors: &mut Vec<GraphErr
         ));
     }
     super::check_shadow_mask(ctx, errors);
-    super::check_shadow_atlas(ctx, errors, true);
+    super::check_shadow_atlas(ctx, errors, Some(super::shadow_ray_jobs::SHADOW_MASK));
     if let (Some(c), Some(d)) = (ctx.slot(slot::COLOR), ctx.slot(slot::DEPTH)) {
         let (cs, ds) = (ctx.samples(c), ctx.samples(d));
         if cs != ds {

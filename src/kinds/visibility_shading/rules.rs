@@ -175,7 +175,7 @@ pub(crate) fn check(p: &VisibilityShading, ctx: &KindCtx, errors: &mut Vec<Graph
         errors,
     );
     super::check_shadow_mask(ctx, errors);
-    super::check_shadow_atlas(ctx, errors, true);
+    super::check_shadow_atlas(ctx, errors, Some(super::shadow_ray_jobs::SHADOW_MASK));
     super::check_bvh_trace(ctx, errors);
     if let Some(nodes) = ctx.slot(BVH_NODES) {
         if ctx.slot(SHADOW_MASK).is_some() || ctx.slot(SHADOW_ATLAS).is_some() {

@@ -128,13 +128,17 @@ pub(super) fn shadow_defines(shadows: Shadows) -> Vec<(&'static str, String)> {
             ("SHADOW_TRACE", "1".into()),
             ("SHADOW_NORMAL_OFFSET", offset),
         ],
-        Shadows::Atlas(filter, raster) | Shadows::Hybrid(filter, raster) => {
+        Shadows::Atlas(filter, raster)
+        | Shadows::Hybrid(filter, raster)
+        | Shadows::HybridTrace(filter, raster) => {
             let mut d = vec![("SHADOWS", "1".into()), ("SHADOW_NORMAL_OFFSET", offset)];
             d.extend(atlas_defines(filter, raster));
-            if matches!(shadows, Shadows::Hybrid(..)) {
-                d.push(("SHADOW_MASK", "1".into()));
-                d.push(("SHADOW_HYBRID", "1".into()));
+            match shadows {
+                Shadows::Hybrid(..) => d.push(("SHADOW_MASK", "1".into())),
+                Shadows::HybridTrace(..) => d.push(("SHADOW_TRACE", "1".into())),
+                _ => return d,
             }
+            d.push(("SHADOW_HYBRID", "1".into()));
             d
         }
     }

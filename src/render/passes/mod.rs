@@ -288,7 +288,7 @@ impl PrepareCtx<'_> {
             return Shadows::None;
         }
         let s = shadows(&sp.roles, &self.graph.plan);
-        if let Shadows::Atlas(..) | Shadows::Hybrid(..) = s {
+        if let Shadows::Atlas(..) | Shadows::Hybrid(..) | Shadows::HybridTrace(..) = s {
             offered.offer("shadow_sampler", comparison_sampler(&self.device()));
         }
         s
