@@ -428,3 +428,40 @@ fn forward_and_deferred_hybrids_equal_their_ray_cast_and_atlas_frames() {
     // 462 pixels on lavapipe (the room's boxes and column hide part of it).
     assert!(changed > 300, "the pane changes {changed} pixels");
 }
+
+/// `policy: RayBudget(rays)`: the lights that could cast the most rays take maps until
+/// the rest could cast no more than the budget, so the frame casts at most that many
+/// rays (each light's rays are bounded by its range's screen box on the CPU). The budget
+/// here is two thirds of the all-rays frame's jobs; the hybrid checks of
+/// `check_hybrid` hold with it.
+#[test]
+fn a_ray_budget_bounds_the_rays_cast() {
+    let mut r = renderer();
+    let scene = scene(14, 7);
+    let (all_rays, _) = run(
+        &mut r,
+        &graph_text("visibility_raycast_shadows.ron"),
+        &scene,
+    );
+    let all_jobs: usize = pixel_jobs(&mut r, &all_rays, W * H)
+        .iter()
+        .map(BTreeMap::len)
+        .sum();
+    let budget = all_jobs * 2 / 3;
+    let text = graph_text("visibility_hybrid_shadows.ron").replace(
+        "policy: Nearest(16)",
+        &format!("policy: RayBudget({budget}.0)"),
+    );
+    assert!(text.contains("RayBudget("));
+    let (atlas, jobs) = check_hybrid(&mut r, &text, &scene);
+    let cast: usize = jobs.iter().map(BTreeMap::len).sum();
+    eprintln!(
+        "all rays {all_jobs}, budget {budget}: {cast} cast, {} mapped, {} left to rays, {} dropped",
+        atlas.shadowed.len(),
+        atlas.left_by_policy.len(),
+        atlas.dropped.len()
+    );
+    assert!(atlas.dropped.is_empty(), "{atlas:?}");
+    assert!(cast <= budget, "{cast} rays over the budget of {budget}");
+    assert!(cast > 0 && !atlas.left_by_policy.is_empty(), "{atlas:?}");
+}

@@ -119,6 +119,7 @@ struct Request {
     tile: u32,
     screen_px: f32,
     distance: f32,
+    ray_pixels: f64,
 }
 
 impl Request {
@@ -176,6 +177,38 @@ fn screen_size(light: &Light, camera: &Camera, height: u32) -> f32 {
     px.min(height as f32)
 }
 
+/// The most pixels whose surface a light's range can reach: the pixel centres inside the
+/// screen box of its range sphere's bounding box (the whole frame when a corner of that
+/// box is not in front of the camera). A shadow ray is cast only from a pixel whose
+/// surface lies in range, so this bounds the light's rays.
+pub(crate) fn ray_pixels_bound(light: &Light, view_proj: &Mat4, width: u32, height: u32) -> f64 {
+    let frame = f64::from(width) * f64::from(height);
+    let r = light.range;
+    let (mut lo, mut hi) = (glam::Vec2::splat(f32::MAX), glam::Vec2::splat(f32::MIN));
+    for k in 0..8 {
+        let corner = light.position
+            + glam::Vec3::new(
+                if k & 1 == 0 { -r } else { r },
+                if k & 2 == 0 { -r } else { r },
+                if k & 4 == 0 { -r } else { r },
+            );
+        let c = *view_proj * corner.extend(1.0);
+        if !(c.w > 0.0 && c.z >= 0.0) {
+            return frame;
+        }
+        let ndc = glam::Vec2::new(c.x, c.y) / c.w;
+        lo = lo.min(ndc);
+        hi = hi.max(ndc);
+    }
+    let lo = lo.clamp(glam::Vec2::splat(-1.0), glam::Vec2::ONE);
+    let hi = hi.clamp(glam::Vec2::splat(-1.0), glam::Vec2::ONE);
+    // A span of s pixels holds at most s + 1 pixel centres.
+    let span = |a: f32, b: f32, pixels: u32| {
+        (f64::from((b - a) * 0.5) * f64::from(pixels) + 1.0).min(f64::from(pixels))
+    };
+    (span(lo.x, hi.x, width) * span(lo.y, hi.y, height)).min(frame)
+}
+
 fn is_cube(light: &Light) -> bool {
     match light.shape {
         LightShape::Point => true,
@@ -193,7 +226,8 @@ pub(crate) fn allocate(
     cfg: &AtlasConfig,
 ) -> Allocation {
     let aspect = width as f32 / height.max(1) as f32;
-    let planes = frustum_planes(camera.projection(aspect) * camera.view());
+    let view_proj = camera.projection(aspect) * camera.view();
+    let planes = frustum_planes(view_proj);
     let mut out = Allocation::default();
     let mut requests = Vec::new();
     for (i, l) in lights.iter().enumerate() {
@@ -218,6 +252,7 @@ pub(crate) fn allocate(
             tile: wanted,
             screen_px,
             distance: l.position.distance(camera.eye),
+            ray_pixels: ray_pixels_bound(l, &view_proj, width, height),
         });
     }
     let candidates: Vec<Candidate> = requests
@@ -226,6 +261,7 @@ pub(crate) fn allocate(
             light: r.light,
             screen_px: r.screen_px,
             distance: r.distance,
+            ray_pixels: r.ray_pixels,
         })
         .collect();
     let keep = policy::select(cfg.policy, &candidates);
@@ -402,6 +438,50 @@ mod tests {
             target: Vec3::ZERO,
             ..Default::default()
         }
+    }
+
+    /// The ray bound holds every pixel whose surface a light reaches: here, every pixel
+    /// centre inside the exact screen ellipse of a sphere in front of the camera, found
+    /// by a ray per pixel; the whole frame when the camera is inside the range.
+    #[test]
+    fn the_ray_bound_holds_the_pixels_in_range() {
+        let (w, h) = (160u32, 90u32);
+        let cam = camera();
+        let view_proj = cam.projection(w as f32 / h as f32) * cam.view();
+        let inv = view_proj.inverse();
+        for light in [
+            caster(Vec3::new(0.0, 0.0, 0.0), 3.0),
+            caster(Vec3::new(6.0, 2.0, 5.0), 1.5),
+            caster(Vec3::new(-9.0, -3.0, -4.0), 4.0),
+        ] {
+            let bound = ray_pixels_bound(&light, &view_proj, w, h);
+            let mut inside = 0.0;
+            for y in 0..h {
+                for x in 0..w {
+                    let ndc = glam::Vec2::new(
+                        (x as f32 + 0.5) / w as f32 * 2.0 - 1.0,
+                        1.0 - (y as f32 + 0.5) / h as f32 * 2.0,
+                    );
+                    let far = inv.project_point3(ndc.extend(1.0));
+                    let dir = (far - cam.eye).normalize();
+                    // The ray meets the sphere: some point of it is in range.
+                    let t = (light.position - cam.eye).dot(dir).max(0.0);
+                    if (cam.eye + dir * t).distance(light.position) <= light.range {
+                        inside += 1.0;
+                    }
+                }
+            }
+            assert!(
+                inside > 0.0 && inside <= bound,
+                "{inside} pixels, bound {bound}"
+            );
+            assert!(bound < f64::from(w * h), "{bound}: not the whole frame");
+        }
+        let around = caster(cam.eye, 1.0);
+        assert_eq!(
+            ray_pixels_bound(&around, &view_proj, w, h),
+            f64::from(w * h)
+        );
     }
 
     fn cfg(size: u32) -> AtlasConfig {

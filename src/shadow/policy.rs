@@ -27,6 +27,13 @@ pub enum AtlasPolicy {
     ProjectedSize(f32),
     /// Lights whose position lies within `distance` world units of the eye.
     Within(f32),
+    /// At most `rays` shadow rays for the lights left to rays: the lights that could
+    /// cast the most take maps first, until the rest could cast no more than `rays`. A
+    /// light's rays are bounded on the CPU by the pixels of its range's screen box (a
+    /// pixel casts at most one ray a light, and only where its surface lies in range),
+    /// so the rays of the lights this leaves out never exceed the budget. Lights the
+    /// allocation then drops for room are ray-cast too, past it (reported).
+    RayBudget(f64),
 }
 
 /// What the allocation does when the requested tiles exceed the atlas.
@@ -57,6 +64,9 @@ impl AtlasPolicy {
             AtlasPolicy::Within(d) if !(d.is_finite() && d > 0.0) => Some(format!(
                 "policy Within({d}): the distance must be positive and finite"
             )),
+            AtlasPolicy::RayBudget(rays) if !(rays.is_finite() && rays > 0.0) => Some(format!(
+                "policy RayBudget({rays}): the budget must be a positive, finite number of rays"
+            )),
             _ => None,
         }
     }
@@ -75,6 +85,8 @@ pub(crate) struct Candidate {
     pub(crate) screen_px: f32,
     /// Distance from the eye to its position.
     pub(crate) distance: f32,
+    /// The most rays it can ask for: the pixels of its range's screen box.
+    pub(crate) ray_pixels: f64,
 }
 
 /// Which candidates ask for a tile: `keep[i]` for `candidates[i]`.
@@ -102,6 +114,25 @@ pub(crate) fn select(policy: AtlasPolicy, candidates: &[Candidate]) -> Vec<bool>
         AtlasPolicy::Within(distance) => {
             candidates.iter().map(|c| c.distance <= distance).collect()
         }
+        AtlasPolicy::RayBudget(budget) => {
+            let mut order: Vec<usize> = (0..candidates.len()).collect();
+            order.sort_by(|&a, &b| {
+                let (a, b) = (&candidates[a], &candidates[b]);
+                b.ray_pixels
+                    .total_cmp(&a.ray_pixels)
+                    .then(a.light.cmp(&b.light))
+            });
+            let mut left: f64 = candidates.iter().map(|c| c.ray_pixels).sum();
+            let mut keep = vec![false; candidates.len()];
+            for i in order {
+                if left <= budget {
+                    break;
+                }
+                keep[i] = true;
+                left -= candidates[i].ray_pixels;
+            }
+            keep
+        }
     }
 }
 
@@ -120,6 +151,7 @@ mod tests {
             light,
             screen_px,
             distance,
+            ray_pixels: f64::from(screen_px * screen_px),
         })
         .to_vec()
     }
@@ -142,6 +174,21 @@ mod tests {
             select(AtlasPolicy::Within(3.0), &c),
             [false, true, false, false]
         );
+        // RayBudget: rays 1,600, 90,000, 14,400, 14,400 (30,400 without light 1); the
+        // largest first, ties to the lower index.
+        assert_eq!(
+            select(AtlasPolicy::RayBudget(30_400.0), &c),
+            [false, true, false, false]
+        );
+        assert_eq!(
+            select(AtlasPolicy::RayBudget(30_399.0), &c),
+            [false, true, true, false]
+        );
+        assert_eq!(select(AtlasPolicy::RayBudget(1e9), &c), [false; 4]);
+        assert_eq!(
+            select(AtlasPolicy::RayBudget(1.0), &c),
+            [true, true, true, true]
+        );
     }
 
     #[test]
@@ -156,6 +203,12 @@ mod tests {
             .contains("min_pixels"));
         assert!(AtlasPolicy::Within(-1.0).problem().is_some());
         assert!(AtlasPolicy::Within(0.5).problem().is_none());
+        assert!(AtlasPolicy::RayBudget(0.0)
+            .problem()
+            .unwrap()
+            .contains("RayBudget(0)"));
+        assert!(AtlasPolicy::RayBudget(f64::INFINITY).problem().is_some());
+        assert!(AtlasPolicy::RayBudget(1e6).problem().is_none());
         assert!(!AtlasPolicy::All.leaves_lights_to_rays());
     }
 }
