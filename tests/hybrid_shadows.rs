@@ -443,7 +443,7 @@ fn a_ray_budget_bounds_the_rays_cast() {
         &graph_text("visibility_raycast_shadows.ron"),
         &scene,
     );
-    let all_jobs: usize = pixel_jobs(&mut r, &all_rays, W * H)
+    let all_jobs: usize = pixel_jobs(&r, &all_rays, W * H)
         .iter()
         .map(BTreeMap::len)
         .sum();
