@@ -441,20 +441,34 @@ fn full_lists_fall_back_to_serial_rasterization_with_the_same_atlas() {
     assert!(e.contains(TEST_LIMITS) && e.contains("'cells=0'"), "{e}");
 }
 
+/// The compute raster draws no alpha mask: with a masked caster, `raster: Compute` has
+/// the raster units draw the views into an internal Depth32Float atlas, copied into the
+/// R32Float atlas. Its frame is the hardware atlas's (within `assert_shaded_alike`'s
+/// bound for the hand comparison), with the mask kept (alpha 1: the boxes cast) or cut
+/// (alpha 0.3 under the 0.5 cutoff: their shadows go).
 #[test]
-fn the_compute_raster_refuses_alpha_masked_casters() {
+fn alpha_masked_casters_are_drawn_by_the_raster_units_and_copied() {
     let mut r = renderer();
-    let mut scene = scene();
-    let mut masked = common::lambert("leaves", Vec3::ONE);
-    masked.alpha_mode = lightgraph::scene::AlphaMode::Mask(0.5);
-    scene.materials[1] = masked;
-    let text = graph("Compute", false);
-    let e = common::prepare_text(&mut r, &text, &scene, W, H, false)
-        .err()
-        .expect("refused")
-        .to_string();
-    assert!(
-        e.contains("shadow_maps") && e.contains("alpha-masked") && e.contains("raster: Hardware"),
-        "{e}"
-    );
+    let mut frames = Vec::new();
+    for alpha in [1.0, 0.3] {
+        let mut scene = scene();
+        let mut masked = common::lambert("leaves", Vec3::ONE);
+        masked.base_color.w = alpha;
+        masked.alpha_mode = lightgraph::scene::AlphaMode::Mask(0.5);
+        scene.materials[1] = masked;
+        let (hw, _) = prepare(&mut r, &graph("Hardware", false), &scene);
+        let (cs, _) = prepare(&mut r, &graph("Compute", false), &scene);
+        let (hw, cs) = (hw.render(&r).unwrap(), cs.render(&r).unwrap());
+        assert_eq!(cs.image.len(), (W * H) as usize, "image size");
+        let (d, at) = common::max_rel_diff(&cs.image, &hw.image);
+        eprintln!("mask alpha {alpha}: compute (drawn and copied) against hardware {d:e}");
+        assert!(d <= 1e-5, "alpha {alpha}: {d:e} at pixel {at}");
+        frames.push(cs.image);
+    }
+    let changed = frames[0]
+        .iter()
+        .zip(&frames[1])
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(changed > 100, "cutting the mask changes {changed} pixels");
 }

@@ -6,8 +6,11 @@
 //! the camera or the lights moved (a viewer moving both between two frames pays for one).
 //! With `cache: true` the lights that kept their tile side keep their place
 //! (`shadow::atlas_cache::keep_places`) and only the views the atlas does not hold yet
-//! are drawn.
+//! are drawn. The compute raster draws no alpha mask: with a masked caster the views are
+//! drawn by the raster units instead, into an internal Depth32Float atlas copied into
+//! the R32Float one (bit-exact), and a warning names the material.
 
+use super::compute_raster_fallback::{depth_copy, draws_opening, record_depth_copy, DepthCopy};
 use super::shadow_atlas_raster::{ComputeAtlas, RasterTarget};
 use super::shadow_atlas_raster_input::{pieces, Work};
 use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
@@ -44,7 +47,6 @@ pub(super) struct ShadowAtlasPass {
         [glam::Vec3; 2],
         std::sync::Arc<[crate::shadow::chunks::Chunk]>,
     )>,
-    atlas: wgpu::TextureView,
     atlas_bytes: u64,
     views: wgpu::Buffer,
     /// The table as the CPU wrote it for the current view; copied into `views` when
@@ -72,6 +74,10 @@ enum Raster {
         draws: MeshDraws,
         /// Writes the far depth over a tile (each view clears its own).
         clear: Arc<wgpu::RenderPipeline>,
+        /// The depth attachment drawn into: the atlas, or (`copy`) an internal
+        /// Depth32Float copied into the R32Float atlas after the draws.
+        target: wgpu::TextureView,
+        copy: Option<DepthCopy>,
     },
     Compute(Box<ComputeAtlas>),
 }
@@ -133,29 +139,44 @@ pub(super) fn prepare(
         mapped_at_creation: false,
     });
     let atlas = cx.view(&sp.name, atlas_name)?;
-    let (raster, casters) = match p.raster {
-        AtlasRaster::Hardware => {
-            let mut offered = cx.declared(sp)?;
-            // The vertex stage reads the table it is about to receive.
-            offered.buffer("shadow_views", &views);
-            let mode = DrawMode::AtlasDepth {
-                format,
-                depth_bias: p.depth_bias as i32,
-                slope_bias_bits: p.slope_bias.to_bits(),
-            };
-            let draws = cx.renderer.mesh_draws(
-                cx.gpu,
-                mode,
-                MeshSet::ShadowCasters,
-                1,
-                &sp.name,
-                &offered,
-            )?;
-            let clear = tile_clear_pipeline(cx, &sp.name, format)?;
-            let casters: Vec<usize> = draws.meshes().collect();
-            (Raster::Hardware { draws, clear }, casters)
+    let hardware = |cx: &mut PrepareCtx,
+                    format: wgpu::TextureFormat,
+                    target: wgpu::TextureView,
+                    copy: Option<DepthCopy>| {
+        let mut offered = cx.declared(sp)?;
+        // The vertex stage reads the table it is about to receive.
+        offered.buffer("shadow_views", &views);
+        let mode = DrawMode::AtlasDepth {
+            format,
+            depth_bias: p.depth_bias as i32,
+            slope_bias_bits: p.slope_bias.to_bits(),
+        };
+        let draws =
+            cx.renderer
+                .mesh_draws(cx.gpu, mode, MeshSet::ShadowCasters, 1, &sp.name, &offered)?;
+        let clear = tile_clear_pipeline(cx, &sp.name, format)?;
+        let casters: Vec<usize> = draws.meshes().collect();
+        Ok::<_, RenderError>((
+            Raster::Hardware {
+                draws,
+                clear,
+                target,
+                copy,
+            },
+            casters,
+        ))
+    };
+    let (raster, casters) = match (p.raster, masked_caster(cx)) {
+        (AtlasRaster::Hardware, _) => hardware(cx, format, atlas.clone(), None)?,
+        (AtlasRaster::Compute, Some(material)) => {
+            log::warn!(
+                "pass '{}': caster material '{material}' is alpha-masked, which the compute raster does not draw: the atlas's views are drawn by the raster units",
+                sp.name
+            );
+            let (drawn, copy) = depth_copy(cx, sp, (side, side), atlas.clone())?;
+            hardware(cx, wgpu::TextureFormat::Depth32Float, drawn, Some(copy))?
         }
-        AtlasRaster::Compute => {
+        (AtlasRaster::Compute, None) => {
             // The casters in the order the hardware path draws them.
             let casters = cx.gpu.shadow_caster_draws();
             let compute = ComputeAtlas::prepare(
@@ -199,7 +220,6 @@ pub(super) fn prepare(
         lights: Mutex::new(cx.scene.lights.clone()),
         camera: Mutex::new(cx.scene.camera),
         meshes,
-        atlas,
         atlas_bytes: side as u64 * side as u64 * bytes_per_texel as u64,
         views,
         staging,
@@ -214,6 +234,17 @@ pub(super) fn prepare(
     };
     pass.allocate();
     Ok(pass)
+}
+
+/// The first alpha-masked material among the shadow casters, which the compute raster
+/// does not draw.
+fn masked_caster(cx: &PrepareCtx) -> Option<String> {
+    let gpu = cx.gpu;
+    gpu.shadow_caster_draws().into_iter().find_map(|m| {
+        let material = &gpu.materials[gpu.meshes[m].material];
+        matches!(material.alpha_mode, crate::scene::AlphaMode::Mask(_))
+            .then(|| material.name.clone())
+    })
 }
 
 /// Whether a ShadowRayJobs pass of the graph reads the view table `views` (and so casts
@@ -407,7 +438,16 @@ impl PreparedPass for ShadowAtlasPass {
         encoder.copy_buffer_to_buffer(&self.staging, 0, &self.views, 0, self.table_bytes);
         let mut frame = self.frame.lock().unwrap_or_else(|e| e.into_inner());
         match &self.raster {
-            Raster::Hardware { draws, clear } => {
+            Raster::Hardware {
+                draws,
+                clear,
+                target,
+                copy,
+            } => {
+                let timestamps = match copy {
+                    Some(_) => draws_opening(ts),
+                    None => ts.render(),
+                };
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some(&self.name),
                     color_attachments: &[],
@@ -415,14 +455,18 @@ impl PreparedPass for ShadowAtlasPass {
                     // clearing the whole atlas is not (about 55 GB/s measured on the H200),
                     // and the cache keeps the tiles not drawn.
                     depth_stencil_attachment: Some(crate::render::draws::depth_attachment(
-                        &self.atlas,
-                        false,
+                        target, false,
                     )),
-                    timestamp_writes: ts.render(),
+                    timestamp_writes: timestamps,
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
                 draws.record_views(&mut pass, &frame.draws, &frame.to_draw, clear);
+                drop(pass);
+                // The whole internal atlas, so tiles a cached frame keeps are copied too.
+                if let Some(copy) = copy {
+                    record_depth_copy(encoder, &self.name, copy, ts);
+                }
             }
             Raster::Compute(compute) => compute.record(encoder, &self.name, ts),
         }
