@@ -11,11 +11,8 @@ use common::compute_raster::{
     has_atomics, DEPTH_TOLERANCE, MAX_COVERAGE_DIFF, TRANSPARENT_COMPARE,
 };
 use common::*;
-use lightgraph::graph::{self, FrameSize};
-use lightgraph::render::{FrameResult, SceneGpu};
+use lightgraph::render::FrameResult;
 use lightgraph::scene::{builtin, Scene};
-use lightgraph::shader::ShaderLibrary;
-use std::path::Path;
 
 /// Odd sizes: partial tiles and blocks at the right and bottom edges.
 const W: u32 = 333;
@@ -24,22 +21,7 @@ const H: u32 = 197;
 /// The frame and the two depths' values.
 fn both_depths(scene: &Scene) -> (FrameResult, Vec<f32>, Vec<f32>) {
     let mut r = renderer();
-    let checked = graph::check_text(
-        Path::new("<test>"),
-        TRANSPARENT_COMPARE,
-        &ShaderLibrary::builtin(),
-    )
-    .expect("valid graph");
-    let size = FrameSize {
-        width: W,
-        height: H,
-        lights: scene.lights.len() as u32,
-    };
-    let compiled = graph::compile(checked, &scene.features(), size);
-    let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, scene).expect("materials");
-    let prepared = r
-        .prepare(compiled, scene, &gpu, size, false)
-        .expect("prepare");
+    let prepared = prepare_text(&mut r, TRANSPARENT_COMPARE, scene, W, H, false).expect("prepare");
     let result = prepared.render(&r).expect("render");
     let read = |name: &str| -> Vec<f32> {
         let bits = prepared.read_texture_bits(&r, name).expect("readback");

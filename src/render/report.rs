@@ -540,6 +540,22 @@ pub struct FallbackReport {
 }
 
 impl FallbackReport {
+    /// Pass `pass` ran `instead` on the device of `ctx`, which lacks `missing`.
+    pub(crate) fn new(
+        pass: &str,
+        ctx: &crate::gpu::GpuContext,
+        missing: wgpu::Features,
+        instead: &'static str,
+    ) -> Self {
+        FallbackReport {
+            pass: pass.to_string(),
+            adapter: ctx.adapter_name(),
+            missing,
+            disabled: missing & ctx.disabled_features,
+            instead,
+        }
+    }
+
     /// One line for `render` and the viewer, e.g. `compute_raster: adapter X lacks
     /// SHADER_INT64_ATOMIC_MIN_MAX; drawn with the hardware rasterizer`.
     pub fn line(&self) -> String {

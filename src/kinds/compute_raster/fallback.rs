@@ -55,14 +55,7 @@ impl HardwareRaster {
         sp: &ScheduledPass,
         missing: wgpu::Features,
     ) -> Result<Self, RenderError> {
-        let ctx = &cx.renderer.ctx;
-        let report = FallbackReport {
-            pass: sp.name.to_string(),
-            adapter: ctx.adapter_name(),
-            missing,
-            disabled: missing & ctx.disabled_features,
-            instead: INSTEAD,
-        };
+        let report = FallbackReport::new(&sp.name, &cx.renderer.ctx, missing, INSTEAD);
         if !cx
             .device()
             .features()

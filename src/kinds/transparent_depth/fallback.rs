@@ -28,14 +28,7 @@ impl DrawnAndCopied {
         sp: &ScheduledPass,
         missing: wgpu::Features,
     ) -> Result<Self, RenderError> {
-        let ctx = &cx.renderer.ctx;
-        let report = FallbackReport {
-            pass: sp.name.to_string(),
-            adapter: ctx.adapter_name(),
-            missing,
-            disabled: missing & ctx.disabled_features,
-            instead: INSTEAD,
-        };
+        let report = FallbackReport::new(&sp.name, &cx.renderer.ctx, missing, INSTEAD);
         let size = (cx.size.width, cx.size.height);
         let target = cx.view(&sp.name, sp.required(slot::DEPTH))?;
         let (drawn, copy) = depth_copy(cx, sp, size, target)?;
