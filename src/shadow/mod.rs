@@ -19,6 +19,7 @@ pub mod chunks;
 pub mod policy;
 pub mod reference;
 mod traverse;
+pub(crate) mod view_bounds;
 
 pub use bvh::{
     BuildOptions, BuildStats, BvhNode, BvhTriangle, ShadowBvh, ShadowError, LEAF_BIT, STACK_SIZE,

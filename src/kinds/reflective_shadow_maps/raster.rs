@@ -25,8 +25,8 @@ use crate::graph::ScheduledPass;
 use crate::indirect::rsm_views::RsmLayout;
 use crate::render::pipelines::PipelineKey;
 use crate::render::RenderError;
-use crate::shadow::atlas::{box_in_frustum, frustum_planes};
 use crate::shadow::chunks::Chunk;
+use crate::shadow::view_bounds::{box_in_frustum, frustum_planes};
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
