@@ -20,7 +20,7 @@ use crate::graph::ScheduledPass;
 use crate::indirect::rsm_views::{layout, layout_lights, view_table, RsmLayout};
 use crate::render::draws::{color_attachment, depth_attachment, DrawMode, MeshDraws, MeshSet};
 use crate::render::{RenderError, Renderer};
-use crate::scene::{AlphaMode, Light, VplControls};
+use crate::scene::{Light, VplControls};
 use std::collections::BTreeMap;
 use std::sync::Mutex;
 
@@ -73,15 +73,6 @@ struct HardwareMaps {
     targets: [wgpu::TextureView; 3],
     draws: MeshDraws,
     copy: Option<DepthCopy>,
-}
-
-/// The first opaque caster material that is alpha-masked, by name.
-fn masked_caster(cx: &PrepareCtx) -> Option<String> {
-    let gpu = cx.gpu;
-    gpu.opaque_draws().into_iter().find_map(|m| {
-        let material = &gpu.materials[gpu.meshes[m].material];
-        matches!(material.alpha_mode, AlphaMode::Mask(_)).then(|| material.name.clone())
-    })
 }
 
 /// The maps drawn by the raster units; `float_depth`: into an internal Depth32Float,
@@ -187,7 +178,7 @@ pub(super) fn prepare(
         .ctx
         .queue
         .write_buffer(&staging, 0, bytemuck::cast_slice(&table));
-    let raster = match (p.raster, masked_caster(cx)) {
+    let raster = match (p.raster, cx.gpu.masked_material(&cx.gpu.opaque_draws())) {
         (RsmRaster::Hardware, _) => {
             Raster::Hardware(Box::new(hardware_maps(cx, sp, &views, None)?))
         }

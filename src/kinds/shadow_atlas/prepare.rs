@@ -167,7 +167,9 @@ pub(super) fn prepare(
             casters,
         ))
     };
-    let (raster, casters) = match (p.raster, masked_caster(cx)) {
+    let gpu = cx.gpu;
+    let masked = gpu.masked_material(&gpu.shadow_caster_draws());
+    let (raster, casters) = match (p.raster, masked) {
         (AtlasRaster::Hardware, _) => hardware(cx, format, atlas.clone(), None)?,
         (AtlasRaster::Compute, Some(material)) => {
             log::warn!(
@@ -235,17 +237,6 @@ pub(super) fn prepare(
     };
     pass.allocate();
     Ok(pass)
-}
-
-/// The first alpha-masked material among the shadow casters, which the compute raster
-/// does not draw.
-fn masked_caster(cx: &PrepareCtx) -> Option<String> {
-    let gpu = cx.gpu;
-    gpu.shadow_caster_draws().into_iter().find_map(|m| {
-        let material = &gpu.materials[gpu.meshes[m].material];
-        matches!(material.alpha_mode, crate::scene::AlphaMode::Mask(_))
-            .then(|| material.name.clone())
-    })
 }
 
 /// Whether a ShadowRayJobs pass of the graph reads the view table `views` (and so casts
