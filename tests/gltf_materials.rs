@@ -123,6 +123,17 @@ fn pixel_uv(x: u32, y: u32) -> [f32; 2] {
 /// onto [UV0, UV0 + UV_SPAN]² (v down the screen). Parallel to the image plane, so its
 /// perspective-correct uv is affine in screen space and `pixel_uv` is exact.
 fn view_filling_quad(w: &mut GltfWriter, material: usize) {
+    view_filling_quad_coloured(w, material, None);
+}
+
+/// `view_filling_quad`, with a vertex colour (COLOR_0) at each corner when `colour` is
+/// given: `colour(tx, ty)` at the corner's place across the quad, 0..1 left to right and
+/// bottom to top.
+fn view_filling_quad_coloured(
+    w: &mut GltfWriter,
+    material: usize,
+    colour: Option<&dyn Fn(f32, f32) -> Vec4>,
+) {
     let half = (FOV_Y / 2.0).tan(); // at z = −1
                                     // NDC ±2: the quad overhangs the view by half its width on each side.
     let ndc = [-2.0f32, 2.0];
@@ -140,6 +151,13 @@ fn view_filling_quad(w: &mut GltfWriter, material: usize) {
     let pos = w.add_positions(&p);
     let nrm = w.add_vec3(&[Vec3::Z; 4]);
     let uvs = w.add_vec2(&uv);
+    let colors = colour.map(|f| {
+        let corners: Vec<Vec4> = [(0, 0), (1, 0), (1, 1), (0, 1)]
+            .iter()
+            .map(|&(sx, sy)| f(sx as f32, sy as f32))
+            .collect();
+        w.add_vec4(&corners)
+    });
     let idx = w.add_indices(&[0, 1, 2, 0, 2, 3]);
     let mesh = w.add_mesh(
         "quad",
@@ -147,6 +165,7 @@ fn view_filling_quad(w: &mut GltfWriter, material: usize) {
             positions: pos,
             normals: Some(nrm),
             uvs: Some(uvs),
+            colors,
             indices: Some(idx),
             material: Some(material),
             ..Default::default()
@@ -229,6 +248,11 @@ const NEAREST_TOL: f32 = 2e-3;
 /// llvmpipe's 8-bit sub-texel weights (up to 1/512 of a neighbour difference ≤ 0.64,
 /// 1.3e-3): 4e-3. A wrong wrap mixes in a texel at least 0.04 away with weight ≥ 1/8.
 const LINEAR_TOL: f32 = 4e-3;
+
+/// Vertex colours: interpolation and the factor's product round in f32 (a few ulps of
+/// values under 1; 1.2e-7 measured on lavapipe in all three paths), so 1e-6. Without the
+/// vertex colour every pixel is off by 0.05 or more.
+const VERTEX_COLOUR_TOL: f32 = 1e-6;
 
 #[test]
 fn sampler_wrap_and_filter_modes_match_a_cpu_sampler_in_forward_and_visibility() {
@@ -640,6 +664,86 @@ fn unlit_ignores_the_lights_that_light_the_same_material_lit() {
             "{graph}: lit differs from the base colour by only {d}"
         );
     }
+}
+
+/// The vertex colour of `coloured_quad` at (tx, ty) across the quad: affine, so the
+/// rasterizer's interpolation over either of its two triangles gives it exactly, and
+/// within 0..1 at every corner (no clamp bends it). Alpha rises left to right.
+fn quad_colour(tx: f32, ty: f32) -> Vec4 {
+    Vec4::new(
+        0.1 + 0.8 * tx,
+        0.2 + 0.8 * ty,
+        0.9 - 0.4 * tx - 0.4 * ty,
+        tx,
+    )
+}
+
+/// Where pixel (x, y)'s centre lies across the quad (which overhangs the view by half
+/// its width on each side: the view is 0.25..0.75 of it).
+fn quad_place(x: u32, y: u32) -> (f32, f32) {
+    let nx = (x as f32 + 0.5) / W as f32 * 2.0 - 1.0;
+    let ny = 1.0 - (y as f32 + 0.5) / H as f32 * 2.0;
+    ((nx + 2.0) / 4.0, (ny + 2.0) / 4.0)
+}
+
+const COLOUR_FACTOR: Vec4 = Vec4::new(0.5, 1.0, 0.8, 1.0);
+
+/// An unlit quad filling the view with `quad_colour` at its corners and base colour
+/// factor COLOUR_FACTOR, opaque or alpha-masked at `cutoff`.
+fn coloured_quad(cutoff: Option<f32>) -> Scene {
+    let mut w = GltfWriter::new();
+    let m = w.add_material(&MaterialDesc {
+        name: "coloured".into(),
+        base_color: COLOUR_FACTOR,
+        alpha_mode: if cutoff.is_some() { "MASK" } else { "OPAQUE" },
+        alpha_cutoff: cutoff,
+        extensions: Some("\"KHR_materials_unlit\":{}".into()),
+        ..Default::default()
+    });
+    w.extensions_required = vec!["KHR_materials_unlit".into()];
+    view_filling_quad_coloured(&mut w, m, Some(&quad_colour));
+    let mut loaded = load(&w, "coloured_quad");
+    stage(&mut loaded.scene);
+    loaded.scene
+}
+
+/// Vertex colours as the Sample Viewer draws them (glTF 3.9.2: base colour × COLOR_0, its
+/// alpha × COLOR_0's): the unlit quad shows factor × the interpolated colour, computed
+/// here from the pixel's place, in forward shading, the hardware visibility buffer and
+/// the compute-first default frame; masked at 0.5, its left half (vertex alpha under
+/// 0.5) is cut away in each.
+#[test]
+fn vertex_colours_multiply_the_base_colour_and_alpha_in_every_fast_path() {
+    let mut r = renderer();
+    let expected = |x: u32, y: u32| {
+        let (tx, ty) = quad_place(x, y);
+        let c = COLOUR_FACTOR * quad_colour(tx, ty);
+        [c.x, c.y, c.z]
+    };
+    let opaque = coloured_quad(None);
+    let masked = coloured_quad(Some(0.5));
+    let mut failures = Vec::new();
+    for graph in ["forward_plus.ron", "visibility_buffer.ron", "default.ron"] {
+        let img = render_file(&mut r, graph, &opaque, W, H).image;
+        let (d, x, y) = worst_abs(&img, expected);
+        println!("{graph} opaque: worst {d:.2e} at ({x}, {y})");
+        if d > VERTEX_COLOUR_TOL {
+            failures.push(format!("{graph}: pixel ({x}, {y}) off by {d}"));
+        }
+        let img = render_file(&mut r, graph, &masked, W, H).image;
+        let (d, x, y) = worst_abs(&img, |x, y| {
+            if quad_place(x, y).0 < 0.5 {
+                [0.0; 3]
+            } else {
+                expected(x, y)
+            }
+        });
+        println!("{graph} masked: worst {d:.2e} at ({x}, {y})");
+        if d > VERTEX_COLOUR_TOL {
+            failures.push(format!("{graph} masked: pixel ({x}, {y}) off by {d}"));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
 /// Khronos's Avocado (tests/assets/khronos/Avocado, geometry only) carries the tangents

@@ -49,6 +49,7 @@ fn max_albedo(m: &Material, tangent: [f64; 4]) -> (f64, f64) {
                 n: [0.0, 0.0, 1.0],
                 tangent,
                 texels: Default::default(),
+                vertex_color: None,
             };
             let a = r::albedo(m, &at, v, SAMPLES);
             let mx = a[0].max(a[1]).max(a[2]);
@@ -284,6 +285,7 @@ fn reciprocity() {
                 n: g.n,
                 tangent: g.t,
                 texels: Default::default(),
+                vertex_color: None,
             };
             let a = r::brdf_at(&m, &at, g.v, g.l);
             let b = r::brdf_at(&m, &at, g.l, g.v);
@@ -333,6 +335,7 @@ fn artist_values_warn_and_stay_finite() {
             n: g.n,
             tangent: g.t,
             texels: Default::default(),
+            vertex_color: None,
         };
         let f = r::eval_at(&m, &at, g.v, g.l);
         assert!(

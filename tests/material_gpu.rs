@@ -431,12 +431,16 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     p.tangent = s.t;
     p.uv = vec2<f32>(0.5);
     p.view = s.v.xyz;
+    p.color = vec4<f32>(0.8, 0.5, 0.25, 0.6);
     let m = material_setup(p);
     out[i] = vec4<f32>(material_eval(m, s.l.xyz), material_alpha(m));
 }
 ";
 
 /// Max error of `material_eval` against `reference::eval_at` over `count` samples.
+/// The vertex colour MATERIAL_HARNESS gives every sample (its WGSL literal).
+const HARNESS_VERTEX_COLOR: [f32; 4] = [0.8, 0.5, 0.25, 0.6];
+
 fn check_material(gpu: &GpuContext, m: &Material, count: usize, seed: u64) -> f64 {
     let code = m
         .wgsl_with(&WgslOptions {
@@ -464,6 +468,7 @@ fn check_material(gpu: &GpuContext, m: &Material, count: usize, seed: u64) -> f6
             n: g.n,
             tangent: g.t,
             texels: Default::default(),
+            vertex_color: Some(HARNESS_VERTEX_COLOR.map(f64::from)),
         };
         let rv = r::eval_at(m, &surf, g.v, g.l);
         for c in 0..3 {
@@ -578,6 +583,30 @@ fn random_layered_materials_match_f64_reference() {
         worst = worst.max(check_material(&gpu, &m, 1024, 1000 + k as u64));
     }
     println!("  {n} random layered materials × 1024 samples: max err {worst:.3e}");
+}
+
+/// `Vertex`, `VertexAlpha` and a colour product read the shading point's vertex colour
+/// (the harness's HARNESS_VERTEX_COLOR) as the f64 reference reads `Surface::vertex_color`:
+/// in a Lambert colour, a GGX F0 mix, emission and alpha.
+#[test]
+fn vertex_colour_expressions_match_f64_reference() {
+    let gpu = GpuContext::new_headless().expect("GPU (lavapipe) needed");
+    let m = Material::parse(
+        "(
+        name: \"painted\",
+        alpha: Mul(0.9, VertexAlpha),
+        emissive: Some(Scale(Vertex, 0.25)),
+        layers: [
+            (ior: Some(1.5), lobes: [Ggx(weight: 1, roughness: 0.4, f0: Some(Mix(a: (0.04, 0.04, 0.04), b: Vertex, t: OneMinus(VertexAlpha))))]),
+            (lobes: [Lambert(weight: 1, color: Mul((0.9, 0.7, 0.3), Vertex))]),
+        ],
+    )",
+        "painted.ron",
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(m.desc().reads_vertex_color());
+    let worst = check_material(&gpu, &m, 4096, 99);
+    println!("  vertex colour expressions: max err {worst:.3e}");
 }
 
 #[test]
@@ -745,6 +774,7 @@ fn textured_gltf_matches_f64_reference() {
             n: n_gpu,
             tangent: [t_gpu[0], t_gpu[1], t_gpu[2], g.t[3]],
             texels: texels.clone(),
+            vertex_color: None,
         };
         let rv = r::eval_at(&m, &at, g.v, g.l);
         for c in 0..3 {

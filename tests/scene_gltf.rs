@@ -465,16 +465,23 @@ fn a_far_plane_past_depth_precision_is_pulled_in_to_the_scene() {
     );
 }
 
-/// Vertex colours (COLOR_0) are not drawn: the import says so, naming the primitive,
-/// rather than dropping them without a word (the mesh still loads).
+/// Vertex colours (COLOR_0) are read per vertex, and mark the material that takes them
+/// (here glTF's default one) as multiplied by them; values outside 0..=1 are clamped
+/// into it with a warning naming the accessor.
 #[test]
-fn vertex_colours_are_refused_with_a_warning() {
+fn vertex_colours_are_read_and_mark_their_material() {
     let (p, n, uv, idx) = quad();
     let mut w = GltfWriter::new();
     let positions = w.add_positions(&p);
     let normals = w.add_vec3(&n);
     let uvs = w.add_vec2(&uv);
-    let colors = w.add_vec4(&[Vec4::new(1.0, 0.0, 0.0, 1.0); 4]);
+    let given = [
+        Vec4::new(1.0, 0.0, 0.0, 1.0),
+        Vec4::new(0.25, 0.5, 0.75, 0.5),
+        Vec4::new(1.5, -0.25, 0.5, 1.0),
+        Vec4::new(0.0, 0.0, 1.0, 0.0),
+    ];
+    let colors = w.add_vec4(&given);
     let indices = w.add_indices(&idx);
     let mesh = w.add_mesh(
         "coloured",
@@ -496,11 +503,15 @@ fn vertex_colours_are_refused_with_a_warning() {
     w.write_glb(&path).unwrap();
     let loaded = scene::load(&path).unwrap();
     assert_eq!(loaded.scene.triangle_count(), 2);
+    let m = &loaded.scene.meshes[0];
+    let clamped = given.map(|c| c.clamp(Vec4::ZERO, Vec4::ONE));
+    assert_eq!(m.colors, clamped);
+    assert!(loaded.scene.materials[m.material].vertex_color);
     assert!(
         loaded
             .warnings
             .iter()
-            .any(|w| w.contains("primitive 0") && w.contains("COLOR_0")),
+            .any(|w| w.contains("COLOR_0") && w.contains("1 vertex colours outside")),
         "{:?}",
         loaded.warnings
     );

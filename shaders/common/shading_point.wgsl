@@ -8,4 +8,7 @@ struct ShadingPoint {
     tangent: vec4<f32>,
     uv: vec2<f32>,
     view: vec3<f32>,
+    // The interpolated vertex colour (glTF COLOR_0, linear RGBA; white without one), which
+    // a material's `Vertex` and `VertexAlpha` read.
+    color: vec4<f32>,
 };

@@ -67,6 +67,10 @@ struct LinkParams {
     _pad2: u32,
 };
 
+// A mesh vertex's floats in the merged vertex array (src/gpu/structs.rs GpuVertex):
+// position xyz, normal xyz, uv, tangent xyzw, colour rgba.
+const VERTEX_FLOATS: u32 = 16u;
+
 const LINK_HEADER_WORDS: u32 = 4u;
 const LINK_WORDS: u32 = 3u;
 const LINK_END: u32 = 0xffffffffu;

@@ -82,6 +82,9 @@
 // surface's uv and tangent (zero without G_SURFACE), and for textured materials the uv
 // derivatives their samples take.
 fn load_surface(q: ptr<function, ShadingPoint>, p: vec2<u32>, s: u32) {
+    // The G-buffer carries no vertex colour: white, as a mesh without one reads (the
+    // pass warns where a material reads it).
+    (*q).color = vec4<f32>(1.0);
 #if G_SURFACE
     let t = textureLoad(g_surface, p, s);
     (*q).uv = t.xy;

@@ -75,6 +75,7 @@ struct VertexIn {
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
     @location(3) tangent: vec4<f32>,
+    @location(4) color: vec4<f32>,
 };
 
 #if MSAA
@@ -87,6 +88,7 @@ struct VertexOut {
     @location(1) @interpolate(perspective, centroid) normal: vec3<f32>,
     @location(2) @interpolate(perspective, centroid) uv: vec2<f32>,
     @location(3) @interpolate(perspective, centroid) tangent: vec4<f32>,
+    @location(4) @interpolate(perspective, centroid) color: vec4<f32>,
 };
 #else
 struct VertexOut {
@@ -95,12 +97,13 @@ struct VertexOut {
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
     @location(3) tangent: vec4<f32>,
+    @location(4) color: vec4<f32>,
 #if RSM
-    @location(4) @interpolate(flat) view: u32,
+    @location(5) @interpolate(flat) view: u32,
 #endif
 #if VISIBILITY
     // The mesh's first triangle id, passed as the instance index.
-    @location(4) @interpolate(flat) first_triangle: u32,
+    @location(5) @interpolate(flat) first_triangle: u32,
 #endif
 };
 #endif
@@ -127,6 +130,7 @@ fn vs_main(v: VertexIn, @builtin(instance_index) instance: u32) -> VertexOut {
     out.normal = v.normal;
     out.uv = v.uv;
     out.tangent = v.tangent;
+    out.color = v.color;
 #if VISIBILITY
     out.first_triangle = instance;
 #endif
@@ -151,6 +155,7 @@ fn shading_point(in: VertexOut, front: bool) -> ShadingPoint {
     p.normal = n;
     p.tangent = in.tangent;
     p.uv = in.uv;
+    p.color = in.color;
     return p;
 }
 

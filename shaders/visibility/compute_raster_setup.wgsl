@@ -41,7 +41,7 @@ fn store_record(r: u32, t: Tri) {
 }
 
 fn clip_position(v: u32) -> vec4<f32> {
-    let b = 12u * v;
+    let b = VERTEX_FLOATS * v;
     let p = vec3<f32>(vertices[b], vertices[b + 1u], vertices[b + 2u]);
     return frame.view_proj * vec4<f32>(p, 1.0);
 }

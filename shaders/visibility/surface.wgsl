@@ -8,13 +8,12 @@
 
 #include "common/shading_point.wgsl"
 
-const VERTEX_FLOATS: u32 = 12u;
-
 struct Vertex {
     position: vec3<f32>,
     normal: vec3<f32>,
     uv: vec2<f32>,
     tangent: vec4<f32>,
+    color: vec4<f32>,
 };
 
 fn fetch(v: u32) -> Vertex {
@@ -24,6 +23,7 @@ fn fetch(v: u32) -> Vertex {
     out.normal = vec3<f32>(vertices[b + 3u], vertices[b + 4u], vertices[b + 5u]);
     out.uv = vec2<f32>(vertices[b + 6u], vertices[b + 7u]);
     out.tangent = vec4<f32>(vertices[b + 8u], vertices[b + 9u], vertices[b + 10u], vertices[b + 11u]);
+    out.color = vec4<f32>(vertices[b + 12u], vertices[b + 13u], vertices[b + 14u], vertices[b + 15u]);
     return out;
 }
 
@@ -114,6 +114,7 @@ fn surface_point(id: vec2<u32>, tri: u32) -> ShadingPoint {
     }
     p.normal = n;
     p.tangent = w.x * a.tangent + w.y * b.tangent + w.z * c.tangent;
+    p.color = w.x * a.color + w.y * b.color + w.z * c.color;
     let uv = mat3x2<f32>(a.uv, b.uv, c.uv);
     p.uv = uv * w;
 #if MATERIAL_TEXTURED

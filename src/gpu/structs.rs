@@ -239,7 +239,7 @@ pub fn gpu_light(l: &Light) -> (GpuLightGeometry, GpuLightProperties) {
     )
 }
 
-/// Vertex layout of every mesh: position, normal, uv, tangent.
+/// Vertex layout of every mesh: position, normal, uv, tangent, colour.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuVertex {
@@ -251,12 +251,15 @@ pub struct GpuVertex {
     pub uv: [f32; 2],
     /// World-space tangent; `w` is the bitangent sign (glTF TANGENT).
     pub tangent: [f32; 4],
+    /// Linear RGBA vertex colour (glTF COLOR_0; white where the mesh has none).
+    pub color: [f32; 4],
 }
 
 impl GpuVertex {
-    pub(crate) const ATTRIBUTES: [wgpu::VertexAttribute; 4] =
-        wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32x4];
-    /// The vertex buffer layout render pipelines draw meshes with (locations 0..=3).
+    pub(crate) const ATTRIBUTES: [wgpu::VertexAttribute; 5] = wgpu::vertex_attr_array![
+        0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32x4, 4 => Float32x4
+    ];
+    /// The vertex buffer layout render pipelines draw meshes with (locations 0..=4).
     pub fn layout() -> wgpu::VertexBufferLayout<'static> {
         wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<GpuVertex>() as u64,

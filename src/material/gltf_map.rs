@@ -5,8 +5,8 @@
 //!
 //! because Schlick's F is linear in F0. So: a top layer of IOR 1.5 holding one GGX lobe
 //! with F0 = mix(0.04, c, m), over a Lambert layer of colour c (1 − m).
-//! c = base colour factor × texture (sRGB), metallic = factor × texture B, roughness =
-//! factor × texture G, alpha = base alpha × texture alpha, emissive = factor × texture,
+//! c = base colour factor × texture (sRGB) × vertex colour (COLOR_0), metallic = factor × texture B, roughness =
+//! factor × texture G, alpha = base alpha × texture alpha × vertex alpha, emissive = factor × texture,
 //! normal map with scale; occlusion (R, with strength) is exposed as `material_occlusion`
 //! for the renderer's ambient term, and does not scale direct light.
 
@@ -53,6 +53,16 @@ pub(super) fn map(s: &SurfaceMaterial) -> (MaterialDesc, Vec<TextureSlot>) {
     } else {
         Color::Rgb(bc.x, bc.y, bc.z)
     };
+    // glTF 3.9.2: the base colour (and its alpha) times the vertex colour, where the
+    // primitives that take this material have COLOR_0 (white where others have none).
+    let base = if s.vertex_color {
+        Color::Expr(ColorExpr::Mul(
+            Box::new(base),
+            Box::new(Color::Expr(ColorExpr::Vertex)),
+        ))
+    } else {
+        base
+    };
     let base_unlit = base.clone();
     let channel = |factor: f32, ch: Channel| {
         if has(MR) {
@@ -75,6 +85,14 @@ pub(super) fn map(s: &SurfaceMaterial) -> (MaterialDesc, Vec<TextureSlot>) {
         })
     } else {
         Scalar::Val(bc.w)
+    };
+    let alpha = if s.vertex_color {
+        Scalar::Expr(ScalarExpr::Mul(
+            Box::new(alpha),
+            Box::new(Scalar::Expr(ScalarExpr::VertexAlpha)),
+        ))
+    } else {
+        alpha
     };
     let e = s.emissive;
     let emissive = if has(EMISSIVE) {

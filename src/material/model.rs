@@ -389,6 +389,9 @@ pub enum ScalarExpr {
     OneMinus(Box<Scalar>),
     /// `a × b`.
     Mul(Box<Scalar>, Box<Scalar>),
+    /// The mesh's vertex alpha (glTF `COLOR_0`'s a, interpolated); 1 where the mesh has
+    /// no vertex colours.
+    VertexAlpha,
 }
 
 /// A colour parameter: `(r, g, b)`, or an expression over textures.
@@ -424,6 +427,11 @@ pub enum ColorExpr {
     },
     /// `color * scalar`.
     Scale(Box<Color>, Scalar),
+    /// `a * b`, channel by channel.
+    Mul(Box<Color>, Box<Color>),
+    /// The mesh's vertex colour (glTF `COLOR_0`'s rgb, linear, interpolated); white where
+    /// the mesh has no vertex colours.
+    Vertex,
 }
 
 fn one_u32() -> u32 {
@@ -442,6 +450,38 @@ fn one_scalar() -> Scalar {
     Scalar::Val(1.0)
 }
 
+impl MaterialDesc {
+    /// Whether any parameter reads the mesh's vertex colour (`Vertex`, `VertexAlpha`).
+    pub fn reads_vertex_color(&self) -> bool {
+        let lobe = |l: &Lobe| match l {
+            Lobe::Lambert { color, .. } => color.reads_vertex(),
+            Lobe::OrenNayar {
+                color, roughness, ..
+            }
+            | Lobe::Sheen {
+                color, roughness, ..
+            } => color.reads_vertex() || roughness.reads_vertex(),
+            Lobe::Ggx { roughness, f0, .. } => {
+                roughness.reads_vertex() || f0.as_ref().is_some_and(Color::reads_vertex)
+            }
+            Lobe::AnisoGgx {
+                roughness,
+                anisotropy,
+                f0,
+                ..
+            } => {
+                roughness.reads_vertex()
+                    || anisotropy.reads_vertex()
+                    || f0.as_ref().is_some_and(Color::reads_vertex)
+            }
+            Lobe::Clearcoat { roughness, .. } => roughness.reads_vertex(),
+        };
+        self.alpha.reads_vertex()
+            || self.emissive.as_ref().is_some_and(Color::reads_vertex)
+            || self.layers.iter().flat_map(|l| &l.lobes).any(lobe)
+    }
+}
+
 impl Scalar {
     /// Names of the textures this expression reads.
     pub(crate) fn textures<'a>(&'a self, out: &mut Vec<&'a str>) {
@@ -453,6 +493,17 @@ impl Scalar {
                 a.textures(out);
                 b.textures(out);
             }
+            Scalar::Expr(ScalarExpr::VertexAlpha) => {}
+        }
+    }
+
+    /// Whether this expression reads the vertex colour.
+    pub(crate) fn reads_vertex(&self) -> bool {
+        match self {
+            Scalar::Val(_) | Scalar::Expr(ScalarExpr::Tex { .. }) => false,
+            Scalar::Expr(ScalarExpr::OneMinus(a)) => a.reads_vertex(),
+            Scalar::Expr(ScalarExpr::Mul(a, b)) => a.reads_vertex() || b.reads_vertex(),
+            Scalar::Expr(ScalarExpr::VertexAlpha) => true,
         }
     }
 }
@@ -471,6 +522,24 @@ impl Color {
                 c.textures(out);
                 s.textures(out);
             }
+            Color::Expr(ColorExpr::Mul(a, b)) => {
+                a.textures(out);
+                b.textures(out);
+            }
+            Color::Expr(ColorExpr::Vertex) => {}
+        }
+    }
+
+    /// Whether this expression reads the vertex colour.
+    pub(crate) fn reads_vertex(&self) -> bool {
+        match self {
+            Color::Rgb(..) | Color::Expr(ColorExpr::Tex { .. }) => false,
+            Color::Expr(ColorExpr::Mix { a, b, t }) => {
+                a.reads_vertex() || b.reads_vertex() || t.reads_vertex()
+            }
+            Color::Expr(ColorExpr::Scale(c, s)) => c.reads_vertex() || s.reads_vertex(),
+            Color::Expr(ColorExpr::Mul(a, b)) => a.reads_vertex() || b.reads_vertex(),
+            Color::Expr(ColorExpr::Vertex) => true,
         }
     }
 }

@@ -290,6 +290,9 @@ pub struct Surface {
     pub tangent: [f64; 4],
     /// Texel values (RGBA, linear) by texture name; a missing name reads (1, 1, 1, 1).
     pub texels: BTreeMap<String, [f64; 4]>,
+    /// The interpolated vertex colour (RGBA, linear); `None` reads (1, 1, 1, 1), as a
+    /// mesh without vertex colours does.
+    pub vertex_color: Option<[f64; 4]>,
 }
 
 impl Surface {
@@ -316,6 +319,7 @@ pub fn scalar(s: &Scalar, at: &Surface) -> f64 {
         }) => at.texel(texture)[channel.index()] * *scale as f64,
         Scalar::Expr(ScalarExpr::OneMinus(a)) => 1.0 - scalar(a, at),
         Scalar::Expr(ScalarExpr::Mul(a, b)) => scalar(a, at) * scalar(b, at),
+        Scalar::Expr(ScalarExpr::VertexAlpha) => at.vertex_color.map_or(1.0, |c| c[3]),
     }
 }
 
@@ -332,6 +336,8 @@ pub fn color(c: &Color, at: &Surface) -> V3 {
             add(scale(a, 1.0 - t), scale(b, t))
         }
         Color::Expr(ColorExpr::Scale(c, s)) => scale(color(c, at), scalar(s, at)),
+        Color::Expr(ColorExpr::Mul(a, b)) => mul(color(a, at), color(b, at)),
+        Color::Expr(ColorExpr::Vertex) => at.vertex_color.map_or([1.0; 3], |c| [c[0], c[1], c[2]]),
     }
 }
 

@@ -78,6 +78,7 @@ impl Ctx {
                 self.scalar(a, r, what);
                 self.scalar(b, r, what);
             }
+            Scalar::Expr(ScalarExpr::VertexAlpha) => {}
         }
     }
 
@@ -103,6 +104,11 @@ impl Ctx {
                 self.color(c, r, what);
                 self.scalar(s, GAIN, &format!("{what} scale"));
             }
+            Color::Expr(ColorExpr::Mul(a, b)) => {
+                self.color(a, r, what);
+                self.color(b, r, what);
+            }
+            Color::Expr(ColorExpr::Vertex) => {}
         }
     }
 }

@@ -114,6 +114,7 @@ impl Gen<'_> {
             Scalar::Expr(ScalarExpr::Mul(a, b)) => {
                 format!("({} * {})", self.scalar(a), self.scalar(b))
             }
+            Scalar::Expr(ScalarExpr::VertexAlpha) => "p.color.w".to_string(),
         }
     }
     fn color(&self, c: &Color) -> String {
@@ -143,6 +144,10 @@ impl Gen<'_> {
             Color::Expr(ColorExpr::Scale(c, s)) => {
                 format!("({} * {})", self.color(c), self.scalar(s))
             }
+            Color::Expr(ColorExpr::Mul(a, b)) => {
+                format!("({} * {})", self.color(a), self.color(b))
+            }
+            Color::Expr(ColorExpr::Vertex) => "p.color.xyz".to_string(),
         }
     }
     fn f0(&self, f0: &Option<Color>, ior: Option<f32>) -> String {

@@ -150,6 +150,10 @@ pub struct MaterialProgram {
     pub texture_bytes: u64,
     /// Whether shading reads the uv or the tangent ([`Material::reads_uv_or_tangent`]).
     pub reads_uv_or_tangent: bool,
+    /// Whether shading reads the vertex colour ([`MaterialDesc::reads_vertex_color`]).
+    ///
+    /// [`MaterialDesc::reads_vertex_color`]: crate::material::model::MaterialDesc::reads_vertex_color
+    pub reads_vertex_color: bool,
 }
 
 impl MaterialProgram {
@@ -327,6 +331,7 @@ impl MaterialProgram {
             textures,
             texture_bytes,
             reads_uv_or_tangent: material.reads_uv_or_tangent(),
+            reads_vertex_color: material.desc().reads_vertex_color(),
         })
     }
 

@@ -423,7 +423,7 @@ fn upload_mesh(
 }
 
 /// A mesh's vertices as the GPU reads them (missing normals point up, missing uvs and
-/// tangents are zero).
+/// tangents are zero, missing colours white).
 pub(super) fn gpu_vertices(m: &crate::scene::Mesh) -> Vec<GpuVertex> {
     (0..m.positions.len())
         .map(|i| GpuVertex {
@@ -431,6 +431,7 @@ pub(super) fn gpu_vertices(m: &crate::scene::Mesh) -> Vec<GpuVertex> {
             normal: m.normals.get(i).copied().unwrap_or(glam::Vec3::Y).into(),
             uv: m.uvs.get(i).copied().unwrap_or_default().into(),
             tangent: m.tangents.get(i).copied().unwrap_or_default().into(),
+            color: m.colors.get(i).copied().unwrap_or(glam::Vec4::ONE).into(),
         })
         .collect()
 }

@@ -74,6 +74,7 @@ pub fn mikktspace_tangents(mesh: &mut Mesh) -> bool {
     out.positions = mesh.positions.clone();
     out.normals = mesh.normals.clone();
     out.uvs = mesh.uvs.clone();
+    out.colors = mesh.colors.clone();
     out.tangents = vec![Vec4::ZERO; n];
     out.indices = Vec::with_capacity(mesh.indices.len());
     for (corner, &v) in mesh.indices.iter().enumerate() {
@@ -92,6 +93,9 @@ pub fn mikktspace_tangents(mesh: &mut Mesh) -> bool {
                 out.positions.push(mesh.positions[v as usize]);
                 out.normals.push(mesh.normals[v as usize]);
                 out.uvs.push(mesh.uvs[v as usize]);
+                if let Some(&c) = mesh.colors.get(v as usize) {
+                    out.colors.push(c);
+                }
                 out.tangents.push(t);
                 i
             }),

@@ -16,6 +16,9 @@ pub struct Mesh {
     pub uvs: Vec<Vec2>,
     /// xyz tangent, w handedness (glTF convention).
     pub tangents: Vec<Vec4>,
+    /// Linear RGBA vertex colours (glTF `COLOR_0`), one per position; empty when the mesh
+    /// has none (read as white).
+    pub colors: Vec<Vec4>,
     /// Triangle list; always present (non-indexed input gets 0..n).
     pub indices: Vec<u32>,
     /// Index into [`Scene::materials`].
@@ -91,6 +94,10 @@ pub struct SurfaceMaterial {
     pub occlusion_strength: f32,
     /// glTF `KHR_materials_unlit`: the base colour (× texture) shows as is, unlit.
     pub unlit: bool,
+    /// The base colour and alpha are multiplied by the mesh's vertex colour (glTF
+    /// `COLOR_0`): set on import where a primitive with vertex colours takes this
+    /// material. Meshes without them read white.
+    pub vertex_color: bool,
     /// Each texture slot's sampler and uv transform.
     pub sampling: SlotSampling,
 }
@@ -127,6 +134,7 @@ impl Default for SurfaceMaterial {
             occlusion_texture: None,
             occlusion_strength: 1.0,
             unlit: false,
+            vertex_color: false,
             sampling: SlotSampling::default(),
         }
     }

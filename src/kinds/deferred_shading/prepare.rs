@@ -86,6 +86,15 @@ pub(super) fn prepare(
             format!("material '{}' has textures: its G-buffer needs the surface targets '{G_SURFACE}' and 'g_uv_grad' (uv, tangent and uv derivatives), which this pass does not read", m.name),
         ));
     }
+    // No G-buffer target holds a vertex colour: such materials shade as over white
+    // vertices, said here rather than left to be noticed in the image.
+    if let Some(m) = cx.gpu.materials.iter().find(|m| m.reads_vertex_color) {
+        log::warn!(
+            "pass '{}': material '{}' reads the vertex colour (glTF COLOR_0), which the G-buffer does not carry: it is shaded as if its vertices were white",
+            sp.name,
+            m.name
+        );
+    }
     let all: Vec<usize> = (0..cx.gpu.materials.len()).collect();
     // The multisampled shader sums samples material by material: one dispatch each.
     let groups = if msaa {

@@ -238,12 +238,25 @@ fn check_mesh(m: &Mesh, scene: &Scene) -> Result<(), MeshEditError> {
             "vertex {v}: texture coordinate {uv:?} is not finite or beyond ±{MAX_UV}"
         )));
     }
-    if [m.normals.len(), m.uvs.len(), m.tangents.len()]
+    if let Some((v, c)) = m
+        .colors
         .iter()
-        .any(|&n| n != 0 && n != m.positions.len())
+        .enumerate()
+        .find(|(_, c)| !(c.cmpge(glam::Vec4::ZERO).all() && c.cmple(glam::Vec4::ONE).all()))
+    {
+        return Err(bad(format!("vertex {v}: colour {c:?} is not within 0..=1")));
+    }
+    if [
+        m.normals.len(),
+        m.uvs.len(),
+        m.tangents.len(),
+        m.colors.len(),
+    ]
+    .iter()
+    .any(|&n| n != 0 && n != m.positions.len())
     {
         return Err(bad(format!(
-            "normals, uvs and tangents must be absent or one per vertex ({} vertices)",
+            "normals, uvs, tangents and colours must be absent or one per vertex ({} vertices)",
             m.positions.len()
         )));
     }

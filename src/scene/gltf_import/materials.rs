@@ -138,6 +138,7 @@ impl Importer {
             occlusion_texture,
             occlusion_strength,
             unlit: m.unlit(),
+            vertex_color: false,
             sampling,
         };
         let idx = self.scene.materials.len();

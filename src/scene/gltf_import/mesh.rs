@@ -36,13 +36,6 @@ impl Importer {
                 self.warn(format!("{pel}: no POSITION attribute; skipped"));
                 continue;
             };
-            // Vertex colours would multiply the base colour (glTF 2.0, 3.7.2.1); no
-            // vertex layout carries them, so the material's colour stands alone.
-            if prim.get(&gltf::Semantic::Colors(0)).is_some() {
-                self.warn(format!(
-                    "{pel}: COLOR_0 (vertex colours) is not supported; the material's base colour is used alone"
-                ));
-            }
             let el =
                 |sem: &str, acc: &gltf::Accessor| format!("{pel} {sem} accessor {}", acc.index());
             let pe = el("POSITION", &pos_acc);
@@ -151,6 +144,11 @@ impl Importer {
                     .collect(),
                 None => Vec::new(),
             };
+            // Vertex colours multiply the base colour and alpha (glTF 2.0, 3.7.2.1).
+            let colors = match read_attr(self, gltf::Semantic::Colors(0), "COLOR_0")? {
+                Some((acc, e)) => self.vertex_colors(&acc, &e)?,
+                None => Vec::new(),
+            };
             let tangents_local: Option<Vec<[f32; 4]>> =
                 match read_attr(self, gltf::Semantic::Tangents, "TANGENT")? {
                     Some((acc, e)) => {
@@ -197,6 +195,9 @@ impl Importer {
             // glTF: a normal-mapped primitive without tangents gets MikkTSpace's (below).
             // (The file's tangents count only with the file's normals, as glTF says.)
             let file_tangents = tangents_local.is_some() && normals_local.is_some();
+            if !colors.is_empty() {
+                self.scene.materials[material].vertex_color = true;
+            }
             let mikktspace = !file_tangents
                 && uvs.len() == n
                 && self.scene.materials[material].normal_texture.is_some();
@@ -227,6 +228,7 @@ impl Importer {
                 normals,
                 uvs,
                 tangents,
+                colors,
                 indices,
                 material,
                 blended_casts_shadow: false,
@@ -241,6 +243,40 @@ impl Importer {
 }
 
 impl Importer {
+    /// COLOR_0 as linear RGBA (VEC3 reads alpha 1): float or normalized unsigned bytes
+    /// or shorts, as glTF allows. Values outside 0..=1 (or not finite) are clamped into
+    /// it, with a warning: glTF allows none, and a negative colour would subtract light.
+    fn vertex_colors(&mut self, acc: &gltf::Accessor, e: &str) -> Result<Vec<Vec4>, SceneError> {
+        let allowed = [DataType::F32, DataType::U8, DataType::U16];
+        let raw: Vec<Vec4> = if acc.dimensions() == gltf::accessor::Dimensions::Vec3 {
+            self.read_f32::<3>(acc, e, &allowed)?
+                .into_iter()
+                .map(|c| Vec3::from(c).extend(1.0))
+                .collect()
+        } else {
+            self.read_f32::<4>(acc, e, &allowed)?
+                .into_iter()
+                .map(Vec4::from)
+                .collect()
+        };
+        let bad = raw
+            .iter()
+            .filter(|c| !(c.cmpge(Vec4::ZERO).all() && c.cmple(Vec4::ONE).all()))
+            .count();
+        if bad > 0 {
+            self.warn(format!(
+                "{e}: {bad} vertex colours outside 0..=1 (or not finite), clamped into it"
+            ));
+        }
+        Ok(raw
+            .into_iter()
+            .map(|c| {
+                let c = Vec4::select(c.is_nan_mask(), Vec4::ZERO, c);
+                c.clamp(Vec4::ZERO, Vec4::ONE)
+            })
+            .collect())
+    }
+
     /// The file's normals in world space. Zero-length ones (exporters write them for
     /// unused or degenerate vertices) take the normal computed from the triangles, with a
     /// warning: a made-up direction would light them wrongly without a word.
