@@ -126,6 +126,45 @@ fn view_filling_quad(w: &mut GltfWriter, material: usize) {
     view_filling_quad_coloured(w, material, None);
 }
 
+/// The second uv set of `view_filling_quad_second_uv`: the first, turned a quarter and
+/// scaled, so any texel read through the wrong set differs.
+fn second_uv(uv: [f32; 2]) -> [f32; 2] {
+    [0.6 * uv[1] + 0.3, 1.4 - 0.8 * uv[0]]
+}
+
+/// `view_filling_quad` with TEXCOORD_1 = second_uv(TEXCOORD_0) at its corners (affine, so
+/// second_uv(pixel_uv) is exact at every pixel).
+fn view_filling_quad_second_uv(w: &mut GltfWriter, material: usize) {
+    let half = (FOV_Y / 2.0).tan();
+    let ndc = [-2.0f32, 2.0];
+    let (mut p, mut uv, mut uv1) = (Vec::new(), Vec::new(), Vec::new());
+    for (sx, sy) in [(0, 0), (1, 0), (1, 1), (0, 1)] {
+        let (nx, ny) = (ndc[sx], ndc[sy]);
+        p.push(Vec3::new(nx * half, ny * half, -1.0));
+        let u = [
+            UV0 + UV_SPAN * (nx + 1.0) / 2.0,
+            UV0 + UV_SPAN * (1.0 - ny) / 2.0,
+        ];
+        uv.push(Vec2::from(u));
+        uv1.push(Vec2::from(second_uv(u)));
+    }
+    let prim = PrimitiveDesc {
+        positions: w.add_positions(&p),
+        normals: Some(w.add_vec3(&[Vec3::Z; 4])),
+        uvs: Some(w.add_vec2(&uv)),
+        uvs1: Some(w.add_vec2(&uv1)),
+        indices: Some(w.add_indices(&[0, 1, 2, 0, 2, 3])),
+        material: Some(material),
+        ..Default::default()
+    };
+    let mesh = w.add_mesh("quad", &[prim]);
+    let node = w.add_node(&lightgraph::scene::gltf_writer::NodeDesc {
+        mesh: Some(mesh),
+        ..Default::default()
+    });
+    w.add_root(node);
+}
+
 /// `view_filling_quad`, with a vertex colour (COLOR_0) at each corner when `colour` is
 /// given: `colour(tx, ty)` at the corner's place across the quad, 0..1 left to right and
 /// bottom to top.
@@ -388,6 +427,7 @@ fn mirrored_pair(tangents: bool, normal_map: bool) -> Loaded {
             positions: w.add_positions(&p),
             normals: Some(w.add_vec3(&[Vec3::Z; 4])),
             uvs: Some(w.add_vec2(&uv)),
+            uvs1: None,
             tangents: tangents.then(|| w.add_vec4(&[tangent; 4])),
             colors: None,
             indices: Some(w.add_indices(&[0, 1, 2, 0, 2, 3])),
@@ -563,12 +603,12 @@ fn importer_reads_samplers_transforms_unlit_and_emissive_strength() {
         extensions: Some("\"KHR_materials_emissive_strength\":{\"emissiveStrength\":4.0}".into()),
         texture_transforms: vec![
             // The gltf crate parses a textureInfo's transform, the importer a normal
-            // texture's (raw JSON); texCoord 1 replaces the textureInfo's set.
+            // texture's (raw JSON); texCoord 2 replaces the textureInfo's set.
             (
                 "normalTexture",
                 "{\"offset\":[0.5,0.25],\"scale\":[2,3],\"rotation\":0.5}".into(),
             ),
-            ("occlusionTexture", "{\"texCoord\":1}".into()),
+            ("occlusionTexture", "{\"texCoord\":2}".into()),
             ("baseColorTexture", "{\"offset\":[1,2]}".into()),
         ],
         ..Default::default()
@@ -624,7 +664,7 @@ fn importer_reads_samplers_transforms_unlit_and_emissive_strength() {
         loaded
             .warnings
             .iter()
-            .any(|w| w.contains("occlusionTexture") && w.contains("TEXCOORD_1")),
+            .any(|w| w.contains("occlusionTexture") && w.contains("TEXCOORD_2")),
         "{:?}",
         loaded.warnings
     );
@@ -664,6 +704,77 @@ fn unlit_ignores_the_lights_that_light_the_same_material_lit() {
             "{graph}: lit differs from the base colour by only {d}"
         );
     }
+}
+
+/// TEXCOORD_1 as the Sample Viewer reads it: a texture whose textureInfo names set 1, or
+/// whose KHR_texture_transform's texCoord does (with an offset there too), samples the
+/// second uv set, checked against the CPU sampler at second_uv(pixel_uv) in forward
+/// shading, the hardware visibility buffer and the compute-first default frame.
+#[test]
+fn texcoord_1_is_sampled_where_a_texture_names_it() {
+    let sampler = format!("{{\"magFilter\":{GL_NEAREST},\"minFilter\":{GL_NEAREST}}}");
+    let desc = SamplerDesc {
+        mag_filter: Filter::Nearest,
+        min_filter: Filter::Nearest,
+        mipmap_filter: MipmapFilter::Nearest,
+        ..Default::default()
+    };
+    let img = texels();
+    let offset = [0.125f32, -0.25];
+    let cases: [(&str, Option<String>, [f32; 2]); 2] = [
+        ("textureInfo texCoord 1", None, [0.0, 0.0]),
+        (
+            "transform texCoord 1",
+            Some(format!(
+                "{{\"texCoord\":1,\"offset\":[{},{}]}}",
+                offset[0], offset[1]
+            )),
+            offset,
+        ),
+    ];
+    let mut r = renderer();
+    let mut failures = Vec::new();
+    for (name, transform, shift) in cases {
+        let mut w = GltfWriter::new();
+        let tex = w.add_texture_png("texels", &img, ImageStorage::BufferView);
+        let smp = w.add_sampler(&sampler);
+        w.set_texture_sampler(tex, smp);
+        let m = w.add_material(&MaterialDesc {
+            name: "unlit".into(),
+            base_color_texture: Some(tex),
+            extensions: Some("\"KHR_materials_unlit\":{}".into()),
+            tex_coords: if transform.is_none() {
+                vec![("baseColorTexture", 1)]
+            } else {
+                Vec::new()
+            },
+            texture_transforms: transform
+                .map(|t| vec![("baseColorTexture", t)])
+                .unwrap_or_default(),
+            ..Default::default()
+        });
+        w.extensions_required = vec!["KHR_materials_unlit".into(), "KHR_texture_transform".into()];
+        view_filling_quad_second_uv(&mut w, m);
+        let mut loaded = load(&w, "second_uv");
+        stage(&mut loaded.scene);
+        assert_eq!(
+            loaded.scene.materials[0].sampling.base_color.tex_coord, 1,
+            "{name}"
+        );
+        let expected = |x: u32, y: u32| {
+            let uv = second_uv(pixel_uv(x, y));
+            sample(&img, [uv[0] + shift[0], uv[1] + shift[1]], &desc)
+        };
+        for graph in ["forward_plus.ron", "visibility_buffer.ron", "default.ron"] {
+            let out = render_file(&mut r, graph, &loaded.scene, W, H);
+            let (d, x, y) = worst_abs(&out.image, expected);
+            println!("{name}, {graph}: worst {d:.2e} at ({x}, {y})");
+            if d > NEAREST_TOL {
+                failures.push(format!("{name}, {graph}: pixel ({x}, {y}) off by {d}"));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
 /// The vertex colour of `coloured_quad` at (tx, ty) across the quad: affine, so the

@@ -7,6 +7,8 @@ struct ShadingPoint {
     normal: vec3<f32>,
     tangent: vec4<f32>,
     uv: vec2<f32>,
+    // The second texture coordinates (glTF TEXCOORD_1; zero without them).
+    uv1: vec2<f32>,
     view: vec3<f32>,
     // The interpolated vertex colour (glTF COLOR_0, linear RGBA; white without one), which
     // a material's `Vertex` and `VertexAlpha` read.

@@ -68,8 +68,8 @@ struct LinkParams {
 };
 
 // A mesh vertex's floats in the merged vertex array (src/gpu/structs.rs GpuVertex):
-// position xyz, normal xyz, uv, tangent xyzw, colour rgba.
-const VERTEX_FLOATS: u32 = 16u;
+// position xyz, normal xyz, uv, tangent xyzw, colour rgba, second uv.
+const VERTEX_FLOATS: u32 = 18u;
 
 const LINK_HEADER_WORDS: u32 = 4u;
 const LINK_WORDS: u32 = 3u;

@@ -88,15 +88,20 @@ fn load_surface(q: ptr<function, ShadingPoint>, p: vec2<u32>, s: u32) {
 #if G_SURFACE
     let t = textureLoad(g_surface, p, s);
     (*q).uv = t.xy;
+    // Only TEXCOORD_0 is kept: a TEXCOORD_1 texture samples it (the pass warns).
+    (*q).uv1 = t.xy;
     (*q).tangent = surface_tangent((*q).normal, t);
 #if MATERIAL_TEXTURED
     let d = textureLoad(g_uv_grad, p, s);
     material_uv_ddx = d.xy;
     material_uv_ddy = d.zw;
+    material_uv1_ddx = d.xy;
+    material_uv1_ddy = d.zw;
 #endif
 #else
     (*q).tangent = vec4<f32>(0.0);
     (*q).uv = vec2<f32>(0.0);
+    (*q).uv1 = vec2<f32>(0.0);
 #endif
 }
 

@@ -76,6 +76,7 @@ struct VertexIn {
     @location(2) uv: vec2<f32>,
     @location(3) tangent: vec4<f32>,
     @location(4) color: vec4<f32>,
+    @location(5) uv1: vec2<f32>,
 };
 
 #if MSAA
@@ -89,6 +90,7 @@ struct VertexOut {
     @location(2) @interpolate(perspective, centroid) uv: vec2<f32>,
     @location(3) @interpolate(perspective, centroid) tangent: vec4<f32>,
     @location(4) @interpolate(perspective, centroid) color: vec4<f32>,
+    @location(5) @interpolate(perspective, centroid) uv1: vec2<f32>,
 };
 #else
 struct VertexOut {
@@ -98,12 +100,13 @@ struct VertexOut {
     @location(2) uv: vec2<f32>,
     @location(3) tangent: vec4<f32>,
     @location(4) color: vec4<f32>,
+    @location(5) uv1: vec2<f32>,
 #if RSM
-    @location(5) @interpolate(flat) view: u32,
+    @location(6) @interpolate(flat) view: u32,
 #endif
 #if VISIBILITY
     // The mesh's first triangle id, passed as the instance index.
-    @location(5) @interpolate(flat) first_triangle: u32,
+    @location(6) @interpolate(flat) first_triangle: u32,
 #endif
 };
 #endif
@@ -131,6 +134,7 @@ fn vs_main(v: VertexIn, @builtin(instance_index) instance: u32) -> VertexOut {
     out.uv = v.uv;
     out.tangent = v.tangent;
     out.color = v.color;
+    out.uv1 = v.uv1;
 #if VISIBILITY
     out.first_triangle = instance;
 #endif
@@ -156,6 +160,7 @@ fn shading_point(in: VertexOut, front: bool) -> ShadingPoint {
     p.tangent = in.tangent;
     p.uv = in.uv;
     p.color = in.color;
+    p.uv1 = in.uv1;
     return p;
 }
 

@@ -4,7 +4,7 @@
 // Shared by visibility shading, the compute rasterizer's alpha test and the ray-cast
 // shadow passes (surface_geometry), so all see the same surface. Needs `frame`,
 // `vertices` and `triangles` bound, and with MATERIAL_TEXTURED the material code (which
-// declares material_uv_ddx and material_uv_ddy) in the module.
+// declares material_uv_ddx, material_uv_ddy and their TEXCOORD_1 twins) in the module.
 
 #include "common/shading_point.wgsl"
 
@@ -14,6 +14,7 @@ struct Vertex {
     uv: vec2<f32>,
     tangent: vec4<f32>,
     color: vec4<f32>,
+    uv1: vec2<f32>,
 };
 
 fn fetch(v: u32) -> Vertex {
@@ -24,6 +25,7 @@ fn fetch(v: u32) -> Vertex {
     out.uv = vec2<f32>(vertices[b + 6u], vertices[b + 7u]);
     out.tangent = vec4<f32>(vertices[b + 8u], vertices[b + 9u], vertices[b + 10u], vertices[b + 11u]);
     out.color = vec4<f32>(vertices[b + 12u], vertices[b + 13u], vertices[b + 14u], vertices[b + 15u]);
+    out.uv1 = vec2<f32>(vertices[b + 16u], vertices[b + 17u]);
     return out;
 }
 
@@ -117,6 +119,8 @@ fn surface_point(id: vec2<u32>, tri: u32) -> ShadingPoint {
     p.color = w.x * a.color + w.y * b.color + w.z * c.color;
     let uv = mat3x2<f32>(a.uv, b.uv, c.uv);
     p.uv = uv * w;
+    let uv1 = mat3x2<f32>(a.uv1, b.uv1, c.uv1);
+    p.uv1 = uv1 * w;
 #if MATERIAL_TEXTURED
     // The footprint textureSampleGrad filters over (its mip level): the uv one pixel
     // right and one down, taken as the rasterizer's coarse derivatives are, across the
@@ -128,9 +132,13 @@ fn surface_point(id: vec2<u32>, tri: u32) -> ShadingPoint {
     let step = vec2<f32>(2.0 / size.x, -2.0 / size.y);
     let corner = vec2<f32>(id & vec2<u32>(~1u)) + 0.5;
     let q0 = vec2<f32>(corner.x / size.x * 2.0 - 1.0, 1.0 - corner.y / size.y * 2.0);
-    let uv0 = uv * bary_at(e, q0);
-    material_uv_ddx = uv * bary_at(e, q0 + vec2<f32>(step.x, 0.0)) - uv0;
-    material_uv_ddy = uv * bary_at(e, q0 + vec2<f32>(0.0, step.y)) - uv0;
+    let b0 = bary_at(e, q0);
+    let bx = bary_at(e, q0 + vec2<f32>(step.x, 0.0));
+    let by = bary_at(e, q0 + vec2<f32>(0.0, step.y));
+    material_uv_ddx = uv * bx - uv * b0;
+    material_uv_ddy = uv * by - uv * b0;
+    material_uv1_ddx = uv1 * bx - uv1 * b0;
+    material_uv1_ddy = uv1 * by - uv1 * b0;
 #endif
     return p;
 }

@@ -239,7 +239,7 @@ pub fn gpu_light(l: &Light) -> (GpuLightGeometry, GpuLightProperties) {
     )
 }
 
-/// Vertex layout of every mesh: position, normal, uv, tangent, colour.
+/// Vertex layout of every mesh: position, normal, uv, tangent, colour, second uv.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuVertex {
@@ -253,13 +253,16 @@ pub struct GpuVertex {
     pub tangent: [f32; 4],
     /// Linear RGBA vertex colour (glTF COLOR_0; white where the mesh has none).
     pub color: [f32; 4],
+    /// The second texture coordinates (glTF TEXCOORD_1; zero where the mesh has none).
+    pub uv1: [f32; 2],
 }
 
 impl GpuVertex {
-    pub(crate) const ATTRIBUTES: [wgpu::VertexAttribute; 5] = wgpu::vertex_attr_array![
-        0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32x4, 4 => Float32x4
+    pub(crate) const ATTRIBUTES: [wgpu::VertexAttribute; 6] = wgpu::vertex_attr_array![
+        0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32x4, 4 => Float32x4,
+        5 => Float32x2
     ];
-    /// The vertex buffer layout render pipelines draw meshes with (locations 0..=4).
+    /// The vertex buffer layout render pipelines draw meshes with (locations 0..=5).
     pub fn layout() -> wgpu::VertexBufferLayout<'static> {
         wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<GpuVertex>() as u64,

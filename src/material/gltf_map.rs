@@ -160,6 +160,7 @@ pub(super) fn map(s: &SurfaceMaterial) -> (MaterialDesc, Vec<TextureSlot>) {
                         file: img.name.clone(),
                         srgb: img.srgb,
                         sampler: how.sampler,
+                        tex_coord: how.tex_coord,
                         transform: how.transform,
                     },
                 )
@@ -186,6 +187,7 @@ pub(super) fn map(s: &SurfaceMaterial) -> (MaterialDesc, Vec<TextureSlot>) {
             name,
             source: TextureSource::Image(img),
             sampler: how.sampler,
+            tex_coord: how.tex_coord,
             transform: how.transform,
         })
         .collect();

@@ -109,6 +109,8 @@ pub struct TextureSlot {
     pub source: TextureSource,
     /// Wrap and filter modes of the sampler the slot reads through.
     pub sampler: model::SamplerDesc,
+    /// The uv set sampled: 0 (`TEXCOORD_0`) or 1 (`TEXCOORD_1`).
+    pub tex_coord: u32,
     /// The uv transform applied before sampling, if any.
     pub transform: Option<model::UvTransform>,
 }
@@ -201,6 +203,10 @@ impl Material {
                 .iter()
                 .flat_map(|l| &l.lobes)
                 .any(|l| matches!(l, model::Lobe::AnisoGgx { .. }))
+    }
+    /// Whether a texture samples the second uv set (`TEXCOORD_1`).
+    pub fn reads_uv1(&self) -> bool {
+        self.slots.iter().any(|s| s.tex_coord == 1)
     }
     /// The bit this material answers to in a light's material mask.
     pub fn type_bit(&self) -> u32 {

@@ -57,6 +57,9 @@ pub(crate) struct TextureDesc {
     /// A transform of the uv before sampling (glTF `KHR_texture_transform`).
     #[serde(default)]
     pub(crate) transform: Option<UvTransform>,
+    /// The uv set sampled: 0 (`TEXCOORD_0`, default) or 1 (`TEXCOORD_1`).
+    #[serde(default)]
+    pub(crate) tex_coord: u32,
 }
 
 /// How a texture is sampled: glTF's sampler (wrapS/wrapT, magFilter, minFilter).
@@ -167,6 +170,8 @@ pub struct TextureSampling {
     pub sampler: SamplerDesc,
     /// The slot's uv transform, if any (`KHR_texture_transform`).
     pub transform: Option<UvTransform>,
+    /// The uv set the slot samples: 0 (`TEXCOORD_0`) or 1 (`TEXCOORD_1`).
+    pub tex_coord: u32,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -244,6 +244,14 @@ pub(crate) fn file_slots(
     let dir = path.parent().unwrap_or(Path::new("."));
     let mut slots = Vec::new();
     for (i, (name, tex)) in desc.textures.iter().enumerate() {
+        if tex.tex_coord > 1 {
+            return Err(MaterialError::OutOfRange {
+                at: locate(src, path, "tex_coord", 0),
+                field: "texture tex_coord",
+                value: tex.tex_coord.to_string(),
+                rule: "must be 0 (TEXCOORD_0) or 1 (TEXCOORD_1)".to_string(),
+            });
+        }
         let resolved = dir.join(&tex.file);
         if !resolved.is_file() {
             return Err(MaterialError::MissingTextureFile {
@@ -260,6 +268,7 @@ pub(crate) fn file_slots(
                 srgb: tex.srgb,
             },
             sampler: tex.sampler,
+            tex_coord: tex.tex_coord,
             transform: tex.transform,
         });
     }

@@ -227,7 +227,7 @@ pub(crate) fn generate_with_constants(m: &Material, opts: &WgslOptions) -> (Stri
             );
         }
         if opts.sample_grad {
-            o.push_str("// The uv's derivatives along x and y, set by the shader before material_setup.\nvar<private> material_uv_ddx: vec2<f32>;\nvar<private> material_uv_ddy: vec2<f32>;\n");
+            o.push_str("// The uv's derivatives along x and y (TEXCOORD_0, and TEXCOORD_1's with uv1), set by the shader before material_setup.\nvar<private> material_uv_ddx: vec2<f32>;\nvar<private> material_uv_ddy: vec2<f32>;\nvar<private> material_uv1_ddx: vec2<f32>;\nvar<private> material_uv1_ddy: vec2<f32>;\n");
         }
         o.push('\n');
     }
@@ -273,20 +273,22 @@ pub(crate) fn generate_with_constants(m: &Material, opts: &WgslOptions) -> (Stri
     );
     for (i, slot) in slots.iter().enumerate() {
         let smp = super::sampler_wgsl_name(sampler_of[i]);
+        // The slot's uv set (TEXCOORD_0 or TEXCOORD_1) and its derivatives.
+        let set = if slot.tex_coord == 1 { "uv1" } else { "uv" };
         // KHR_texture_transform: uv' = M (uv, 1); the derivatives take M's linear part.
         let (uv, ddx, ddy) = match &slot.transform {
             Some(t) => {
                 let [r0, r1] = t.matrix().map(|r| r.map(|x| g.num(x)));
                 let _ = writeln!(
                     o,
-                    "    let uv{i} = vec2<f32>({} * p.uv.x + {} * p.uv.y + {}, {} * p.uv.x + {} * p.uv.y + {});",
+                    "    let uv{i} = vec2<f32>({} * p.{set}.x + {} * p.{set}.y + {}, {} * p.{set}.x + {} * p.{set}.y + {});",
                     r0[0], r0[1], r0[2], r1[0], r1[1], r1[2]
                 );
                 if opts.sample_grad {
                     for d in ["ddx", "ddy"] {
                         let _ = writeln!(
                             o,
-                            "    let {d}{i} = vec2<f32>({} * material_uv_{d}.x + {} * material_uv_{d}.y, {} * material_uv_{d}.x + {} * material_uv_{d}.y);",
+                            "    let {d}{i} = vec2<f32>({} * material_{set}_{d}.x + {} * material_{set}_{d}.y, {} * material_{set}_{d}.x + {} * material_{set}_{d}.y);",
                             r0[0], r0[1], r1[0], r1[1]
                         );
                     }
@@ -294,9 +296,9 @@ pub(crate) fn generate_with_constants(m: &Material, opts: &WgslOptions) -> (Stri
                 (format!("uv{i}"), format!("ddx{i}"), format!("ddy{i}"))
             }
             None => (
-                "p.uv".to_string(),
-                "material_uv_ddx".to_string(),
-                "material_uv_ddy".to_string(),
+                format!("p.{set}"),
+                format!("material_{set}_ddx"),
+                format!("material_{set}_ddy"),
             ),
         };
         let sample = if opts.sample_grad {

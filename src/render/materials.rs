@@ -154,6 +154,8 @@ pub struct MaterialProgram {
     ///
     /// [`MaterialDesc::reads_vertex_color`]: crate::material::model::MaterialDesc::reads_vertex_color
     pub reads_vertex_color: bool,
+    /// Whether a texture samples TEXCOORD_1 ([`Material::reads_uv1`]).
+    pub reads_uv1: bool,
 }
 
 impl MaterialProgram {
@@ -332,6 +334,7 @@ impl MaterialProgram {
             texture_bytes,
             reads_uv_or_tangent: material.reads_uv_or_tangent(),
             reads_vertex_color: material.desc().reads_vertex_color(),
+            reads_uv1: material.reads_uv1(),
         })
     }
 

@@ -432,6 +432,7 @@ pub(super) fn gpu_vertices(m: &crate::scene::Mesh) -> Vec<GpuVertex> {
             uv: m.uvs.get(i).copied().unwrap_or_default().into(),
             tangent: m.tangents.get(i).copied().unwrap_or_default().into(),
             color: m.colors.get(i).copied().unwrap_or(glam::Vec4::ONE).into(),
+            uv1: m.uvs1.get(i).copied().unwrap_or_default().into(),
         })
         .collect()
 }

@@ -10,8 +10,8 @@
 //! `GpuMesh::first_triangle + t`. [`NO_TRIANGLE`] marks a pixel nothing covers.
 //!
 //! Layouts, as WGSL reads them:
-//! - `vertices: array<f32>`: 16 floats per vertex (position xyz, normal xyz, uv, tangent
-//!   xyzw, colour rgba: [`GpuVertex`]), world space.
+//! - `vertices: array<f32>`: 18 floats per vertex (position xyz, normal xyz, uv, tangent
+//!   xyzw, colour rgba, second uv: [`GpuVertex`]), world space.
 //! - `triangles: array<u32>`: three vertex indices per triangle, already offset into the
 //!   merged `vertices`.
 //! - `material_triangles: array<vec2<u32>>`: per scene material, its triangles' range

@@ -48,6 +48,7 @@ impl Scene {
             if let Some((vi, uv)) = mesh
                 .uvs
                 .iter()
+                .chain(&mesh.uvs1)
                 .enumerate()
                 .find(|(_, uv)| !(uv.is_finite() && uv.abs().max_element() <= MAX_UV))
             {

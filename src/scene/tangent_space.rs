@@ -75,6 +75,7 @@ pub fn mikktspace_tangents(mesh: &mut Mesh) -> bool {
     out.normals = mesh.normals.clone();
     out.uvs = mesh.uvs.clone();
     out.colors = mesh.colors.clone();
+    out.uvs1 = mesh.uvs1.clone();
     out.tangents = vec![Vec4::ZERO; n];
     out.indices = Vec::with_capacity(mesh.indices.len());
     for (corner, &v) in mesh.indices.iter().enumerate() {
@@ -95,6 +96,9 @@ pub fn mikktspace_tangents(mesh: &mut Mesh) -> bool {
                 out.uvs.push(mesh.uvs[v as usize]);
                 if let Some(&c) = mesh.colors.get(v as usize) {
                     out.colors.push(c);
+                }
+                if let Some(&uv) = mesh.uvs1.get(v as usize) {
+                    out.uvs1.push(uv);
                 }
                 out.tangents.push(t);
                 i

@@ -14,6 +14,9 @@ pub struct Mesh {
     pub normals: Vec<Vec3>,
     /// Texture coordinates (glTF `TEXCOORD_0`), one per position; empty when the mesh has none.
     pub uvs: Vec<Vec2>,
+    /// The second set (glTF `TEXCOORD_1`), one per position; empty when the mesh has none
+    /// (read as zero).
+    pub uvs1: Vec<Vec2>,
     /// xyz tangent, w handedness (glTF convention).
     pub tangents: Vec<Vec4>,
     /// Linear RGBA vertex colours (glTF `COLOR_0`), one per position; empty when the mesh

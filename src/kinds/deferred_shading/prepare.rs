@@ -88,6 +88,13 @@ pub(super) fn prepare(
     }
     // No G-buffer target holds a vertex colour: such materials shade as over white
     // vertices, said here rather than left to be noticed in the image.
+    if let Some(m) = cx.gpu.materials.iter().find(|m| m.reads_uv1) {
+        log::warn!(
+            "pass '{}': material '{}' samples a texture with TEXCOORD_1, which the G-buffer does not carry: it samples TEXCOORD_0 there",
+            sp.name,
+            m.name
+        );
+    }
     if let Some(m) = cx.gpu.materials.iter().find(|m| m.reads_vertex_color) {
         log::warn!(
             "pass '{}': material '{}' reads the vertex colour (glTF COLOR_0), which the G-buffer does not carry: it is shaded as if its vertices were white",

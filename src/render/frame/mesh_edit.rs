@@ -231,6 +231,7 @@ fn check_mesh(m: &Mesh, scene: &Scene) -> Result<(), MeshEditError> {
     if let Some((v, uv)) = m
         .uvs
         .iter()
+        .chain(&m.uvs1)
         .enumerate()
         .find(|(_, uv)| !(uv.is_finite() && uv.abs().max_element() <= MAX_UV))
     {
@@ -249,6 +250,7 @@ fn check_mesh(m: &Mesh, scene: &Scene) -> Result<(), MeshEditError> {
     if [
         m.normals.len(),
         m.uvs.len(),
+        m.uvs1.len(),
         m.tangents.len(),
         m.colors.len(),
     ]
@@ -256,7 +258,7 @@ fn check_mesh(m: &Mesh, scene: &Scene) -> Result<(), MeshEditError> {
     .any(|&n| n != 0 && n != m.positions.len())
     {
         return Err(bad(format!(
-            "normals, uvs, tangents and colours must be absent or one per vertex ({} vertices)",
+            "normals, uvs (both sets), tangents and colours must be absent or one per vertex ({} vertices)",
             m.positions.len()
         )));
     }

@@ -34,15 +34,17 @@ impl Importer {
             let at = format!("{element} {slot}");
             let transform = transform.map(|j| j.read(&this.file, &at)).transpose()?;
             // KHR_texture_transform's texCoord replaces the textureInfo's.
-            let set = transform.and_then(|t| t.1).unwrap_or(set);
-            if set != 0 {
+            let mut set = transform.and_then(|t| t.1).unwrap_or(set);
+            if set > 1 {
                 this.warn(format!(
-                    "{at}: TEXCOORD_{set} is not supported; TEXCOORD_0 used"
+                    "{at}: TEXCOORD_{set} is not supported (sets 0 and 1 are); TEXCOORD_0 used"
                 ));
+                set = 0;
             }
             let sampling = TextureSampling {
                 sampler: sampler_desc(&t.sampler()),
                 transform: transform.map(|t| t.0),
+                tex_coord: set,
             };
             Ok((this.texture(t.source().index(), srgb, &at), sampling))
         };

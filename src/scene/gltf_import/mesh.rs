@@ -129,21 +129,27 @@ impl Importer {
                     }
                     None => None,
                 };
-            let uvs: Vec<Vec2> = match read_attr(self, gltf::Semantic::TexCoords(0), "TEXCOORD_0")?
-            {
-                Some((acc, e)) => self
-                    .read_f32::<2>(&acc, &e, &[DataType::F32, DataType::U8, DataType::U16])?
-                    .into_iter()
-                    .map(|[u, v]| {
-                        if u.is_finite() && v.is_finite() {
-                            Vec2::new(u, v)
-                        } else {
-                            Vec2::ZERO
-                        }
-                    })
-                    .collect(),
-                None => Vec::new(),
+            let read_uvs = |this: &mut Self, set: u32| -> Result<Vec<Vec2>, SceneError> {
+                let name = format!("TEXCOORD_{set}");
+                Ok(
+                    match read_attr(this, gltf::Semantic::TexCoords(set), &name)? {
+                        Some((acc, e)) => this
+                            .read_f32::<2>(&acc, &e, &[DataType::F32, DataType::U8, DataType::U16])?
+                            .into_iter()
+                            .map(|[u, v]| {
+                                if u.is_finite() && v.is_finite() {
+                                    Vec2::new(u, v)
+                                } else {
+                                    Vec2::ZERO
+                                }
+                            })
+                            .collect(),
+                        None => Vec::new(),
+                    },
+                )
             };
+            let uvs = read_uvs(self, 0)?;
+            let uvs1 = read_uvs(self, 1)?;
             // Vertex colours multiply the base colour and alpha (glTF 2.0, 3.7.2.1).
             let colors = match read_attr(self, gltf::Semantic::Colors(0), "COLOR_0")? {
                 Some((acc, e)) => self.vertex_colors(&acc, &e)?,
@@ -227,6 +233,7 @@ impl Importer {
                 positions,
                 normals,
                 uvs,
+                uvs1,
                 tangents,
                 colors,
                 indices,

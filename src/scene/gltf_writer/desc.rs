@@ -32,6 +32,8 @@ pub struct PrimitiveDesc {
     pub normals: Option<usize>,
     /// Accessor of the texture coordinates (`TEXCOORD_0`).
     pub uvs: Option<usize>,
+    /// Accessor of the second texture coordinates (`TEXCOORD_1`).
+    pub uvs1: Option<usize>,
     /// Accessor of the tangents (`TANGENT`, xyz and handedness w).
     pub tangents: Option<usize>,
     /// Accessor of the vertex colours (`COLOR_0`, VEC3 or VEC4).
@@ -83,6 +85,8 @@ pub struct MaterialDesc {
     /// A `KHR_texture_transform` object (JSON text, written as given, so malformed ones
     /// can be tested) per textureInfo key (`"baseColorTexture"`, `"normalTexture"`, ...).
     pub texture_transforms: Vec<(&'static str, String)>,
+    /// The `texCoord` (uv set) per textureInfo key; 0 where not listed.
+    pub tex_coords: Vec<(&'static str, u32)>,
 }
 
 impl Default for MaterialDesc {
@@ -103,6 +107,7 @@ impl Default for MaterialDesc {
             occlusion_texture: None,
             extensions: None,
             texture_transforms: Vec::new(),
+            tex_coords: Vec::new(),
         }
     }
 }

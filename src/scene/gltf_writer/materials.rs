@@ -16,10 +16,16 @@ impl GltfWriter {
     /// When `alpha_mode` is not one of glTF's three, or the extension texts are not JSON
     /// objects' members (a caller's mistake in a test).
     pub fn add_material(&mut self, m: &MaterialDesc) -> usize {
+        let tex_coord = |key: &str| {
+            m.tex_coords
+                .iter()
+                .find(|(k, _)| *k == key)
+                .map_or(0, |&(_, set)| set)
+        };
         let info = |key: &str, texture: Option<usize>| {
             texture.map(|i| json::texture::Info {
                 index: index(i),
-                tex_coord: 0,
+                tex_coord: tex_coord(key),
                 extensions: transform(m, key).map(|others| json::extensions::texture::Info {
                     others,
                     ..Default::default()

@@ -24,6 +24,7 @@ impl GltfWriter {
                 for (semantic, accessor) in [
                     (Semantic::Normals, p.normals),
                     (Semantic::TexCoords(0), p.uvs),
+                    (Semantic::TexCoords(1), p.uvs1),
                     (Semantic::Tangents, p.tangents),
                     (Semantic::Colors(0), p.colors),
                 ] {
@@ -65,6 +66,7 @@ impl GltfWriter {
             positions: self.add_positions(positions),
             normals: normals.map(|n| self.add_vec3(n)),
             uvs: uvs.map(|u| self.add_vec2(u)),
+            uvs1: None,
             tangents: None,
             colors: None,
             indices: indices.map(|i| self.add_indices(i)),
