@@ -135,6 +135,35 @@ fn png(dir: &Path, name: &str, rgba: [u8; 4]) {
     img.save(dir.join(name)).unwrap();
 }
 
+/// A texture's uv set: 1 samples `p.uv1`; past 1 is refused, naming the file and line.
+#[test]
+fn texture_tex_coord_picks_the_uv_set_and_refuses_others() {
+    let dir = std::env::temp_dir().join(format!("lightgraph_tex_coord_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    png(&dir, "base.png", [255, 128, 0, 255]);
+    let src = |set: u32| {
+        format!(
+            "(\n    name: \"second\",\n    textures: {{\n        \"base\": (file: \"base.png\", tex_coord: {set}),\n    }},\n    layers: [(lobes: [Lambert(color: Tex(texture: \"base\"))])],\n)"
+        )
+    };
+    let path = dir.join("second.ron");
+    std::fs::write(&path, src(1)).unwrap();
+    let m = Material::load(&path).unwrap();
+    assert_eq!(m.texture_slots()[0].tex_coord, 1);
+    assert!(m.reads_uv1());
+    assert!(m
+        .wgsl()
+        .unwrap()
+        .contains("textureSample(material_tex0, material_sampler, p.uv1)"));
+    std::fs::write(&path, src(2)).unwrap();
+    let e = Material::load(&path).unwrap_err().to_string();
+    assert!(
+        e.contains("second.ron:4:") && e.contains("tex_coord 2") && e.contains("TEXCOORD_1"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn texture_slots_from_files() {
     let dir = std::env::temp_dir().join(format!("lightgraph_material_{}", std::process::id()));
