@@ -166,7 +166,7 @@ impl ComputeAtlas {
             indices,
             index_base,
             tri_ids,
-        } = merge_casters(cx, pass, casters, ids)?;
+        } = merge_casters(cx, pass, casters, ids);
         let (side, rows, atlas) = match target {
             RasterTarget::Atlas { atlas, side } => (side, side, Some(atlas)),
             RasterTarget::Buffers { width, height } => (width, height, None),

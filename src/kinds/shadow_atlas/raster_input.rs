@@ -2,9 +2,8 @@
 //! merged into one geometry, each frame's list of views to draw (jobs, tiles and the
 //! pieces `store` copies), and the test hook that caps the lists.
 
-use super::{pass_error, PrepareCtx};
+use super::PrepareCtx;
 use crate::render::scene_gpu::SceneGpu;
-use crate::render::RenderError;
 use crate::scene::AlphaMode;
 
 /// Texels per side of a store workgroup's piece.
@@ -96,14 +95,15 @@ pub(super) struct MergedCasters {
     pub tri_ids: Vec<u32>,
 }
 
-/// The meshes `casters` merged, each mesh's triangles as the hardware path draws them;
-/// alpha-masked materials are refused, naming the first.
+/// The meshes `casters` merged, each mesh's triangles as the hardware path draws them.
+/// None is alpha-masked: the compute raster draws no masks, and its callers fall back to
+/// the raster units for such scenes.
 pub(super) fn merge_casters(
     cx: &PrepareCtx,
     pass: &str,
     casters: &[usize],
     ids: bool,
-) -> Result<MergedCasters, RenderError> {
+) -> MergedCasters {
     let gpu: &SceneGpu = cx.gpu;
     let mut positions: Vec<[f32; 4]> = Vec::new();
     let mut indices: Vec<u32> = Vec::new();
@@ -111,16 +111,15 @@ pub(super) fn merge_casters(
     // Per merged triangle, its visibility id (the IDS pass's).
     let mut tri_ids: Vec<u32> = Vec::new();
     for &m in casters {
-        let material = &gpu.materials[gpu.meshes[m].material];
-        if matches!(material.alpha_mode, AlphaMode::Mask(_)) {
-            return Err(pass_error(
-                pass,
-                format!(
-                    "raster: Compute draws no alpha masks, and caster material '{}' is alpha-masked: use raster: Hardware for this scene",
-                    material.name
-                ),
-            ));
-        }
+        // The atlas and the reflective shadow maps send scenes with masked casters to the
+        // raster units (SceneGpu::masked_material) before they get here.
+        debug_assert!(
+            !matches!(
+                gpu.materials[gpu.meshes[m].material].alpha_mode,
+                AlphaMode::Mask(_)
+            ),
+            "pass '{pass}': an alpha-masked caster reached the compute raster"
+        );
         let mesh = &cx.scene.meshes[gpu.meshes[m].scene_mesh];
         let base = positions.len() as u32;
         index_base.push(indices.len() as u32);
@@ -135,10 +134,10 @@ pub(super) fn merge_casters(
             tri_ids.extend(sources.iter().map(|t| first + t));
         }
     }
-    Ok(MergedCasters {
+    MergedCasters {
         positions,
         indices,
         index_base,
         tri_ids,
-    })
+    }
 }
