@@ -14,10 +14,10 @@
 mod common;
 
 use common::{graph_text, lambert, render_text_with, renderer};
-use glam::{DMat4, DVec3, DVec4, Vec2, Vec3, Vec4};
+use glam::{DMat4, DVec3, DVec4, Vec2, Vec3};
 use lightgraph::render::{FrameResult, Renderer};
 use lightgraph::scene::geometry::MeshBuilder;
-use lightgraph::scene::{light_flags, AlphaMode, Camera, Light, Scene, SurfaceMaterial};
+use lightgraph::scene::{light_flags, AlphaMode, Camera, Light, Scene};
 use lightgraph::shadow::atlas::GUARD_TEXELS;
 use lightgraph::shadow::reference::near_edge;
 use lightgraph::shadow::{occluded_reference, scene_triangles_f64, shadow_ray, ShadowBvh};
@@ -58,15 +58,6 @@ fn caster(position: Vec3) -> Light {
     let mut l = Light::point(position, 30.0, Vec3::ONE, 5.0);
     l.flags |= light_flags::CASTS_SHADOW;
     l
-}
-
-fn glass() -> SurfaceMaterial {
-    SurfaceMaterial {
-        name: "glass".into(),
-        base_color: Vec4::new(0.6, 0.8, 1.0, 0.5),
-        alpha_mode: AlphaMode::Blend,
-        ..Default::default()
-    }
 }
 
 /// A horizontal square at height `y`, half-side `half`, facing up.
@@ -137,7 +128,10 @@ fn pane_over_floor(pane: bool, pane_casts: bool) -> Scene {
     let scene = Scene {
         name: "pane over floor".into(),
         meshes,
-        materials: vec![lambert("floor", Vec3::splat(0.8)), glass()],
+        materials: vec![
+            lambert("floor", Vec3::splat(0.8)),
+            common::glass::pale_glass(),
+        ],
         lights: vec![caster(FLOOR_LIGHT)],
         camera: Camera {
             eye: Vec3::new(0.0, 1.0, 3.0),
@@ -290,7 +284,10 @@ fn box_over_pane(occluder: bool, pane_casts: bool) -> Scene {
     Scene {
         name: "box over pane".into(),
         meshes,
-        materials: vec![lambert("box", Vec3::splat(0.8)), glass()],
+        materials: vec![
+            lambert("box", Vec3::splat(0.8)),
+            common::glass::pale_glass(),
+        ],
         lights: vec![caster(BOX_LIGHT)],
         camera: Camera {
             eye: Vec3::new(0.0, 4.0, 1.5),

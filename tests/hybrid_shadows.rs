@@ -378,12 +378,7 @@ fn forward_and_deferred_hybrids_equal_their_ray_cast_and_atlas_frames() {
     // the mapped lights, its own traced rays for the rest), so its parts are the glass of
     // tiled_deferred_raycast_shadows.ron (traced) and tiled_deferred_shadow_atlas.ron
     // (the atlas); Forward+'s graphs have no glass passes and skip it.
-    scene.materials.push(lightgraph::scene::SurfaceMaterial {
-        name: "glass".into(),
-        base_color: glam::Vec4::new(0.6, 0.8, 1.0, 0.5),
-        alpha_mode: lightgraph::scene::AlphaMode::Blend,
-        ..Default::default()
-    });
+    scene.materials.push(common::glass::pale_glass());
     let mut pane = lightgraph::scene::geometry::MeshBuilder::new("pane", 2);
     pane.quad(
         Vec3::new(-5.0, 2.5, -9.0),

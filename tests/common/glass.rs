@@ -1,6 +1,17 @@
 //! Glass over an opaque frame against a reference with the same blending order: the glass
 //! must show, and add no error beyond the opaque layers' own difference.
 
+/// A pale blue glass that lets half the light through (alpha-blended), as the shadow
+/// tests put over their rooms.
+pub fn pale_glass() -> lightgraph::scene::SurfaceMaterial {
+    lightgraph::scene::SurfaceMaterial {
+        name: "glass".into(),
+        base_color: glam::Vec4::new(0.6, 0.8, 1.0, 0.5),
+        alpha_mode: lightgraph::scene::AlphaMode::Blend,
+        ..Default::default()
+    }
+}
+
 /// Pixels that differ between two images of one size.
 pub fn differing(a: &[[f32; 4]], b: &[[f32; 4]]) -> usize {
     assert_eq!(a.len(), b.len(), "images of different sizes");
