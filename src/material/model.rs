@@ -455,19 +455,61 @@ fn one_scalar() -> Scalar {
     Scalar::Val(1.0)
 }
 
+/// What a parameter expression reads besides constants: a texture (its slot name) or the
+/// mesh's vertex colour.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Source<'a> {
+    Texture(&'a str),
+    Vertex,
+}
+
 impl MaterialDesc {
+    /// What the material reads besides constants, in order, repeats kept: its alpha and
+    /// emission expressions, the normal map's and occlusion's textures, then every
+    /// lobe's parameters.
+    pub(crate) fn sources(&self) -> Vec<Source<'_>> {
+        let mut out = Vec::new();
+        self.alpha.sources(&mut out);
+        if let Some(e) = &self.emissive {
+            e.sources(&mut out);
+        }
+        if let Some(n) = &self.normal_map {
+            out.push(Source::Texture(&n.texture));
+        }
+        if let Some(o) = &self.occlusion {
+            out.push(Source::Texture(&o.texture));
+        }
+        for lobe in self.layers.iter().flat_map(|l| &l.lobes) {
+            lobe.sources(&mut out);
+        }
+        out
+    }
+
     /// Whether any parameter reads the mesh's vertex colour (`Vertex`, `VertexAlpha`).
     pub fn reads_vertex_color(&self) -> bool {
-        let lobe = |l: &Lobe| match l {
-            Lobe::Lambert { color, .. } => color.reads_vertex(),
+        self.sources().contains(&Source::Vertex)
+    }
+}
+
+impl Lobe {
+    /// What the lobe's parameters read, in order.
+    pub(crate) fn sources<'a>(&'a self, out: &mut Vec<Source<'a>>) {
+        match self {
+            Lobe::Lambert { color, .. } => color.sources(out),
             Lobe::OrenNayar {
                 color, roughness, ..
             }
             | Lobe::Sheen {
                 color, roughness, ..
-            } => color.reads_vertex() || roughness.reads_vertex(),
+            } => {
+                color.sources(out);
+                roughness.sources(out);
+            }
             Lobe::Ggx { roughness, f0, .. } => {
-                roughness.reads_vertex() || f0.as_ref().is_some_and(Color::reads_vertex)
+                roughness.sources(out);
+                if let Some(f) = f0 {
+                    f.sources(out);
+                }
             }
             Lobe::AnisoGgx {
                 roughness,
@@ -475,76 +517,53 @@ impl MaterialDesc {
                 f0,
                 ..
             } => {
-                roughness.reads_vertex()
-                    || anisotropy.reads_vertex()
-                    || f0.as_ref().is_some_and(Color::reads_vertex)
+                roughness.sources(out);
+                anisotropy.sources(out);
+                if let Some(f) = f0 {
+                    f.sources(out);
+                }
             }
-            Lobe::Clearcoat { roughness, .. } => roughness.reads_vertex(),
-        };
-        self.alpha.reads_vertex()
-            || self.emissive.as_ref().is_some_and(Color::reads_vertex)
-            || self.layers.iter().flat_map(|l| &l.lobes).any(lobe)
+            Lobe::Clearcoat { roughness, .. } => roughness.sources(out),
+        }
     }
 }
 
 impl Scalar {
-    /// Names of the textures this expression reads.
-    pub(crate) fn textures<'a>(&'a self, out: &mut Vec<&'a str>) {
+    /// What this expression reads, in order.
+    pub(crate) fn sources<'a>(&'a self, out: &mut Vec<Source<'a>>) {
         match self {
             Scalar::Val(_) => {}
-            Scalar::Expr(ScalarExpr::Tex { texture, .. }) => out.push(texture),
-            Scalar::Expr(ScalarExpr::OneMinus(a)) => a.textures(out),
+            Scalar::Expr(ScalarExpr::Tex { texture, .. }) => out.push(Source::Texture(texture)),
+            Scalar::Expr(ScalarExpr::OneMinus(a)) => a.sources(out),
             Scalar::Expr(ScalarExpr::Mul(a, b)) => {
-                a.textures(out);
-                b.textures(out);
+                a.sources(out);
+                b.sources(out);
             }
-            Scalar::Expr(ScalarExpr::VertexAlpha) => {}
-        }
-    }
-
-    /// Whether this expression reads the vertex colour.
-    pub(crate) fn reads_vertex(&self) -> bool {
-        match self {
-            Scalar::Val(_) | Scalar::Expr(ScalarExpr::Tex { .. }) => false,
-            Scalar::Expr(ScalarExpr::OneMinus(a)) => a.reads_vertex(),
-            Scalar::Expr(ScalarExpr::Mul(a, b)) => a.reads_vertex() || b.reads_vertex(),
-            Scalar::Expr(ScalarExpr::VertexAlpha) => true,
+            Scalar::Expr(ScalarExpr::VertexAlpha) => out.push(Source::Vertex),
         }
     }
 }
 
 impl Color {
-    pub(crate) fn textures<'a>(&'a self, out: &mut Vec<&'a str>) {
+    /// What this expression reads, in order.
+    pub(crate) fn sources<'a>(&'a self, out: &mut Vec<Source<'a>>) {
         match self {
             Color::Rgb(..) => {}
-            Color::Expr(ColorExpr::Tex { texture, .. }) => out.push(texture),
+            Color::Expr(ColorExpr::Tex { texture, .. }) => out.push(Source::Texture(texture)),
             Color::Expr(ColorExpr::Mix { a, b, t }) => {
-                a.textures(out);
-                b.textures(out);
-                t.textures(out);
+                a.sources(out);
+                b.sources(out);
+                t.sources(out);
             }
             Color::Expr(ColorExpr::Scale(c, s)) => {
-                c.textures(out);
-                s.textures(out);
+                c.sources(out);
+                s.sources(out);
             }
             Color::Expr(ColorExpr::Mul(a, b)) => {
-                a.textures(out);
-                b.textures(out);
+                a.sources(out);
+                b.sources(out);
             }
-            Color::Expr(ColorExpr::Vertex) => {}
-        }
-    }
-
-    /// Whether this expression reads the vertex colour.
-    pub(crate) fn reads_vertex(&self) -> bool {
-        match self {
-            Color::Rgb(..) | Color::Expr(ColorExpr::Tex { .. }) => false,
-            Color::Expr(ColorExpr::Mix { a, b, t }) => {
-                a.reads_vertex() || b.reads_vertex() || t.reads_vertex()
-            }
-            Color::Expr(ColorExpr::Scale(c, s)) => c.reads_vertex() || s.reads_vertex(),
-            Color::Expr(ColorExpr::Mul(a, b)) => a.reads_vertex() || b.reads_vertex(),
-            Color::Expr(ColorExpr::Vertex) => true,
+            Color::Expr(ColorExpr::Vertex) => out.push(Source::Vertex),
         }
     }
 }

@@ -3,7 +3,7 @@
 //! by finding the offending token in the source text.
 
 use super::error::{Location, MaterialError};
-use super::model::{Lobe, MaterialDesc};
+use super::model::{MaterialDesc, Source};
 use super::{TextureSlot, TextureSource};
 use crate::scene::AlphaMode;
 use std::path::Path;
@@ -165,23 +165,11 @@ fn check(desc: &MaterialDesc, src: &str, path: &Path) -> Result<(), MaterialErro
             return Err(MaterialError::EmptyLobes { at, layer: i });
         }
     }
-    // Every texture an expression names must be declared.
-    let mut used = Vec::new();
-    desc.alpha.textures(&mut used);
-    if let Some(e) = &desc.emissive {
-        e.textures(&mut used);
-    }
-    if let Some(n) = &desc.normal_map {
-        used.push(&n.texture);
-    }
-    if let Some(o) = &desc.occlusion {
-        used.push(&o.texture);
-    }
-    for layer in &desc.layers {
-        for lobe in &layer.lobes {
-            lobe_textures(lobe, &mut used);
-        }
-    }
+    // Every texture the material names must be declared.
+    let used = desc.sources().into_iter().filter_map(|s| match s {
+        Source::Texture(name) => Some(name),
+        Source::Vertex => None,
+    });
     for name in used {
         if !desc.textures.contains_key(name) {
             return Err(MaterialError::UnknownTexture {
@@ -198,41 +186,6 @@ fn check(desc: &MaterialDesc, src: &str, path: &Path) -> Result<(), MaterialErro
 /// it keeps every fragment or none, and a non-finite one is no WGSL literal at all.
 pub(crate) fn alpha_cutoff_rule(cutoff: f32) -> Option<&'static str> {
     (!(0.0..=1.0).contains(&cutoff)).then_some("must be a finite number in 0..=1")
-}
-
-/// Names of the textures a lobe reads.
-pub(crate) fn lobe_textures<'a>(lobe: &'a Lobe, out: &mut Vec<&'a str>) {
-    match lobe {
-        Lobe::Lambert { color, .. } => color.textures(out),
-        Lobe::OrenNayar {
-            color, roughness, ..
-        }
-        | Lobe::Sheen {
-            color, roughness, ..
-        } => {
-            color.textures(out);
-            roughness.textures(out);
-        }
-        Lobe::Ggx { roughness, f0, .. } => {
-            roughness.textures(out);
-            if let Some(f) = f0 {
-                f.textures(out);
-            }
-        }
-        Lobe::AnisoGgx {
-            roughness,
-            anisotropy,
-            f0,
-            ..
-        } => {
-            roughness.textures(out);
-            anisotropy.textures(out);
-            if let Some(f) = f0 {
-                f.textures(out);
-            }
-        }
-        Lobe::Clearcoat { roughness, .. } => roughness.textures(out),
-    }
 }
 
 /// Texture slots of a RON material: its declared files, in name order, which must exist.
