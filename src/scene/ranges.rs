@@ -3,7 +3,7 @@
 //! these in f32; past these limits a finite input still overflows to Inf or NaN there.
 
 use super::error::SceneError;
-use super::types::{Camera, Light, Scene};
+use super::types::{Camera, Light, Mesh, Scene};
 use std::path::Path;
 
 /// Largest coordinate of a vertex, light or camera, in metres. f32 spacing at 1e5 is
@@ -45,17 +45,11 @@ impl Scene {
             }
         }
         for (mi, mesh) in self.meshes.iter().enumerate() {
-            if let Some((vi, uv)) = mesh
-                .uvs
-                .iter()
-                .chain(&mesh.uvs1)
-                .enumerate()
-                .find(|(_, uv)| !(uv.is_finite() && uv.abs().max_element() <= MAX_UV))
-            {
+            if let Some((vi, problem)) = bad_texture_coordinate(mesh) {
                 return Err(SceneError::invalid(
                     file,
                     format!("mesh {mi} (\"{}\") vertex {vi}", mesh.name),
-                    format!("texture coordinate {uv:?} is not finite or beyond ±{MAX_UV}"),
+                    problem,
                 ));
             }
         }
@@ -71,6 +65,25 @@ fn in_range(p: glam::Vec3) -> bool {
 }
 
 /// A light's position, reach and power after every transform.
+/// The first vertex of `mesh` whose texture coordinates (either set) are not finite or
+/// lie beyond ±MAX_UV, and what is wrong with them.
+pub(crate) fn bad_texture_coordinate(mesh: &Mesh) -> Option<(usize, String)> {
+    let sets = [
+        ("texture coordinate", &mesh.uvs),
+        ("second texture coordinate", &mesh.uvs1),
+    ];
+    sets.into_iter().find_map(|(what, uvs)| {
+        let (v, uv) = uvs
+            .iter()
+            .enumerate()
+            .find(|(_, uv)| !(uv.is_finite() && uv.abs().max_element() <= MAX_UV))?;
+        Some((
+            v,
+            format!("{what} {uv:?} is not finite or beyond ±{MAX_UV}"),
+        ))
+    })
+}
+
 pub(crate) fn check_light_range(l: &Light) -> Result<(), String> {
     if !in_range(l.position) {
         return Err(format!(
@@ -117,6 +130,29 @@ pub(crate) fn check_camera(c: &Camera) -> Result<(), String> {
 mod tests {
     use super::*;
     use glam::Vec3;
+
+    #[test]
+    fn a_bad_second_texture_coordinate_names_its_own_vertex() {
+        let ok = glam::Vec2::new(0.5, 0.5);
+        let mesh = Mesh {
+            uvs: vec![ok; 3],
+            uvs1: vec![ok, glam::Vec2::new(f32::NAN, 0.0), ok],
+            ..Default::default()
+        };
+        let (vertex, problem) = bad_texture_coordinate(&mesh).unwrap();
+        assert_eq!(vertex, 1);
+        assert!(
+            problem.starts_with("second texture coordinate"),
+            "{problem}"
+        );
+        assert_eq!(
+            bad_texture_coordinate(&Mesh {
+                uvs1: vec![ok; 3],
+                ..mesh
+            }),
+            None
+        );
+    }
 
     #[test]
     fn refuses_overbright_lights_far_vertices_and_a_degenerate_camera() {

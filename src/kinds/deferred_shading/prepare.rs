@@ -86,8 +86,8 @@ pub(super) fn prepare(
             format!("material '{}' has textures: its G-buffer needs the surface targets '{G_SURFACE}' and 'g_uv_grad' (uv, tangent and uv derivatives), which this pass does not read", m.name),
         ));
     }
-    // No G-buffer target holds a vertex colour: such materials shade as over white
-    // vertices, said here rather than left to be noticed in the image.
+    // No G-buffer target holds a second uv set or a vertex colour: materials that read
+    // one are shaded without it here, said rather than left to be noticed in the image.
     if let Some(m) = cx.gpu.materials.iter().find(|m| m.reads_uv1) {
         log::warn!(
             "pass '{}': material '{}' samples a texture with TEXCOORD_1, which the G-buffer does not carry: it samples TEXCOORD_0 there",

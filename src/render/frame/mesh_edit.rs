@@ -8,7 +8,7 @@
 use super::PreparedFrame;
 use crate::render::scene_gpu::SceneGpu;
 use crate::render::{RenderError, Renderer};
-use crate::scene::ranges::{MAX_COORDINATE, MAX_UV};
+use crate::scene::ranges::MAX_COORDINATE;
 use crate::scene::{Mesh, Scene, SceneFeatures};
 
 /// Why a mesh edit was refused; the scene, its upload and the frame are as before.
@@ -228,16 +228,8 @@ fn check_mesh(m: &Mesh, scene: &Scene) -> Result<(), MeshEditError> {
             "vertex {v}: position {p:?} is not finite or beyond ±{MAX_COORDINATE:e} m"
         )));
     }
-    if let Some((v, uv)) = m
-        .uvs
-        .iter()
-        .chain(&m.uvs1)
-        .enumerate()
-        .find(|(_, uv)| !(uv.is_finite() && uv.abs().max_element() <= MAX_UV))
-    {
-        return Err(bad(format!(
-            "vertex {v}: texture coordinate {uv:?} is not finite or beyond ±{MAX_UV}"
-        )));
+    if let Some((v, problem)) = crate::scene::ranges::bad_texture_coordinate(m) {
+        return Err(bad(format!("vertex {v}: {problem}")));
     }
     if let Some((v, c)) = m
         .colors
