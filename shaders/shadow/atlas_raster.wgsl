@@ -34,11 +34,19 @@
 // (`tri_ids`: the triangles are in shadow chunk order) by a 32-bit atomic max in `ids`,
 // as the raster pipeline's LessEqual test keeps the later draw of equal depth. Two 32-bit passes instead of one 64-bit atomic of (depth, id): no device
 // feature needed, and the views are small, so the second pass costs little.
+//
+// Alpha-masked casters (ALPHA_TEST, with MATERIAL_INDEX and its material code): `setup`
+// and `raster` run again per masked material over its triangles only (their own jobs,
+// from `params.capacity.z`), after the opaque run. A covered texel nearer than what the
+// buffer holds (with IDS: at the depth it holds) is rebuilt as visibility shading
+// rebuilds a pixel (visibility/surface.wgsl through the view's view-projection, the
+// view's tile as the frame) and kept only where the material's alpha reaches its
+// cutoff, as the hardware pass's fragment stage discards below it.
 
 struct Params {
     // Pairs, jobs, workgroups per dispatch dimension, atlas side.
     work: vec4<u32>,
-    // Capacities of the record and cell lists; unused.
+    // Capacities of the record and cell lists; the run's first job; unused.
     capacity: vec4<u32>,
 };
 
@@ -53,12 +61,22 @@ struct Params {
 // The first pass's depths (read only) and the nearest triangle's id + 1 (0: none).
 @group(0) @binding(6) var<storage, read> depth: array<u32>;
 @group(0) @binding(12) var<storage, read_write> ids: array<atomic<u32>>;
-#if SETUP
-// Per triangle of `indices`, the id `ids` keeps (its visibility id).
-@group(0) @binding(13) var<storage, read> tri_ids: array<u32>;
-#endif
 #else
 @group(0) @binding(6) var<storage, read_write> depth: array<atomic<u32>>;
+#endif
+#if TRI_IDS
+// Setup's, per triangle of `indices`, its visibility id: what `ids` keeps (IDS), the
+// triangle of the merged geometry the alpha test rebuilds (ALPHA_TEST).
+@group(0) @binding(13) var<storage, read> tri_ids: array<u32>;
+#endif
+#if ALPHA_TEST
+#include "common/types.wgsl"
+@group(0) @binding(14) var<storage, read> vertices: array<f32>;
+@group(0) @binding(15) var<storage, read> triangles: array<u32>;
+#if RASTER
+@group(0) @binding(1) var<storage, read> shadow_views: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> rects: array<vec4<u32>>;
+#endif
 #endif
 #if SETUP
 @group(0) @binding(1) var<storage, read> shadow_views: array<vec4<f32>>;
@@ -132,9 +150,29 @@ struct Tri {
     offset: f32,
     // Texels whose centres lie in the vertices' box, within the view's tile.
     box: vec4<i32>,
-    // IDS: the triangle's id (`tri_ids`), what a texel it is nearest in keeps.
+    // IDS: the triangle's id (`tri_ids`), what a texel it is nearest in keeps; with
+    // ALPHA_TEST also the triangle the alpha test rebuilds, in view `view`.
     id: u32,
+    view: u32,
 };
+
+#if ALPHA_TEST
+// The view's tile stands for the frame in visibility/surface.wgsl: its view-projection
+// and size (set per texel before the rebuild).
+var<private> frame: Frame;
+#include "visibility/surface.wgsl"
+#include <material>
+
+// Whether `t`'s material keeps texel (px, py): its alpha there reaches the cutoff.
+fn alpha_keeps(t: Tri, px: i32, py: i32) -> bool {
+    let rect = rects[t.view];
+    let base = 1u + VIEW_VEC4S * t.view;
+    frame.view_proj = mat4x4<f32>(shadow_views[base], shadow_views[base + 1u], shadow_views[base + 2u], shadow_views[base + 3u]);
+    frame.size = vec2<u32>(rect.z);
+    let p = surface_point(vec2<u32>(vec2<i32>(px, py) - vec2<i32>(rect.xy)), t.id);
+    return material_alpha(material_setup(p)) >= MATERIAL_ALPHA_CUTOFF;
+}
+#endif
 
 // Texel (px, py) of `t`, if its centre is covered and its depth within the far plane.
 fn cover(t: Tri, px: i32, py: i32) {
@@ -152,10 +190,23 @@ fn cover(t: Tri, px: i32, py: i32) {
     let bits = select(bitcast<u32>(d), 0u, !(d > 0.0));
     let at = u32(py) * params.work.w + u32(px);
 #if IDS
-    if (bits == depth[at]) {
-        atomicMax(&ids[at], t.id + 1u);
+    if (bits != depth[at]) {
+        return;
     }
+#if ALPHA_TEST
+    if (!alpha_keeps(t, px, py)) {
+        return;
+    }
+#endif
+    atomicMax(&ids[at], t.id + 1u);
 #else
+#if ALPHA_TEST
+    // The material only where it could win: at or behind what the buffer holds, the
+    // min would keep that anyway.
+    if (bits >= atomicLoad(&depth[at]) || !alpha_keeps(t, px, py)) {
+        return;
+    }
+#endif
     atomicMin(&depth[at], bits);
 #endif
 }
@@ -192,6 +243,7 @@ fn load_record(r: u32) -> Tri {
     t.dz = vec2<f32>(bitcast<f32>(w2.w), bitcast<f32>(w3.x));
     t.offset = bitcast<f32>(w3.y);
     t.bias = -vec3<i32>(vec3<u32>(w3.z, w3.z >> 1u, w3.z >> 2u) & vec3<u32>(1u));
+    t.view = w3.z >> 3u;
     t.id = w3.w;
     return t;
 }
@@ -207,7 +259,8 @@ fn cell_region(box: vec4<i32>, cell: vec2<u32>) -> vec4<i32> {
 
 fn store_record(r: u32, t: Tri) {
     let i = 4u * r;
-    let flags = u32(-t.bias.x) | (u32(-t.bias.y) << 1u) | (u32(-t.bias.z) << 2u);
+    // The top-left biases in bits 0..2, the view above them.
+    let flags = u32(-t.bias.x) | (u32(-t.bias.y) << 1u) | (u32(-t.bias.z) << 2u) | (t.view << 3u);
     records[i] = bitcast<vec4<u32>>(vec4<i32>(t.a, t.b));
     records[i + 1u] = vec4<u32>(bitcast<vec2<u32>>(t.c), pack_point(t.box.xy), pack_point(t.box.zw));
     records[i + 2u] = vec4<u32>(bitcast<vec3<u32>>(t.sa), bitcast<u32>(t.dz.x));
@@ -256,7 +309,7 @@ fn depth_bias(z: vec3<f32>, dz: vec2<f32>) -> f32 {
     return DEPTH_BIAS * unit + SLOPE_BIAS * max(abs(dz.x), abs(dz.y));
 }
 
-fn setup_triangle(ca: vec4<f32>, cb: vec4<f32>, cc: vec4<f32>, rect: vec4<u32>, id: u32) {
+fn setup_triangle(ca: vec4<f32>, cb: vec4<f32>, cc: vec4<f32>, rect: vec4<u32>, id: u32, view: u32) {
     // Both faces: either facing is drawn, ordered clockwise for the edge tests.
     let s = snap_triangle(to_screen(ca, rect), to_screen(cb, rect), to_screen(cc, rect));
     if (s.facing == 0) {
@@ -279,6 +332,7 @@ fn setup_triangle(ca: vec4<f32>, cb: vec4<f32>, cc: vec4<f32>, rect: vec4<u32>, 
     t.offset = depth_bias(vec3<f32>(s.sa.z, s.sb.z, s.sc.z), t.dz);
     t.box = box;
     t.id = id;
+    t.view = view;
     let size = box.zw - box.xy + vec2<i32>(1);
     if (size.x * size.y <= SMALL_BOX) {
         raster_region(t, box);
@@ -340,8 +394,8 @@ fn setup_triangle(ca: vec4<f32>, cb: vec4<f32>, cc: vec4<f32>, rect: vec4<u32>, 
 
 // The job holding pair `i`: the last whose first pair is at most i.
 fn find_job(i: u32) -> u32 {
-    var lo = 0u;
-    var hi = params.work.y;
+    var lo = params.capacity.z;
+    var hi = lo + params.work.y;
     while (hi - lo > 1u) {
         let mid = (lo + hi) / 2u;
         if (jobs[mid].x <= i) {
@@ -375,13 +429,13 @@ fn setup(
     let a = clip_position(view_proj, indices[3u * tri]);
     let b = clip_position(view_proj, indices[3u * tri + 1u]);
     let c = clip_position(view_proj, indices[3u * tri + 2u]);
-#if IDS
+#if TRI_IDS
     let id = tri_ids[tri];
 #else
     let id = 0u;
 #endif
     if (!needs_clipping(a, b, c)) {
-        setup_triangle(a, b, c, rect, id);
+        setup_triangle(a, b, c, rect, id, job.w);
         return;
     }
     // Most of a view's triangles lie wholly outside it.
@@ -390,7 +444,7 @@ fn setup(
     }
     let poly = clip_triangle(a, b, c);
     for (var k = 1u; k + 1u < poly.n; k++) {
-        setup_triangle(poly.v[0], poly.v[k], poly.v[k + 1u], rect, id);
+        setup_triangle(poly.v[0], poly.v[k], poly.v[k + 1u], rect, id, job.w);
     }
 }
 #endif

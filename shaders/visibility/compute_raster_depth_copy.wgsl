@@ -1,5 +1,5 @@
-// A hardware fallback with an R32Float depth (the compute rasterizer's, the reflective
-// shadow maps' where a caster is alpha-masked): the depth its draws left in an internal
+// A hardware fallback with an R32Float depth (the compute rasterizer's, the transparent
+// depth's): the depth its draws left in an internal
 // Depth32Float texture, copied texel by texel into the pass's R32Float depth of the same
 // size (a load of a depth texture gives its stored f32 unchanged, so the copy is
 // bit-exact). One invocation a texel, in 8×8 tiles.

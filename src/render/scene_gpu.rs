@@ -356,15 +356,6 @@ impl SceneGpu {
 
     /// Mesh indices of blended (glTF `alphaMode: BLEND`) geometry, in scene order: the
     /// transparency passes draw these, sorted per frame by view depth.
-    /// The name of the first alpha-masked material among `draws` (mesh indices): what a
-    /// compute raster, which draws no alpha mask, falls back on.
-    pub(crate) fn masked_material(&self, draws: &[usize]) -> Option<&str> {
-        draws.iter().find_map(|&m| {
-            let material = &self.materials[self.meshes[m].material];
-            matches!(material.alpha_mode, AlphaMode::Mask(_)).then_some(material.name.as_str())
-        })
-    }
-
     pub(crate) fn transparent_draws(&self) -> Vec<usize> {
         (0..self.meshes.len())
             .filter(|&i| self.materials[self.meshes[i].material].alpha_mode == AlphaMode::Blend)

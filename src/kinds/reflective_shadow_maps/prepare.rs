@@ -4,11 +4,9 @@
 //! layout depends only on the lights (not the camera): made at prepare, and again on the
 //! CPU for every light update, written into the same table (no pipeline or bind group
 //! changes). With `raster: Compute` the views are rasterized in compute instead
-//! (`reflective_shadow_maps_raster`), unless a caster is alpha-masked (the compute raster
-//! draws no masks): then the raster units draw them into an internal Depth32Float, copied
-//! into the R32Float depth, and a warning names the material.
+//! (`reflective_shadow_maps_raster`; alpha-masked casters alpha-tested in a run of their
+//! material's own).
 
-use super::compute_raster_fallback::{depth_copy, DepthCopy};
 use super::reflective_shadow_maps_raster::ComputeRsm;
 use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::reflective_shadow_maps::{
@@ -65,23 +63,18 @@ enum Raster {
     Compute(Box<ComputeRsm>),
 }
 
-/// One render pass: the mesh draws, a viewport a view, over the depth attachment; with
-/// an R32Float depth (`raster: Compute` meeting an alpha-masked caster) the attachment is
-/// an internal Depth32Float and a dispatch copies it.
+/// One render pass: the mesh draws, a viewport a view, over the depth attachment.
 struct HardwareMaps {
     depth: wgpu::TextureView,
     targets: [wgpu::TextureView; 3],
     draws: MeshDraws,
-    copy: Option<DepthCopy>,
 }
 
-/// The maps drawn by the raster units; `float_depth`: into an internal Depth32Float,
-/// copied into the R32Float `rsm_depth`.
+/// The maps drawn by the raster units.
 fn hardware_maps(
     cx: &mut PrepareCtx,
     sp: &ScheduledPass,
     views: &wgpu::Buffer,
-    float_depth: Option<(u32, u32)>,
 ) -> Result<HardwareMaps, RenderError> {
     let mut offered = cx.declared(sp)?;
     offered.buffer("rsm_views", views);
@@ -93,14 +86,7 @@ fn hardware_maps(
         &sp.name,
         &offered,
     )?;
-    let (depth, copy) = match float_depth {
-        Some(size) => {
-            let target = cx.view(&sp.name, sp.required(RSM_DEPTH))?;
-            let (drawn, copy) = depth_copy(cx, sp, size, target)?;
-            (drawn, Some(copy))
-        }
-        None => (cx.view(&sp.name, sp.required(RSM_DEPTH))?, None),
-    };
+    let depth = cx.view(&sp.name, sp.required(RSM_DEPTH))?;
     let target = |slot: &str| cx.view(&sp.name, sp.required(slot));
     Ok(HardwareMaps {
         depth,
@@ -110,7 +96,6 @@ fn hardware_maps(
             target(RSM_POSITION)?,
         ],
         draws,
-        copy,
     })
 }
 
@@ -178,18 +163,9 @@ pub(super) fn prepare(
         .ctx
         .queue
         .write_buffer(&staging, 0, bytemuck::cast_slice(&table));
-    let raster = match (p.raster, cx.gpu.masked_material(&cx.gpu.opaque_draws())) {
-        (RsmRaster::Hardware, _) => {
-            Raster::Hardware(Box::new(hardware_maps(cx, sp, &views, None)?))
-        }
-        (RsmRaster::Compute, Some(material)) => {
-            log::warn!(
-                "pass '{}': caster material '{material}' is alpha-masked, which the compute raster does not draw: the reflective shadow maps are drawn by the raster units",
-                sp.name
-            );
-            Raster::Hardware(Box::new(hardware_maps(cx, sp, &views, Some((w, h)))?))
-        }
-        (RsmRaster::Compute, None) => {
+    let raster = match p.raster {
+        RsmRaster::Hardware => Raster::Hardware(Box::new(hardware_maps(cx, sp, &views)?)),
+        RsmRaster::Compute => {
             let compute = ComputeRsm::prepare(cx, sp, p, (w, h), &views)?;
             compute.upload(&l);
             Raster::Compute(Box::new(compute))
@@ -233,7 +209,6 @@ impl PreparedPass for RsmPass {
             depth,
             targets,
             draws,
-            copy,
         } = match &self.raster {
             Raster::Hardware(maps) => &**maps,
             Raster::Compute(compute) => return compute.record(encoder, &self.name, ts),
@@ -255,15 +230,5 @@ impl PreparedPass for RsmPass {
         });
         let origins = self.origins.lock().unwrap_or_else(|e| e.into_inner());
         draws.record_tiles(&mut pass, &origins, self.tile);
-        drop(pass);
-        if let Some((pipeline, bind, groups)) = copy {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(&self.name),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, bind, &[]);
-            pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
-        }
     }
 }

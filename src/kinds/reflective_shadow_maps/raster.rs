@@ -18,7 +18,6 @@
 //! All in one compute pass.
 
 use super::shadow_atlas_raster::{ComputeAtlas, RasterTarget};
-use super::shadow_atlas_raster_input::Work;
 use super::{defines, grid, pass_error, PrepareCtx, Timestamps};
 use crate::graph::kinds::reflective_shadow_maps::{ReflectiveShadowMaps, VIEW_VEC4S};
 use crate::graph::ScheduledPass;
@@ -82,8 +81,7 @@ impl ComputeRsm {
     ) -> Result<Self, RenderError> {
         let device = cx.device();
         let casters = cx.gpu.opaque_draws();
-        // Alpha-masked casters never reach here (the pass draws them with the raster
-        // units); the atlas raster would refuse them, naming the first.
+        // Alpha-masked casters are alpha-tested by runs of their own.
         let raster = ComputeAtlas::prepare(
             cx,
             &sp.name,
@@ -212,29 +210,23 @@ impl ComputeRsm {
     /// view a job for each run of chunks whose bounds touch its frustum (as the atlas
     /// culls its views), and its tile's pieces.
     pub(super) fn upload(&self, layout: &RsmLayout) {
-        let mut work = Work::default();
+        let mut jobs = self.raster.job_lists();
+        let mut rects = Vec::new();
         let mut pieces: Vec<[u32; 4]> = Vec::new();
         let step = self.tile.min(PIECE);
         for (v, view) in layout.views.iter().enumerate() {
             let v = v as u32;
-            work.rects.push([view.x, view.y, self.tile, 0]);
+            rects.push([view.x, view.y, self.tile, 0]);
             let planes = frustum_planes(view.view_proj);
             for (draw, ([lo, hi], chunks)) in self.meshes.iter().enumerate() {
                 if !box_in_frustum(&planes, *lo, *hi) {
                     continue;
                 }
-                let base = self.raster.index_base[draw];
                 for c in chunks
                     .iter()
                     .filter(|c| box_in_frustum(&planes, c.min, c.max))
                 {
-                    let (first, count) = ((base + c.first) / 3, c.count / 3);
-                    // Consecutive chunks make one job.
-                    match work.jobs.last_mut() {
-                        Some(job) if job[3] == v && job[1] + job[2] == first => job[2] += count,
-                        _ => work.jobs.push([work.pairs, first, count, v]),
-                    }
-                    work.pairs += count;
+                    jobs.push(v, draw, c.first, c.count);
                 }
             }
             for py in (0..self.tile).step_by(step as usize) {
@@ -243,6 +235,8 @@ impl ComputeRsm {
                 }
             }
         }
+        // The store's pieces carry their view; the raster's are not used (no store).
+        let work = jobs.finish(rects, Vec::new());
         self.raster.upload(&work);
         if !pieces.is_empty() {
             let room = (self.pieces.size() / 16) as usize;

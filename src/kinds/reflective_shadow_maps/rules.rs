@@ -39,8 +39,7 @@ pub enum RsmRaster {
     /// nearest triangle's id where the depth matches, then per material the texels of
     /// its triangles set up and stored (`shaders/indirect/rsm_raster.wgsl`). The depth
     /// is stored into an R32Float texture (compute cannot store a depth format).
-    /// Where a caster is alpha-masked (which it does not draw) the raster units draw
-    /// the maps instead, their depth copied into the R32Float texture, with a warning.
+    /// Alpha-masked casters are alpha-tested in compute, a run per material.
     Compute,
 }
 

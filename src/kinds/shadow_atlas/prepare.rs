@@ -6,11 +6,9 @@
 //! the camera or the lights moved (a viewer moving both between two frames pays for one).
 //! With `cache: true` the lights that kept their tile side keep their place
 //! (`shadow::atlas_cache::keep_places`) and only the views the atlas does not hold yet
-//! are drawn. The compute raster draws no alpha mask: with a masked caster the views are
-//! drawn by the raster units instead, into an internal Depth32Float atlas copied into
-//! the R32Float one (bit-exact), and a warning names the material.
+//! are drawn. The compute raster alpha-tests masked casters in a run of their
+//! material's own (`shadow_atlas_raster`).
 
-use super::compute_raster_fallback::{depth_copy, draws_opening, record_depth_copy, DepthCopy};
 use super::shadow_atlas_raster::{ComputeAtlas, RasterTarget};
 use super::shadow_atlas_raster_input::{pieces, Work};
 use super::{pass_error, PrepareCtx, PreparedPass, Timestamps};
@@ -75,10 +73,8 @@ enum Raster {
         draws: MeshDraws,
         /// Writes the far depth over a tile (each view clears its own).
         clear: Arc<wgpu::RenderPipeline>,
-        /// The depth attachment drawn into: the atlas, or (`copy`) an internal
-        /// Depth32Float copied into the R32Float atlas after the draws.
+        /// The depth attachment drawn into: the atlas.
         target: wgpu::TextureView,
-        copy: Option<DepthCopy>,
     },
     Compute(Box<ComputeAtlas>),
 }
@@ -140,46 +136,37 @@ pub(super) fn prepare(
         mapped_at_creation: false,
     });
     let atlas = cx.view(&sp.name, atlas_name)?;
-    let hardware = |cx: &mut PrepareCtx,
-                    format: wgpu::TextureFormat,
-                    target: wgpu::TextureView,
-                    copy: Option<DepthCopy>| {
-        let mut offered = cx.declared(sp)?;
-        // The vertex stage reads the table it is about to receive.
-        offered.buffer("shadow_views", &views);
-        let mode = DrawMode::AtlasDepth {
-            format,
-            depth_bias: p.depth_bias as i32,
-            slope_bias_bits: p.slope_bias.to_bits(),
-        };
-        let draws =
-            cx.renderer
-                .mesh_draws(cx.gpu, mode, MeshSet::ShadowCasters, 1, &sp.name, &offered)?;
-        let clear = tile_clear_pipeline(cx, &sp.name, format)?;
-        let casters: Vec<usize> = draws.meshes().collect();
-        Ok::<_, RenderError>((
-            Raster::Hardware {
-                draws,
-                clear,
-                target,
-                copy,
-            },
-            casters,
-        ))
-    };
-    let gpu = cx.gpu;
-    let masked = gpu.masked_material(&gpu.shadow_caster_draws());
-    let (raster, casters) = match (p.raster, masked) {
-        (AtlasRaster::Hardware, _) => hardware(cx, format, atlas.clone(), None)?,
-        (AtlasRaster::Compute, Some(material)) => {
-            log::warn!(
-                "pass '{}': caster material '{material}' is alpha-masked, which the compute raster does not draw: the atlas's views are drawn by the raster units",
-                sp.name
-            );
-            let (drawn, copy) = depth_copy(cx, sp, (side, side), atlas.clone())?;
-            hardware(cx, wgpu::TextureFormat::Depth32Float, drawn, Some(copy))?
+    let (raster, casters) = match p.raster {
+        AtlasRaster::Hardware => {
+            let mut offered = cx.declared(sp)?;
+            // The vertex stage reads the table it is about to receive.
+            offered.buffer("shadow_views", &views);
+            let mode = DrawMode::AtlasDepth {
+                format,
+                depth_bias: p.depth_bias as i32,
+                slope_bias_bits: p.slope_bias.to_bits(),
+            };
+            let draws = cx.renderer.mesh_draws(
+                cx.gpu,
+                mode,
+                MeshSet::ShadowCasters,
+                1,
+                &sp.name,
+                &offered,
+            )?;
+            let clear = tile_clear_pipeline(cx, &sp.name, format)?;
+            let casters: Vec<usize> = draws.meshes().collect();
+            let target = atlas.clone();
+            (
+                Raster::Hardware {
+                    draws,
+                    clear,
+                    target,
+                },
+                casters,
+            )
         }
-        (AtlasRaster::Compute, None) => {
+        AtlasRaster::Compute => {
             // The casters in the order the hardware path draws them.
             let casters = cx.gpu.shadow_caster_draws();
             let compute = ComputeAtlas::prepare(
@@ -434,12 +421,7 @@ impl PreparedPass for ShadowAtlasPass {
                 draws,
                 clear,
                 target,
-                copy,
             } => {
-                let timestamps = match copy {
-                    Some(_) => draws_opening(ts),
-                    None => ts.render(),
-                };
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some(&self.name),
                     color_attachments: &[],
@@ -449,16 +431,11 @@ impl PreparedPass for ShadowAtlasPass {
                     depth_stencil_attachment: Some(crate::render::draws::depth_attachment(
                         target, false,
                     )),
-                    timestamp_writes: timestamps,
+                    timestamp_writes: ts.render(),
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
                 draws.record_views(&mut pass, &frame.draws, &frame.to_draw, clear);
-                drop(pass);
-                // The whole internal atlas, so tiles a cached frame keeps are copied too.
-                if let Some(copy) = copy {
-                    record_depth_copy(encoder, &self.name, copy, ts);
-                }
             }
             Raster::Compute(compute) => compute.record(encoder, &self.name, ts),
         }
@@ -523,25 +500,20 @@ impl PreparedPass for ShadowAtlasPass {
     }
 }
 
-/// The compute raster's lists for the views at `to_draw`: a job per culled range, each
-/// view's tile, the pieces of the tiles to store.
+/// The compute raster's lists for the views at `to_draw`: a job per culled range (in its
+/// caster's raster run), each view's tile, the pieces of the tiles to store.
 fn compute_work(compute: &ComputeAtlas, draws: &[ViewDraw], to_draw: &[u32]) -> Work {
-    let mut work = Work {
-        rects: draws.iter().map(|d| [d.x, d.y, d.tile, 0]).collect(),
-        ..Work::default()
-    };
+    let mut jobs = compute.job_lists();
+    let mut stored = Vec::new();
     for &v in to_draw {
         let d = &draws[v as usize];
         for &(draw, first, count) in &d.ranges {
-            work.jobs.push([
-                work.pairs,
-                (compute.index_base[draw] + first) / 3,
-                count / 3,
-                v,
-            ]);
-            work.pairs += count / 3;
+            jobs.push(v, draw, first, count);
         }
-        pieces(d.x, d.y, d.tile, &mut work.pieces);
+        pieces(d.x, d.y, d.tile, &mut stored);
     }
-    work
+    jobs.finish(
+        draws.iter().map(|d| [d.x, d.y, d.tile, 0]).collect(),
+        stored,
+    )
 }

@@ -14,10 +14,12 @@
 //! its visibility id (`tri_ids`: the merged triangles are in shadow chunk order).
 
 use super::shadow_atlas_raster_input::{
-    list_capacity, merge_casters, MergedCasters, Work, ENTRY_BYTES, RECORD_BYTES, STORE_CELL,
+    list_capacity, merge_casters, JobLists, MergedCasters, Work, ENTRY_BYTES, RECORD_BYTES,
+    STORE_CELL,
 };
 use super::{grid, pass_error, PrepareCtx, Timestamps};
 use crate::gpu::readback::read_buffer;
+use crate::render::bind::BindingSet;
 use crate::render::pipelines::{Pipeline, PipelineKey};
 use crate::render::{RenderError, Renderer};
 use std::collections::BTreeMap;
@@ -29,14 +31,14 @@ const SHADER: &str = "shadow/atlas_raster.wgsl";
 const GROUP: u32 = 64;
 /// Counter words (the shader's RECORDS..SERIAL_CELLS).
 const COUNTERS: u64 = 4;
+
 /// Grown buffers and the bind groups over them.
 struct Bound {
     jobs: wgpu::Buffer,
     rects: wgpu::Buffer,
     pieces: wgpu::Buffer,
-    setup: wgpu::BindGroup,
-    /// The IDS pass's setup (with [`RasterTarget::Buffers`]).
-    setup_ids: Option<wgpu::BindGroup>,
+    /// Per raster run, its passes' (depth, then ids) setup and raster bind groups.
+    runs: Vec<Vec<[wgpu::BindGroup; 2]>>,
     store: Option<wgpu::BindGroup>,
 }
 
@@ -51,34 +53,46 @@ pub(super) enum RasterTarget {
     Buffers { width: u32, height: u32 },
 }
 
-/// The IDS pass: its pipelines, its own counters and arguments (the two passes run in
-/// one compute pass, so neither clears the other's), and the ids.
-struct IdsPass {
+/// One pass of a raster run over the depth buffer (the depth, or with IDS the nearest
+/// triangle): its pipelines, and its own counters and arguments (the passes run in one
+/// compute pass, so none can clear another's).
+struct RunPass {
     setup: Arc<wgpu::ComputePipeline>,
     raster: Arc<wgpu::ComputePipeline>,
-    raster_bind: wgpu::BindGroup,
+    ids: bool,
     counters: wgpu::Buffer,
     args: wgpu::Buffer,
-    ids: wgpu::Buffer,
-    /// Per merged triangle, its visibility id.
-    tri_ids: wgpu::Buffer,
+}
+
+/// A raster run: the solid casters (run 0), or one alpha-masked material's casters,
+/// alpha-tested against its material.
+struct Run {
+    /// The depth pass, then (with [`RasterTarget::Buffers`]) the IDS pass.
+    passes: Vec<RunPass>,
+    /// This run's work and list capacities, with its first job.
+    params: wgpu::Buffer,
+    /// The material's textures (group 2), for a textured masked material.
+    textures: Option<wgpu::BindGroup>,
+    /// Whether it alpha-tests (binds the merged geometry and the views in raster).
+    masked: bool,
 }
 
 pub(super) struct ComputeAtlas {
-    setup: Arc<wgpu::ComputePipeline>,
-    raster: Arc<wgpu::ComputePipeline>,
     store: Option<Arc<wgpu::ComputePipeline>>,
-    ids_pass: Option<IdsPass>,
-    raster_bind: wgpu::BindGroup,
-    params: wgpu::Buffer,
+    runs: Vec<Run>,
     store_params: wgpu::Buffer,
     positions: wgpu::Buffer,
     indices: wgpu::Buffer,
     depth: wgpu::Buffer,
+    /// One more than each texel's nearest triangle's visibility id (the IDS passes').
+    ids: Option<wgpu::Buffer>,
+    /// Per merged triangle, its visibility id (with IDS or masked casters).
+    tri_ids: wgpu::Buffer,
+    /// The merged visibility geometry the alpha test rebuilds triangles from (with
+    /// masked casters).
+    geometry: Option<(wgpu::Buffer, wgpu::Buffer)>,
     records: wgpu::Buffer,
     cells: wgpu::Buffer,
-    counters: wgpu::Buffer,
-    args: wgpu::Buffer,
     table: wgpu::Buffer,
     atlas: Option<wgpu::TextureView>,
     capacity: [u32; 2],
@@ -89,8 +103,12 @@ pub(super) struct ComputeAtlas {
     /// The uploaded work's pairs and pieces, drawn by every frame until the next upload
     /// (zero after `drawn`: the cache keeps what the last frame drew).
     pending: Mutex<(u32, u32)>,
+    /// The uploaded work's pairs per raster run.
+    run_pairs: Mutex<Vec<u32>>,
     /// The first index of each caster draw in the merged index buffer.
-    pub(super) index_base: Vec<u32>,
+    index_base: Vec<u32>,
+    /// Each caster draw's raster run.
+    run_of_draw: Vec<usize>,
     device: wgpu::Device,
     queue: wgpu::Queue,
 }
@@ -148,7 +166,7 @@ fn counters_and_args(device: &wgpu::Device, what: &str) -> [wgpu::Buffer; 2] {
 impl ComputeAtlas {
     /// The rasterizer for `casters` (scene GPU mesh indices, in draw order) into
     /// `target`, reading view-projections from `table` (`view_vec4s` words a view, after
-    /// a header vec4).
+    /// a header vec4). Alpha-masked casters are drawn by a run of their material's own.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn prepare(
         cx: &mut PrepareCtx,
@@ -160,13 +178,15 @@ impl ComputeAtlas {
         depth_bias: u32,
         slope_bias: f32,
     ) -> Result<Self, RenderError> {
-        let ids = matches!(target, RasterTarget::Buffers { .. });
+        let with_ids = matches!(target, RasterTarget::Buffers { .. });
         let MergedCasters {
             positions,
             indices,
             index_base,
             tri_ids,
-        } = merge_casters(cx, pass, casters, ids);
+            run_of_draw,
+            masked,
+        } = merge_casters(cx, casters, with_ids);
         let (side, rows, atlas) = match target {
             RasterTarget::Atlas { atlas, side } => (side, side, Some(atlas)),
             RasterTarget::Buffers { width, height } => (width, height, None),
@@ -199,6 +219,10 @@ impl ComputeAtlas {
         };
         let positions = init("atlas caster positions", bytemuck::cast_slice(&positions));
         let indices = init("atlas caster indices", bytemuck::cast_slice(&indices));
+        let tri_ids = init(
+            "atlas caster visibility ids",
+            bytemuck::cast_slice(&tri_ids),
+        );
         // The far depth everywhere: `store` puts it back after each drawn view.
         let far = vec![1.0f32.to_bits(); (side as usize) * (rows as usize)];
         let depth = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -207,21 +231,39 @@ impl ComputeAtlas {
             usage: wgpu::BufferUsages::STORAGE,
         });
         drop(far);
+        // Zero: no triangle (the reader puts it back to zero after reading).
+        let ids = with_ids.then(|| {
+            storage(
+                &device,
+                "rsm raster nearest triangles",
+                depth_bytes,
+                wgpu::BufferUsages::empty(),
+            )
+        });
+        let geometry = match masked.is_empty() {
+            true => None,
+            false => {
+                let g = cx
+                    .gpu
+                    .visibility_geometry(&device, cx.scene)
+                    .map_err(|m| pass_error(pass, m))?;
+                Some((g.vertices.clone(), g.triangles.clone()))
+            }
+        };
         let capacity =
             list_capacity(side as u64 * rows as u64, limit).map_err(|m| pass_error(pass, m))?;
-        let records_buf = storage(
+        let records = storage(
             &device,
             "atlas raster records",
             RECORD_BYTES * capacity[0] as u64,
             wgpu::BufferUsages::empty(),
         );
-        let cells_buf = storage(
+        let cells = storage(
             &device,
             "atlas raster cells",
             ENTRY_BYTES * capacity[1] as u64,
             wgpu::BufferUsages::empty(),
         );
-        let [counters, args] = counters_and_args(&device, "atlas raster");
         let uniform = |label: &str| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -230,135 +272,126 @@ impl ComputeAtlas {
                 mapped_at_creation: false,
             })
         };
-        let params = uniform("atlas raster parameters");
         let store_params = uniform("atlas store parameters");
         let max_groups = device.limits().max_compute_workgroups_per_dimension;
-        let pipeline = |cx: &mut PrepareCtx,
-                        stage: &str,
-                        entry: &str,
-                        ids: bool|
-         -> Result<Arc<wgpu::ComputePipeline>, RenderError> {
-            let mut d = vec![
+        let base_defines = |stage: &str| {
+            vec![
                 (stage.to_string(), "1".to_string()),
                 ("GROUP".into(), GROUP.to_string()),
                 ("STORE_CELL".into(), STORE_CELL.to_string()),
                 ("DEPTH_BIAS".into(), format!("{:?}", depth_bias as f32)),
                 ("VIEW_VEC4S".into(), format!("{view_vec4s}u")),
                 ("SLOPE_BIAS".into(), format!("{slope_bias:?}")),
-            ];
-            if ids {
-                d.push(("IDS".into(), "1".into()));
-            }
-            let key = PipelineKey {
-                shader: SHADER.into(),
-                defines: d.into_iter().collect(),
-                virtual_code: BTreeMap::new(),
-                state: String::new(),
-            };
-            let device = cx.device();
-            let layouts = cx.renderer.layouts.clone();
-            let (p, _) = cx
-                .renderer
-                .pipelines
-                .get_or_build_reflected(
-                    &cx.renderer.shaders,
-                    key,
-                    |_, module, bindings| {
-                        let bgl = layouts.get(
-                            &device,
-                            crate::render::bind::layout_entries(
-                                bindings,
-                                0,
-                                wgpu::ShaderStages::COMPUTE,
-                            ),
-                        );
-                        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                            label: Some(entry),
-                            bind_group_layouts: &[Some(&*bgl)],
-                            immediate_size: 0,
-                        });
-                        Pipeline::compute(&device, entry, Some(&pl), &module, entry)
-                    },
-                    &device,
-                )
-                .map_err(|source| RenderError::Shader {
-                    pass: pass.to_string(),
-                    source,
-                })?;
-            match p {
-                Pipeline::Compute(p) => Ok(p),
-                _ => Err(pass_error(pass, "expected a compute pipeline".into())),
-            }
+            ]
         };
-        let setup = pipeline(cx, "SETUP", "setup", false)?;
-        let raster = pipeline(cx, "RASTER", "raster", false)?;
         let store = match atlas {
-            Some(_) => Some(pipeline(cx, "STORE", "store", false)?),
+            Some(_) => Some(plain_pipeline(cx, pass, base_defines("STORE"), "store")?),
             None => None,
         };
-        let ids_pass = match atlas {
-            Some(_) => None,
-            None => {
-                let setup = pipeline(cx, "SETUP", "setup", true)?;
-                let raster = pipeline(cx, "RASTER", "raster", true)?;
-                let [counters, args] = counters_and_args(&device, "rsm raster id");
-                // Zero: no triangle (the reader puts it back to zero after reading).
-                let ids = storage(
-                    &device,
-                    "rsm raster nearest triangles",
-                    depth_bytes,
-                    wgpu::BufferUsages::empty(),
-                );
-                let raster_bind = bind(
-                    &device,
-                    &raster,
-                    &[
-                        (0, params.as_entire_binding()),
-                        (6, depth.as_entire_binding()),
-                        (7, records_buf.as_entire_binding()),
-                        (8, cells_buf.as_entire_binding()),
-                        (9, counters.as_entire_binding()),
-                        (12, ids.as_entire_binding()),
-                    ],
-                );
-                let tri_ids = init("rsm raster visibility ids", bytemuck::cast_slice(&tri_ids));
-                Some(IdsPass {
-                    tri_ids,
+        // Every buffer under its shader name, for the masked runs' reflected layouts
+        // (their bind groups are made in `bind_lists`, over the grown lists).
+        let mut offered = BindingSet::default();
+        let lists = [16u64; 3].map(|n| {
+            storage(
+                &device,
+                "atlas raster lists",
+                16 * n,
+                wgpu::BufferUsages::empty(),
+            )
+        });
+        for (name, buffer) in [
+            ("shadow_views", table),
+            ("positions", &positions),
+            ("indices", &indices),
+            ("jobs", &lists[0]),
+            ("rects", &lists[1]),
+            ("depth", &depth),
+            ("records", &records),
+            ("cells", &cells),
+            ("tri_ids", &tri_ids),
+        ] {
+            offered.buffer(name, buffer);
+        }
+        if let Some(ids) = &ids {
+            offered.buffer("ids", ids);
+        }
+        if let Some((vertices, triangles)) = &geometry {
+            offered.buffer("vertices", vertices);
+            offered.buffer("triangles", triangles);
+        }
+        let mut runs = Vec::new();
+        for run in std::iter::once(None).chain(masked.iter().copied().map(Some)) {
+            let params = uniform("atlas raster parameters");
+            let mut offered = offered.clone();
+            offered.buffer("params", &params);
+            let mut passes = Vec::new();
+            let mut textures = None;
+            for ids_pass in [false, true] {
+                if ids_pass && !with_ids {
+                    continue;
+                }
+                let what = if ids_pass {
+                    "rsm raster id"
+                } else {
+                    "atlas raster"
+                };
+                let [counters, args] = counters_and_args(&device, what);
+                offered.buffer("counters", &counters);
+                offered.buffer("args", &args);
+                let stage = |stage: &str| {
+                    let mut d = base_defines(stage);
+                    if ids_pass {
+                        d.push(("IDS".into(), "1".into()));
+                    }
+                    if stage == "SETUP" && (ids_pass || run.is_some()) {
+                        d.push(("TRI_IDS".into(), "1".into()));
+                    }
+                    d
+                };
+                let (setup, raster) = match run {
+                    None => (
+                        plain_pipeline(cx, pass, stage("SETUP"), "setup")?,
+                        plain_pipeline(cx, pass, stage("RASTER"), "raster")?,
+                    ),
+                    Some(material) => {
+                        let mut built = Vec::new();
+                        for (name, entry) in [("SETUP", "setup"), ("RASTER", "raster")] {
+                            let (pipeline, t) =
+                                masked_pipeline(cx, pass, stage(name), entry, material, &offered)?;
+                            textures = t;
+                            built.push(pipeline);
+                        }
+                        let raster = built.pop().expect("two pipelines");
+                        (built.pop().expect("two pipelines"), raster)
+                    }
+                };
+                passes.push(RunPass {
                     setup,
                     raster,
-                    raster_bind,
+                    ids: ids_pass,
                     counters,
                     args,
-                    ids,
-                })
+                });
             }
-        };
-        let raster_bind = bind(
-            &device,
-            &raster,
-            &[
-                (0, params.as_entire_binding()),
-                (6, depth.as_entire_binding()),
-                (7, records_buf.as_entire_binding()),
-                (8, cells_buf.as_entire_binding()),
-                (9, counters.as_entire_binding()),
-            ],
-        );
+            runs.push(Run {
+                passes,
+                params,
+                textures,
+                masked: run.is_some(),
+            });
+        }
         let this = ComputeAtlas {
-            setup,
-            raster,
             store,
-            ids_pass,
-            raster_bind,
-            params,
+            runs,
             store_params,
             positions,
             indices,
             depth,
-            records: records_buf,
-            cells: cells_buf,
-            counters,
-            args,
+            ids,
+            tri_ids,
+            geometry,
+            records,
+            cells,
             table: table.clone(),
             atlas,
             capacity,
@@ -366,13 +399,20 @@ impl ComputeAtlas {
             max_groups,
             bound: Mutex::new(None),
             pending: Mutex::new((0, 0)),
+            run_pairs: Mutex::new(Vec::new()),
             index_base,
+            run_of_draw,
             queue: cx.renderer.ctx.queue.clone(),
             device,
         };
         let first = this.bind_lists(16, 16, 16);
         *this.bound.lock().unwrap_or_else(|e| e.into_inner()) = Some(first);
         Ok(this)
+    }
+
+    /// A frame's job lists, each caster's jobs into its raster run.
+    pub(super) fn job_lists(&self) -> JobLists<'_> {
+        JobLists::new(&self.run_of_draw, &self.index_base, self.runs.len())
     }
 
     /// Lists of room for `jobs`, `rects` and `pieces` entries, bound.
@@ -388,34 +428,56 @@ impl ComputeAtlas {
         let jobs = list("atlas raster jobs", jobs);
         let rects = list("atlas raster tiles", rects);
         let pieces = list("atlas store pieces", pieces);
-        let setup_bind = |pipeline: &wgpu::ComputePipeline,
-                          counters: &wgpu::Buffer,
-                          args: &wgpu::Buffer,
-                          ids: Option<&IdsPass>| {
-            let mut entries = vec![
-                (0, self.params.as_entire_binding()),
-                (1, self.table.as_entire_binding()),
-                (2, self.positions.as_entire_binding()),
-                (3, self.indices.as_entire_binding()),
-                (4, jobs.as_entire_binding()),
-                (5, rects.as_entire_binding()),
-                (6, self.depth.as_entire_binding()),
-                (7, self.records.as_entire_binding()),
-                (8, self.cells.as_entire_binding()),
-                (9, counters.as_entire_binding()),
-                (10, args.as_entire_binding()),
-            ];
-            if let Some(p) = ids {
-                entries.push((12, p.ids.as_entire_binding()));
-                entries.push((13, p.tri_ids.as_entire_binding()));
-            }
-            bind(&self.device, pipeline, &entries)
-        };
-        let setup = setup_bind(&self.setup, &self.counters, &self.args, None);
-        let setup_ids = self
-            .ids_pass
-            .as_ref()
-            .map(|p| setup_bind(&p.setup, &p.counters, &p.args, Some(p)));
+        let runs = self
+            .runs
+            .iter()
+            .map(|run| {
+                run.passes
+                    .iter()
+                    .map(|p| {
+                        let mut setup = vec![
+                            (0, run.params.as_entire_binding()),
+                            (1, self.table.as_entire_binding()),
+                            (2, self.positions.as_entire_binding()),
+                            (3, self.indices.as_entire_binding()),
+                            (4, jobs.as_entire_binding()),
+                            (5, rects.as_entire_binding()),
+                            (6, self.depth.as_entire_binding()),
+                            (7, self.records.as_entire_binding()),
+                            (8, self.cells.as_entire_binding()),
+                            (9, p.counters.as_entire_binding()),
+                            (10, p.args.as_entire_binding()),
+                        ];
+                        let mut raster = vec![
+                            (0, run.params.as_entire_binding()),
+                            (6, self.depth.as_entire_binding()),
+                            (7, self.records.as_entire_binding()),
+                            (8, self.cells.as_entire_binding()),
+                            (9, p.counters.as_entire_binding()),
+                        ];
+                        if let (true, Some(ids)) = (p.ids, &self.ids) {
+                            setup.push((12, ids.as_entire_binding()));
+                            raster.push((12, ids.as_entire_binding()));
+                        }
+                        if p.ids || run.masked {
+                            setup.push((13, self.tri_ids.as_entire_binding()));
+                        }
+                        if let (true, Some((vertices, triangles))) = (run.masked, &self.geometry) {
+                            for entries in [&mut setup, &mut raster] {
+                                entries.push((14, vertices.as_entire_binding()));
+                                entries.push((15, triangles.as_entire_binding()));
+                            }
+                            raster.push((1, self.table.as_entire_binding()));
+                            raster.push((5, rects.as_entire_binding()));
+                        }
+                        [
+                            bind(&self.device, &p.setup, &setup),
+                            bind(&self.device, &p.raster, &raster),
+                        ]
+                    })
+                    .collect()
+            })
+            .collect();
         let store = match (&self.store, &self.atlas) {
             (Some(store), Some(atlas)) => Some(bind(
                 &self.device,
@@ -433,8 +495,7 @@ impl ComputeAtlas {
             jobs,
             rects,
             pieces,
-            setup,
-            setup_ids,
+            runs,
             store,
         }
     }
@@ -473,18 +534,23 @@ impl ComputeAtlas {
                     .write_buffer(buffer, 0, bytemuck::cast_slice(list));
             }
         }
-        let params = [
-            work.pairs,
-            work.jobs.len() as u32,
-            self.max_groups,
-            self.side,
-            self.capacity[0],
-            self.capacity[1],
-            0,
-            0,
-        ];
-        self.queue
-            .write_buffer(&self.params, 0, bytemuck::cast_slice(&params));
+        let mut pairs = self.run_pairs.lock().unwrap_or_else(|e| e.into_inner());
+        pairs.clear();
+        for (run, &[first_job, jobs, run_pairs]) in self.runs.iter().zip(&work.runs) {
+            let params = [
+                run_pairs,
+                jobs,
+                self.max_groups,
+                self.side,
+                self.capacity[0],
+                self.capacity[1],
+                first_job,
+                0,
+            ];
+            self.queue
+                .write_buffer(&run.params, 0, bytemuck::cast_slice(&params));
+            pairs.push(run_pairs);
+        }
         let store = [
             work.pieces.len() as u32,
             0,
@@ -498,7 +564,7 @@ impl ComputeAtlas {
         self.queue
             .write_buffer(&self.store_params, 0, bytemuck::cast_slice(&store));
         *self.pending.lock().unwrap_or_else(|e| e.into_inner()) =
-            (work.pairs, work.pieces.len() as u32);
+            (work.pairs(), work.pieces.len() as u32);
     }
 
     /// The atlas holds the uploaded work's views: later frames draw none until the next
@@ -529,37 +595,45 @@ impl ComputeAtlas {
         if pairs == 0 {
             return;
         }
-        encoder.clear_buffer(&self.counters, 0, None);
-        encoder.clear_buffer(&self.args, 0, None);
-        if let Some(ids) = &self.ids_pass {
-            encoder.clear_buffer(&ids.counters, 0, None);
-            encoder.clear_buffer(&ids.args, 0, None);
+        for p in self.runs.iter().flat_map(|r| &r.passes) {
+            encoder.clear_buffer(&p.counters, 0, None);
+            encoder.clear_buffer(&p.args, 0, None);
         }
     }
 
-    /// The uploaded work's dispatches into `pass`: setup and raster (then again with
-    /// IDS), then the store.
+    /// The uploaded work's dispatches into `pass`: each run's setup and raster (then
+    /// again with IDS; the masked runs after the solid one), then the store.
     pub(super) fn record_into(&self, pass: &mut wgpu::ComputePass<'_>) {
         let (pairs, pieces) = *self.pending.lock().unwrap_or_else(|e| e.into_inner());
         let guard = self.bound.lock().unwrap_or_else(|e| e.into_inner());
         let Some(bound) = guard.as_ref() else {
             return;
         };
-        if pairs > 0 {
-            let [x, y, z] = grid(pairs, GROUP, self.max_groups);
-            pass.set_pipeline(&self.setup);
-            pass.set_bind_group(0, &bound.setup, &[]);
-            pass.dispatch_workgroups(x, y, z);
-            pass.set_pipeline(&self.raster);
-            pass.set_bind_group(0, &self.raster_bind, &[]);
-            pass.dispatch_workgroups_indirect(&self.args, 0);
-            if let (Some(ids), Some(setup_ids)) = (&self.ids_pass, &bound.setup_ids) {
-                pass.set_pipeline(&ids.setup);
-                pass.set_bind_group(0, setup_ids, &[]);
-                pass.dispatch_workgroups(x, y, z);
-                pass.set_pipeline(&ids.raster);
-                pass.set_bind_group(0, &ids.raster_bind, &[]);
-                pass.dispatch_workgroups_indirect(&ids.args, 0);
+        let run_pairs = self.run_pairs.lock().unwrap_or_else(|e| e.into_inner());
+        // The depth passes of every run before any IDS pass: the ids need the nearest
+        // depth of all casters.
+        for ids in [false, true] {
+            if pairs == 0 {
+                break;
+            }
+            for ((run, binds), &n) in self.runs.iter().zip(&bound.runs).zip(run_pairs.iter()) {
+                if n == 0 {
+                    continue;
+                }
+                if let Some(t) = &run.textures {
+                    pass.set_bind_group(2, t, &[]);
+                }
+                let [x, y, z] = grid(n, GROUP, self.max_groups);
+                for (p, [setup, raster]) in
+                    run.passes.iter().zip(binds).filter(|(p, _)| p.ids == ids)
+                {
+                    pass.set_pipeline(&p.setup);
+                    pass.set_bind_group(0, setup, &[]);
+                    pass.dispatch_workgroups(x, y, z);
+                    pass.set_pipeline(&p.raster);
+                    pass.set_bind_group(0, raster, &[]);
+                    pass.dispatch_workgroups_indirect(&p.args, 0);
+                }
             }
         }
         if let (true, Some(store), Some(bind)) = (pieces > 0, &self.store, &bound.store) {
@@ -578,22 +652,104 @@ impl ComputeAtlas {
     /// With [`RasterTarget::Buffers`]: each texel's nearest triangle's visibility id + 1
     /// (0: none), as the depth buffer is laid out.
     pub(super) fn ids(&self) -> Option<&wgpu::Buffer> {
-        self.ids_pass.as_ref().map(|p| &p.ids)
+        self.ids.as_ref()
     }
 
-    /// The lists' fill and serial fallbacks of the last frame that drew.
+    /// The lists' fill (the fullest run's) and serial fallbacks (all runs') of the last
+    /// frame that drew.
     pub(super) fn report(&self, r: &Renderer) -> Result<AtlasRasterReport, RenderError> {
-        let bytes = read_buffer(&r.ctx.device, &r.ctx.queue, &self.counters)?;
-        let c: &[u32] = bytemuck::cast_slice(&bytes);
-        Ok(AtlasRasterReport {
-            records: c[0].min(self.capacity[0]),
+        let mut report = AtlasRasterReport {
             records_capacity: self.capacity[0],
-            cells: c[1].min(self.capacity[1]),
             cells_capacity: self.capacity[1],
-            serial_triangles: c[2],
-            serial_cells: c[3],
-        })
+            ..Default::default()
+        };
+        for run in &self.runs {
+            let Some(p) = run.passes.first() else {
+                continue;
+            };
+            let bytes = read_buffer(&r.ctx.device, &r.ctx.queue, &p.counters)?;
+            let c: &[u32] = bytemuck::cast_slice(&bytes);
+            report.records = report.records.max(c[0].min(self.capacity[0]));
+            report.cells = report.cells.max(c[1].min(self.capacity[1]));
+            report.serial_triangles += c[2];
+            report.serial_cells += c[3];
+        }
+        Ok(report)
     }
+}
+
+/// A pipeline of the shader without a material (group 0 only).
+fn plain_pipeline(
+    cx: &mut PrepareCtx,
+    pass: &str,
+    defines: Vec<(String, String)>,
+    entry: &str,
+) -> Result<Arc<wgpu::ComputePipeline>, RenderError> {
+    let key = PipelineKey {
+        shader: SHADER.into(),
+        defines: defines.into_iter().collect(),
+        virtual_code: BTreeMap::new(),
+        state: String::new(),
+    };
+    let device = cx.device();
+    let layouts = cx.renderer.layouts.clone();
+    let (p, _) = cx
+        .renderer
+        .pipelines
+        .get_or_build_reflected(
+            &cx.renderer.shaders,
+            key,
+            |_, module, bindings| {
+                let bgl = layouts.get(
+                    &device,
+                    crate::render::bind::layout_entries(bindings, 0, wgpu::ShaderStages::COMPUTE),
+                );
+                let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some(entry),
+                    bind_group_layouts: &[Some(&*bgl)],
+                    immediate_size: 0,
+                });
+                Pipeline::compute(&device, entry, Some(&pl), &module, entry)
+            },
+            &device,
+        )
+        .map_err(|source| RenderError::Shader {
+            pass: pass.to_string(),
+            source,
+        })?;
+    match p {
+        Pipeline::Compute(p) => Ok(p),
+        _ => Err(pass_error(pass, "expected a compute pipeline".into())),
+    }
+}
+
+/// A pipeline of the shader alpha-testing `material` (its code, and its textures bound
+/// in group 2, returned with it).
+fn masked_pipeline(
+    cx: &mut PrepareCtx,
+    pass: &str,
+    mut defines: Vec<(String, String)>,
+    entry: &str,
+    material: usize,
+    offered: &BindingSet,
+) -> Result<(Arc<wgpu::ComputePipeline>, Option<wgpu::BindGroup>), RenderError> {
+    let m = &cx.gpu.materials[material];
+    defines.push(("ALPHA_TEST".into(), "1".into()));
+    defines.push(("MATERIAL_INDEX".into(), format!("{material}u")));
+    if m.textures.is_some() {
+        defines.push(("MATERIAL_TEXTURED".into(), "1".into()));
+    }
+    let key = PipelineKey {
+        shader: SHADER.into(),
+        defines: defines.into_iter().collect(),
+        virtual_code: BTreeMap::from([("material".to_string(), m.wgsl_for_compute().to_string())]),
+        state: entry.into(),
+    };
+    let textures = m.textures.clone();
+    let label = format!("{pass} (alpha test of material '{}')", m.name);
+    let (pipeline, _, textures) =
+        cx.compute_pipeline_with_material(&label, key, entry, offered, textures.as_ref())?;
+    Ok((pipeline, textures))
 }
 
 fn bind(

@@ -63,14 +63,70 @@ pub(super) fn list_capacity(texels: u64, limit: u64) -> Result<[u32; 2], String>
 /// One frame's work, as the CPU listed it for the views to draw.
 #[derive(Default)]
 pub(super) struct Work {
-    /// (first pair, first triangle, triangles, view) per run of one view's triangles.
+    /// (first pair of its run, first triangle, triangles, view) per run of one view's
+    /// consecutive triangles, raster run after raster run.
     pub jobs: Vec<[u32; 4]>,
+    /// Per raster run (the opaque casters, then each alpha-masked material's): its first
+    /// job, its jobs and its pairs.
+    pub runs: Vec<[u32; 3]>,
     /// Per view of the table: its tile (x, y, side, 0).
     pub rects: Vec<[u32; 4]>,
     /// Pieces (x, y, side, 0) of the drawn views' tiles, at most STORE_CELL a side.
     pub pieces: Vec<[u32; 4]>,
-    /// Pairs of a view and a triangle.
-    pub pairs: u32,
+}
+
+impl Work {
+    /// Pairs of a view and a triangle, over every run.
+    pub fn pairs(&self) -> u32 {
+        self.runs.iter().map(|r| r[2]).sum()
+    }
+}
+
+/// A frame's jobs as they are listed, each into its caster's raster run.
+pub(super) struct JobLists<'a> {
+    /// Per caster draw, its raster run.
+    run_of_draw: &'a [usize],
+    /// Per caster draw, its first index in the merged index buffer.
+    index_base: &'a [u32],
+    /// Per run, its jobs (first pairs counted within the run) and pairs.
+    runs: Vec<(Vec<[u32; 4]>, u32)>,
+}
+
+impl<'a> JobLists<'a> {
+    pub fn new(run_of_draw: &'a [usize], index_base: &'a [u32], runs: usize) -> Self {
+        JobLists {
+            run_of_draw,
+            index_base,
+            runs: vec![(Vec::new(), 0); runs],
+        }
+    }
+
+    /// View `view` draws `count` indices of caster `draw` from its index `first`.
+    pub fn push(&mut self, view: u32, draw: usize, first: u32, count: u32) {
+        let (jobs, pairs) = &mut self.runs[self.run_of_draw[draw]];
+        let (first, count) = ((self.index_base[draw] + first) / 3, count / 3);
+        // Consecutive triangles of one view make one job.
+        match jobs.last_mut() {
+            Some(job) if job[3] == view && job[1] + job[2] == first => job[2] += count,
+            _ => jobs.push([*pairs, first, count, view]),
+        }
+        *pairs += count;
+    }
+
+    /// The work: the runs' jobs one after another, with `rects` and `pieces`.
+    pub fn finish(self, rects: Vec<[u32; 4]>, pieces: Vec<[u32; 4]>) -> Work {
+        let mut work = Work {
+            rects,
+            pieces,
+            ..Work::default()
+        };
+        for (jobs, pairs) in self.runs {
+            work.runs
+                .push([work.jobs.len() as u32, jobs.len() as u32, pairs]);
+            work.jobs.extend(jobs);
+        }
+        work
+    }
 }
 
 /// Pieces of at most STORE_CELL² texels covering the tile at (x, y) of side `tile`.
@@ -91,53 +147,58 @@ pub(super) struct MergedCasters {
     pub indices: Vec<u32>,
     /// Where each caster's indices start.
     pub index_base: Vec<u32>,
-    /// Per merged triangle, its visibility id (with `ids`; the IDS pass's), else empty.
+    /// Per merged triangle, its visibility id (the IDS pass keeps it, the alpha test
+    /// rebuilds it), where either runs; else empty.
     pub tri_ids: Vec<u32>,
+    /// Per caster, its raster run: 0 draws solid, k > 0 alpha-tests `masked[k - 1]`.
+    pub run_of_draw: Vec<usize>,
+    /// The alpha-masked materials among the casters, in the order they first appear.
+    pub masked: Vec<usize>,
 }
 
-/// The meshes `casters` merged, each mesh's triangles as the hardware path draws them.
-/// None is alpha-masked: the compute raster draws no masks, and its callers fall back to
-/// the raster units for such scenes.
-pub(super) fn merge_casters(
-    cx: &PrepareCtx,
-    pass: &str,
-    casters: &[usize],
-    ids: bool,
-) -> MergedCasters {
+/// The meshes `casters` merged, each mesh's triangles as the hardware path draws them,
+/// with visibility ids where `ids` asks for them or a caster is alpha-masked.
+pub(super) fn merge_casters(cx: &PrepareCtx, casters: &[usize], ids: bool) -> MergedCasters {
     let gpu: &SceneGpu = cx.gpu;
-    let mut positions: Vec<[f32; 4]> = Vec::new();
-    let mut indices: Vec<u32> = Vec::new();
-    let mut index_base = Vec::new();
-    // Per merged triangle, its visibility id (the IDS pass's).
-    let mut tri_ids: Vec<u32> = Vec::new();
+    let mut merged = MergedCasters {
+        positions: Vec::new(),
+        indices: Vec::new(),
+        index_base: Vec::new(),
+        tri_ids: Vec::new(),
+        run_of_draw: Vec::new(),
+        masked: Vec::new(),
+    };
     for &m in casters {
-        // The atlas and the reflective shadow maps send scenes with masked casters to the
-        // raster units (SceneGpu::masked_material) before they get here.
-        debug_assert!(
-            !matches!(
-                gpu.materials[gpu.meshes[m].material].alpha_mode,
-                AlphaMode::Mask(_)
-            ),
-            "pass '{pass}': an alpha-masked caster reached the compute raster"
-        );
+        let material = gpu.meshes[m].material;
+        let run = match gpu.materials[material].alpha_mode {
+            AlphaMode::Mask(_) => match merged.masked.iter().position(|&k| k == material) {
+                Some(k) => k + 1,
+                None => {
+                    merged.masked.push(material);
+                    merged.masked.len()
+                }
+            },
+            _ => 0,
+        };
+        merged.run_of_draw.push(run);
+    }
+    let with_ids = ids || !merged.masked.is_empty();
+    for &m in casters {
         let mesh = &cx.scene.meshes[gpu.meshes[m].scene_mesh];
-        let base = positions.len() as u32;
-        index_base.push(indices.len() as u32);
-        positions.extend(mesh.positions.iter().map(|p| [p.x, p.y, p.z, 1.0]));
+        let base = merged.positions.len() as u32;
+        merged.index_base.push(merged.indices.len() as u32);
+        merged
+            .positions
+            .extend(mesh.positions.iter().map(|p| [p.x, p.y, p.z, 1.0]));
         // The triangles as the hardware path draws them (shadow chunk order), so a
         // view's culled ranges index both the same way.
         let (order, _, sources) =
             crate::shadow::chunks::chunk_triangles_with_sources(&mesh.positions, &mesh.indices);
-        indices.extend(order.iter().map(|i| i + base));
-        if ids {
+        merged.indices.extend(order.iter().map(|i| i + base));
+        if with_ids {
             let first = gpu.meshes[m].first_triangle;
-            tri_ids.extend(sources.iter().map(|t| first + t));
+            merged.tri_ids.extend(sources.iter().map(|t| first + t));
         }
     }
-    MergedCasters {
-        positions,
-        indices,
-        index_base,
-        tri_ids,
-    }
+    merged
 }

@@ -66,7 +66,8 @@ pub enum AtlasRaster {
     Hardware,
     /// Compute: a thread per (view, triangle), 32-bit atomic min of the depth bits into
     /// a buffer, stored into an R32Float atlas that shading compares by hand (compute
-    /// cannot store a depth format). Refuses alpha-masked casters.
+    /// cannot store a depth format). Alpha-masked casters are alpha-tested, a run per
+    /// material, as visibility shading rebuilds a pixel.
     Compute,
 }
 
