@@ -142,7 +142,7 @@ fn a_textured_material_needs_the_surface_targets() {
     assert!(
         e.contains("deferred_shading")
             && e.contains(
-                "has textures: its G-buffer needs the surface targets 'g_surface' and 'g_uv_grad'"
+                "reads textures, the tangent or the vertex colour: its G-buffer needs the surface targets 'g_surface' and 'g_uv_grad'"
             ),
         "{e}"
     );

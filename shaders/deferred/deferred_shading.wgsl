@@ -82,11 +82,10 @@
 // surface's uv and tangent (zero without G_SURFACE), and for textured materials the uv
 // derivatives their samples take.
 fn load_surface(q: ptr<function, ShadingPoint>, p: vec2<u32>, s: u32) {
-    // The G-buffer carries no vertex colour: white, as a mesh without one reads (the
-    // pass warns where a material reads it).
-    (*q).color = vec4<f32>(1.0);
 #if G_SURFACE
     let t = textureLoad(g_surface, p, s);
+    // Its rgb to 8 bits, alpha 1 (deferred/g_surface.wgsl).
+    (*q).color = surface_color(t);
     (*q).uv = t.xy;
     // Only TEXCOORD_0 is kept: a TEXCOORD_1 texture samples it (the pass warns).
     (*q).uv1 = t.xy;
@@ -99,6 +98,7 @@ fn load_surface(q: ptr<function, ShadingPoint>, p: vec2<u32>, s: u32) {
     material_uv1_ddy = d.zw;
 #endif
 #else
+    (*q).color = vec4<f32>(1.0);
     (*q).tangent = vec4<f32>(0.0);
     (*q).uv = vec2<f32>(0.0);
     (*q).uv1 = vec2<f32>(0.0);

@@ -235,14 +235,14 @@ fn fs_gbuffer(in: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
     out.packed = vec4<f32>(view_z, n.x, n.y, f32(MATERIAL_INDEX));
 #if GBUFFER_SURFACE
     // The tangent about the normal deferred shading decodes, so both build one frame.
-    out.surface = encode_surface(oct_decode(n), p.tangent, p.uv);
+    out.surface = encode_surface(oct_decode(n), p.tangent, p.uv, p.color.rgb);
 #endif
 #else
     out.position = vec4<f32>(in.world, f32(MATERIAL_INDEX));
 #if GBUFFER_NORMALS
     out.normal = vec4<f32>(p.normal, 0.0);
 #if GBUFFER_SURFACE
-    out.surface = encode_surface(p.normal, p.tangent, p.uv);
+    out.surface = encode_surface(p.normal, p.tangent, p.uv, p.color.rgb);
 #endif
 #endif
 #if GBUFFER_GEOMETRIC

@@ -32,10 +32,15 @@ struct ShadeDispatch {
 
 /// Whether the G-buffer's surface pair (`g_surface`, `g_uv_grad`) is written and read:
 /// where the graph gives it (the G-buffer pass and deferred shading name it alike) and a
-/// material of the scene reads the uv or the tangent. Without such a material the pair
-/// would be bandwidth for nothing, so neither pass touches it.
+/// material of the scene reads the uv, the tangent or the vertex colour. Without such a
+/// material the pair would be bandwidth for nothing, so neither pass touches it.
 pub(super) fn writes_surface(cx: &PrepareCtx, sp: &ScheduledPass) -> bool {
-    sp.roles.slot(G_SURFACE).is_some() && cx.gpu.materials.iter().any(|m| m.reads_uv_or_tangent)
+    sp.roles.slot(G_SURFACE).is_some()
+        && cx
+            .gpu
+            .materials
+            .iter()
+            .any(|m| m.reads_uv_or_tangent || m.reads_vertex_color)
 }
 
 pub(super) fn prepare(
@@ -79,25 +84,18 @@ pub(super) fn prepare(
         .gpu
         .materials
         .iter()
-        .find(|m| m.reads_uv_or_tangent && !surface)
+        .find(|m| (m.reads_uv_or_tangent || m.reads_vertex_color) && !surface)
     {
         return Err(pass_error(
             &sp.name,
-            format!("material '{}' has textures: its G-buffer needs the surface targets '{G_SURFACE}' and 'g_uv_grad' (uv, tangent and uv derivatives), which this pass does not read", m.name),
+            format!("material '{}' reads textures, the tangent or the vertex colour: its G-buffer needs the surface targets '{G_SURFACE}' and 'g_uv_grad' (uv, tangent, vertex colour and uv derivatives), which this pass does not read", m.name),
         ));
     }
-    // No G-buffer target holds a second uv set or a vertex colour: materials that read
-    // one are shaded without it here, said rather than left to be noticed in the image.
+    // No G-buffer target holds a second uv set: materials that read one are shaded
+    // without it here, said rather than left to be noticed in the image.
     if let Some(m) = cx.gpu.materials.iter().find(|m| m.reads_uv1) {
         log::warn!(
             "pass '{}': material '{}' samples a texture with TEXCOORD_1, which the G-buffer does not carry: it samples TEXCOORD_0 there",
-            sp.name,
-            m.name
-        );
-    }
-    if let Some(m) = cx.gpu.materials.iter().find(|m| m.reads_vertex_color) {
-        log::warn!(
-            "pass '{}': material '{}' reads the vertex colour (glTF COLOR_0), which the G-buffer does not carry: it is shaded as if its vertices were white",
             sp.name,
             m.name
         );
