@@ -205,7 +205,7 @@ fn alpha_masked_geometry_is_cut_out_in_prepass_and_shading() {
 /// The default scene (`cargo run --release` in a checkout) shows what lightgraph is for:
 /// textured glTF models, many materials and over 250,000 triangles, many coloured lights
 /// and blended glass, drawn by the default graph (graphs/default.ron) with its
-/// transparency passes, lit across the frame.
+/// transparency passes, lit across the frame, its key lights casting ray-cast shadows.
 #[test]
 fn the_default_scene_has_textures_many_lights_and_glass_through_the_default_graph() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/gallery.ron");
@@ -260,5 +260,30 @@ fn the_default_scene_has_textures_many_lights_and_glass_through_the_default_grap
     assert!(
         listed > 10 * tiles,
         "{listed} lights listed over {tiles} tiles"
+    );
+    // Its key lights cast shadows through the default frame's ray-cast passes: without
+    // their shadows part of the frame is brighter.
+    let casters = s
+        .lights
+        .iter()
+        .filter(|l| l.flags & scene::light_flags::CASTS_SHADOW != 0)
+        .count();
+    assert!(casters >= 2, "{casters} shadow-casting lights");
+    let mut unshadowed = s.clone();
+    for l in &mut unshadowed.lights {
+        l.flags &= !scene::light_flags::CASTS_SHADOW;
+    }
+    let bright = render_file(&mut r, "default.ron", &unshadowed, w, h);
+    let luma = |p: &[f32; 4]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    let shadowed = frame
+        .image
+        .iter()
+        .zip(&bright.image)
+        .filter(|(a, b)| luma(a) < 0.8 * luma(b))
+        .count();
+    println!("{shadowed} pixels over 20% darker for the key lights' shadows");
+    assert!(
+        shadowed > frame.image.len() / 50,
+        "only {shadowed} pixels shadowed"
     );
 }
