@@ -260,16 +260,11 @@ fn slice_bound(k: u32, slices: u32) -> f32 {
     return frame.near * pow(frame.far / frame.near, f32(k) / f32(slices));
 }
 
-// One-dimensional (a pixel's place in its tile from its index), as naga takes subgroup
-// invocation ids only there.
-@compute @workgroup_size(THREADS, 1, 1)
+@compute @workgroup_size(TILE, TILE, 1)
 fn main(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
-#if SUBGROUPS
-    @builtin(subgroup_invocation_id) lane: u32,
-    @builtin(subgroup_size) lanes: u32,
-#endif
+    @builtin(local_invocation_id) lid: vec3<u32>,
 ) {
     let list_index = (group.y * list_params.tiles_x + group.x) * list_params.lists_per_tile + group.z;
 #if COMPACT
@@ -309,7 +304,7 @@ fn main(
     }
 
     // 1. The tile's depth range, over the samples that hold geometry.
-    let pixel = group.xy * TILE + vec2<u32>(local % TILE, local / TILE);
+    let pixel = group.xy * TILE + lid.xy;
     let range = workgroup_depth_range(local, add_depth_sample(vec2<u32>(FAR_BITS, 0u), pixel));
     let tile_min = bitcast<f32>(range.x);
     let tile_max = bitcast<f32>(range.y);
@@ -383,13 +378,9 @@ fn main(
             i = candidate(from_coarse, coarse_base, k);
             hit = i >= below && light_touches_tile(i, light_sphere(i, false), bounds, lo, hi, tile_mask, tile_min, tile_max, 0.0);
         }
-#if SUBGROUPS
-        set_hit_bit(h, local, hit, lane, lanes);
-#else
         if (hit) {
             atomicOr(&hits[h][local / 32u], 1u << (local % 32u));
         }
-#endif
         workgroupBarrier();
         let slot = total + rank_in_batch(h, local);
 #if COMPACT
@@ -506,36 +497,6 @@ fn tile_bounds(origin: vec2<u32>, span: u32, lo: f32, hi: f32, empty: bool) -> T
 
 // How many lights before this invocation's in the batch hit (its place in the list);
 // `h` is the batch's set of hit bits.
-#if SUBGROUPS
-// Sets bit `local` of hit set `h` where `hit`. Every hit of a warp ORing the same word
-// waits in line for it; a subgroup whose invocations hold consecutive indices (as every
-// GPU we know forms them, but no API promises) sets its bits with one atomic from its
-// ballot instead. Any other layout takes the per-hit atomics. Call in uniform control
-// flow.
-fn set_hit_bit(h: u32, local: u32, hit: bool, lane: u32, lanes: u32) {
-    let ballot = subgroupBallot(hit);
-    let lane0 = local - lane;
-    let consecutive = subgroupAll(lane0 == subgroupBroadcastFirst(lane0));
-    // Whole words for wide subgroups, or within one word for narrow ones.
-    let fits = select(lane0 % 32u + lanes <= 32u, lane0 % 32u == 0u, lanes >= 32u);
-    if (consecutive && fits) {
-        if (lane == 0u) {
-            if (lanes >= 32u) {
-                for (var j = 0u; j < lanes / 32u; j++) {
-                    if (ballot[j] != 0u) {
-                        atomicOr(&hits[h][lane0 / 32u + j], ballot[j]);
-                    }
-                }
-            } else if (ballot.x != 0u) {
-                atomicOr(&hits[h][lane0 / 32u], ballot.x << (lane0 % 32u));
-            }
-        }
-    } else if (hit) {
-        atomicOr(&hits[h][local / 32u], 1u << (local % 32u));
-    }
-}
-#endif
-
 fn rank_in_batch(h: u32, local: u32) -> u32 {
     var rank = 0u;
     let word = local / 32u;

@@ -111,10 +111,7 @@ fn bvh_occluded(origin: vec3<f32>, dir: vec3<f32>, t_max: f32) -> bool {
     var sp = 0u;
     var overflow = false;
     var current = 0u;
-    // The node at `current`: a child entered keeps the copy its parent's test loaded, so
-    // only a node popped from the stack is loaded again.
-    var node = bvh_nodes[0];
-    var alive = bvh_slab(node, origin, inv_dir, t_max) >= 0.0;
+    var alive = bvh_slab(bvh_nodes[0], origin, inv_dir, t_max) >= 0.0;
     // A well-formed tree visits each node at most once; more means a malformed one, and
     // the fallback (which always terminates) takes over.
     let node_count = arrayLength(&bvh_nodes);
@@ -125,9 +122,9 @@ fn bvh_occluded(origin: vec3<f32>, dir: vec3<f32>, t_max: f32) -> bool {
             overflow = true;
             break;
         }
+        let node = bvh_nodes[current];
         var has_next = false;
         var next = 0u;
-        var next_node: BvhNode;
         if (bvh_is_leaf(node)) {
             if (bvh_leaf_hit(node, origin, dir, t_max)) {
                 return true;
@@ -135,10 +132,8 @@ fn bvh_occluded(origin: vec3<f32>, dir: vec3<f32>, t_max: f32) -> bool {
         } else {
             let left = current + 1u;
             let right = node.a;
-            let left_node = bvh_nodes[left];
-            let right_node = bvh_nodes[right];
-            let tl = bvh_slab(left_node, origin, inv_dir, t_max);
-            let tr = bvh_slab(right_node, origin, inv_dir, t_max);
+            let tl = bvh_slab(bvh_nodes[left], origin, inv_dir, t_max);
+            let tr = bvh_slab(bvh_nodes[right], origin, inv_dir, t_max);
             if (tl >= 0.0 && tr >= 0.0) {
                 if (sp == BVH_STACK_SIZE) {
                     overflow = true;
@@ -148,29 +143,20 @@ fn bvh_occluded(origin: vec3<f32>, dir: vec3<f32>, t_max: f32) -> bool {
                 stack[sp] = select(left, right, left_first);
                 sp += 1u;
                 next = select(right, left, left_first);
-                if (left_first) {
-                    next_node = left_node;
-                } else {
-                    next_node = right_node;
-                }
                 has_next = true;
             } else if (tl >= 0.0) {
                 next = left;
-                next_node = left_node;
                 has_next = true;
             } else if (tr >= 0.0) {
                 next = right;
-                next_node = right_node;
                 has_next = true;
             }
         }
         if (has_next) {
             current = next;
-            node = next_node;
         } else if (sp > 0u) {
             sp -= 1u;
             current = stack[sp];
-            node = bvh_nodes[current];
         } else {
             alive = false;
         }

@@ -20,8 +20,7 @@
 // They keep their caster numbers, so every other light's bit is where it is without
 // the atlas.
 // Defines: TILE-free; JOB_CAPACITY, LIGHT_LISTS, SHADOW_NORMAL_OFFSET, VISIBILITY_IDS,
-// SHADOW_ATLAS_LIGHTS, SUBGROUPS (the device has wgpu's SUBGROUP: bucket atomics per
-// subgroup).
+// SHADOW_ATLAS_LIGHTS.
 
 #include "common/types.wgsl"
 #include "common/lighting.wgsl"
@@ -76,95 +75,51 @@ fn load_pixel(xy: vec2<u32>) -> Pixel {
 
 // Walks the pixel's casters. Without `emit`, counts its jobs into their buckets; with it,
 // writes each job at its bucket's next slot (those past JOB_CAPACITY are dropped, counted
-// by the caller) and the pixel's mask. Every invocation of the workgroup walks, an
-// invalid pixel with an empty list, so the subgroup operations run in uniform flow.
-fn walk(px: Pixel, emit: bool, local: u32) {
+// by the caller) and the pixel's mask.
+fn walk(px: Pixel, emit: bool) {
     var caster = 0u;
     var hidden = array<u32, 4>(0u, 0u, 0u, 0u);
-    let own = select(0u, px.range.count, px.valid);
-#if SUBGROUPS
-    // The subgroup steps through list positions together, so a position's jobs share a
-    // bucket (positions, not lights: lists may differ between pixels).
-    let steps = subgroupMax(own);
-#else
-    let steps = own;
-#endif
-    for (var k = 0u; k < steps; k++) {
-        var job = false;
-        var i = 0u;
-        var job_caster = 0u;
-        if (k < own) {
-            i = light_at(px.range, k);
-            let props = light_properties[i];
-            if ((props.flags & LIGHT_CASTS_SHADOW) != 0u) {
-                let g = light_geometry[i];
-                let inc = incident_light(g, props, px.position);
-                if (any(inc.radiance > vec3<f32>(0.0))) {
+    for (var k = 0u; k < px.range.count; k++) {
+        let i = light_at(px.range, k);
+        let props = light_properties[i];
+        if ((props.flags & LIGHT_CASTS_SHADOW) == 0u) {
+            continue;
+        }
+        let g = light_geometry[i];
+        let inc = incident_light(g, props, px.position);
+        if (!any(inc.radiance > vec3<f32>(0.0))) {
+            continue;
+        }
 #if SHADOW_ATLAS_LIGHTS
-                    let rays = shadow_atlas_entry(i) == 0u;
+        let rays = shadow_atlas_entry(i) == 0u;
 #else
-                    let rays = true;
+        let rays = true;
 #endif
-                    if (caster < SHADOW_MAX_CASTERS && rays) {
-                        if (shadow_faces(px.position, px.ng, g.position)) {
-                            job = true;
-                            job_caster = caster;
-                        } else {
-                            hidden[caster / 32u] |= 1u << (caster % 32u);
-                        }
+        if (caster < SHADOW_MAX_CASTERS && rays) {
+            if (shadow_faces(px.position, px.ng, g.position)) {
+                let bucket = min(k, BUCKETS - 1u);
+                if (emit) {
+                    let slot = group_base + atomicAdd(&bucket_next[bucket], 1u);
+                    if (slot < JOB_CAPACITY) {
+                        atomicStore(&shadow_jobs[JOB_HEADER_WORDS + JOB_WORDS * slot], px.index);
+                        atomicStore(&shadow_jobs[JOB_HEADER_WORDS + JOB_WORDS * slot + 1u], i | (caster << 24u));
                     }
-                    caster += 1u;
+                } else {
+                    atomicAdd(&bucket_count[bucket], 1u);
                 }
-            }
-        }
-        let bucket = min(k, BUCKETS - 1u);
-#if SUBGROUPS
-        // One workgroup atomic per subgroup and position instead of one per job: a warp's
-        // jobs at one position all add to the same bucket, and would wait in line for it.
-        let one = select(0u, 1u, job);
-        let jobs = subgroupAdd(one);
-        if (jobs > 0u) {
-            if (emit) {
-                let before = subgroupExclusiveAdd(one);
-                // The subgroup's first invocation takes the slots for all.
-                var first = 0u;
-                let leader = subgroupBroadcastFirst(local) == local;
-                if (leader) {
-                    first = atomicAdd(&bucket_next[bucket], jobs);
-                }
-                first = subgroupBroadcastFirst(first);
-                if (job) {
-                    emit_job(group_base + first + before, px.index, i, job_caster);
-                }
-            } else if (subgroupBroadcastFirst(local) == local) {
-                atomicAdd(&bucket_count[bucket], jobs);
-            }
-        }
-#else
-        if (job) {
-            if (emit) {
-                emit_job(group_base + atomicAdd(&bucket_next[bucket], 1u), px.index, i, job_caster);
             } else {
-                atomicAdd(&bucket_count[bucket], 1u);
+                hidden[caster / 32u] |= 1u << (caster % 32u);
             }
         }
-#endif
+        caster += 1u;
     }
-    if (emit && px.valid) {
+    if (emit) {
         for (var w = 0u; w < SHADOW_MASK_WORDS; w++) {
             shadow_mask[px.index * SHADOW_MASK_WORDS + w] = hidden[w];
         }
         if (caster > SHADOW_MAX_CASTERS) {
             atomicAdd(&shadow_jobs[2], 1u);
         }
-    }
-}
-
-// Job `slot` (dropped past JOB_CAPACITY): pixel, light and caster number.
-fn emit_job(slot: u32, pixel: u32, light: u32, caster: u32) {
-    if (slot < JOB_CAPACITY) {
-        atomicStore(&shadow_jobs[JOB_HEADER_WORDS + JOB_WORDS * slot], pixel);
-        atomicStore(&shadow_jobs[JOB_HEADER_WORDS + JOB_WORDS * slot + 1u], light | (caster << 24u));
     }
 }
 
@@ -176,13 +131,14 @@ fn main(
     atomicStore(&bucket_count[local], 0u);
     workgroupBarrier();
     let px = load_pixel(id.xy);
-    if (!px.valid && all(id.xy < frame.size)) {
+    if (px.valid) {
+        walk(px, false);
+    } else if (all(id.xy < frame.size)) {
         let base = (id.y * frame.size.x + id.x) * SHADOW_MASK_WORDS;
         for (var w = 0u; w < SHADOW_MASK_WORDS; w++) {
             shadow_mask[base + w] = 0u;
         }
     }
-    walk(px, false, local);
     workgroupBarrier();
     // Inclusive prefix sum of the bucket counts (Hillis-Steele), one bucket a thread.
     let count = atomicLoad(&bucket_count[local]);
@@ -208,7 +164,9 @@ fn main(
         }
     }
     workgroupBarrier();
-    walk(px, true, local);
+    if (px.valid) {
+        walk(px, true);
+    }
 }
 
 // The casting pass's indirect dispatch: SHADOW_CAST_GROUP jobs a workgroup, in rows of MAX_GROUPS_X.

@@ -12,25 +12,24 @@
 //! runs the same rasterizer over its own views ([`RasterTarget::Buffers`]): no store,
 //! and a second `setup` and `raster` (IDS) that keep each texel's nearest triangle by
 //! its visibility id (`tri_ids`: the merged triangles are in shadow chunk order).
+//!
+//! Alpha-masked casters are drawn by raster runs of their material's own after the
+//! solid casters' (raster_runs.rs), alpha-testing each texel they could win.
 
 use super::shadow_atlas_raster_input::{
     list_capacity, merge_casters, JobLists, MergedCasters, Work, ENTRY_BYTES, RECORD_BYTES,
     STORE_CELL,
 };
+use super::shadow_atlas_raster_runs::{plain_pipeline, prepare_runs, storage, Run};
 use super::{grid, pass_error, PrepareCtx, Timestamps};
 use crate::gpu::readback::read_buffer;
 use crate::render::bind::BindingSet;
-use crate::render::pipelines::{Pipeline, PipelineKey};
 use crate::render::{RenderError, Renderer};
-use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 use wgpu::util::DeviceExt;
 
-const SHADER: &str = "shadow/atlas_raster.wgsl";
 /// Threads per setup workgroup (a thread per view and triangle).
 const GROUP: u32 = 64;
-/// Counter words (the shader's RECORDS..SERIAL_CELLS).
-const COUNTERS: u64 = 4;
 
 /// Grown buffers and the bind groups over them.
 struct Bound {
@@ -51,30 +50,6 @@ pub(super) enum RasterTarget {
     /// texels a row, for the caller to read and put back to far and zero:
     /// [`ComputeAtlas::depth`], [`ComputeAtlas::ids`].
     Buffers { width: u32, height: u32 },
-}
-
-/// One pass of a raster run over the depth buffer (the depth, or with IDS the nearest
-/// triangle): its pipelines, and its own counters and arguments (the passes run in one
-/// compute pass, so none can clear another's).
-struct RunPass {
-    setup: Arc<wgpu::ComputePipeline>,
-    raster: Arc<wgpu::ComputePipeline>,
-    ids: bool,
-    counters: wgpu::Buffer,
-    args: wgpu::Buffer,
-}
-
-/// A raster run: the solid casters (run 0), or one alpha-masked material's casters,
-/// alpha-tested against its material.
-struct Run {
-    /// The depth pass, then (with [`RasterTarget::Buffers`]) the IDS pass.
-    passes: Vec<RunPass>,
-    /// This run's work and list capacities, with its first job.
-    params: wgpu::Buffer,
-    /// The material's textures (group 2), for a textured masked material.
-    textures: Option<wgpu::BindGroup>,
-    /// Whether it alpha-tests (binds the merged geometry and the views in raster).
-    masked: bool,
 }
 
 pub(super) struct ComputeAtlas {
@@ -129,38 +104,6 @@ pub struct AtlasRasterReport {
     pub serial_triangles: u32,
     /// Cells a setup thread rasterized itself (the cell list was full).
     pub serial_cells: u32,
-}
-
-fn storage(
-    device: &wgpu::Device,
-    label: &str,
-    bytes: u64,
-    extra: wgpu::BufferUsages,
-) -> wgpu::Buffer {
-    device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: bytes.max(16),
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | extra,
-        mapped_at_creation: false,
-    })
-}
-
-/// A raster run's counters (read back for the report) and its indirect arguments.
-fn counters_and_args(device: &wgpu::Device, what: &str) -> [wgpu::Buffer; 2] {
-    [
-        storage(
-            device,
-            &format!("{what} counters"),
-            4 * COUNTERS,
-            wgpu::BufferUsages::COPY_SRC,
-        ),
-        storage(
-            device,
-            &format!("{what} arguments"),
-            16,
-            wgpu::BufferUsages::INDIRECT,
-        ),
-    ]
 }
 
 impl ComputeAtlas {
@@ -291,7 +234,7 @@ impl ComputeAtlas {
         // Every buffer under its shader name, for the masked runs' reflected layouts
         // (their bind groups are made in `bind_lists`, over the grown lists).
         let mut offered = BindingSet::default();
-        let lists = [16u64; 3].map(|n| {
+        let lists = [16u64; 2].map(|n| {
             storage(
                 &device,
                 "atlas raster lists",
@@ -319,67 +262,7 @@ impl ComputeAtlas {
             offered.buffer("vertices", vertices);
             offered.buffer("triangles", triangles);
         }
-        let mut runs = Vec::new();
-        for run in std::iter::once(None).chain(masked.iter().copied().map(Some)) {
-            let params = uniform("atlas raster parameters");
-            let mut offered = offered.clone();
-            offered.buffer("params", &params);
-            let mut passes = Vec::new();
-            let mut textures = None;
-            for ids_pass in [false, true] {
-                if ids_pass && !with_ids {
-                    continue;
-                }
-                let what = if ids_pass {
-                    "rsm raster id"
-                } else {
-                    "atlas raster"
-                };
-                let [counters, args] = counters_and_args(&device, what);
-                offered.buffer("counters", &counters);
-                offered.buffer("args", &args);
-                let stage = |stage: &str| {
-                    let mut d = base_defines(stage);
-                    if ids_pass {
-                        d.push(("IDS".into(), "1".into()));
-                    }
-                    if stage == "SETUP" && (ids_pass || run.is_some()) {
-                        d.push(("TRI_IDS".into(), "1".into()));
-                    }
-                    d
-                };
-                let (setup, raster) = match run {
-                    None => (
-                        plain_pipeline(cx, pass, stage("SETUP"), "setup")?,
-                        plain_pipeline(cx, pass, stage("RASTER"), "raster")?,
-                    ),
-                    Some(material) => {
-                        let mut built = Vec::new();
-                        for (name, entry) in [("SETUP", "setup"), ("RASTER", "raster")] {
-                            let (pipeline, t) =
-                                masked_pipeline(cx, pass, stage(name), entry, material, &offered)?;
-                            textures = t;
-                            built.push(pipeline);
-                        }
-                        let raster = built.pop().expect("two pipelines");
-                        (built.pop().expect("two pipelines"), raster)
-                    }
-                };
-                passes.push(RunPass {
-                    setup,
-                    raster,
-                    ids: ids_pass,
-                    counters,
-                    args,
-                });
-            }
-            runs.push(Run {
-                passes,
-                params,
-                textures,
-                masked: run.is_some(),
-            });
-        }
+        let runs = prepare_runs(cx, pass, &masked, with_ids, &base_defines, &offered)?;
         let this = ComputeAtlas {
             store,
             runs,
@@ -676,80 +559,6 @@ impl ComputeAtlas {
         }
         Ok(report)
     }
-}
-
-/// A pipeline of the shader without a material (group 0 only).
-fn plain_pipeline(
-    cx: &mut PrepareCtx,
-    pass: &str,
-    defines: Vec<(String, String)>,
-    entry: &str,
-) -> Result<Arc<wgpu::ComputePipeline>, RenderError> {
-    let key = PipelineKey {
-        shader: SHADER.into(),
-        defines: defines.into_iter().collect(),
-        virtual_code: BTreeMap::new(),
-        state: String::new(),
-    };
-    let device = cx.device();
-    let layouts = cx.renderer.layouts.clone();
-    let (p, _) = cx
-        .renderer
-        .pipelines
-        .get_or_build_reflected(
-            &cx.renderer.shaders,
-            key,
-            |_, module, bindings| {
-                let bgl = layouts.get(
-                    &device,
-                    crate::render::bind::layout_entries(bindings, 0, wgpu::ShaderStages::COMPUTE),
-                );
-                let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some(entry),
-                    bind_group_layouts: &[Some(&*bgl)],
-                    immediate_size: 0,
-                });
-                Pipeline::compute(&device, entry, Some(&pl), &module, entry)
-            },
-            &device,
-        )
-        .map_err(|source| RenderError::Shader {
-            pass: pass.to_string(),
-            source,
-        })?;
-    match p {
-        Pipeline::Compute(p) => Ok(p),
-        _ => Err(pass_error(pass, "expected a compute pipeline".into())),
-    }
-}
-
-/// A pipeline of the shader alpha-testing `material` (its code, and its textures bound
-/// in group 2, returned with it).
-fn masked_pipeline(
-    cx: &mut PrepareCtx,
-    pass: &str,
-    mut defines: Vec<(String, String)>,
-    entry: &str,
-    material: usize,
-    offered: &BindingSet,
-) -> Result<(Arc<wgpu::ComputePipeline>, Option<wgpu::BindGroup>), RenderError> {
-    let m = &cx.gpu.materials[material];
-    defines.push(("ALPHA_TEST".into(), "1".into()));
-    defines.push(("MATERIAL_INDEX".into(), format!("{material}u")));
-    if m.textures.is_some() {
-        defines.push(("MATERIAL_TEXTURED".into(), "1".into()));
-    }
-    let key = PipelineKey {
-        shader: SHADER.into(),
-        defines: defines.into_iter().collect(),
-        virtual_code: BTreeMap::from([("material".to_string(), m.wgsl_for_compute().to_string())]),
-        state: entry.into(),
-    };
-    let textures = m.textures.clone();
-    let label = format!("{pass} (alpha test of material '{}')", m.name);
-    let (pipeline, _, textures) =
-        cx.compute_pipeline_with_material(&label, key, entry, offered, textures.as_ref())?;
-    Ok((pipeline, textures))
 }
 
 fn bind(
