@@ -47,10 +47,6 @@ pub(super) fn prepare(
         ("SHADOW_NORMAL_OFFSET", format!("{DEFAULT_NORMAL_OFFSET:?}")),
     ];
     d.extend(surface_define(&sp.roles));
-    // Bucket counts and slots taken a subgroup at a time.
-    if cx.device().features().contains(wgpu::Features::SUBGROUP) {
-        d.push(("SUBGROUPS", "1".into()));
-    }
     // The hybrid: lights with an atlas map this frame get no job.
     if sp
         .roles
