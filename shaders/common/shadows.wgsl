@@ -29,6 +29,9 @@ const SHADOW_MASK_WORDS: u32 = 4u;
 // words a job (pixel index, then light index | caster number << 24).
 const JOB_HEADER_WORDS: u32 = 8u;
 const JOB_WORDS: u32 = 2u;
+// After JOB_CAPACITY jobs, per pixel the surface job creation found (position, then
+// geometric normal): every ray of the pixel reads it instead of rebuilding it.
+const JOB_SURFACE_WORDS: u32 = 6u;
 // Jobs a workgroup of the casting pass (its dispatch is written by job creation).
 const SHADOW_CAST_GROUP: u32 = 64u;
 

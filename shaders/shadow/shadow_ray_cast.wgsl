@@ -1,9 +1,9 @@
 // Ray-cast shadows: one invocation per job (pixel, light, caster number), an any-hit
 // ray from the pixel's offset position towards the light against the scene BVH; a hit
 // sets the caster's bit in the pixel's mask. Dispatched indirectly from the job count.
-// Surfaces come from the G-buffer or, with VISIBILITY_IDS, from the visibility buffer
-// (shadow/surface_source.wgsl), as job creation read them.
-// Defines: JOB_CAPACITY, SHADOW_NORMAL_OFFSET, VISIBILITY_IDS.
+// The pixel's surface is the one job creation read (from the G-buffer or the visibility
+// buffer) and stored after the jobs, once a pixel for all its rays.
+// Defines: JOB_CAPACITY, SHADOW_NORMAL_OFFSET.
 
 #include "common/types.wgsl"
 
@@ -16,7 +16,6 @@
 
 #include "shadow/bvh.wgsl"
 #include "common/shadows.wgsl"
-#include "shadow/surface_source.wgsl"
 
 @compute @workgroup_size(SHADOW_CAST_GROUP, 1, 1)
 fn main(
@@ -32,9 +31,10 @@ fn main(
     let packed = shadow_jobs[JOB_HEADER_WORDS + JOB_WORDS * job + 1u];
     let light = packed & 0xffffffu;
     let caster = packed >> 24u;
-    let xy = vec2<u32>(pixel % frame.size.x, pixel / frame.size.x);
-    let s = shadow_surface(xy);
-    let origin = shadow_origin(s.position, s.ng);
+    let at = JOB_HEADER_WORDS + JOB_WORDS * JOB_CAPACITY + JOB_SURFACE_WORDS * pixel;
+    let position = bitcast<vec3<f32>>(vec3<u32>(shadow_jobs[at], shadow_jobs[at + 1u], shadow_jobs[at + 2u]));
+    let ng = bitcast<vec3<f32>>(vec3<u32>(shadow_jobs[at + 3u], shadow_jobs[at + 4u], shadow_jobs[at + 5u]));
+    let origin = shadow_origin(position, ng);
     let light_pos = light_geometry[light].position;
     if (bvh_occluded(origin, light_pos - origin, shadow_t_max(origin, light_pos))) {
         atomicOr(&shadow_mask[pixel * SHADOW_MASK_WORDS + caster / 32u], 1u << (caster % 32u));

@@ -132,6 +132,12 @@ fn main(
     workgroupBarrier();
     let px = load_pixel(id.xy);
     if (px.valid) {
+        // The surface every ray of this pixel starts from (shadow_ray_cast.wgsl).
+        let at = JOB_HEADER_WORDS + JOB_WORDS * JOB_CAPACITY + JOB_SURFACE_WORDS * px.index;
+        let words = array<u32, 6>(bitcast<u32>(px.position.x), bitcast<u32>(px.position.y), bitcast<u32>(px.position.z), bitcast<u32>(px.ng.x), bitcast<u32>(px.ng.y), bitcast<u32>(px.ng.z));
+        for (var w = 0u; w < JOB_SURFACE_WORDS; w++) {
+            atomicStore(&shadow_jobs[at + w], words[w]);
+        }
         walk(px, false);
     } else if (all(id.xy < frame.size)) {
         let base = (id.y * frame.size.x + id.x) * SHADOW_MASK_WORDS;

@@ -3,7 +3,9 @@
 //! structs; these are crate-private, so they are checked here).
 
 use crate::graph::kinds::light_linked_list::LinkLayout;
-use crate::graph::kinds::shadow_ray_jobs::{JOB_HEADER_WORDS, JOB_WORDS, MASK_WORDS};
+use crate::graph::kinds::shadow_ray_jobs::{
+    JOB_HEADER_WORDS, JOB_SURFACE_WORDS, JOB_WORDS, MASK_WORDS,
+};
 use crate::graph::ListLayout;
 use crate::shader::ShaderLibrary;
 use std::collections::BTreeMap;
@@ -51,5 +53,6 @@ fn shadow_job_and_mask_words_match() {
     let m = module("common/shadows.wgsl", &[("SHADOW_NORMAL_OFFSET", "1e-4")]);
     assert_eq!(constant(&m, "JOB_HEADER_WORDS"), JOB_HEADER_WORDS);
     assert_eq!(constant(&m, "JOB_WORDS"), JOB_WORDS);
+    assert_eq!(constant(&m, "JOB_SURFACE_WORDS"), JOB_SURFACE_WORDS);
     assert_eq!(constant(&m, "SHADOW_MASK_WORDS"), MASK_WORDS);
 }

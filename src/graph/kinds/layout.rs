@@ -13,10 +13,12 @@ pub enum BufferLayout {
     LightLists(ListLayout),
     /// Per-pixel light linked lists: heads and the link pool.
     LightLinks(light_linked_list::LinkLayout),
-    /// Ray-cast shadow jobs: a header and room for `capacity` jobs.
+    /// Ray-cast shadow jobs: a header, room for `capacity` jobs, and each pixel's surface.
     ShadowJobs {
         /// Jobs the buffer has room for.
         capacity: u64,
+        /// Pixels whose surfaces follow the jobs.
+        pixels: u64,
     },
     /// A 128-bit hit mask per pixel.
     ShadowMask {
@@ -120,7 +122,9 @@ impl BufferLayout {
         match self {
             BufferLayout::LightLists(l) => l.bytes(),
             BufferLayout::LightLinks(l) => l.bytes(),
-            BufferLayout::ShadowJobs { capacity } => shadow_ray_jobs::job_buffer_bytes(*capacity),
+            BufferLayout::ShadowJobs { capacity, pixels } => {
+                shadow_ray_jobs::job_buffer_bytes(*capacity, *pixels)
+            }
             BufferLayout::ShadowMask { pixels } => 4 * shadow_ray_jobs::MASK_WORDS * pixels,
             BufferLayout::Lights { lights, stride } => (*lights).max(1) * stride,
             BufferLayout::RsmViews { max_views } => {

@@ -30,7 +30,7 @@ pub(super) fn prepare(
     let jobs = cx.buffer(&sp.name, jobs_name)?;
     // The job pass declared to write this buffer published its capacity on it.
     let capacity = match cx.graph.plan.get(jobs_name).and_then(|r| r.layout) {
-        Some(BufferLayout::ShadowJobs { capacity }) => capacity,
+        Some(BufferLayout::ShadowJobs { capacity, .. }) => capacity,
         _ => {
             return Err(pass_error(
                 &sp.name,

@@ -47,6 +47,9 @@ pub(crate) const SHADOW_MASK: &str = "shadow_mask";
 pub(crate) const JOB_HEADER_WORDS: u64 = 8;
 /// A job: pixel index, then light index | caster number << 24.
 pub(crate) const JOB_WORDS: u64 = 2;
+/// After the jobs, per pixel its surface as job creation found it (position, geometric
+/// normal), so each of its rays reads it instead of rebuilding it.
+pub(crate) const JOB_SURFACE_WORDS: u64 = 6;
 /// Mask words a pixel (128 casters).
 pub(crate) const MASK_WORDS: u64 = 4;
 
@@ -57,9 +60,9 @@ impl ShadowRayJobs {
     }
 }
 
-/// Bytes of a job buffer holding `capacity` jobs.
-pub(crate) fn job_buffer_bytes(capacity: u64) -> u64 {
-    4 * (JOB_HEADER_WORDS + JOB_WORDS * capacity)
+/// Bytes of a job buffer holding `capacity` jobs and the surfaces of `pixels` pixels.
+pub(crate) fn job_buffer_bytes(capacity: u64, pixels: u64) -> u64 {
+    4 * (JOB_HEADER_WORDS + JOB_WORDS * capacity + JOB_SURFACE_WORDS * pixels)
 }
 
 /// Where a shadow pass reads its pixels' surfaces from.
@@ -309,6 +312,7 @@ impl KindRules for ShadowRayJobs {
         match slot {
             SHADOW_JOBS => Some(BufferLayout::ShadowJobs {
                 capacity: self.capacity(frame.width, frame.height),
+                pixels: frame.width as u64 * frame.height as u64,
             }),
             SHADOW_MASK => Some(BufferLayout::ShadowMask {
                 pixels: frame.width as u64 * frame.height as u64,
