@@ -229,4 +229,3 @@ fn masked_pipeline(
         cx.compute_pipeline_with_material(&label, key, entry, offered, textures.as_ref())?;
     Ok((pipeline, textures))
 }
-
