@@ -73,8 +73,8 @@ fn counters_and_args(device: &wgpu::Device, what: &str) -> [wgpu::Buffer; 2] {
 
 /// The raster runs over `offered` (every buffer under its shader name but `params`,
 /// `counters` and `args`, which each run and pass adds): the solid casters', then one per
-/// material of `masked`; with `with_ids` each also an id pass. `defines` gives a stage's
-/// defines.
+/// material of `masked`; with `with_ids` each also an id pass. `base_defines` gives a
+/// stage's defines.
 pub(super) fn prepare_runs(
     cx: &mut PrepareCtx,
     pass: &str,
@@ -127,15 +127,13 @@ pub(super) fn prepare_runs(
                     plain_pipeline(cx, pass, stage("RASTER"), "raster")?,
                 ),
                 Some(material) => {
-                    let mut built = Vec::new();
-                    for (name, entry) in [("SETUP", "setup"), ("RASTER", "raster")] {
-                        let (pipeline, t) =
-                            masked_pipeline(cx, pass, stage(name), entry, material, &offered)?;
-                        textures = t;
-                        built.push(pipeline);
-                    }
-                    let raster = built.pop().expect("two pipelines");
-                    (built.pop().expect("two pipelines"), raster)
+                    let (setup, _) =
+                        masked_pipeline(cx, pass, stage("SETUP"), "setup", material, &offered)?;
+                    // Both stages bind the material's textures alike: one bind group.
+                    let (raster, t) =
+                        masked_pipeline(cx, pass, stage("RASTER"), "raster", material, &offered)?;
+                    textures = t;
+                    (setup, raster)
                 }
             };
             passes.push(RunPass {
