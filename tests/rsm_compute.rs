@@ -7,7 +7,7 @@ mod common;
 use common::{graph_text, max_rel_diff, renderer};
 use lightgraph::graph::{self, FrameSize};
 use lightgraph::render::{FrameResult, PreparedFrame, Renderer, SceneGpu};
-use lightgraph::scene::{self, AlphaMode, Scene};
+use lightgraph::scene::{self, Scene};
 use lightgraph::shader::ShaderLibrary;
 use std::path::Path;
 
@@ -316,29 +316,15 @@ fn the_vpls_and_the_image_equal_the_hardware_paths() {
 /// checker whose alpha is 255 and 20 in stripes, cut at 0.5); `solid`: the same quad
 /// opaque.
 fn masked_quad_scene(solid: bool) -> Scene {
-    use common::textured::{checker, quad};
-    use lightgraph::scene::SurfaceMaterial;
     let mut s = load("cornell_indirect.ron");
-    let tex = std::sync::Arc::new(checker("stripes", 64, 8, [230, 120, 40], [40, 90, 200]));
-    s.materials.push(SurfaceMaterial {
-        name: "stripes".into(),
-        base_color_texture: Some(tex),
-        alpha_mode: if solid {
-            AlphaMode::Opaque
-        } else {
-            AlphaMode::Mask(0.5)
-        },
-        double_sided: true,
-        ..Default::default()
-    });
-    let m = s.materials.len() - 1;
-    s.meshes.push(quad(
+    common::textured::push_striped_quad(
+        &mut s,
         "stripes",
         glam::Vec3::new(0.0, 0.3, 0.0),
         glam::Vec3::X * 0.7,
         glam::Vec3::Z * 0.7,
-        m,
-    ));
+        solid,
+    );
     s
 }
 

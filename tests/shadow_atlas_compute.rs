@@ -445,29 +445,15 @@ fn full_lists_fall_back_to_serial_rasterization_with_the_same_atlas() {
 /// 255 and 20 in stripes, cut at 0.5) held level under the first spot light, both faces
 /// casting; `solid`: the same panel opaque.
 fn masked_panel_scene(solid: bool) -> Scene {
-    use common::textured::{checker, quad};
-    use lightgraph::scene::{AlphaMode, SurfaceMaterial};
     let mut scene = scene();
-    let tex = std::sync::Arc::new(checker("stripes", 64, 8, [230, 120, 40], [40, 90, 200]));
-    scene.materials.push(SurfaceMaterial {
-        name: "stripes".into(),
-        base_color_texture: Some(tex),
-        alpha_mode: if solid {
-            AlphaMode::Opaque
-        } else {
-            AlphaMode::Mask(0.5)
-        },
-        double_sided: true,
-        ..Default::default()
-    });
-    let m = scene.materials.len() - 1;
-    scene.meshes.push(quad(
+    common::textured::push_striped_quad(
+        &mut scene,
         "panel",
         Vec3::new(-0.8, 2.6, -3.0),
         Vec3::X * 1.2,
         Vec3::Z * 1.2,
-        m,
-    ));
+        solid,
+    );
     scene
 }
 

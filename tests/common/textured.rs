@@ -74,6 +74,26 @@ pub fn quad(name: &str, centre: Vec3, u: Vec3, v: Vec3, material: usize) -> Mesh
     m
 }
 
+/// Adds to `s` a double-sided quad at `centre` spanning ±`u`, ±`v`, textured with the
+/// mip-mapped stripes `checker` makes (alpha 255 and 20), alpha-masked at 0.5, or opaque
+/// where `solid`: what the compute rasterizers' alpha tests are checked on.
+pub fn push_striped_quad(s: &mut Scene, name: &str, centre: Vec3, u: Vec3, v: Vec3, solid: bool) {
+    let tex = Arc::new(checker("stripes", 64, 8, [230, 120, 40], [40, 90, 200]));
+    s.materials.push(SurfaceMaterial {
+        name: "stripes".into(),
+        base_color_texture: Some(tex),
+        alpha_mode: if solid {
+            AlphaMode::Opaque
+        } else {
+            AlphaMode::Mask(0.5)
+        },
+        double_sided: true,
+        ..Default::default()
+    });
+    let m = s.materials.len() - 1;
+    s.meshes.push(quad(name, centre, u, v, m));
+}
+
 /// The culling scene's room with every kind of material compute shading must handle: a
 /// glossy checker floor with a normal map, an alpha-masked striped panel facing the
 /// camera and a double-sided one showing its back face (masked too), lit by 200 lights.
