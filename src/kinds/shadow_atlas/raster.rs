@@ -20,7 +20,7 @@ use super::shadow_atlas_raster_input::{
     list_capacity, merge_casters, JobLists, MergedCasters, Work, ENTRY_BYTES, RECORD_BYTES,
     STORE_CELL,
 };
-use super::shadow_atlas_raster_runs::{plain_pipeline, prepare_runs, storage, Run};
+use super::shadow_atlas_raster_runs::{plain_pipeline, prepare_runs, storage, uniform, Run};
 use super::{grid, pass_error, PrepareCtx, Timestamps};
 use crate::gpu::readback::read_buffer;
 use crate::render::bind::BindingSet;
@@ -207,15 +207,7 @@ impl ComputeAtlas {
             ENTRY_BYTES * capacity[1] as u64,
             wgpu::BufferUsages::empty(),
         );
-        let uniform = |label: &str| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: 32,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            })
-        };
-        let store_params = uniform("atlas store parameters");
+        let store_params = uniform(&device, "atlas store parameters");
         let max_groups = device.limits().max_compute_workgroups_per_dimension;
         let base_defines = |stage: &str| {
             vec![

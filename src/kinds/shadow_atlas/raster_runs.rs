@@ -53,6 +53,16 @@ pub(super) fn storage(
     })
 }
 
+/// A 32-byte uniform buffer the queue writes (a run's or the store's parameters).
+pub(super) fn uniform(device: &wgpu::Device, label: &str) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: 32,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
 /// A raster run's counters (read back for the report) and its indirect arguments.
 fn counters_and_args(device: &wgpu::Device, what: &str) -> [wgpu::Buffer; 2] {
     [
@@ -84,17 +94,9 @@ pub(super) fn prepare_runs(
     offered: &BindingSet,
 ) -> Result<Vec<Run>, RenderError> {
     let device = cx.device();
-    let uniform = |label: &str| {
-        device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size: 32,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        })
-    };
     let mut runs = Vec::new();
     for run in std::iter::once(None).chain(masked.iter().copied().map(Some)) {
-        let params = uniform("atlas raster parameters");
+        let params = uniform(&device, "atlas raster parameters");
         let mut offered = offered.clone();
         offered.buffer("params", &params);
         let mut passes = Vec::new();
