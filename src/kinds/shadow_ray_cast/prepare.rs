@@ -50,18 +50,14 @@ pub(super) fn prepare(
     let offered = cx.declared(sp)?;
     let key = PipelineKey {
         shader: "shadow/shadow_ray_cast.wgsl".into(),
-        defines: defines(
-            &[
-                (
-                    "JOB_CAPACITY",
-                    format!("{}u", capacity.min(u32::MAX as u64)),
-                ),
-                ("SHADOW_NORMAL_OFFSET", format!("{:?}", p.normal_offset)),
-            ]
-            .into_iter()
-            .chain(super::shadow_ray_jobs::surface_define(&sp.roles))
-            .collect::<Vec<_>>(),
-        ),
+        // The pixels' surfaces come from the job buffer, whatever source the jobs read.
+        defines: defines(&[
+            (
+                "JOB_CAPACITY",
+                format!("{}u", capacity.min(u32::MAX as u64)),
+            ),
+            ("SHADOW_NORMAL_OFFSET", format!("{:?}", p.normal_offset)),
+        ]),
         virtual_code: BTreeMap::new(),
         state: String::new(),
     };

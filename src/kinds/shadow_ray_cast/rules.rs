@@ -1,8 +1,9 @@
 //! `ShadowRayCast`: one invocation per job, dispatched indirectly from the job count: an
 //! any-hit ray against the scene BVH from the pixel's position offset along its geometric
-//! normal (from a G-buffer or a visibility buffer, as its jobs pass reads them:
-//! [`super::shadow_ray_jobs::SurfaceSource`]); a hit sets the light's bit in the pixel's mask. Runs
-//! `shaders/shadow/shadow_ray_cast.wgsl`.
+//! normal (which its jobs pass read from a G-buffer or a visibility buffer,
+//! [`super::shadow_ray_jobs::SurfaceSource`], and stored in the job buffer); a hit sets the
+//! light's bit in the pixel's mask. Runs `shaders/shadow/shadow_ray_cast.wgsl`. The
+//! surface slots stay declared, as the jobs pass's: the shader reads the stored copy.
 
 use super::shadow_ray_jobs::{check_surface_source, SHADOW_JOBS, SHADOW_MASK, SURFACE_SLOTS};
 use super::{Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
