@@ -512,6 +512,7 @@ fn malformed_tree_terminates() {
         nodes: vec![bounds(2, 0), bounds(LEAF_BIT | 1, 0)],
         triangles: vec![tri],
         stats: Default::default(),
+        alpha: Default::default(),
     };
     assert!(bad.occluded(Vec3::new(0.0, 0.0, -1.0), Vec3::Z, 2.0));
     // A miss would cycle root → leaf → root... for ever.
@@ -604,7 +605,7 @@ fn wgsl_structs_match_rust_layout() {
             ("v0", offset_of!(BvhTriangle, v0)),
             ("id", offset_of!(BvhTriangle, id)),
             ("e1", offset_of!(BvhTriangle, e1)),
-            ("_pad0", offset_of!(BvhTriangle, _pad0)),
+            ("alpha", offset_of!(BvhTriangle, alpha)),
             ("e2", offset_of!(BvhTriangle, e2)),
             ("_pad1", offset_of!(BvhTriangle, _pad1)),
         ],

@@ -28,6 +28,9 @@ enable primitive_index;
 #if SHADOW_TRACE
 @group(0) @binding(6) var<storage, read> bvh_nodes: array<BvhNode>;
 @group(0) @binding(7) var<storage, read> bvh_triangles: array<BvhTriangle>;
+#if BVH_ALPHA_TEST
+@group(0) @binding(14) var<storage, read> bvh_alpha: array<u32>;
+#endif
 #include "shadow/bvh.wgsl"
 #endif
 #if SHADOW_ATLAS

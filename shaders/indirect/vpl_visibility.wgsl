@@ -16,6 +16,9 @@
 @group(0) @binding(2) var<storage, read> light_properties: array<LightProperties>;
 @group(0) @binding(5) var<storage, read> bvh_nodes: array<BvhNode>;
 @group(0) @binding(6) var<storage, read> bvh_triangles: array<BvhTriangle>;
+#if BVH_ALPHA_TEST
+@group(0) @binding(8) var<storage, read> bvh_alpha: array<u32>;
+#endif
 @group(0) @binding(7) var<storage, read_write> vpl_visibility: array<u32>;
 
 #include "shadow/bvh.wgsl"

@@ -46,6 +46,9 @@
 #include "common/light_inputs.wgsl"
 @group(0) @binding(5) var<storage, read> bvh_nodes: array<BvhNode>;
 @group(0) @binding(6) var<storage, read> bvh_triangles: array<BvhTriangle>;
+#if BVH_ALPHA_TEST
+@group(0) @binding(8) var<storage, read> bvh_alpha: array<u32>;
+#endif
 @group(0) @binding(7) var<storage, read_write> light_samples: array<u32>;
 
 #include "shadow/bvh.wgsl"

@@ -45,6 +45,9 @@
 #if SHADOW_TRACE
 @group(0) @binding(18) var<storage, read> bvh_nodes: array<BvhNode>;
 @group(0) @binding(19) var<storage, read> bvh_triangles: array<BvhTriangle>;
+#if BVH_ALPHA_TEST
+@group(0) @binding(21) var<storage, read> bvh_alpha: array<u32>;
+#endif
 #include "shadow/bvh.wgsl"
 #endif
 #if SHADOW_ATLAS

@@ -56,3 +56,53 @@ fn shadow_job_and_mask_words_match() {
     assert_eq!(constant(&m, "JOB_SURFACE_WORDS"), JOB_SURFACE_WORDS);
     assert_eq!(constant(&m, "SHADOW_MASK_WORDS"), MASK_WORDS);
 }
+
+#[test]
+fn shadow_ray_alpha_layout_matches() {
+    use crate::shadow::alpha as a;
+    let m = module(
+        "shadow/bvh.wgsl",
+        &[("BVH_STANDALONE", "1"), ("BVH_ALPHA_TEST", "1")],
+    );
+    let pairs = [
+        ("BVH_ALPHA_RECORD_WORDS", a::RECORD_WORDS as u32),
+        ("BVH_ALPHA_TEXTURE_WORDS", a::TEXTURE_WORDS as u32),
+        ("BVH_ALPHA_OP_WORDS", a::OP_WORDS as u32),
+        ("BVH_ALPHA_STACK", a::STACK as u32),
+        ("BVH_ALPHA_OP_CONST", a::OP_CONST),
+        ("BVH_ALPHA_OP_TEXTURE", a::OP_TEXTURE),
+        ("BVH_ALPHA_OP_VERTEX_ALPHA", a::OP_VERTEX_ALPHA),
+        ("BVH_ALPHA_OP_ONE_MINUS", a::OP_ONE_MINUS),
+        ("BVH_ALPHA_OP_MUL", a::OP_MUL),
+        ("BVH_ALPHA_LINEAR", a::FLAG_LINEAR),
+        ("BVH_ALPHA_SRGB", a::FLAG_SRGB),
+        ("BVH_ALPHA_UV1", a::FLAG_UV1),
+        ("BVH_ALPHA_WRAP_REPEAT", a::WRAP_REPEAT),
+        ("BVH_ALPHA_WRAP_MIRROR", a::WRAP_MIRROR),
+    ];
+    for (name, value) in pairs {
+        assert_eq!(constant(&m, name), value as u64, "{name}");
+    }
+}
+
+#[test]
+fn vpl_visibility_compiles_with_the_alpha_test() {
+    // The other tracers with BVH_ALPHA_TEST render in tests/masked_shadow_rays.rs; VPL
+    // visibility runs only with indirect lights, so its composed shader is checked here.
+    for ids in [false, true] {
+        let mut d = vec![
+            ("VPL_BLOCK", "8u"),
+            ("VPL_WORDS", "4u"),
+            ("SHADOW_NORMAL_OFFSET", "1e-4"),
+            ("BVH_ALPHA_TEST", "1"),
+        ];
+        if ids {
+            d.push(("VISIBILITY_IDS", "1"));
+        }
+        let m = module("indirect/vpl_visibility.wgsl", &d);
+        assert!(m
+            .global_variables
+            .iter()
+            .any(|(_, g)| g.name.as_deref() == Some("bvh_alpha")));
+    }
+}

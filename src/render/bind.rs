@@ -38,6 +38,10 @@ impl BindingSet {
             _ => None,
         }
     }
+    /// Whether something is offered under `name`.
+    pub fn has(&self, name: &str) -> bool {
+        self.get(name).is_some()
+    }
     fn get(&self, name: &str) -> Option<&Bound> {
         self.named.iter().find(|(n, _)| n == name).map(|(_, b)| b)
     }

@@ -399,7 +399,7 @@ impl MaterialProgram {
 /// The layered material a scene material stands for, and the files it was read from:
 /// its override RON (and texture files) where the scene names one, else the glTF
 /// material mapped onto the layered model.
-fn scene_material(
+pub(crate) fn scene_material(
     scene: &Scene,
     surface: &SurfaceMaterial,
 ) -> Result<(Material, Vec<PathBuf>), MaterialError> {

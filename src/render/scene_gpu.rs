@@ -73,6 +73,9 @@ pub struct GpuBvh {
     pub nodes: wgpu::Buffer,
     /// The triangles in leaf order (`bvh_triangles` binding).
     pub triangles: wgpu::Buffer,
+    /// What alpha-tested rays read (`bvh_alpha` binding); None when no caster is
+    /// alpha-masked.
+    pub alpha: Option<wgpu::Buffer>,
     /// What the build found: triangles kept and skipped, and the tree's shape.
     pub stats: crate::shadow::BuildStats,
 }
@@ -102,16 +105,20 @@ impl GpuBvh {
                 usage: wgpu::BufferUsages::STORAGE,
             })
         };
+        for unsupported in &bvh.alpha.unsupported {
+            log::warn!("masked caster material {unsupported}: its cut-out parts block shadow rays");
+        }
         Ok(Self {
             nodes: upload("bvh_nodes", nodes),
             triangles: upload("bvh_triangles", triangles),
+            alpha: bvh.alpha_bytes().map(|b| upload("bvh_alpha", b)),
             stats: bvh.stats,
         })
     }
 
-    /// Bytes on the GPU (nodes and triangles).
+    /// Bytes on the GPU (nodes, triangles and alpha data).
     pub fn bytes(&self) -> u64 {
-        self.nodes.size() + self.triangles.size()
+        self.nodes.size() + self.triangles.size() + self.alpha.as_ref().map_or(0, |a| a.size())
     }
 }
 

@@ -13,7 +13,8 @@
 //! `shaders/shadow/bvh.wgsl`: the same f32 slab and triangle tests, the same 32-entry
 //! stack and the same exact fallback when that stack would overflow.
 
-use crate::scene::Scene;
+use super::alpha::{AlphaBuilder, AlphaTable};
+use crate::scene::{Mesh, Scene};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use std::time::{Duration, Instant};
@@ -73,8 +74,10 @@ pub struct BvhTriangle {
     pub id: u32,
     /// Edge from `v0` to the second vertex (v1 − v0), precomputed for the ray–triangle test.
     pub e1: [f32; 3],
-    /// Padding to the WGSL struct's 16-byte alignment.
-    pub _pad0: u32,
+    /// 0 for a triangle that blocks every ray it meets; 1 + its record in
+    /// [`ShadowBvh::alpha`] for an alpha-masked one, which blocks only where its
+    /// material's alpha reaches the cutoff.
+    pub alpha: u32,
     /// Edge from `v0` to the third vertex (v2 − v0).
     pub e2: [f32; 3],
     /// Padding to the WGSL struct's 16-byte alignment.
@@ -192,29 +195,39 @@ pub struct ShadowBvh {
     pub triangles: Vec<BvhTriangle>,
     /// What the build did and how long it took.
     pub stats: BuildStats,
+    /// What alpha-tested rays read where they hit a masked caster (`bvh_alpha`).
+    pub alpha: AlphaTable,
 }
 
 struct Gathered {
     tris: Vec<[Vec3; 3]>,
     ids: Vec<u32>,
+    /// Each triangle's [`BvhTriangle::alpha`].
+    alpha: Vec<u32>,
     stats: BuildStats,
 }
 
-/// One mesh for [`gather`]: its positions, its indices, and whether it casts shadows.
-type GatherMesh<'a> = (&'a [Vec3], &'a [u32], bool);
+/// One mesh for [`gather`]: its positions, its indices, whether it casts shadows, and
+/// the scene mesh where its material may alpha-test rays.
+type GatherMesh<'a> = (&'a [Vec3], &'a [u32], bool, Option<&'a Mesh>);
 
 /// Every drawable triangle of the casting meshes, in world space exactly as the renderer
 /// draws it (`Mesh::positions` are already world space; no transforms), with the skips
 /// counted. Ids count the triangles of every mesh, casting or not, so they stay scene
 /// triangle indices.
-fn gather<'a>(meshes: impl Iterator<Item = GatherMesh<'a>>) -> Gathered {
+fn gather<'a>(
+    meshes: impl Iterator<Item = GatherMesh<'a>>,
+    mut alpha: Option<&mut AlphaBuilder>,
+) -> Gathered {
     let mut g = Gathered {
         tris: Vec::new(),
         ids: Vec::new(),
+        alpha: Vec::new(),
         stats: BuildStats::default(),
     };
     let mut id: u64 = 0;
-    for (positions, indices, casts) in meshes {
+    for (positions, indices, casts, mesh) in meshes {
+        let masked = mesh.filter(|m| alpha.as_ref().is_some_and(|a| a.tests(m.material)));
         if !casts {
             let count = indices.len() / 3;
             g.stats.input_triangles += count;
@@ -245,6 +258,10 @@ fn gather<'a>(meshes: impl Iterator<Item = GatherMesh<'a>>) -> Gathered {
             }
             g.tris.push([p0, p1, p2]);
             g.ids.push(this.min(u32::MAX as u64) as u32);
+            g.alpha.push(match (masked, alpha.as_deref_mut()) {
+                (Some(m), Some(a)) => a.push_triangle(m, [t[0], t[1], t[2]]),
+                _ => 0,
+            });
         }
     }
     g
@@ -273,14 +290,21 @@ impl ShadowBvh {
     /// Builds over every triangle of every mesh in the scene with the given options.
     pub fn build_with(scene: &Scene, options: &BuildOptions) -> Result<Self, ShadowError> {
         let start = Instant::now();
-        let g = gather(scene.meshes.iter().map(|m| {
-            (
-                m.positions.as_slice(),
-                m.indices.as_slice(),
-                scene.casts_shadow(m),
-            )
-        }));
-        Self::finish(g, options, start)
+        let mut alpha = AlphaTable::builder(scene);
+        let g = gather(
+            scene.meshes.iter().map(|m| {
+                (
+                    m.positions.as_slice(),
+                    m.indices.as_slice(),
+                    scene.casts_shadow(m),
+                    Some(m),
+                )
+            }),
+            Some(&mut alpha),
+        );
+        let mut bvh = Self::finish(g, options, start)?;
+        bvh.alpha = alpha.finish();
+        Ok(bvh)
     }
 
     /// Builds over a triangle soup (ids are the positions in `tris`).
@@ -288,11 +312,10 @@ impl ShadowBvh {
         let start = Instant::now();
         let positions: Vec<Vec3> = tris.iter().flatten().copied().collect();
         let indices: Vec<u32> = (0..positions.len() as u32).collect();
-        let g = gather(std::iter::once((
-            positions.as_slice(),
-            indices.as_slice(),
-            true,
-        )));
+        let g = gather(
+            std::iter::once((positions.as_slice(), indices.as_slice(), true, None)),
+            None,
+        );
         Self::finish(g, options, start)
     }
 
@@ -300,6 +323,7 @@ impl ShadowBvh {
         let Gathered {
             tris,
             ids,
+            alpha,
             mut stats,
         } = g;
         if tris.len() >= LEAF_BIT as usize {
@@ -310,6 +334,7 @@ impl ShadowBvh {
             nodes: Vec::new(),
             triangles: Vec::with_capacity(tris.len().max(1)),
             stats,
+            alpha: AlphaTable::default(),
         };
         if tris.is_empty() {
             out.nodes.push(EMPTY_LEAF);
@@ -350,7 +375,7 @@ impl ShadowBvh {
             });
         }
         let flatten = Instant::now();
-        out.flatten(&bvh, &tris, &ids, options);
+        out.flatten(&bvh, &tris, &ids, &alpha, options);
         out.stats.flatten_time = flatten.elapsed();
         out.stats.nodes = out.nodes.len();
         out.stats.build_time = start.elapsed();
@@ -365,6 +390,7 @@ impl ShadowBvh {
         bvh: &obvhs::bvh2::Bvh2,
         tris: &[[Vec3; 3]],
         ids: &[u32],
+        alpha: &[u32],
         options: &BuildOptions,
     ) {
         let src = &bvh.nodes;
@@ -524,7 +550,7 @@ impl ShadowBvh {
                     v0: p0.to_array(),
                     id: ids[p as usize],
                     e1: (p1 - p0).to_array(),
-                    _pad0: 0,
+                    alpha: alpha.get(p as usize).copied().unwrap_or(0),
                     e2: (p2 - p0).to_array(),
                     _pad1: 0,
                 }
@@ -538,5 +564,10 @@ impl ShadowBvh {
             bytemuck::cast_slice(&self.nodes),
             bytemuck::cast_slice(&self.triangles),
         )
+    }
+
+    /// The bytes to upload into `bvh_alpha`, or None when no triangle alpha-tests.
+    pub fn alpha_bytes(&self) -> Option<&[u8]> {
+        (self.alpha.records() > 0).then(|| bytemuck::cast_slice(&self.alpha.words[..]))
     }
 }

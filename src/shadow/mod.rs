@@ -12,6 +12,7 @@
 //! open; `dir` need not be unit length, `t` is in units of `dir`). Offsetting the origin
 //! off the surface is the caller's job.
 
+pub mod alpha;
 pub mod atlas;
 pub(crate) mod atlas_cache;
 pub mod bvh;

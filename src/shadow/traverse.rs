@@ -120,7 +120,9 @@ impl ShadowBvh {
         let tris = self.triangles.get(first..first + count).unwrap_or(&[]);
         tris.iter().any(|t| {
             stats.triangles_tested += 1;
+            // A masked caster's triangle blocks only where its alpha is not cut out.
             triangle_hit(t, ray)
+                .is_some_and(|(u, v)| t.alpha == 0 || !self.alpha.cut_out(t.alpha - 1, u, v))
         })
     }
 }
@@ -156,23 +158,24 @@ fn slab(node: &BvhNode, ray: &Ray) -> Option<f32> {
     (near <= far).then_some(near)
 }
 
-/// Möller–Trumbore in f32, two-sided, hit for `0 < t < t_max`.
-fn triangle_hit(tri: &BvhTriangle, ray: &Ray) -> bool {
+/// Möller–Trumbore in f32, two-sided, hit for `0 < t < t_max`: the barycentrics of the
+/// second and third vertex where it is hit.
+fn triangle_hit(tri: &BvhTriangle, ray: &Ray) -> Option<(f32, f32)> {
     let (v0, e1, e2) = (Vec3::from(tri.v0), Vec3::from(tri.e1), Vec3::from(tri.e2));
     let p = ray.dir.cross(e2);
     let det = e1.dot(p);
     if det.abs() < MIN_DET {
-        return false;
+        return None;
     }
     let inv_det = 1.0 / det;
     let s = ray.origin - v0;
     let u = s.dot(p) * inv_det;
     if !(0.0..=1.0).contains(&u) {
-        return false;
+        return None;
     }
     let q = s.cross(e1);
     let v = ray.dir.dot(q) * inv_det;
     let t = e2.dot(q) * inv_det;
     // Every comparison is false for NaN, so NaN misses.
-    v >= 0.0 && u + v <= 1.0 && t > 0.0 && t < ray.t_max
+    (v >= 0.0 && u + v <= 1.0 && t > 0.0 && t < ray.t_max).then_some((u, v))
 }

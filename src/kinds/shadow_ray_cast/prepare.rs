@@ -7,7 +7,6 @@ use crate::graph::Name;
 use crate::graph::{BufferLayout, ScheduledPass, ShadowRayCast};
 use crate::render::pipelines::PipelineKey;
 use crate::render::RenderError;
-use crate::scene::{light_flags, AlphaMode};
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
@@ -38,15 +37,6 @@ pub(super) fn prepare(
             ))
         }
     };
-    // The BVH holds triangles, not materials: a masked caster blocks rays over its
-    // cut-out parts too. Said where a shadow-casting light reaches one (as the lights
-    // stand now), not left to be found in the image.
-    if let Some(material) = masked_caster_in_reach(cx) {
-        log::warn!(
-            "pass '{}': caster material '{material}' is alpha-masked, and ray-cast shadows do not alpha-test: its cut-out parts cast shadows too (a ShadowAtlas alpha-tests them)",
-            sp.name
-        );
-    }
     let offered = cx.declared(sp)?;
     let key = PipelineKey {
         shader: "shadow/shadow_ray_cast.wgsl".into(),
@@ -67,28 +57,6 @@ pub(super) fn prepare(
         pipeline,
         bind,
         jobs,
-    })
-}
-
-/// The first alpha-masked caster material whose mesh bounds a shadow-casting light's
-/// range reaches.
-fn masked_caster_in_reach<'a>(cx: &'a PrepareCtx) -> Option<&'a str> {
-    let gpu = cx.gpu;
-    let casting: Vec<_> = cx
-        .scene
-        .lights
-        .iter()
-        .filter(|l| l.flags & light_flags::CASTS_SHADOW != 0)
-        .collect();
-    gpu.shadow_caster_draws().into_iter().find_map(|m| {
-        let mesh = &gpu.meshes[m];
-        let material = &gpu.materials[mesh.material];
-        let [lo, hi] = mesh.bounds;
-        let reached = casting
-            .iter()
-            .any(|l| l.position.clamp(lo, hi).distance(l.position) < l.range);
-        (matches!(material.alpha_mode, AlphaMode::Mask(_)) && reached)
-            .then_some(material.name.as_str())
     })
 }
 

@@ -276,15 +276,18 @@ impl Renderer {
                 Some(neutral) if material_unused => neutral.to_string(),
                 _ => m.wgsl.clone(),
             };
-            let key = PipelineKey {
-                shader: SHADER.into(),
-                defines: super::passes::defines(&d),
-                virtual_code: BTreeMap::from([("material".to_string(), code)]),
-                state: format!(
-                    "samples={samples} double_sided={} mode={mode:?} set={set:?}",
-                    m.double_sided
-                ),
-            };
+            let key = super::passes::with_bvh_alpha(
+                PipelineKey {
+                    shader: SHADER.into(),
+                    defines: super::passes::defines(&d),
+                    virtual_code: BTreeMap::from([("material".to_string(), code)]),
+                    state: format!(
+                        "samples={samples} double_sided={} mode={mode:?} set={set:?}",
+                        m.double_sided
+                    ),
+                },
+                offered,
+            );
             // Shadow views draw both faces (any surface occludes, as for a ray) and their
             // triangles in spatial chunks. Transparent surfaces show both faces (AMD's TiledLighting11 sample:
             // shaded two-sided; the normal flips on back faces in `shading_point`).

@@ -258,6 +258,7 @@ impl PrepareCtx<'_> {
             } else if let Some(b) = self.bound(&sp.name, name)? {
                 set.offer(slot, b);
             }
+            self.offer_bvh_alpha(&sp.name, name, &mut set)?;
         }
         for (_, name) in &sp.roles.bindings {
             if crate::graph::BUILTIN_BINDINGS.contains(&name.as_str()) {
@@ -266,8 +267,30 @@ impl PrepareCtx<'_> {
             if let Some(b) = self.bound(&sp.name, name)? {
                 set.offer(name, b);
             }
+            self.offer_bvh_alpha(&sp.name, name, &mut set)?;
         }
         Ok(set)
+    }
+
+    /// Where a pass binds the BVH's triangles and some of them are alpha-masked, their
+    /// alpha data comes with them as `bvh_alpha`; the pipelines then alpha-test rays
+    /// (`BVH_ALPHA_TEST`, see [`with_bvh_alpha`]).
+    fn offer_bvh_alpha(
+        &self,
+        pass: &str,
+        name: &str,
+        set: &mut BindingSet,
+    ) -> Result<(), RenderError> {
+        if let Some(ResourceDesc::Import {
+            from: SceneResource::BvhTriangles,
+            ..
+        }) = self.resource(name)
+        {
+            if let Some(alpha) = &self.bvh(pass)?.alpha {
+                set.offer(BVH_ALPHA, Bound::Buffer(alpha.clone()));
+            }
+        }
+        Ok(())
     }
 
     /// What a shading pass binds to sample a shadow atlas: the comparison sampler
@@ -423,6 +446,7 @@ impl PrepareCtx<'_> {
         RenderError,
     > {
         use super::draws::{material_layout, MATERIAL_GROUP};
+        let key = with_bvh_alpha(key, offered);
         let device = self.device();
         let layouts = self.renderer.layouts.clone();
         let compute = wgpu::ShaderStages::COMPUTE;
@@ -508,6 +532,19 @@ pub(super) fn pass_error(pass: &str, message: String) -> RenderError {
         pass: pass.to_string(),
         message,
     }
+}
+
+/// The binding alpha-tested rays read (`shaders/shadow/bvh.wgsl`).
+pub(super) const BVH_ALPHA: &str = "bvh_alpha";
+
+/// `key` with `BVH_ALPHA_TEST` where `offered` holds the BVH's alpha data: a shader
+/// tracing rays then alpha-tests the masked casters' triangles it hits. One rule for
+/// every pass that traces, so none can bind the data and skip the test.
+pub(super) fn with_bvh_alpha(mut key: PipelineKey, offered: &BindingSet) -> PipelineKey {
+    if offered.has(BVH_ALPHA) {
+        key.defines.insert("BVH_ALPHA_TEST".into(), "1".into());
+    }
+    key
 }
 
 pub(super) fn defines(pairs: &[(&str, String)]) -> BTreeMap<String, String> {
