@@ -6,6 +6,12 @@
 //! (computed here from the texture's stripe layout, not by the shaders' code), except
 //! pixels whose projection lies within a texel and a half of a stripe's or the quad's
 //! edge (counted). The CPU twin (`ShadowBvh::occluded`) agrees on the same pixels.
+//!
+//! Each sampler a masked material may read through (mirrored repeat, clamp to edge, a
+//! uv transform, the second uv set, bilinear filtering, the vertex alpha) on quads hit by
+//! rays straight down: the GPU's `bvh_occluded` (a standalone kernel) and the CPU twin
+//! each equal the texel the glTF sampler's definition picks (computed here in f64),
+//! except rays within 1e-3 texel of a texel's edge or 1e-3 of the cutoff (counted).
 
 mod common;
 
@@ -201,4 +207,410 @@ fn the_same_quad_opaque_shadows_its_whole_square() {
         through_cut_outs > 150,
         "{through_cut_outs} pixels under cut-outs"
     );
+}
+
+/// What a standalone kernel of `shadow/bvh.wgsl` answers for each ray (origin, dir,
+/// t_max): `bvh_occluded` on the GPU with the BVH's alpha data bound.
+fn gpu_occluded(
+    r: &lightgraph::render::Renderer,
+    bvh: &ShadowBvh,
+    rays: &[(Vec3, Vec3, f32)],
+) -> Vec<bool> {
+    use lightgraph::shader::ShaderLibrary;
+    use std::collections::BTreeMap;
+    use wgpu::util::DeviceExt;
+    let defines = BTreeMap::from([
+        ("BVH_STANDALONE".to_string(), "1".to_string()),
+        ("BVH_ALPHA_TEST".to_string(), "1".to_string()),
+    ]);
+    let mut text = ShaderLibrary::builtin()
+        .compose("shadow/bvh.wgsl", &defines, &BTreeMap::new())
+        .unwrap()
+        .text;
+    text.push_str(
+        "@group(0) @binding(3) var<storage, read> rays: array<vec4<f32>>;\n\
+         @group(0) @binding(4) var<storage, read_write> hits: array<u32>;\n\
+         @compute @workgroup_size(64)\n\
+         fn main(@builtin(global_invocation_id) id: vec3<u32>) {\n\
+             let k = id.x;\n\
+             if (k >= arrayLength(&hits)) { return; }\n\
+             let o = rays[2u * k];\n\
+             let d = rays[2u * k + 1u];\n\
+             hits[k] = select(0u, 1u, bvh_occluded(o.xyz, d.xyz, d.w));\n\
+         }\n",
+    );
+    let device = &r.ctx.device;
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("alpha rays"),
+        source: wgpu::ShaderSource::Wgsl(text.into()),
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("alpha rays"),
+        layout: None,
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let storage = |label: &str, bytes: &[u8], extra: wgpu::BufferUsages| {
+        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytes,
+            usage: wgpu::BufferUsages::STORAGE | extra,
+        })
+    };
+    let (nodes, tris) = bvh.gpu_bytes();
+    let ray_data: Vec<[f32; 4]> = rays
+        .iter()
+        .flat_map(|(o, d, t)| [o.extend(0.0).to_array(), d.extend(*t).to_array()])
+        .collect();
+    let buffers = [
+        storage("nodes", nodes, wgpu::BufferUsages::empty()),
+        storage("triangles", tris, wgpu::BufferUsages::empty()),
+        storage(
+            "alpha",
+            bvh.alpha_bytes().unwrap(),
+            wgpu::BufferUsages::empty(),
+        ),
+        storage(
+            "rays",
+            bytemuck::cast_slice(&ray_data),
+            wgpu::BufferUsages::empty(),
+        ),
+        storage(
+            "hits",
+            &vec![0u8; 4 * rays.len()],
+            wgpu::BufferUsages::COPY_SRC,
+        ),
+    ];
+    let entries: Vec<wgpu::BindGroupEntry> = buffers
+        .iter()
+        .enumerate()
+        .map(|(k, b)| wgpu::BindGroupEntry {
+            binding: k as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &entries,
+    });
+    let read = device.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: 4 * rays.len() as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.dispatch_workgroups((rays.len() as u32).div_ceil(64), 1, 1);
+    }
+    encoder.copy_buffer_to_buffer(&buffers[4], 0, &read, 0, read.size());
+    r.ctx.queue.submit([encoder.finish()]);
+    read.slice(..).map_async(wgpu::MapMode::Read, |_| {});
+    device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+    let words: Vec<u32> =
+        bytemuck::cast_slice(&read.slice(..).get_mapped_range().unwrap()[..]).to_vec();
+    words.into_iter().map(|w| w != 0).collect()
+}
+
+/// How one quad of the sampler scene maps its points to what its material reads.
+#[derive(Clone, Copy)]
+struct SamplerCase {
+    name: &'static str,
+    wrap: Wrap,
+    filter: Filter,
+    /// uv at the quad's (0, 0) and (1, 1) corners.
+    uv: ([f64; 2], [f64; 2]),
+    transform: Option<UvTransform>,
+    /// The texture read through TEXCOORD_1 (TEXCOORD_0 left at zero).
+    uv1: bool,
+    /// No texture: alpha is the vertex alpha, 0 along the quad's left edge, 1 along its right.
+    vertex_alpha: bool,
+}
+
+use lightgraph::material::model::{
+    Filter, MipmapFilter, SamplerDesc, TextureSampling, UvTransform, Wrap,
+};
+
+const CASES: [SamplerCase; 6] = [
+    SamplerCase {
+        name: "mirrored repeat, nearest",
+        wrap: Wrap::MirroredRepeat,
+        filter: Filter::Nearest,
+        uv: ([-1.5, -1.25], [2.5, 2.0]),
+        transform: None,
+        uv1: false,
+        vertex_alpha: false,
+    },
+    SamplerCase {
+        name: "clamp to edge, nearest",
+        wrap: Wrap::ClampToEdge,
+        filter: Filter::Nearest,
+        uv: ([-0.5, -0.75], [1.5, 1.25]),
+        transform: None,
+        uv1: false,
+        vertex_alpha: false,
+    },
+    SamplerCase {
+        name: "repeat, nearest, uv transform",
+        wrap: Wrap::Repeat,
+        filter: Filter::Nearest,
+        uv: ([0.0, 0.0], [1.0, 1.0]),
+        transform: Some(UvTransform {
+            offset: (0.1, 0.2),
+            rotation: 0.3,
+            scale: (1.5, 2.0),
+        }),
+        uv1: false,
+        vertex_alpha: false,
+    },
+    SamplerCase {
+        name: "repeat, nearest, second uv set",
+        wrap: Wrap::Repeat,
+        filter: Filter::Nearest,
+        uv: ([0.25, 0.0], [1.75, 1.0]),
+        transform: None,
+        uv1: true,
+        vertex_alpha: false,
+    },
+    SamplerCase {
+        name: "vertex alpha",
+        wrap: Wrap::Repeat,
+        filter: Filter::Nearest,
+        uv: ([0.0, 0.0], [1.0, 1.0]),
+        transform: None,
+        uv1: false,
+        vertex_alpha: true,
+    },
+    SamplerCase {
+        name: "repeat, bilinear",
+        wrap: Wrap::Repeat,
+        filter: Filter::Linear,
+        uv: ([-0.5, 0.0], [1.5, 1.0]),
+        transform: None,
+        uv1: false,
+        vertex_alpha: false,
+    },
+];
+
+/// Texels a side of the random alpha texture.
+const N: usize = 8;
+
+/// Alpha 0 or 255 per texel, fixed.
+fn alpha_texels() -> Vec<u8> {
+    let mut rng = common::Rng(5);
+    (0..N * N)
+        .map(|_| if rng.f32() < 0.5 { 0 } else { 255 })
+        .collect()
+}
+
+/// Quads side by side in the plane z = 0, 1 m a side, facing +z: quad k spans
+/// x in [2k, 2k + 1], y in [0, 1].
+fn sampler_scene() -> Scene {
+    use lightgraph::scene::{AlphaMode, Mesh, SlotSampling, SurfaceMaterial, TextureImage};
+    let rgba8: Vec<u8> = alpha_texels()
+        .iter()
+        .flat_map(|&a| [200, 100, 50, a])
+        .collect();
+    let image = std::sync::Arc::new(TextureImage {
+        name: "random alpha".into(),
+        width: N as u32,
+        height: N as u32,
+        rgba8,
+        srgb: true,
+    });
+    let mut s = Scene::default();
+    for (k, c) in CASES.iter().enumerate() {
+        let sampler = SamplerDesc {
+            wrap_u: c.wrap,
+            wrap_v: c.wrap,
+            mag_filter: c.filter,
+            min_filter: c.filter,
+            mipmap_filter: MipmapFilter::Linear,
+        };
+        let mut sampling = SlotSampling::default();
+        sampling.base_color = TextureSampling {
+            sampler,
+            transform: c.transform,
+            tex_coord: u32::from(c.uv1),
+        };
+        s.materials.push(SurfaceMaterial {
+            name: c.name.into(),
+            base_color_texture: (!c.vertex_alpha).then(|| image.clone()),
+            alpha_mode: AlphaMode::Mask(0.5),
+            double_sided: true,
+            vertex_color: c.vertex_alpha,
+            sampling,
+            ..Default::default()
+        });
+        let x0 = 2.0 * k as f32;
+        let mut m = Mesh {
+            name: c.name.into(),
+            material: k,
+            ..Default::default()
+        };
+        for (s_, t) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
+            m.positions.push(Vec3::new(x0 + s_, t, 0.0));
+            m.normals.push(Vec3::Z);
+            let (lo, hi) = c.uv;
+            let uv = glam::Vec2::new(
+                (lo[0] + (hi[0] - lo[0]) * s_ as f64) as f32,
+                (lo[1] + (hi[1] - lo[1]) * t as f64) as f32,
+            );
+            if c.uv1 {
+                m.uvs.push(glam::Vec2::ZERO);
+                m.uvs1.push(uv);
+            } else {
+                m.uvs.push(uv);
+            }
+            m.tangents.push(glam::Vec4::new(1.0, 0.0, 0.0, 1.0));
+            if c.vertex_alpha {
+                m.colors.push(glam::Vec4::new(1.0, 1.0, 1.0, s_));
+            }
+        }
+        m.indices.extend([0, 1, 2, 0, 2, 3]);
+        s.meshes.push(m);
+    }
+    s
+}
+
+/// The texel index a nearest sampler reads at `c` (uv units) by the glTF sampler's
+/// definition, or None within 1e-3 of a texel's edge.
+fn nearest_texel(c: f64, wrap: Wrap) -> Option<usize> {
+    let n = N as f64;
+    let folded = match wrap {
+        Wrap::Repeat => c - c.floor(),
+        // Past either side: the edge texel, whatever the distance.
+        Wrap::ClampToEdge if c <= 0.0 => return Some(0),
+        Wrap::ClampToEdge if c >= 1.0 => return Some(N - 1),
+        Wrap::ClampToEdge => c,
+        // Even periods run forwards, odd ones backwards.
+        Wrap::MirroredRepeat => {
+            let period = c.floor();
+            let f = c - period;
+            if (period as i64).rem_euclid(2) == 0 {
+                f
+            } else {
+                1.0 - f
+            }
+        }
+    };
+    let x = folded * n;
+    if (x - x.round()).abs() < 1e-3 {
+        return None;
+    }
+    Some((x.floor() as usize).min(N - 1))
+}
+
+/// Whether case `c`'s material keeps (blocks rays) at point (s, t) of its quad, computed
+/// from the case's definition; None where a texel's edge or the cutoff is too near to say.
+fn kept(c: &SamplerCase, s: f64, t: f64, texels: &[u8]) -> Option<bool> {
+    if c.vertex_alpha {
+        return ((s - 0.5).abs() > 1e-4).then_some(s >= 0.5);
+    }
+    let (lo, hi) = c.uv;
+    let (mut u, mut v) = (lo[0] + (hi[0] - lo[0]) * s, lo[1] + (hi[1] - lo[1]) * t);
+    if let Some(tr) = c.transform {
+        // KHR_texture_transform: scale, then rotate, then offset.
+        let (su, sv) = (u * tr.scale.0 as f64, v * tr.scale.1 as f64);
+        let (sin, cos) = (tr.rotation as f64).sin_cos();
+        u = cos * su + sin * sv + tr.offset.0 as f64;
+        v = -sin * su + cos * sv + tr.offset.1 as f64;
+    }
+    if c.filter == Filter::Linear {
+        // Bilinear between the four texel centres around (u, v), tiled (repeat only).
+        assert_eq!(c.wrap, Wrap::Repeat);
+        let (x, y) = (u * N as f64 - 0.5, v * N as f64 - 0.5);
+        let (x0, y0) = (x.floor(), y.floor());
+        let at = |i: f64, j: f64| {
+            let (i, j) = (
+                i.rem_euclid(N as f64) as usize,
+                j.rem_euclid(N as f64) as usize,
+            );
+            texels[j * N + i] as f64 / 255.0
+        };
+        let (tx, ty) = (x - x0, y - y0);
+        let top = at(x0, y0) * (1.0 - tx) + at(x0 + 1.0, y0) * tx;
+        let bottom = at(x0, y0 + 1.0) * (1.0 - tx) + at(x0 + 1.0, y0 + 1.0) * tx;
+        let alpha = top * (1.0 - ty) + bottom * ty;
+        return ((alpha - 0.5).abs() > 1e-3).then_some(alpha >= 0.5);
+    }
+    let (i, j) = (nearest_texel(u, c.wrap)?, nearest_texel(v, c.wrap)?);
+    Some(texels[j * N + i] >= 128)
+}
+
+#[test]
+fn every_wrap_mode_filter_transform_and_uv_set_alpha_tests_rays_as_sampled() {
+    let r = renderer();
+    let scene = sampler_scene();
+    let bvh = ShadowBvh::build(&scene).unwrap();
+    assert!(
+        bvh.alpha.unsupported.is_empty(),
+        "{:?}",
+        bvh.alpha.unsupported
+    );
+    assert_eq!(bvh.alpha.records(), 2 * CASES.len() as u32);
+    let texels = alpha_texels();
+    let mut rng = common::Rng(17);
+    let mut rays = Vec::new();
+    let mut points = Vec::new();
+    for k in 0..CASES.len() {
+        for _ in 0..600 {
+            let (s, t) = (rng.f32() as f64, rng.f32() as f64);
+            let x = 2.0 * k as f64 + s;
+            // Straight down through the quad; a ray on its diagonal may meet both
+            // triangles or neither, so the diagonal's neighbourhood is left out.
+            if (s - t).abs() < 1e-4 {
+                continue;
+            }
+            rays.push((
+                Vec3::new(x as f32, t as f32, 1.0),
+                Vec3::new(0.0, 0.0, -2.0),
+                1.0,
+            ));
+            points.push((k, s, t));
+        }
+    }
+    let gpu = gpu_occluded(&r, &bvh, &rays);
+    for (k, c) in CASES.iter().enumerate() {
+        let (mut blocked, mut passed, mut unsure, mut gpu_differs) = (0, 0, 0, 0);
+        for (i, &(case, s, t)) in points.iter().enumerate() {
+            if case != k {
+                continue;
+            }
+            let (o, d, t_max) = rays[i];
+            let cpu = bvh.occluded(o, d, t_max);
+            if cpu != gpu[i] {
+                gpu_differs += 1;
+            }
+            match kept(c, s, t, &texels) {
+                Some(want) => {
+                    assert_eq!(cpu, want, "{}: CPU twin at ({s}, {t})", c.name);
+                    assert_eq!(gpu[i], want, "{}: GPU at ({s}, {t})", c.name);
+                    if want {
+                        blocked += 1;
+                    } else {
+                        passed += 1;
+                    }
+                }
+                None => unsure += 1,
+            }
+        }
+        eprintln!(
+            "{}: {blocked} blocked, {passed} through, {unsure} by an edge; GPU against the CPU twin: {gpu_differs} differ",
+            c.name
+        );
+        // The twins run the same f32 steps; only a rounding at the cutoff could split them.
+        assert!(gpu_differs <= 2, "{}: {gpu_differs} rays differ", c.name);
+        assert!(
+            blocked > 100 && passed > 100,
+            "{}: {blocked} / {passed}",
+            c.name
+        );
+    }
 }
