@@ -12,6 +12,9 @@
 //! rays straight down: the GPU's `bvh_occluded` (a standalone kernel) and the CPU twin
 //! each equal the texel the glTF sampler's definition picks (computed here in f64),
 //! except rays within 1e-3 texel of a texel's edge or 1e-3 of the cutoff (counted).
+//!
+//! A byte budget (the device's storage binding limit) first copies the textures at a
+//! smaller mip level, then gives the alpha test up, saying so.
 
 mod common;
 
@@ -612,5 +615,77 @@ fn every_wrap_mode_filter_transform_and_uv_set_alpha_tests_rays_as_sampled() {
             "{}: {blocked} / {passed}",
             c.name
         );
+    }
+}
+
+#[test]
+fn a_byte_budget_shrinks_the_textures_then_gives_the_alpha_test_up() {
+    use common::textured::checker;
+    use lightgraph::shadow::BuildOptions;
+    // The stripes at 256 texels a side (256 KiB of texels), over a grid of floor points.
+    let mut s = scene(true);
+    s.materials[1].base_color_texture = Some(std::sync::Arc::new(checker(
+        "stripes",
+        256,
+        8,
+        [230, 120, 40],
+        [40, 90, 200],
+    )));
+    let points: Vec<DVec3> = (0..80 * 80)
+        .map(|k| {
+            DVec3::new(
+                -2.0 + (k % 80) as f64 * 0.05,
+                0.0,
+                -2.0 + (k / 80) as f64 * 0.05,
+            )
+        })
+        .collect();
+    let agreement = |budget: u64| {
+        let options = BuildOptions {
+            max_alpha_bytes: budget,
+            ..Default::default()
+        };
+        let bvh = ShadowBvh::build_with(&s, &options).unwrap();
+        let bytes = 4 * bvh.alpha.words.len() as u64;
+        assert!(bytes <= budget, "{bytes} bytes over a budget of {budget}");
+        let (mut agree, mut total) = (0, 0);
+        for p in &points {
+            let Some(hidden) = expected(*p) else { continue };
+            let (o, dir, t_max) = shadow_ray(p.as_vec3(), Vec3::Y, LIGHT, OFFSET);
+            total += 1;
+            agree += usize::from(bvh.occluded(o, dir, t_max) == hidden);
+        }
+        (bvh, bytes, agree, total)
+    };
+    let (full, full_bytes, agree, total) = agreement(1 << 20);
+    assert!(full.alpha.unsupported.is_empty());
+    assert_eq!(agree, total, "at level 0");
+    // Half the level-0 texels: the next level (128 a side, 64 KiB) fits, and its box
+    // filter keeps the 32-texel stripes but for their edge texels.
+    let (half, bytes, agree, total) = agreement(full_bytes / 2);
+    assert_eq!(half.alpha.records(), 2);
+    assert!(bytes < full_bytes / 3, "{bytes} of {full_bytes}");
+    assert!(agree * 100 >= total * 98, "{agree} of {total} at level 1");
+    // Under the 64-texel floor: no alpha test, said, and the quad blocks as a solid one.
+    let (none, _, _, _) = agreement(8 << 10);
+    assert_eq!(none.alpha.records(), 0);
+    assert!(
+        none.alpha.unsupported[0].contains("over the 0 MiB"),
+        "{:?}",
+        none.alpha.unsupported
+    );
+    let l = LIGHT.as_dvec3();
+    let under_cut_outs: Vec<&DVec3> = points
+        .iter()
+        .filter(|p| {
+            let q = **p + (l - **p) * ((QUAD_Y - p.y) / (l.y - p.y));
+            expected(**p) == Some(false) && q.x.abs() < HALF && q.z.abs() < HALF
+        })
+        .collect();
+    assert!(under_cut_outs.len() > 100, "{}", under_cut_outs.len());
+    for p in under_cut_outs {
+        let (o, dir, t_max) = shadow_ray(p.as_vec3(), Vec3::Y, LIGHT, OFFSET);
+        assert!(none.occluded(o, dir, t_max), "under a cut-out at {p}");
+        assert!(!full.occluded(o, dir, t_max), "under a cut-out at {p}");
     }
 }

@@ -91,6 +91,7 @@ impl GpuBvh {
         let bvh = if full {
             let options = crate::shadow::BuildOptions {
                 quality: scene.shadow_bvh,
+                max_alpha_bytes: device.limits().max_storage_buffer_binding_size,
                 ..Default::default()
             };
             crate::shadow::ShadowBvh::build_with(scene, &options)?
@@ -106,7 +107,9 @@ impl GpuBvh {
             })
         };
         for unsupported in &bvh.alpha.unsupported {
-            log::warn!("masked caster material {unsupported}: its cut-out parts block shadow rays");
+            log::warn!(
+                "shadow rays do not alpha-test {unsupported}; cut-out parts block rays as opaque ones"
+            );
         }
         Ok(Self {
             nodes: upload("bvh_nodes", nodes),

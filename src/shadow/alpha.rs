@@ -30,8 +30,11 @@ pub const TEXTURE_WORDS: usize = 12;
 pub const OP_WORDS: usize = 3;
 /// Values an alpha expression may hold at once (`BVH_ALPHA_STACK` in the WGSL).
 pub const STACK: usize = 8;
-/// Textures are copied at the first mip level no side of which is longer.
+/// Textures are copied at the first mip level no side of which is longer (or shorter
+/// sides, where the whole table must fit a byte budget: [`AlphaTable::builder`]).
 pub const MAX_TEXTURE_SIDE: u32 = 2048;
+/// The shortest side a budget may shrink textures to before the alpha test is given up.
+const MIN_TEXTURE_SIDE: u32 = 64;
 
 /// Operation codes (`BVH_ALPHA_OP_*` in the WGSL).
 pub(crate) const OP_CONST: u32 = 0;
@@ -54,8 +57,9 @@ pub(crate) const WRAP_MIRROR: u32 = 2;
 pub struct AlphaTable {
     /// The `bvh_alpha` buffer's words.
     pub words: Vec<u32>,
-    /// Masked materials whose alpha could not be compiled (named, with why): their
-    /// triangles block rays as opaque ones do.
+    /// What is not alpha-tested, and why (a material whose alpha could not be compiled,
+    /// or every masked caster where the data would not fit): those triangles block rays
+    /// as opaque ones do.
     pub unsupported: Vec<String>,
 }
 
@@ -86,8 +90,49 @@ struct TextureKey {
 
 impl AlphaTable {
     /// Compiles the alpha of every alpha-masked material of `scene` (by its index in
-    /// `scene.materials`); [`AlphaBuilder::push_mesh`] then adds the triangles.
-    pub(crate) fn builder(scene: &Scene) -> AlphaBuilder {
+    /// `scene.materials`) whose meshes cast shadows; [`AlphaBuilder::push_triangle`] then
+    /// adds their triangles. The whole table (with a record for each of those triangles)
+    /// stays within `max_bytes` (a storage binding's limit): textures are copied at
+    /// smaller mip levels until it fits, down to [`MIN_TEXTURE_SIDE`]; past that no
+    /// triangle alpha-tests, and `unsupported` says why.
+    pub(crate) fn builder(scene: &Scene, max_bytes: u64) -> AlphaBuilder {
+        let masked = |m: &Mesh| {
+            scene.casts_shadow(m)
+                && scene
+                    .materials
+                    .get(m.material)
+                    .is_some_and(|s| matches!(s.alpha_mode, AlphaMode::Mask(_)))
+        };
+        let triangles: u64 = scene
+            .meshes
+            .iter()
+            .filter(|m| masked(m))
+            .map(|m| (m.indices.len() / 3) as u64)
+            .sum();
+        let record_bytes = 4 * RECORD_WORDS as u64 * triangles;
+        let mut side = MAX_TEXTURE_SIDE;
+        loop {
+            let builder = Self::builder_with_side(scene, side);
+            let bytes = 4 * builder.table.words.len() as u64 + record_bytes;
+            if bytes <= max_bytes || triangles == 0 {
+                return builder;
+            }
+            if side <= MIN_TEXTURE_SIDE {
+                let mut none = Self::builder_with_side(&Scene::default(), side);
+                none.programs = vec![None; scene.materials.len()];
+                none.table.unsupported.push(format!(
+                    "any masked caster: their alpha data takes {} MiB with textures of {side} texels a side, over the {} MiB a storage binding holds here",
+                    bytes.div_ceil(1 << 20),
+                    max_bytes >> 20
+                ));
+                return none;
+            }
+            side /= 2;
+        }
+    }
+
+    /// [`Self::builder`] with textures at most `side` texels a side, whatever the bytes.
+    fn builder_with_side(scene: &Scene, side: u32) -> AlphaBuilder {
         let mut programs_words: Vec<u32> = Vec::new();
         let mut programs = vec![None; scene.materials.len()];
         let mut textures: Vec<(TextureKey, [u32; TEXTURE_WORDS])> = Vec::new();
@@ -100,7 +145,7 @@ impl AlphaTable {
             let compiled = crate::render::materials::scene_material(scene, surface)
                 .map_err(|e| e.to_string())
                 .and_then(|(material, _)| {
-                    compile(&material, &mut textures, &mut texels)
+                    compile(&material, side, &mut textures, &mut texels)
                         .map_err(|why| format!("its alpha {why}"))
                 });
             match compiled {
@@ -108,7 +153,7 @@ impl AlphaTable {
                     programs[index] = Some(programs_words.len() as u32);
                     programs_words.extend(words);
                 }
-                Err(why) => unsupported.push(format!("'{}': {why}", surface.name)),
+                Err(why) => unsupported.push(format!("material '{}': {why}", surface.name)),
             }
         }
         let textures_at = HEADER_WORDS + programs_words.len();
@@ -284,6 +329,7 @@ fn sample(get: &impl Fn(usize) -> u32, texture: usize, uv: Vec2) -> Vec4 {
 /// The program words of `material`'s alpha: cutoff, operation count, operations.
 fn compile(
     material: &Material,
+    side: u32,
     textures: &mut Vec<(TextureKey, [u32; TEXTURE_WORDS])>,
     texels: &mut Vec<u32>,
 ) -> Result<Vec<u32>, String> {
@@ -293,13 +339,8 @@ fn compile(
         _ => 0.0,
     };
     let mut ops: Vec<[u32; OP_WORDS]> = Vec::new();
-    let depth = emit(
-        &desc.alpha,
-        material.texture_slots(),
-        textures,
-        texels,
-        &mut ops,
-    )?;
+    let mut copy = |slot: &TextureSlot| texture_index(slot, side, textures, texels);
+    let depth = emit(&desc.alpha, material.texture_slots(), &mut copy, &mut ops)?;
     if depth > STACK {
         return Err(format!("needs {depth} values at once, over {STACK}"));
     }
@@ -312,8 +353,7 @@ fn compile(
 fn emit(
     s: &Scalar,
     slots: &[TextureSlot],
-    textures: &mut Vec<(TextureKey, [u32; TEXTURE_WORDS])>,
-    texels: &mut Vec<u32>,
+    copy: &mut impl FnMut(&TextureSlot) -> Result<u32, String>,
     ops: &mut Vec<[u32; OP_WORDS]>,
 ) -> Result<usize, String> {
     Ok(match s {
@@ -330,7 +370,7 @@ fn emit(
                 .iter()
                 .find(|s| &s.name == texture)
                 .ok_or_else(|| format!("reads texture '{texture}', which it does not declare"))?;
-            let index = texture_index(slot, textures, texels)?;
+            let index = copy(slot)?;
             ops.push([
                 OP_TEXTURE | ((channel.index() as u32) << 8),
                 index,
@@ -343,22 +383,24 @@ fn emit(
             1
         }
         Scalar::Expr(ScalarExpr::OneMinus(a)) => {
-            let d = emit(a, slots, textures, texels, ops)?;
+            let d = emit(a, slots, copy, ops)?;
             ops.push([OP_ONE_MINUS, 0, 0]);
             d
         }
         Scalar::Expr(ScalarExpr::Mul(a, b)) => {
-            let da = emit(a, slots, textures, texels, ops)?;
-            let db = emit(b, slots, textures, texels, ops)?;
+            let da = emit(a, slots, copy, ops)?;
+            let db = emit(b, slots, copy, ops)?;
             ops.push([OP_MUL, 0, 0]);
             da.max(db + 1)
         }
     })
 }
 
-/// The index of `slot`'s texture record, copying its texels the first time.
+/// The index of `slot`'s texture record, copying its texels (at most `side` a side) the
+/// first time.
 fn texture_index(
     slot: &TextureSlot,
+    side: u32,
     textures: &mut Vec<(TextureKey, [u32; TEXTURE_WORDS])>,
     texels: &mut Vec<u32>,
 ) -> Result<u32, String> {
@@ -397,7 +439,7 @@ fn texture_index(
     if let Some(i) = textures.iter().position(|(k, _)| *k == key) {
         return Ok(i as u32);
     }
-    let (width, height, bytes) = level_within(&image)?;
+    let (width, height, bytes) = level_within(&image, side)?;
     let mut record = [0u32; TEXTURE_WORDS];
     record[0] = texels.len() as u32;
     record[1] = width;
@@ -413,10 +455,13 @@ fn texture_index(
     Ok(textures.len() as u32 - 1)
 }
 
-/// Level 0 of `image`, or its first mip level within [`MAX_TEXTURE_SIDE`].
-fn level_within(image: &crate::scene::TextureImage) -> Result<(u32, u32, Vec<u8>), String> {
+/// Level 0 of `image`, or its first mip level within `side`.
+fn level_within(
+    image: &crate::scene::TextureImage,
+    side: u32,
+) -> Result<(u32, u32, Vec<u8>), String> {
     let (w, h) = (image.width, image.height);
-    if w.max(h) <= MAX_TEXTURE_SIDE {
+    if w.max(h) <= side {
         return Ok((w, h, image.rgba8.clone()));
     }
     let chain = crate::render::texture_mips::mip_chain(w, h, &image.rgba8, image.srgb)?;
@@ -425,7 +470,7 @@ fn level_within(image: &crate::scene::TextureImage) -> Result<(u32, u32, Vec<u8>
     loop {
         let (lw, lh) = ((w >> level).max(1), (h >> level).max(1));
         let bytes = 4 * lw as usize * lh as usize;
-        if lw.max(lh) <= MAX_TEXTURE_SIDE {
+        if lw.max(lh) <= side {
             return Ok((lw, lh, chain.rgba8[at..at + bytes].to_vec()));
         }
         at += bytes;

@@ -115,6 +115,9 @@ pub struct BuildOptions {
     /// Cost of visiting an inner node relative to testing one triangle, for that
     /// leaf-collapse decision.
     pub traversal_cost: f32,
+    /// Most bytes the alpha data of masked casters may take ([`ShadowBvh::alpha`]: the
+    /// device's storage binding limit).
+    pub max_alpha_bytes: u64,
 }
 
 impl Default for BuildOptions {
@@ -123,6 +126,8 @@ impl Default for BuildOptions {
             quality: BuildQuality::default(),
             max_leaf_triangles: 8,
             traversal_cost: 2.0,
+            // wgpu's default storage binding limit.
+            max_alpha_bytes: 128 << 20,
         }
     }
 }
@@ -290,7 +295,7 @@ impl ShadowBvh {
     /// Builds over every triangle of every mesh in the scene with the given options.
     pub fn build_with(scene: &Scene, options: &BuildOptions) -> Result<Self, ShadowError> {
         let start = Instant::now();
-        let mut alpha = AlphaTable::builder(scene);
+        let mut alpha = AlphaTable::builder(scene, options.max_alpha_bytes);
         let g = gather(
             scene.meshes.iter().map(|m| {
                 (
