@@ -50,7 +50,7 @@ fn no_arguments_writes_lightgraph_png_sized_for_the_adapter() {
 }
 
 /// In a checkout (the root has scenes/gallery.ron) no arguments render the gallery, its
-/// glTF models, 1,026 lights (two casting shadows) and glass, through the default graph,
+/// glTF models, 1,027 lights (three casting shadows) and glass, through the default graph,
 /// and say where the picture went.
 #[test]
 fn no_arguments_in_a_checkout_render_the_gallery() {
@@ -59,7 +59,7 @@ fn no_arguments_in_a_checkout_render_the_gallery() {
     let o = lightgraph(dir.path(), &["--root", root.to_str().unwrap()]);
     let (out, err) = text(&o);
     assert!(o.status.success(), "{out}\n{err}");
-    assert!(err.contains("rendering gallery (1026 lights) at "), "{err}");
+    assert!(err.contains("rendering gallery (1027 lights) at "), "{err}");
     assert!(out.contains("shadow_ray_cast"), "{out}");
     assert!(out.contains("graphs/default.ron, "), "{out}");
     assert!(out.contains("transparent_shading"), "{out}");
