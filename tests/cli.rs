@@ -61,6 +61,11 @@ fn no_arguments_in_a_checkout_render_the_gallery() {
     assert!(o.status.success(), "{out}\n{err}");
     assert!(err.contains("rendering gallery (1027 lights) at "), "{err}");
     assert!(out.contains("shadow_ray_cast"), "{out}");
+    // AlphaBlendModeTest's masked strips: six triangles whose cut-outs rays pass through.
+    assert!(
+        out.contains("shadow rays alpha-test 6 triangles of alpha-masked casters"),
+        "{out}"
+    );
     assert!(out.contains("graphs/default.ron, "), "{out}");
     assert!(out.contains("transparent_shading"), "{out}");
     assert!(!err.contains("TransparentShading"), "{err}");

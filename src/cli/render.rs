@@ -367,6 +367,12 @@ fn shadow_report(scene: &Scene, gpu: &SceneGpu, result: &FrameResult) {
             s.build_time.as_secs_f64() * 1e3,
             b.bytes() as f64 / (1 << 20) as f64
         );
+        if b.alpha_triangles > 0 {
+            println!(
+                "  shadow rays alpha-test {} triangles of alpha-masked casters",
+                b.alpha_triangles
+            );
+        }
     }
     for a in &result.atlases {
         atlas_report(a);

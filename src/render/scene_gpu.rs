@@ -76,6 +76,8 @@ pub struct GpuBvh {
     /// What alpha-tested rays read (`bvh_alpha` binding); None when no caster is
     /// alpha-masked.
     pub alpha: Option<wgpu::Buffer>,
+    /// Triangles of alpha-masked casters that rays alpha-test.
+    pub alpha_triangles: u32,
     /// What the build found: triangles kept and skipped, and the tree's shape.
     pub stats: crate::shadow::BuildStats,
 }
@@ -115,6 +117,7 @@ impl GpuBvh {
             nodes: upload("bvh_nodes", nodes),
             triangles: upload("bvh_triangles", triangles),
             alpha: bvh.alpha_bytes().map(|b| upload("bvh_alpha", b)),
+            alpha_triangles: bvh.alpha.records(),
             stats: bvh.stats,
         })
     }
