@@ -84,25 +84,3 @@ fn shadow_ray_alpha_layout_matches() {
         assert_eq!(constant(&m, name), value as u64, "{name}");
     }
 }
-
-#[test]
-fn vpl_visibility_compiles_with_the_alpha_test() {
-    // The other tracers with BVH_ALPHA_TEST render in tests/masked_shadow_rays.rs; VPL
-    // visibility runs only with indirect lights, so its composed shader is checked here.
-    for ids in [false, true] {
-        let mut d = vec![
-            ("VPL_BLOCK", "8u"),
-            ("VPL_WORDS", "4u"),
-            ("SHADOW_NORMAL_OFFSET", "1e-4"),
-            ("BVH_ALPHA_TEST", "1"),
-        ];
-        if ids {
-            d.push(("VISIBILITY_IDS", "1"));
-        }
-        let m = module("indirect/vpl_visibility.wgsl", &d);
-        assert!(m
-            .global_variables
-            .iter()
-            .any(|(_, g)| g.name.as_deref() == Some("bvh_alpha")));
-    }
-}
