@@ -79,23 +79,33 @@ fn bvh_slab(n: BvhNode, origin: vec3<f32>, inv_dir: vec3<f32>, t_max: f32) -> f3
     return select(BVH_MISS, near, near <= far);
 }
 
-// Two-sided Möller–Trumbore, hit for 0 < t < t_max.
-fn bvh_triangle_hit(tri: BvhTriangle, origin: vec3<f32>, dir: vec3<f32>, t_max: f32) -> bool {
+// Two-sided Möller–Trumbore, hit for 0 < t < t_max: the hit's barycentrics (u, v) of the
+// second and third vertex (alpha-tested triangles read the material there), or (-1, -1)
+// for a miss.
+fn bvh_triangle_hit_uv(tri: BvhTriangle, origin: vec3<f32>, dir: vec3<f32>, t_max: f32) -> vec2<f32> {
+    let miss = vec2<f32>(-1.0);
     let p = cross(dir, tri.e2);
     let det = dot(tri.e1, p);
     if (abs(det) < BVH_MIN_DET) {
-        return false;
+        return miss;
     }
     let inv_det = 1.0 / det;
     let s = origin - tri.v0;
     let u = dot(s, p) * inv_det;
     if (u < 0.0 || u > 1.0) {
-        return false;
+        return miss;
     }
     let q = cross(s, tri.e1);
     let v = dot(dir, q) * inv_det;
     let t = dot(tri.e2, q) * inv_det;
-    return v >= 0.0 && u + v <= 1.0 && t > 0.0 && t < t_max;
+    if (v >= 0.0 && u + v <= 1.0 && t > 0.0 && t < t_max) {
+        return vec2<f32>(u, v);
+    }
+    return miss;
+}
+
+fn bvh_triangle_hit(tri: BvhTriangle, origin: vec3<f32>, dir: vec3<f32>, t_max: f32) -> bool {
+    return bvh_triangle_hit_uv(tri, origin, dir, t_max).x >= 0.0;
 }
 
 #if BVH_ALPHA_TEST
@@ -258,29 +268,6 @@ fn bvh_alpha_cut_out(record: u32, u: f32, v: f32) -> bool {
     return alpha < cutoff;
 }
 
-// Möller–Trumbore as bvh_triangle_hit, giving the hit's barycentrics (u, v) of the
-// second and third vertex, or (-1, -1) for a miss.
-fn bvh_triangle_hit_uv(tri: BvhTriangle, origin: vec3<f32>, dir: vec3<f32>, t_max: f32) -> vec2<f32> {
-    let miss = vec2<f32>(-1.0);
-    let p = cross(dir, tri.e2);
-    let det = dot(tri.e1, p);
-    if (abs(det) < BVH_MIN_DET) {
-        return miss;
-    }
-    let inv_det = 1.0 / det;
-    let s = origin - tri.v0;
-    let u = dot(s, p) * inv_det;
-    if (u < 0.0 || u > 1.0) {
-        return miss;
-    }
-    let q = cross(s, tri.e1);
-    let v = dot(dir, q) * inv_det;
-    let t = dot(tri.e2, q) * inv_det;
-    if (v >= 0.0 && u + v <= 1.0 && t > 0.0 && t < t_max) {
-        return vec2<f32>(u, v);
-    }
-    return miss;
-}
 #endif
 
 fn bvh_leaf_hit(n: BvhNode, origin: vec3<f32>, dir: vec3<f32>, t_max: f32) -> bool {
