@@ -14,7 +14,9 @@
 //! except rays within 1e-3 texel of a texel's edge or 1e-3 of the cutoff (counted).
 //!
 //! A byte budget (the device's storage binding limit) first copies the textures at a
-//! smaller mip level, then gives the alpha test up, saying so.
+//! smaller mip level, then gives the alpha test up, saying so. A reloaded masked
+//! material (a copy of the upload with its program replaced, as hot reload makes)
+//! reshapes the rays' shadows: the BVH's alpha is built again.
 
 mod common;
 
@@ -688,4 +690,67 @@ fn a_byte_budget_shrinks_the_textures_then_gives_the_alpha_test_up() {
         assert!(none.occluded(o, dir, t_max), "under a cut-out at {p}");
         assert!(!full.occluded(o, dir, t_max), "under a cut-out at {p}");
     }
+}
+
+#[test]
+fn a_reloaded_masked_material_reshapes_the_rays_shadows() {
+    use lightgraph::graph::{self, FrameSize};
+    use lightgraph::material::Material;
+    use lightgraph::render::{MaterialProgram, SceneGpu};
+    use lightgraph::scene::AlphaMode;
+    use lightgraph::shader::ShaderLibrary;
+    let mut r = renderer();
+    let before = scene(true);
+    let floor = floor_positions(&mut r, &before);
+    // The stripes' cut-out alpha is 20/255: a cutoff of 0.05 keeps every texel.
+    let mut after = before.clone();
+    after.materials[1].alpha_mode = AlphaMode::Mask(0.05);
+    let size = FrameSize {
+        width: W,
+        height: H,
+        lights: 1,
+    };
+    let frame = |r: &mut lightgraph::render::Renderer, s: &Scene, gpu: &SceneGpu| {
+        let checked = graph::check_text(
+            std::path::Path::new("default.ron"),
+            &graph_text("default.ron"),
+            &ShaderLibrary::builtin(),
+        )
+        .unwrap();
+        let compiled = graph::compile(checked, &s.features(), size);
+        let prepared = r.prepare(compiled, s, gpu, size, false).unwrap();
+        prepared.render(r).unwrap().image
+    };
+    let gpu = SceneGpu::upload(&r.ctx.device, &r.ctx.queue, &before).unwrap();
+    let stripes = frame(&mut r, &before, &gpu);
+    // What a material hot reload does: a copy of the live upload with the program
+    // replaced, the scene (whose material the BVH's alpha reads) as it now stands.
+    let mut edited = gpu.clone();
+    let program = MaterialProgram::new(
+        &r.ctx.device,
+        &r.ctx.queue,
+        &Material::from_surface(&after.materials[1]),
+        after.materials[1].alpha_mode,
+        true,
+    )
+    .unwrap();
+    edited.set_material(1, program);
+    let solid = frame(&mut r, &after, &edited);
+    // Pixels that show the floor in both frames (the solid quad now hides some).
+    let floor_after = floor_positions(&mut r, &after);
+    let mut newly_shadowed = 0;
+    for (pixel, p) in floor.iter().enumerate() {
+        let (Some(p), Some(false), Some(_)) = (p, p.and_then(expected), floor_after[pixel]) else {
+            continue;
+        };
+        let l = LIGHT.as_dvec3();
+        let q = *p + (l - *p) * ((QUAD_Y - p.y) / (l.y - p.y));
+        if q.x.abs() < HALF && q.z.abs() < HALF {
+            // Under a cut-out: lit through it before, shadowed once every texel is kept.
+            assert!(stripes[pixel][0] > 0.0, "pixel {pixel} lit before");
+            assert_eq!(solid[pixel][0], 0.0, "pixel {pixel} after the edit");
+            newly_shadowed += 1;
+        }
+    }
+    assert!(newly_shadowed > 150, "{newly_shadowed} pixels");
 }

@@ -457,7 +457,8 @@ impl ReloadSession {
                         &mut uploads,
                     )
                     .map_err(|e| e.to_string())?;
-                    gpu.get_or_insert_with(|| self.gpu.clone()).materials[i] = program;
+                    gpu.get_or_insert_with(|| self.gpu.clone())
+                        .set_material(i, program);
                     files = used;
                 }
                 materials.push((name.to_string(), files));

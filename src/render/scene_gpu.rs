@@ -336,6 +336,20 @@ impl SceneGpu {
         self.geometry_changed();
     }
 
+    /// Replaces material `index` (a hot-reloaded material). Where it alpha-tests, before
+    /// or now, the BVH is dropped, so the next pass that binds it builds it again with the
+    /// material's alpha (rays read it, `bvh_alpha`); clones of this upload keep theirs.
+    pub fn set_material(&mut self, index: usize, program: MaterialProgram) {
+        let masked = |m: &MaterialProgram| matches!(m.alpha_mode, AlphaMode::Mask(_));
+        let was_masked = self.materials.get(index).is_some_and(masked);
+        if was_masked || masked(&program) {
+            self.bvh = Default::default();
+        }
+        if let Some(m) = self.materials.get_mut(index) {
+            *m = program;
+        }
+    }
+
     /// The meshes changed: number the ids again and drop what was built from the old
     /// geometry (clones of this upload keep theirs).
     fn geometry_changed(&mut self) {
