@@ -80,6 +80,15 @@ pub(crate) struct AlphaBuilder {
     records: Vec<[u32; RECORD_WORDS]>,
 }
 
+/// An alpha-masked scene material, as its alpha is compiled from.
+struct MaskedMaterial<'a> {
+    /// Its index in `Scene::materials`.
+    index: usize,
+    name: &'a str,
+    /// The layered material (an override's or the glTF mapping), or why it is not there.
+    material: Result<Material, String>,
+}
+
 /// One texture as it is copied: which image, sampled how.
 #[derive(PartialEq)]
 struct TextureKey {
@@ -110,16 +119,31 @@ impl AlphaTable {
             .map(|m| (m.indices.len() / 3) as u64)
             .sum();
         let record_bytes = 4 * RECORD_WORDS as u64 * triangles;
+        // Each masked material read once (an override's file parsed once), whatever the
+        // sides tried.
+        let masked_materials: Vec<MaskedMaterial> = scene
+            .materials
+            .iter()
+            .enumerate()
+            .filter(|(_, surface)| matches!(surface.alpha_mode, AlphaMode::Mask(_)))
+            .map(|(index, surface)| MaskedMaterial {
+                index,
+                name: &surface.name,
+                material: crate::render::materials::scene_material(scene, surface)
+                    .map(|(material, _)| material)
+                    .map_err(|e| e.to_string()),
+            })
+            .collect();
+        let count = scene.materials.len();
         let mut side = MAX_TEXTURE_SIDE;
         loop {
-            let builder = Self::builder_with_side(scene, side);
+            let builder = Self::builder_with_side(&masked_materials, count, side);
             let bytes = 4 * builder.table.words.len() as u64 + record_bytes;
             if bytes <= max_bytes || triangles == 0 {
                 return builder;
             }
             if side <= MIN_TEXTURE_SIDE {
-                let mut none = Self::builder_with_side(&Scene::default(), side);
-                none.programs = vec![None; scene.materials.len()];
+                let mut none = Self::builder_with_side(&[], count, side);
                 none.table.unsupported.push(format!(
                     "any masked caster: their alpha data takes {} MiB with textures of {side} texels a side, over the {} MiB a storage binding holds here",
                     bytes.div_ceil(1 << 20),
@@ -131,29 +155,29 @@ impl AlphaTable {
         }
     }
 
-    /// [`Self::builder`] with textures at most `side` texels a side, whatever the bytes.
-    fn builder_with_side(scene: &Scene, side: u32) -> AlphaBuilder {
+    /// [`Self::builder`] over `masked` (of `count` scene materials) with textures at most
+    /// `side` texels a side, whatever the bytes.
+    fn builder_with_side(masked: &[MaskedMaterial], count: usize, side: u32) -> AlphaBuilder {
         let mut programs_words: Vec<u32> = Vec::new();
-        let mut programs = vec![None; scene.materials.len()];
+        let mut programs = vec![None; count];
         let mut textures: Vec<(TextureKey, [u32; TEXTURE_WORDS])> = Vec::new();
         let mut texels: Vec<u32> = Vec::new();
         let mut unsupported = Vec::new();
-        for (index, surface) in scene.materials.iter().enumerate() {
-            if !matches!(surface.alpha_mode, AlphaMode::Mask(_)) {
-                continue;
-            }
-            let compiled = crate::render::materials::scene_material(scene, surface)
-                .map_err(|e| e.to_string())
-                .and_then(|(material, _)| {
-                    compile(&material, side, &mut textures, &mut texels)
+        for m in masked {
+            let compiled = m
+                .material
+                .as_ref()
+                .map_err(Clone::clone)
+                .and_then(|material| {
+                    compile(material, side, &mut textures, &mut texels)
                         .map_err(|why| format!("its alpha {why}"))
                 });
             match compiled {
                 Ok(words) => {
-                    programs[index] = Some(programs_words.len() as u32);
+                    programs[m.index] = Some(programs_words.len() as u32);
                     programs_words.extend(words);
                 }
-                Err(why) => unsupported.push(format!("material '{}': {why}", surface.name)),
+                Err(why) => unsupported.push(format!("material '{}': {why}", m.name)),
             }
         }
         let textures_at = HEADER_WORDS + programs_words.len();
