@@ -20,6 +20,7 @@
 
 mod common;
 
+use common::shadow_jobs::raycast_inspection_graph;
 use common::textured::push_striped_quad;
 use common::{graph_text, lambert, prepare_text, renderer};
 use glam::{DVec3, Vec3};
@@ -95,18 +96,9 @@ fn expected(p: DVec3) -> Option<bool> {
 }
 
 /// The floor's world positions per pixel (None off the floor), from the G-buffer of
-/// raycast_shadows.ron made the output (its shading pass left out: the frame's colour
-/// texture reuses the G-buffer's).
+/// raycast_shadows.ron.
 fn floor_positions(r: &mut lightgraph::render::Renderer, s: &Scene) -> Vec<Option<DVec3>> {
-    let full = graph_text("raycast_shadows.ron");
-    let start = full
-        .find("        Pass(\n            name: \"forward_shading\"")
-        .expect("shading pass");
-    let end = start + full[start..].find("        ),\n").unwrap() + "        ),\n".len();
-    let text = format!("{}{}", &full[..start], &full[end..]).replace(
-        "output: \"hdr\",",
-        "output: \"g_position\",\n    side_effects: [\"shadow_ray_cast\"],",
-    );
+    let text = raycast_inspection_graph();
     let prepared = prepare_text(r, &text, s, W, H, false).expect("prepare");
     prepared.render(r).expect("render");
     let g = prepared.read_texture(r, "g_position").unwrap();

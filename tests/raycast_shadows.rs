@@ -12,6 +12,7 @@
 
 mod common;
 
+use common::shadow_jobs::raycast_inspection_graph;
 use common::{graph_text, lambert, renderer, shadow_room, Rng};
 use glam::{DVec3, Vec3};
 use lightgraph::graph::{self, FrameSize};
@@ -27,22 +28,6 @@ const W: u32 = 96;
 const H: u32 = 64;
 /// Shaders' SHADOW_NORMAL_OFFSET default (ShadowRayCast's normal_offset).
 const OFFSET: f32 = 1e-4;
-
-/// raycast_shadows.ron without its shading pass, the G-buffer as the output and the
-/// casting pass kept as a side effect: what the shadow passes leave can be read back
-/// (in the full graph the frame's colour texture reuses the G-buffer's).
-fn inspection_graph(text: &str) -> String {
-    let start = text
-        .find("        Pass(\n            name: \"forward_shading\"")
-        .expect("shading pass");
-    let end = start + text[start..].find("        ),\n").unwrap() + "        ),\n".len();
-    let mut t = format!("{}{}", &text[..start], &text[end..]);
-    t = t.replace(
-        "output: \"hdr\",",
-        "output: \"g_position\",\n    side_effects: [\"shadow_ray_cast\"],",
-    );
-    t
-}
 
 fn caster(position: Vec3, range: f32, intensity: f32) -> Light {
     let mut l = Light::point(position, range, Vec3::ONE, intensity);
@@ -177,11 +162,7 @@ fn compare_with_reference(
 fn masks_equal_the_f64_reference_and_jobs_are_complete() {
     let mut r = renderer();
     let scene = shadow_scene(24, 7);
-    let (prepared, result) = run(
-        &mut r,
-        &inspection_graph(&graph_text("raycast_shadows.ron")),
-        &scene,
-    );
+    let (prepared, result) = run(&mut r, &raycast_inspection_graph(), &scene);
     let f = read_frame(&r, &prepared);
     let tris = scene_triangles_f64(&scene);
     let (agree, ambiguous, disagree) = compare_with_reference(&f, &tris, &scene.lights, OFFSET);
@@ -301,11 +282,7 @@ fn a_quad_over_a_floor_casts_its_projection() {
         },
         ..Default::default()
     };
-    let (prepared, _) = run(
-        &mut r,
-        &inspection_graph(&graph_text("raycast_shadows.ron")),
-        &scene,
-    );
+    let (prepared, _) = run(&mut r, &raycast_inspection_graph(), &scene);
     let f = read_frame(&r, &prepared);
     let (_, result) = run(&mut r, &graph_text("raycast_shadows.ron"), &scene);
     let (mut shadowed, mut lit, mut near_edge) = (0, 0, 0);
@@ -386,7 +363,7 @@ fn with_offset(text: &str, offset: f32) -> String {
 fn no_acne_at_grazing_light_and_acne_without_the_offset() {
     let mut r = renderer();
     let scene = grazing_scene();
-    let text = inspection_graph(&graph_text("raycast_shadows.ron"));
+    let text = raycast_inspection_graph();
     let acne = |r: &mut Renderer, offset: f32| {
         let (prepared, _) = run(r, &with_offset(&text, offset), &scene);
         let f = read_frame(r, &prepared);

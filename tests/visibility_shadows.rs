@@ -16,7 +16,7 @@
 
 mod common;
 
-use common::shadow_jobs::{compare_with_cpu_twin, pixel_jobs, Surfaces};
+use common::shadow_jobs::{compare_with_cpu_twin, pixel_jobs, raycast_inspection_graph, Surfaces};
 use common::{graph_text, lambert, prepare_text, renderer, shadow_room, Rng};
 use glam::{DVec3, Vec3};
 use lightgraph::render::{FrameResult, PreparedFrame, Renderer};
@@ -49,21 +49,6 @@ fn hardware_ids_graph() -> String {
         );
     assert!(out.contains("VisibilityBuffer") && out.contains("Depth32Float"));
     out
-}
-
-/// raycast_shadows.ron without its shading pass, the G-buffer as the output and the
-/// casting pass kept as a side effect, so its positions and normals can be read back (in
-/// the full graph the colour texture reuses the G-buffer's).
-fn forward_inspection_graph() -> String {
-    let text = graph_text("raycast_shadows.ron");
-    let start = text
-        .find("        Pass(\n            name: \"forward_shading\"")
-        .expect("shading pass");
-    let end = start + text[start..].find("        ),\n").unwrap() + "        ),\n".len();
-    format!("{}{}", &text[..start], &text[end..]).replace(
-        "output: \"hdr\",",
-        "output: \"g_position\",\n    side_effects: [\"shadow_ray_cast\"],",
-    )
 }
 
 fn caster(position: Vec3, range: f32, intensity: f32) -> Light {
@@ -251,7 +236,7 @@ fn check_against_forward_and_cpu(
     let (prepared, _) = run(r, vis_text, scene);
     let vis = pixel_jobs(r, &prepared, W * H);
     let ids = prepared.read_texture_bits(r, "visibility").unwrap();
-    let (fwd_prepared, _) = run(r, &forward_inspection_graph(), scene);
+    let (fwd_prepared, _) = run(r, &raycast_inspection_graph(), scene);
     let fwd = pixel_jobs(r, &fwd_prepared, W * H);
     let positions = fwd_prepared.read_texture(r, "g_position").unwrap();
     let normals = fwd_prepared.read_texture(r, "g_geometric").unwrap();

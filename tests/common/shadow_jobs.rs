@@ -121,3 +121,18 @@ pub fn compare_with_cpu_twin(
     }
     (agree, grazing, failures)
 }
+
+/// raycast_shadows.ron without its shading pass, the G-buffer as the output and the
+/// casting pass kept as a side effect, so its positions, normals, jobs and mask can be
+/// read back (in the full graph the frame's colour texture reuses the G-buffer's).
+pub fn raycast_inspection_graph() -> String {
+    let text = super::graph_text("raycast_shadows.ron");
+    let start = text
+        .find("        Pass(\n            name: \"forward_shading\"")
+        .expect("shading pass");
+    let end = start + text[start..].find("        ),\n").unwrap() + "        ),\n".len();
+    format!("{}{}", &text[..start], &text[end..]).replace(
+        "output: \"hdr\",",
+        "output: \"g_position\",\n    side_effects: [\"shadow_ray_cast\"],",
+    )
+}
