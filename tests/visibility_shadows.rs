@@ -445,6 +445,64 @@ fn default_graph_with_casters_is_the_visibility_shadow_frame() {
     );
 }
 
+/// Shadow jobs stop walking a pixel's list past the last casting light (the frame's
+/// `caster_end`; lists ascend). The casters first, then moved behind every light that
+/// casts none by an update: the updated frame equals one prepared for that order from
+/// the start, bit for bit and ray for ray, and the shadows are still there (without the
+/// update raising `caster_end`, the casters past the old end would cast nothing).
+#[test]
+fn casters_moved_down_the_list_by_an_update_still_cast() {
+    let scene = shadow_scene(24, 5);
+    let (casting, plain): (Vec<Light>, Vec<Light>) = scene
+        .lights
+        .iter()
+        .partition(|l| l.flags & light_flags::CASTS_SHADOW != 0);
+    assert!(casting.len() >= 8 && plain.len() >= 4);
+    let with = |lights: Vec<Light>| Scene {
+        lights,
+        ..scene.clone()
+    };
+    let first = with([casting.clone(), plain.clone()].concat());
+    let last = with([plain.clone(), casting.clone()].concat());
+    let mut r = renderer();
+    let text = graph_text("default.ron");
+    let (prepared, gpu) =
+        common::prepare_text_with_gpu(&mut r, "default.ron", &text, &first, W, H, 0);
+    prepared.update_lights(&r, &gpu, &last.lights).unwrap();
+    let updated = prepared.render(&r).unwrap();
+    let (_, fresh) = run(&mut r, &text, &last);
+    assert_eq!(updated.shadows[0].rays(), fresh.shadows[0].rays());
+    let bits = updated
+        .image
+        .iter()
+        .zip(&fresh.image)
+        .filter(|(a, b)| a.map(f32::to_bits) != b.map(f32::to_bits))
+        .count();
+    assert_eq!(bits, 0, "{bits} pixels differ");
+    // The casters shadow something: the same lights casting nothing light more pixels.
+    let unshadowed = with(
+        last.lights
+            .iter()
+            .map(|l| Light {
+                flags: l.flags & !light_flags::CASTS_SHADOW,
+                ..*l
+            })
+            .collect(),
+    );
+    let (_, open) = run(
+        &mut r,
+        &graph_text("visibility_compute_raster.ron"),
+        &unshadowed,
+    );
+    let darker = fresh
+        .image
+        .iter()
+        .zip(&open.image)
+        .filter(|(a, b)| a[0] < b[0] * 0.9)
+        .count();
+    assert!(darker > 100, "only {darker} pixels shadowed");
+}
+
 /// The gallery's textured glTF models (scenes/gallery.ron) without its glass and its
 /// untextured spheres (1.04 million of its triangles, which the CPU ray caster would
 /// spend minutes on), half of 512 of its lights casting shadows.

@@ -11,7 +11,9 @@ struct Frame {
     ambient: vec4<f32>,
     size: vec2<u32>,
     light_count: u32,
-    _pad0: u32,
+    // One past the highest index of a shadow-casting light (0 without): lists hold
+    // lights in ascending index, so a walk over a list's casters stops there.
+    caster_end: u32,
     near: f32,
     far: f32,
     _pad1: vec2<f32>,

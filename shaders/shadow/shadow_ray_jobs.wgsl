@@ -81,6 +81,11 @@ fn walk(px: Pixel, emit: bool) {
     var hidden = array<u32, 4>(0u, 0u, 0u, 0u);
     for (var k = 0u; k < px.range.count; k++) {
         let i = light_at(px.range, k);
+        // The list ascends: no caster past the last one (a scene's unshadowed crowd
+        // listed after its casters costs nothing here).
+        if (i >= frame.caster_end) {
+            break;
+        }
         let props = light_properties[i];
         if ((props.flags & LIGHT_CASTS_SHADOW) == 0u) {
             continue;

@@ -26,8 +26,10 @@ pub struct GpuFrame {
     pub size: [u32; 2],
     /// Lights the passes loop over: the scene upload's count, or the last light update's.
     pub light_count: u32,
-    /// Padding to WGSL's alignment; always 0.
-    pub _pad0: u32,
+    /// One past the highest index of a light that casts a shadow (0 without casters).
+    /// Light lists hold their lights in ascending index, so a walk over a list's
+    /// casters (shadow-ray jobs) stops there.
+    pub caster_end: u32,
     /// The camera's near plane distance (world units).
     pub near: f32,
     /// The camera's far plane distance (world units).
@@ -37,8 +39,16 @@ pub struct GpuFrame {
 }
 
 impl GpuFrame {
-    /// The uniforms for `camera` at `width`×`height` pixels with `light_count` lights.
-    pub fn new(camera: &Camera, ambient: Vec3, width: u32, height: u32, light_count: u32) -> Self {
+    /// The uniforms for `camera` at `width`×`height` pixels with `light_count` lights,
+    /// the casters among the first `caster_end` ([`caster_end`]).
+    pub fn new(
+        camera: &Camera,
+        ambient: Vec3,
+        width: u32,
+        height: u32,
+        light_count: u32,
+        caster_end: u32,
+    ) -> Self {
         let view = camera.view();
         let proj = camera.projection(width as f32 / height as f32);
         Self {
@@ -50,7 +60,7 @@ impl GpuFrame {
             ambient: ambient.extend(0.0).into(),
             size: [width, height],
             light_count,
-            _pad0: 0,
+            caster_end,
             near: camera.near,
             far: camera.far,
             _pad1: [0.0; 2],
@@ -60,6 +70,14 @@ impl GpuFrame {
     pub fn view_matrix(&self) -> Mat4 {
         Mat4::from_cols_array_2d(&self.view)
     }
+}
+
+/// One past the highest index of a light in `lights` that casts a shadow; 0 without one.
+pub fn caster_end(lights: &[Light]) -> u32 {
+    lights
+        .iter()
+        .rposition(|l| l.flags & crate::scene::light_flags::CASTS_SHADOW != 0)
+        .map_or(0, |i| i as u32 + 1)
 }
 
 /// What culling reads. Point lights have `cos_outer = -1`.

@@ -160,11 +160,13 @@ impl PreparedFrame {
     /// The light count and the passes' per-light state follow `lights`.
     fn lights_changed(&self, r: &Renderer, lights: &[Light]) {
         let count = lights.len() as u32;
-        self.light_count.set(count);
+        let caster_end = crate::gpu::structs::caster_end(lights);
+        self.light_count.set(count, caster_end);
+        // light_count and caster_end are neighbours in the uniform.
         r.ctx.queue.write_buffer(
             &self.frame_uniform,
             LIGHT_COUNT_OFFSET,
-            &count.to_ne_bytes(),
+            bytemuck::cast_slice(&[count, caster_end]),
         );
         for (_, pass) in &self.passes {
             pass.follow_lights(r, lights);
@@ -182,28 +184,37 @@ impl PreparedFrame {
     }
 }
 
-/// The light count of a prepared frame: the one number the CPU side reads it from (the
-/// frame uniform's `light_count`, which the GPU reads, is written from it). Shared with
-/// the passes that size work by it at record (a `Compute` pass dispatched `PerLight`).
+/// The light count of a prepared frame and its casters' end: the numbers the CPU side
+/// reads them from (the frame uniform's `light_count` and `caster_end`, which the GPU
+/// reads, are written from them). Shared with the passes that size work by the count at
+/// record (a `Compute` pass dispatched `PerLight`).
 #[derive(Clone, Debug, Default)]
-pub(crate) struct LightCount(std::sync::Arc<std::sync::atomic::AtomicU32>);
+pub(crate) struct LightCount(std::sync::Arc<[std::sync::atomic::AtomicU32; 2]>);
 
 impl LightCount {
-    /// A count starting at `n`.
-    pub fn new(n: u32) -> Self {
-        Self(std::sync::Arc::new(n.into()))
+    /// `n` lights, the casters among the first `caster_end`.
+    pub fn new(n: u32, caster_end: u32) -> Self {
+        Self(std::sync::Arc::new([n.into(), caster_end.into()]))
     }
     /// The lights passes loop over now.
     pub fn get(&self) -> u32 {
-        self.0.load(Ordering::Relaxed)
+        self.0[0].load(Ordering::Relaxed)
     }
-    fn set(&self, n: u32) {
-        self.0.store(n, Ordering::Relaxed)
+    /// One past the highest index of a light that casts a shadow now.
+    pub fn caster_end(&self) -> u32 {
+        self.0[1].load(Ordering::Relaxed)
+    }
+    fn set(&self, n: u32, caster_end: u32) {
+        self.0[0].store(n, Ordering::Relaxed);
+        self.0[1].store(caster_end, Ordering::Relaxed);
     }
 }
 
-/// Where the frame uniform keeps the light count.
+/// Where the frame uniform keeps the light count; `caster_end` follows it.
 const LIGHT_COUNT_OFFSET: u64 = std::mem::offset_of!(GpuFrame, light_count) as u64;
+const _: () = assert!(
+    std::mem::offset_of!(GpuFrame, caster_end) == std::mem::offset_of!(GpuFrame, light_count) + 4
+);
 
 /// The first light that needs a feature the compiled graph was made without.
 fn check_features(had: &SceneFeatures, lights: &[Light]) -> Result<(), LightUpdateError> {

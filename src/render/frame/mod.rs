@@ -204,8 +204,9 @@ impl Renderer {
             size.width,
             size.height,
             scene.lights.len() as u32,
+            crate::gpu::structs::caster_end(&scene.lights),
         );
-        let light_count = LightCount::new(gpu_frame.light_count);
+        let light_count = LightCount::new(gpu_frame.light_count, gpu_frame.caster_end);
         let frame_uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("frame"),
             contents: bytemuck::bytes_of(&gpu_frame),
@@ -491,6 +492,7 @@ impl PreparedFrame {
             self.size.width,
             self.size.height,
             self.light_count(),
+            self.light_count.caster_end(),
         );
         r.ctx
             .queue
