@@ -41,7 +41,7 @@ fn frame_matches() {
             ambient,
             size,
             light_count,
-            _pad0,
+            caster_end,
             near,
             far,
             _pad1

@@ -48,7 +48,6 @@ struct BvhTriangle {
 #endif
 
 const BVH_LEAF_BIT: u32 = 0x80000000u;
-const BVH_STACK_SIZE: u32 = 32u;
 // Direction components below this are replaced by +-this before the reciprocal, so the
 // slab test never computes 0 * inf.
 const BVH_MIN_DIR: f32 = 1e-20;
@@ -290,79 +289,24 @@ fn bvh_leaf_hit(n: BvhNode, origin: vec3<f32>, dir: vec3<f32>, t_max: f32) -> bo
     return false;
 }
 
-// Whether anything blocks origin + t * dir for 0 < t < t_max. Stack pass: both children
-// are tested at their parent, the nearer is entered and the farther pushed on a
-// BVH_STACK_SIZE-entry private stack. Should that stack overflow, the ray is re-cast from
-// the root stackless along the skip links (exact: what the stack pass tested missed).
+// Whether anything blocks origin + t * dir for 0 < t < t_max. Stackless: the nodes in
+// pre-order, a missed inner node's subtree skipped along its skip link (b). A private
+// traversal stack lives in local memory; without it the chairs' rays at 1280x720 cast
+// in 1.11 ms against 1.93 ms with a 32-entry stack and nearer-child-first order (NVIDIA
+// H100 80GB HBM3, two interleaved rounds). Every step moves forward, so even a
+// malformed tree ends within one pass over the nodes.
 fn bvh_occluded(origin: vec3<f32>, dir: vec3<f32>, t_max: f32) -> bool {
     if (!(t_max > 0.0)) {
         return false;
     }
     let inv_dir = bvh_safe_inverse(dir);
-    var stack: array<u32, BVH_STACK_SIZE>;
-    var sp = 0u;
-    var overflow = false;
-    var current = 0u;
-    var alive = bvh_slab(bvh_nodes[0], origin, inv_dir, t_max) >= 0.0;
-    // A well-formed tree visits each node at most once; more means a malformed one, and
-    // the fallback (which always terminates) takes over.
     let node_count = arrayLength(&bvh_nodes);
-    var steps = 0u;
-    while (alive) {
-        steps += 1u;
-        if (steps > node_count) {
-            overflow = true;
-            break;
-        }
-        let node = bvh_nodes[current];
-        var has_next = false;
-        var next = 0u;
-        if (bvh_is_leaf(node)) {
-            if (bvh_leaf_hit(node, origin, dir, t_max)) {
-                return true;
-            }
-        } else {
-            let left = current + 1u;
-            let right = node.a;
-            let tl = bvh_slab(bvh_nodes[left], origin, inv_dir, t_max);
-            let tr = bvh_slab(bvh_nodes[right], origin, inv_dir, t_max);
-            if (tl >= 0.0 && tr >= 0.0) {
-                if (sp == BVH_STACK_SIZE) {
-                    overflow = true;
-                    break;
-                }
-                let left_first = tl <= tr;
-                stack[sp] = select(left, right, left_first);
-                sp += 1u;
-                next = select(right, left, left_first);
-                has_next = true;
-            } else if (tl >= 0.0) {
-                next = left;
-                has_next = true;
-            } else if (tr >= 0.0) {
-                next = right;
-                has_next = true;
-            }
-        }
-        if (has_next) {
-            current = next;
-        } else if (sp > 0u) {
-            sp -= 1u;
-            current = stack[sp];
-        } else {
-            alive = false;
-        }
-    }
-    if (!overflow) {
-        return false;
-    }
     var i = 0u;
     while (i < node_count) {
         let node = bvh_nodes[i];
         let leaf = bvh_is_leaf(node);
-        let skip = select(node.b, i + 1u, leaf);
         if (bvh_slab(node, origin, inv_dir, t_max) < 0.0) {
-            i = max(skip, i + 1u);
+            i = select(max(node.b, i + 1u), i + 1u, leaf);
             continue;
         }
         if (leaf && bvh_leaf_hit(node, origin, dir, t_max)) {

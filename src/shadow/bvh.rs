@@ -22,8 +22,6 @@ use thiserror::Error;
 
 /// Set in [`BvhNode::b`] of a leaf; the low bits are its triangle count.
 pub const LEAF_BIT: u32 = 0x8000_0000;
-/// Entries in the traversal stack (`BVH_STACK_SIZE` in the WGSL).
-pub const STACK_SIZE: usize = 32;
 /// Direction components smaller than this are replaced by ±this before the reciprocal,
 /// so the slab test never computes `0 * inf`.
 pub const MIN_DIR: f32 = 1e-20;
@@ -179,15 +177,6 @@ pub struct BuildStats {
     /// Surface-area-heuristic cost of the tree: expected triangle tests plus
     /// `traversal_cost` × inner-node visits for a random ray through the root box.
     pub(crate) sah_cost: f32,
-}
-
-/// What one traversal did (CPU twin only).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct TraversalStats {
-    pub(crate) nodes_visited: u32,
-    pub(crate) triangles_tested: u32,
-    /// The stack would have overflowed, so the ray was re-cast stackless from the root.
-    pub fell_back: bool,
 }
 
 /// The flattened BVH: what the GPU uploads, and its CPU twin traversal.

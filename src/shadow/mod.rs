@@ -22,9 +22,7 @@ pub mod reference;
 mod traverse;
 pub(crate) mod view_bounds;
 
-pub use bvh::{
-    BuildOptions, BuildStats, BvhNode, BvhTriangle, ShadowBvh, ShadowError, LEAF_BIT, STACK_SIZE,
-};
+pub use bvh::{BuildOptions, BuildStats, BvhNode, BvhTriangle, ShadowBvh, ShadowError, LEAF_BIT};
 pub use reference::{near_edge, occluded_reference, scene_triangles_f64, Triangle64};
 
 /// A shadow ray from a shaded point towards a light, as every tracer casts it (the twin of
