@@ -78,7 +78,9 @@ fn load_pixel(xy: vec2<u32>) -> Pixel {
 // by the caller) and the pixel's mask.
 fn walk(px: Pixel, emit: bool) {
     var caster = 0u;
-    var hidden = array<u32, 4>(0u, 0u, 0u, 0u);
+    // A vector, set by a select: a private array indexed by caster / 32 lived in local
+    // memory (the chairs' jobs at 1280x720: 0.278 against 0.292 ms, NVIDIA H100).
+    var hidden = vec4<u32>(0u);
     for (var k = 0u; k < px.range.count; k++) {
         let i = light_at(px.range, k);
         // The list ascends: no caster past the last one (a scene's unshadowed crowd
@@ -113,7 +115,7 @@ fn walk(px: Pixel, emit: bool) {
                     atomicAdd(&bucket_count[bucket], 1u);
                 }
             } else {
-                hidden[caster / 32u] |= 1u << (caster % 32u);
+                hidden |= select(vec4<u32>(0u), vec4<u32>(1u << (caster % 32u)), vec4<u32>(0u, 1u, 2u, 3u) == vec4<u32>(caster / 32u));
             }
         }
         caster += 1u;
