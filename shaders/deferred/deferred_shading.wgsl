@@ -57,6 +57,7 @@
 @group(0) @binding(9) var<storage, read> shadow_views: array<vec4<f32>>;
 #if SHADOW_ATLAS_FLOAT
 @group(0) @binding(10) var shadow_atlas: texture_2d<f32>;
+@group(0) @binding(11) var shadow_gather: sampler;
 #else
 @group(0) @binding(10) var shadow_atlas: texture_depth_2d;
 @group(0) @binding(11) var shadow_sampler: sampler_comparison;

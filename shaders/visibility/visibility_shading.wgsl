@@ -54,6 +54,7 @@
 @group(0) @binding(13) var<storage, read> shadow_views: array<vec4<f32>>;
 #if SHADOW_ATLAS_FLOAT
 @group(0) @binding(14) var shadow_atlas: texture_2d<f32>;
+@group(0) @binding(15) var shadow_gather: sampler;
 #else
 @group(0) @binding(14) var shadow_atlas: texture_depth_2d;
 @group(0) @binding(15) var shadow_sampler: sampler_comparison;

@@ -43,6 +43,7 @@ pub(super) fn prepare(
     let params = cx.list_params(&sp.name, sp.required(slot::LIGHT_LISTS))?;
     offered.buffer("list_params", &params);
     offered.offer("shadow_sampler", super::comparison_sampler(&cx.device()));
+    offered.offer("shadow_gather", super::gather_sampler(&cx.device()));
     // Both filters are compared; the atlas's raster says how it is read.
     let raster = match crate::graph::kinds::forward_shading::shadows(&sp.roles, &cx.graph.plan) {
         Shadows::Atlas(_, raster) => raster,

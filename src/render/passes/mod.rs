@@ -313,6 +313,7 @@ impl PrepareCtx<'_> {
         let s = shadows(&sp.roles, &self.graph.plan);
         if let Shadows::Atlas(..) | Shadows::Hybrid(..) | Shadows::HybridTrace(..) = s {
             offered.offer("shadow_sampler", comparison_sampler(&self.device()));
+            offered.offer("shadow_gather", gather_sampler(&self.device()));
         }
         s
     }
@@ -512,6 +513,15 @@ pub(super) fn comparison_sampler(device: &wgpu::Device) -> Bound {
         mag_filter: wgpu::FilterMode::Linear,
         min_filter: wgpu::FilterMode::Linear,
         compare: Some(wgpu::CompareFunction::LessEqual),
+        ..Default::default()
+    }))
+}
+
+/// An R32Float shadow atlas's sampler (a compute raster's): its filter compares by hand,
+/// four texels a `textureGather`.
+pub(super) fn gather_sampler(device: &wgpu::Device) -> Bound {
+    Bound::Sampler(device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("shadow_gather"),
         ..Default::default()
     }))
 }
