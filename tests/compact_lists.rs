@@ -848,8 +848,8 @@ fn mutations_are_caught() {
         // The fill leaves the slot's lights out of the pooled list.
         (
             "slot not copied",
-            "for (var k = local; k < min(compact.scratch, kept); k += THREADS) {",
-            "for (var k = local; k < 0u; k += THREADS) {",
+            "for (var k = local; k < min(compact.scratch, kept); k += MAIN_THREADS) {",
+            "for (var k = local; k < 0u; k += MAIN_THREADS) {",
         ),
         // The fill tests the slot's last light again: listed twice.
         (

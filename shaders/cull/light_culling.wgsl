@@ -102,6 +102,12 @@ struct CompactParams {
 
 const THREADS: u32 = TILE * TILE;
 const MASK_WORDS: u32 = THREADS / 32u;
+// The tiles' pass (`main`) folds MAIN_STEP × MAIN_STEP pixels an invocation, so a tile
+// is a workgroup of MAIN_THREADS: more tiles fit an SM at once, and a tile's chain of
+// dependent steps (depth, range, candidates, hits, list) overlaps more of the others'.
+const MAIN_STEP: u32 = 2u;
+const MAIN_SIDE: u32 = TILE / MAIN_STEP;
+const MAIN_THREADS: u32 = MAIN_SIDE * MAIN_SIDE;
 const FAR_BITS: u32 = 0x7f7fffffu;
 
 #if SUBGROUPS
@@ -191,7 +197,7 @@ fn add_depth_sample(acc: vec2<u32>, pixel: vec2<u32>) -> vec2<u32> {
 // workgroup words with atomics (a few per word, not one per invocation). Min and max are
 // exact in any order, so this is bit for bit the other way's result. The barrier also
 // orders what was stored before it.
-fn workgroup_depth_range(local: u32, v: vec2<u32>) -> vec2<u32> {
+fn workgroup_depth_range(local: u32, side: u32, v: vec2<u32>) -> vec2<u32> {
     let inverted_min = subgroupMax(~v.x);
     let max_bits = subgroupMax(v.y);
     if (subgroupBroadcastFirst(local) == local) {
@@ -202,26 +208,27 @@ fn workgroup_depth_range(local: u32, v: vec2<u32>) -> vec2<u32> {
     return vec2<u32>(~atomicLoad(&depth_inverted_min), atomicLoad(&depth_max));
 }
 #else
-// The (min, max) of every invocation's `v`, for every invocation: each of the first TILE
-// invocations folds a column of TILE values (THREADS = TILE²), then every invocation
-// folds the TILE column results. Min and max are exact in any order, so this is bit for
-// bit what atomics on two workgroup words gave, without 2·THREADS atomics queueing on
-// the same two words. Two barriers; the first also orders what was stored before it.
-fn workgroup_depth_range(local: u32, v: vec2<u32>) -> vec2<u32> {
+// The (min, max) of every invocation's `v`, for every invocation of a workgroup of
+// side² invocations: each of the first `side` invocations folds a column of `side`
+// values, then every invocation folds the `side` column results. Min and max are exact
+// in any order, so this is bit for bit what atomics on two workgroup words gave, without
+// 2·side² atomics queueing on the same two words. Two barriers; the first also orders
+// what was stored before it.
+fn workgroup_depth_range(local: u32, side: u32, v: vec2<u32>) -> vec2<u32> {
     depth_partial[local] = v;
     workgroupBarrier();
-    if (local < TILE) {
-        // Reads only words TILE.. and writes only its own word below TILE.
+    if (local < side) {
+        // Reads only words side.. and writes only its own word below side.
         var a = v;
-        for (var k = 1u; k < TILE; k++) {
-            let b = depth_partial[local + k * TILE];
+        for (var k = 1u; k < side; k++) {
+            let b = depth_partial[local + k * side];
             a = vec2<u32>(min(a.x, b.x), max(a.y, b.y));
         }
         depth_partial[local] = a;
     }
     workgroupBarrier();
     var a = depth_partial[0];
-    for (var k = 1u; k < TILE; k++) {
+    for (var k = 1u; k < side; k++) {
         let b = depth_partial[k];
         a = vec2<u32>(min(a.x, b.x), max(a.y, b.y));
     }
@@ -260,7 +267,7 @@ fn slice_bound(k: u32, slices: u32) -> f32 {
     return frame.near * pow(frame.far / frame.near, f32(k) / f32(slices));
 }
 
-@compute @workgroup_size(TILE, TILE, 1)
+@compute @workgroup_size(MAIN_SIDE, MAIN_SIDE, 1)
 fn main(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
@@ -304,8 +311,14 @@ fn main(
     }
 
     // 1. The tile's depth range, over the samples that hold geometry.
-    let pixel = group.xy * TILE + lid.xy;
-    let range = workgroup_depth_range(local, add_depth_sample(vec2<u32>(FAR_BITS, 0u), pixel));
+    let pixel = group.xy * TILE + lid.xy * MAIN_STEP;
+    var acc = vec2<u32>(FAR_BITS, 0u);
+    for (var dy = 0u; dy < MAIN_STEP; dy++) {
+        for (var dx = 0u; dx < MAIN_STEP; dx++) {
+            acc = add_depth_sample(acc, pixel + vec2<u32>(dx, dy));
+        }
+    }
+    let range = workgroup_depth_range(local, MAIN_SIDE, acc);
     let tile_min = bitcast<f32>(range.x);
     let tile_max = bitcast<f32>(range.y);
     let empty_tile = range.y == 0u;
@@ -331,13 +344,17 @@ fn main(
     var tile_mask = 0u;
     if (VARIANT == VARIANT_DEPTH_MASK) {
         if (!empty_tile) {
-            add_depth_cells(pixel, tile_min, tile_max);
+            for (var dy = 0u; dy < MAIN_STEP; dy++) {
+                for (var dx = 0u; dx < MAIN_STEP; dx++) {
+                    add_depth_cells(pixel + vec2<u32>(dx, dy), tile_min, tile_max);
+                }
+            }
         }
         workgroupBarrier();
         tile_mask = atomicLoad(&depth_mask);
     }
 
-    // 4. Candidates: the coarse tile's lights, or every light. In batches of THREADS;
+    // 4. Candidates: the coarse tile's lights, or every light. In batches of MAIN_THREADS;
     //    ranks within a batch from a bit mask keep the list in ascending light order.
     var count = frame.light_count;
     var from_coarse = false;
@@ -358,7 +375,7 @@ fn main(
         // and only the candidates after the last of them are tested again. Candidates
         // ascend, so the first `scratch` of them (of all lights: `below`) come no later.
         let slot_word = list_params.pool_offset + list_index * compact.scratch;
-        for (var k = local; k < min(compact.scratch, kept); k += THREADS) {
+        for (var k = local; k < min(compact.scratch, kept); k += MAIN_THREADS) {
             atomicStore(&light_lists[offset + k], atomicLoad(&light_lists[slot_word + k]));
         }
         if (local == 0u) {
@@ -370,7 +387,7 @@ fn main(
     }
 #endif
     var h = 0u;
-    for (var base = first; base < count; base += THREADS) {
+    for (var base = first; base < count; base += MAIN_THREADS) {
         let k = base + local;
         var i = k;
         var hit = false;
@@ -392,7 +409,7 @@ fn main(
             list[slot] = i;
         }
 #endif
-        total += close_batch(h, local, base + THREADS < count);
+        total += close_batch(h, local, base + MAIN_THREADS < count);
         h = 1u - h;
     }
 
@@ -438,7 +455,7 @@ fn main(
     }
     workgroupBarrier();
     let base_word = list_params.pool_offset + workgroupUniformLoad(&pool_base);
-    for (var k = local; k < kept; k += THREADS) {
+    for (var k = local; k < kept; k += MAIN_THREADS) {
         atomicStore(&light_lists[base_word + k], list[k]);
     }
 #endif
@@ -648,7 +665,7 @@ fn coarse(
             acc = add_depth_sample(acc, origin + lid.xy * COARSE + vec2<u32>(dx, dy));
         }
     }
-    let range = workgroup_depth_range(local, acc);
+    let range = workgroup_depth_range(local, TILE, acc);
     let lo = bitcast<f32>(range.x);
     let hi = bitcast<f32>(range.y);
     let empty = range.y == 0u;
