@@ -281,12 +281,7 @@ fn ray_lights_equal_the_ray_cast_frame_and_mapped_lights_the_atlas_frame() {
         );
         assert_ne!(other_text, text);
         let (_, other) = run(&mut r, &other_text, &scene);
-        let bits = base
-            .image
-            .iter()
-            .zip(&other.image)
-            .filter(|(a, b)| a.map(f32::to_bits) != b.map(f32::to_bits))
-            .count();
+        let bits = common::pixels_differing_in_bits(&base.image, &other.image);
         assert_eq!(bits, 0, "{kind}: {bits} pixels differ from RangeFirst");
     }
 }

@@ -405,12 +405,7 @@ fn shaded_image_equals_forward_plus(vis_graph: &str, fwd_graph: &str, max_extra:
         );
         assert_ne!(text, vis_text);
         let (_, other) = run(&mut r, &text, &scene);
-        let bits = vis
-            .image
-            .iter()
-            .zip(&other.image)
-            .filter(|(a, b)| a.map(f32::to_bits) != b.map(f32::to_bits))
-            .count();
+        let bits = common::pixels_differing_in_bits(&vis.image, &other.image);
         assert_eq!(bits, 0, "{kind}: {bits} pixels differ from RangeFirst");
     }
 }
@@ -432,12 +427,7 @@ fn default_graph_with_casters_is_the_visibility_shadow_frame() {
     assert_eq!(names(&d_prepared), names(&v_prepared));
     assert_eq!(d.shadows.len(), 1);
     assert_eq!(d.shadows[0].rays(), v.shadows[0].rays());
-    let bits = d
-        .image
-        .iter()
-        .zip(&v.image)
-        .filter(|(a, b)| a.map(f32::to_bits) != b.map(f32::to_bits))
-        .count();
+    let bits = common::pixels_differing_in_bits(&d.image, &v.image);
     assert_eq!(bits, 0, "{bits} pixels differ");
     assert!(
         d.image.iter().any(|p| p[0] > 0.0),
@@ -472,12 +462,7 @@ fn casters_moved_down_the_list_by_an_update_still_cast() {
     let updated = prepared.render(&r).unwrap();
     let (_, fresh) = run(&mut r, &text, &last);
     assert_eq!(updated.shadows[0].rays(), fresh.shadows[0].rays());
-    let bits = updated
-        .image
-        .iter()
-        .zip(&fresh.image)
-        .filter(|(a, b)| a.map(f32::to_bits) != b.map(f32::to_bits))
-        .count();
+    let bits = common::pixels_differing_in_bits(&updated.image, &fresh.image);
     assert_eq!(bits, 0, "{bits} pixels differ");
     // The casters shadow something: the same lights casting nothing light more pixels.
     let unshadowed = with(

@@ -399,6 +399,15 @@ pub fn render_file(
 }
 
 /// Largest absolute difference, relative to the brightest reference pixel.
+/// Pixels of two images of one size whose bits differ in any channel.
+pub fn pixels_differing_in_bits(a: &[[f32; 4]], b: &[[f32; 4]]) -> usize {
+    assert_eq!(a.len(), b.len(), "image sizes");
+    a.iter()
+        .zip(b)
+        .filter(|(a, b)| a.map(f32::to_bits) != b.map(f32::to_bits))
+        .count()
+}
+
 pub fn max_rel_diff(a: &[[f32; 4]], b: &[[f32; 4]]) -> (f32, usize) {
     // Without this an empty or truncated image would pass as identical.
     assert_eq!(a.len(), b.len(), "images of different sizes");
