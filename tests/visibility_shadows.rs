@@ -488,6 +488,42 @@ fn casters_moved_down_the_list_by_an_update_still_cast() {
     assert!(darker > 100, "only {darker} pixels shadowed");
 }
 
+/// Job creation writes the jobs its counting walk found without walking the list again
+/// when all of them lie in the first 256 positions of the pixel's list, and walks again
+/// otherwise. The same 24 casters listed first, and listed after 270 lights that cast
+/// none and reach every pixel (so every job lies past position 256): both frames' jobs
+/// and masks equal Forward+'s and the CPU twin's.
+#[test]
+fn jobs_past_the_256th_list_position_equal_the_cpu_twin() {
+    let scene = shadow_scene(36, 7);
+    let casters: Vec<Light> = scene
+        .lights
+        .iter()
+        .filter(|l| l.flags & light_flags::CASTS_SHADOW != 0)
+        .copied()
+        .collect();
+    let mut rng = Rng(11);
+    let crowd: Vec<Light> = (0..270)
+        .map(|_| {
+            let p = rng.vec3(Vec3::new(-6.0, 1.0, -10.0), Vec3::new(6.0, 5.0, 2.0));
+            Light::point(p, 60.0, Vec3::ONE, 0.01)
+        })
+        .collect();
+    let mut r = renderer();
+    let text = graph_text("visibility_raycast_shadows.ron");
+    for (what, lights) in [
+        ("casters first", [casters.clone(), crowd.clone()].concat()),
+        ("casters last", [crowd, casters].concat()),
+    ] {
+        let s = Scene {
+            name: what.into(),
+            lights,
+            ..scene.clone()
+        };
+        check_against_forward_and_cpu(&mut r, &text, &s, COMPUTE_RASTER_EDGE_PIXELS);
+    }
+}
+
 /// The gallery's textured glTF models (scenes/gallery.ron) without its glass and its
 /// untextured spheres (1.04 million of its triangles, which the CPU ray caster would
 /// spend minutes on), half of 512 of its lights casting shadows.
