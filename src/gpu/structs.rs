@@ -289,3 +289,23 @@ impl GpuVertex {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::caster_end;
+    use crate::scene::{light_flags, Light};
+    use glam::Vec3;
+
+    #[test]
+    fn caster_end_is_one_past_the_last_casting_light() {
+        let plain = Light::point(Vec3::ZERO, 1.0, Vec3::ONE, 1.0);
+        let casting = Light {
+            flags: light_flags::CASTS_SHADOW,
+            ..plain
+        };
+        assert_eq!(caster_end(&[]), 0);
+        assert_eq!(caster_end(&[plain, plain]), 0);
+        assert_eq!(caster_end(&[casting, plain, plain]), 1);
+        assert_eq!(caster_end(&[plain, casting, plain, casting, plain]), 4);
+    }
+}
