@@ -101,13 +101,14 @@ struct CompactParams {
 #endif
 
 const THREADS: u32 = TILE * TILE;
-const MASK_WORDS: u32 = THREADS / 32u;
 // The tiles' pass (`main`) folds MAIN_STEP × MAIN_STEP pixels an invocation, so a tile
 // is a workgroup of MAIN_THREADS: more tiles fit an SM at once, and a tile's chain of
 // dependent steps (depth, range, candidates, hits, list) overlaps more of the others'.
 const MAIN_STEP: u32 = 2u;
 const MAIN_SIDE: u32 = TILE / MAIN_STEP;
 const MAIN_THREADS: u32 = MAIN_SIDE * MAIN_SIDE;
+// Words of a batch's hit bits: one bit a `main` invocation.
+const MASK_WORDS: u32 = (MAIN_THREADS + 31u) / 32u;
 const FAR_BITS: u32 = 0x7f7fffffu;
 
 #if SUBGROUPS
@@ -189,6 +190,17 @@ fn add_depth_sample(acc: vec2<u32>, pixel: vec2<u32>) -> vec2<u32> {
         }
     }
     return a;
+}
+
+// The (min, max) bits (add_depth_sample) of the step × step pixels from `corner`.
+fn block_depth_range(corner: vec2<u32>, step: u32) -> vec2<u32> {
+    var acc = vec2<u32>(FAR_BITS, 0u);
+    for (var dy = 0u; dy < step; dy++) {
+        for (var dx = 0u; dx < step; dx++) {
+            acc = add_depth_sample(acc, corner + vec2<u32>(dx, dy));
+        }
+    }
+    return acc;
 }
 
 #if SUBGROUPS
@@ -312,13 +324,7 @@ fn main(
 
     // 1. The tile's depth range, over the samples that hold geometry.
     let pixel = group.xy * TILE + lid.xy * MAIN_STEP;
-    var acc = vec2<u32>(FAR_BITS, 0u);
-    for (var dy = 0u; dy < MAIN_STEP; dy++) {
-        for (var dx = 0u; dx < MAIN_STEP; dx++) {
-            acc = add_depth_sample(acc, pixel + vec2<u32>(dx, dy));
-        }
-    }
-    let range = workgroup_depth_range(local, MAIN_SIDE, acc);
+    let range = workgroup_depth_range(local, MAIN_SIDE, block_depth_range(pixel, MAIN_STEP));
     let tile_min = bitcast<f32>(range.x);
     let tile_max = bitcast<f32>(range.y);
     let empty_tile = range.y == 0u;
@@ -659,13 +665,7 @@ fn coarse(
     }
     let span = TILE * COARSE;
     let origin = group.xy * span;
-    var acc = vec2<u32>(FAR_BITS, 0u);
-    for (var dy = 0u; dy < COARSE; dy++) {
-        for (var dx = 0u; dx < COARSE; dx++) {
-            acc = add_depth_sample(acc, origin + lid.xy * COARSE + vec2<u32>(dx, dy));
-        }
-    }
-    let range = workgroup_depth_range(local, TILE, acc);
+    let range = workgroup_depth_range(local, TILE, block_depth_range(origin + lid.xy * COARSE, COARSE));
     let lo = bitcast<f32>(range.x);
     let hi = bitcast<f32>(range.y);
     let empty = range.y == 0u;
