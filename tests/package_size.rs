@@ -9,28 +9,38 @@ use std::process::Command;
 /// crates.io refuses a .crate over 10 MB.
 const LIMIT: u64 = 10 * 1024 * 1024;
 
+/// `cargo` with `args` (then `extra`) in the project root; its stdout, once it succeeded.
+fn cargo(root: &Path, args: &[&str], extra: &[&Path]) -> Vec<u8> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = Command::new(cargo)
+        .args(args)
+        .args(extra)
+        .current_dir(root)
+        .output()
+        .expect("cargo runs");
+    assert!(
+        out.status.success(),
+        "cargo {args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out.stdout
+}
+
 #[test]
 fn the_package_is_under_the_registry_limit() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let target = tempfile::tempdir().unwrap();
     // The crate as crates.io would receive it (not built: that is what the suite does).
-    let packed = Command::new(&cargo)
-        .args([
+    cargo(
+        root,
+        &[
             "package",
             "--no-verify",
             "--allow-dirty",
             "--offline",
             "--target-dir",
-        ])
-        .arg(target.path())
-        .current_dir(root)
-        .output()
-        .expect("cargo runs");
-    assert!(
-        packed.status.success(),
-        "cargo package failed: {}",
-        String::from_utf8_lossy(&packed.stderr)
+        ],
+        &[target.path()],
     );
     let name = format!(
         "{}-{}.crate",
@@ -40,17 +50,8 @@ fn the_package_is_under_the_registry_limit() {
     let size = std::fs::metadata(target.path().join("package").join(&name))
         .unwrap_or_else(|e| panic!("{name}: {e}"))
         .len();
-    let out = Command::new(cargo)
-        .args(["package", "--list", "--allow-dirty"])
-        .current_dir(root)
-        .output()
-        .expect("cargo runs");
-    assert!(
-        out.status.success(),
-        "cargo package --list failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let list = String::from_utf8(out.stdout).expect("the list is UTF-8");
+    let list = String::from_utf8(cargo(root, &["package", "--list", "--allow-dirty"], &[]))
+        .expect("the list is UTF-8");
     let mut biggest = Vec::new();
     for file in list.lines() {
         assert!(

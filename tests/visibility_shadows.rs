@@ -57,6 +57,17 @@ fn caster(position: Vec3, range: f32, intensity: f32) -> Light {
     l
 }
 
+/// Pixels of `shadowed` whose red is under `factor` times the same pixel's in `open`
+/// (the frame without shadows).
+fn darkened(shadowed: &[[f32; 4]], open: &[[f32; 4]], factor: f32) -> usize {
+    assert_eq!(shadowed.len(), open.len(), "image sizes");
+    shadowed
+        .iter()
+        .zip(open)
+        .filter(|(s, o)| s[0] < o[0] * factor)
+        .count()
+}
+
 fn run(r: &mut Renderer, text: &str, scene: &Scene) -> (PreparedFrame, FrameResult) {
     let prepared = prepare_text(r, text, scene, W, H, false).expect("prepare");
     let result = prepared.render(r).expect("render");
@@ -371,12 +382,7 @@ fn shaded_image_equals_forward_plus(vis_graph: &str, fwd_graph: &str, max_extra:
     let tol = 3e-3;
     let unshadowed = differing(&vis_plain.image, &fwd_plain.image, tol);
     let shadowed = differing(&vis.image, &fwd.image, tol);
-    let darker = vis
-        .image
-        .iter()
-        .zip(&vis_plain.image)
-        .filter(|(s, u)| s[0] < u[0] * 0.99)
-        .count();
+    let darker = darkened(&vis.image, &vis_plain.image, 0.99);
     eprintln!(
         "{vis_graph}: {} pixels differ from {fwd_graph}, {} without shadows; {darker} darkened by shadows",
         shadowed.len(),
@@ -479,12 +485,7 @@ fn casters_moved_down_the_list_by_an_update_still_cast() {
         &graph_text("visibility_compute_raster.ron"),
         &unshadowed,
     );
-    let darker = fresh
-        .image
-        .iter()
-        .zip(&open.image)
-        .filter(|(a, b)| a[0] < b[0] * 0.9)
-        .count();
+    let darker = darkened(&fresh.image, &open.image, 0.9);
     assert!(darker > 100, "only {darker} pixels shadowed");
 }
 
