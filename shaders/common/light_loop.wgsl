@@ -5,6 +5,18 @@
 
 #include "common/shading_point.wgsl"
 
+// Light arriving as `inc`, reflected towards the eye. A light seen as a disc of angular
+// radius θ (a VPL, `inc.spread` = θ²) reflects through glossy lobes widened to take it
+// in: directions spread over the disc spread half vectors over radius θ/2, whose slope
+// variance (θ/2)²/4 per axis adds to the lobe's α²/2, so α² grows by θ²/8 (measured
+// against the path-traced bounce in docs/indirect_light.md).
+fn reflect_incident(m: MaterialSample, inc: Incident) -> vec3<f32> {
+    if (inc.spread > 0.0) {
+        return material_eval(material_widened(m, inc.spread * 0.125), inc.dir);
+    }
+    return material_eval(m, inc.dir);
+}
+
 fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f32) -> vec3<f32> {
     var color = material_emission(m) + frame.ambient.rgb * material_eval(m, p.normal);
 #if VPL_VISIBILITY
@@ -43,7 +55,7 @@ fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f
         }
         let inc = incident_light(light_geometry[i], props, p.position);
         if (any(inc.radiance > vec3<f32>(0.0))) {
-            color += inc.radiance * material_eval(m, inc.dir);
+            color += inc.radiance * reflect_incident(m, inc);
         }
 #else
 #if SHADOWS
@@ -55,7 +67,7 @@ fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f
             caster += 1u;
         }
         if (visibility > 0.0 && (props.material_mask & MATERIAL_TYPE_BIT) != 0u) {
-            color += (visibility * inc.radiance) * material_eval(m, inc.dir);
+            color += (visibility * inc.radiance) * reflect_incident(m, inc);
         }
 #else
         if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
@@ -63,7 +75,7 @@ fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f
         }
         let inc = incident_light(light_geometry[i], props, p.position);
         if (any(inc.radiance > vec3<f32>(0.0))) {
-            color += inc.radiance * material_eval(m, inc.dir);
+            color += inc.radiance * reflect_incident(m, inc);
         }
 #endif
 #endif
@@ -94,7 +106,7 @@ fn exact_light(pixel: u32, p: ShadingPoint, m: MaterialSample) -> vec3<f32> {
         }
         let inc = incident_light(light_geometry[light], props, p.position);
         if (any(inc.radiance > vec3<f32>(0.0))) {
-            sum += inc.radiance * material_eval(m, inc.dir);
+            sum += inc.radiance * reflect_incident(m, inc);
         }
     }
     return sum;
@@ -116,7 +128,7 @@ fn sampled_light(pixel: u32, p: ShadingPoint, m: MaterialSample) -> vec3<f32> {
             continue;
         }
         let inc = incident_light(light_geometry[light], props, p.position);
-        sum += (weight * inc.radiance) * material_eval(m, inc.dir);
+        sum += (weight * inc.radiance) * reflect_incident(m, inc);
     }
     return sum / f32(SAMPLE_COUNT);
 }

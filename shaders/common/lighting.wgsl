@@ -23,6 +23,9 @@ fn spot_factor(g: LightGeometry, p: LightProperties, to_light_dir: vec3<f32>) ->
 struct Incident {
     radiance: vec3<f32>,
     dir: vec3<f32>,
+    // The light's angular radius squared as seen from `pos`: a VPL's disc (`disc_sq` over
+    // the squared distance); 0 for a point.
+    spread: f32,
 };
 
 // How far a light reaches a point: the vector to the light, its squared length, and the
@@ -52,6 +55,7 @@ fn incident_reached(g: LightGeometry, p: LightProperties, r: LightReach) -> Inci
     if ((p.flags & LIGHT_VPL) != 0u) {
         let lobe = max(dot(g.direction, -out.dir), 0.0);
         out.radiance = p.color * (lobe * r.window / max(r.dist_sq + p.disc_sq, p.cos_inner * p.cos_inner));
+        out.spread = p.disc_sq / max(r.dist_sq, MIN_DISTANCE_SQ);
         return out;
     }
     let falloff = r.window / max(r.dist_sq, MIN_DISTANCE_SQ);

@@ -50,7 +50,7 @@ fn add_reached(color: vec3<f32>, i: u32, g: LightGeometry, props: LightPropertie
         if (visibility <= 0.0) {
             return color;
         }
-        return color + (visibility * inc.radiance) * material_eval(m, inc.dir);
+        return color + (visibility * inc.radiance) * reflect_incident(m, inc);
     }
 #endif
     if ((props.material_mask & MATERIAL_TYPE_BIT) == 0u) {
@@ -58,7 +58,7 @@ fn add_reached(color: vec3<f32>, i: u32, g: LightGeometry, props: LightPropertie
     }
     let inc = incident_reached(g, props, r);
     if (any(inc.radiance > vec3<f32>(0.0))) {
-        return color + inc.radiance * material_eval(m, inc.dir);
+        return color + inc.radiance * reflect_incident(m, inc);
     }
     return color;
 }

@@ -92,6 +92,24 @@ fn frame(
     Ok((prepared.render(r)?, times))
 }
 
+/// Where the VPL image errs: red where it has more light than the reference, blue where
+/// less, each pixel's luminance difference over the largest one's, square-rooted so that
+/// errors a hundredth of the worst still show.
+fn error_map(vpl: &[glam::Vec3], reference: &[glam::Vec3]) -> Vec<u8> {
+    let luma = |c: glam::Vec3| c.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722));
+    let diff: Vec<f32> = vpl
+        .iter()
+        .zip(reference)
+        .map(|(a, b)| luma(*a) - luma(*b))
+        .map(|d| if d.is_finite() { d } else { 0.0 })
+        .collect();
+    let worst = diff.iter().fold(0.0f32, |m, d| m.max(d.abs())).max(1e-30);
+    let level = |d: f32| ((d.max(0.0) / worst).sqrt() * 255.0).round() as u8;
+    diff.iter()
+        .flat_map(|&d| [level(d), 0, level(-d)])
+        .collect()
+}
+
 /// A label as a file name's part: letters and digits, anything else `_`.
 fn file_label(label: &str) -> String {
     label
@@ -227,6 +245,16 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
                     w,
                     h,
                     &tonemap,
+                )?;
+                lightgraph::bench::write_png_rgb8(
+                    args.out.join(format!(
+                        "{}_{}_n{n}_error.png",
+                        base.name,
+                        file_label(&variant.label)
+                    )),
+                    error_map(&vpl_image, &reference),
+                    w,
+                    h,
                 )?;
                 // Total indirect light of the VPL image over the reference's: bias, apart from noise.
                 let total =

@@ -449,80 +449,122 @@ pub fn brdf(m: &Material, n: V3, v: V3, l: V3) -> V3 {
     brdf_at(m, &Surface::new(n), v, l)
 }
 
-/// Directional albedo ∫ f(l, v) cos θl dl over the hemisphere for view `v`, estimated with
-/// `samples` deterministic low-discrepancy (R2) samples, by multiple importance sampling:
-/// an equal mixture of cosine sampling and GGX visible-normal sampling (Heitz 2018) for
-/// every microfacet lobe of the material (one-sample balance heuristic).
-pub fn albedo(m: &Material, at: &Surface, v: V3, samples: usize) -> V3 {
-    let n = at.n;
-    let t = tangent(n, at.tangent);
-    let b = bitangent(n, t, at.tangent[3]);
-    // Proposals: None = cosine; Some((αx, αy)) = GGX VNDF along (t, b).
-    let mut props: Vec<Option<(f64, f64)>> = vec![None];
-    for layer in &m.desc().layers {
-        for lb in &layer.lobes {
-            let p = match lb {
-                Lobe::Ggx { roughness, .. } | Lobe::Clearcoat { roughness, .. } => {
-                    let a = alpha(scalar(roughness, at));
-                    Some((a, a))
+/// Directions for integrating `eval_at` over the hemisphere by multiple importance
+/// sampling: an equal mixture of cosine sampling and GGX visible-normal sampling (Heitz
+/// 2018) for every microfacet lobe of the material (one-sample balance heuristic).
+pub struct LobeSampler {
+    t: V3,
+    b: V3,
+    n: V3,
+    /// None = cosine; Some((αx, αy)) = GGX VNDF along (t, b).
+    proposals: Vec<Option<(f64, f64)>>,
+}
+
+impl LobeSampler {
+    /// The proposals for `m` at `at` (cosine first).
+    pub fn new(m: &Material, at: &Surface) -> Self {
+        let n = at.n;
+        let t = tangent(n, at.tangent);
+        let b = bitangent(n, t, at.tangent[3]);
+        let mut proposals: Vec<Option<(f64, f64)>> = vec![None];
+        for layer in &m.desc().layers {
+            for lb in &layer.lobes {
+                let p = match lb {
+                    Lobe::Ggx { roughness, .. } | Lobe::Clearcoat { roughness, .. } => {
+                        let a = alpha(scalar(roughness, at));
+                        Some((a, a))
+                    }
+                    Lobe::AnisoGgx {
+                        roughness,
+                        anisotropy,
+                        ..
+                    } => {
+                        let a = alpha(scalar(roughness, at));
+                        let an = scalar(anisotropy, at).clamp(-1.0, 1.0);
+                        Some((
+                            (a * (1.0 + an)).max(ALPHA_MIN),
+                            (a * (1.0 - an)).max(ALPHA_MIN),
+                        ))
+                    }
+                    _ => None,
+                };
+                if p.is_some() && !proposals.contains(&p) {
+                    proposals.push(p);
                 }
-                Lobe::AnisoGgx {
-                    roughness,
-                    anisotropy,
-                    ..
-                } => {
-                    let a = alpha(scalar(roughness, at));
-                    let an = scalar(anisotropy, at).clamp(-1.0, 1.0);
-                    Some((
-                        (a * (1.0 + an)).max(ALPHA_MIN),
-                        (a * (1.0 - an)).max(ALPHA_MIN),
-                    ))
-                }
-                _ => None,
-            };
-            if p.is_some() && !props.contains(&p) {
-                props.push(p);
             }
         }
+        Self { t, b, n, proposals }
     }
-    let to_local = |x: V3| [dot(x, t), dot(x, b), dot(x, n)];
-    let to_world = |x: V3| add(add(scale(t, x[0]), scale(b, x[1])), scale(n, x[2]));
-    let vl = to_local(v);
-    let k = props.len();
-    let g = 1.324_717_957_244_746_f64;
-    let (a1, a2) = (1.0 / g, 1.0 / (g * g));
-    let mut sum = [0.0; 3];
-    for i in 0..samples {
-        let which = i % k;
-        let j = (i / k) as f64;
-        let u1 = (0.5 + a1 * j).fract();
-        let u2 = (0.5 + a2 * j).fract();
-        let ll = match props[which] {
+
+    /// How many proposals: 1 (cosine alone) for a material without microfacet lobes.
+    pub fn proposals(&self) -> usize {
+        self.proposals.len()
+    }
+
+    fn to_local(&self, x: V3) -> V3 {
+        [dot(x, self.t), dot(x, self.b), dot(x, self.n)]
+    }
+
+    /// A direction (world space) drawn from proposal `which` for view `v`, from uniform
+    /// (u1, u2); None when it falls below the surface.
+    pub fn sample(&self, which: usize, v: V3, u1: f64, u2: f64) -> Option<V3> {
+        let ll = match self.proposals[which] {
             None => {
                 let r = u1.sqrt();
                 let phi = 2.0 * PI * u2;
                 [r * phi.cos(), r * phi.sin(), (1.0 - u1).max(0.0).sqrt()]
             }
             Some((ax, ay)) => {
+                let vl = self.to_local(v);
                 let h = sample_vndf(vl, ax, ay, u1, u2);
                 add(scale(h, 2.0 * dot(vl, h)), scale(vl, -1.0))
             }
         };
+        (ll[2] > 0.0).then(|| {
+            add(
+                add(scale(self.t, ll[0]), scale(self.b, ll[1])),
+                scale(self.n, ll[2]),
+            )
+        })
+    }
+
+    /// The mixture's density over solid angle at direction `l` for view `v`.
+    pub fn pdf(&self, v: V3, l: V3) -> f64 {
+        let (vl, ll) = (self.to_local(v), self.to_local(l));
         if ll[2] <= 0.0 {
-            continue;
+            return 0.0;
         }
-        let pdf: f64 = props
+        self.proposals
             .iter()
             .map(|p| match p {
                 None => ll[2] * INV_PI,
                 Some((ax, ay)) => pdf_vndf(vl, ll, *ax, *ay),
             })
             .sum::<f64>()
-            / k as f64;
+            / self.proposals.len() as f64
+    }
+}
+
+/// Directional albedo ∫ f(l, v) cos θl dl over the hemisphere for view `v`, estimated with
+/// `samples` deterministic low-discrepancy (R2) samples through a [`LobeSampler`].
+pub fn albedo(m: &Material, at: &Surface, v: V3, samples: usize) -> V3 {
+    let sampler = LobeSampler::new(m, at);
+    let k = sampler.proposals();
+    let g = 1.324_717_957_244_746_f64;
+    let (a1, a2) = (1.0 / g, 1.0 / (g * g));
+    let mut sum = [0.0; 3];
+    for i in 0..samples {
+        let j = (i / k) as f64;
+        let u1 = (0.5 + a1 * j).fract();
+        let u2 = (0.5 + a2 * j).fract();
+        let Some(l) = sampler.sample(i % k, v, u1, u2) else {
+            continue;
+        };
+        let pdf = sampler.pdf(v, l);
         if pdf <= 0.0 {
             continue;
         }
-        let f = eval_at(m, at, v, to_world(ll));
+        let f = eval_at(m, at, v, l);
         sum = add(sum, scale(f, 1.0 / pdf));
     }
     scale(sum, 1.0 / samples as f64)

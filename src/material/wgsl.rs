@@ -468,6 +468,28 @@ pub(crate) fn generate_with_constants(m: &Material, opts: &WgslOptions) -> (Stri
         }
     }
     o.push_str("    return acc;\n}\n\n");
+    // A light seen as a disc of angular radius θ (a VPL standing for a patch of surface)
+    // blurs a glossy reflection: each GGX lobe's α grows with θ (`spread` = θ², in
+    // half-vector angle θ/2), so a receiver's lobe spreads the light as the patch would
+    // rather than as a point (Hašan et al., "Virtual Spherical Lights for Many-Light
+    // Rendering of Glossy Scenes").
+    o.push_str(
+        "fn material_widened(m: MaterialSample, alpha_sq: f32) -> MaterialSample {\n    var w = m;\n",
+    );
+    for (i, layer) in desc.layers.iter().enumerate() {
+        for (j, lobe) in layer.lobes.iter().enumerate() {
+            if matches!(
+                lobe,
+                Lobe::Ggx { .. } | Lobe::AnisoGgx { .. } | Lobe::Clearcoat { .. }
+            ) {
+                let _ = writeln!(
+                    o,
+                    "    w.r{i}_{j} = min(sqrt(m.r{i}_{j} * m.r{i}_{j} + alpha_sq), 1.0);"
+                );
+            }
+        }
+    }
+    o.push_str("    return w;\n}\n\n");
     o.push_str("fn material_emission(m: MaterialSample) -> vec3<f32> {\n    return m.emission;\n}\n\nfn material_alpha(m: MaterialSample) -> f32 {\n    return m.alpha;\n}\n\n// Ambient occlusion for the renderer's ambient/indirect term; material_eval ignores it.\nfn material_occlusion(m: MaterialSample) -> f32 {\n    return m.occlusion;\n}\n");
     let constants = g.constants.map(|c| c.into_inner()).unwrap_or_default();
     (o, constants)
