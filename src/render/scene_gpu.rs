@@ -340,7 +340,7 @@ impl SceneGpu {
     /// or now, the BVH is dropped, so the next pass that binds it builds it again with the
     /// material's alpha (rays read it, `bvh_alpha`); clones of this upload keep theirs.
     pub fn set_material(&mut self, index: usize, program: MaterialProgram) {
-        let masked = |m: &MaterialProgram| matches!(m.alpha_mode, AlphaMode::Mask(_));
+        let masked = |m: &MaterialProgram| m.alpha_mode.is_masked();
         let was_masked = self.materials.get(index).is_some_and(masked);
         if was_masked || masked(&program) {
             self.bvh = Default::default();

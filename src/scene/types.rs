@@ -44,6 +44,13 @@ pub enum AlphaMode {
     Blend,
 }
 
+impl AlphaMode {
+    /// Alpha-tested (`Mask`), whatever its cutoff.
+    pub fn is_masked(self) -> bool {
+        matches!(self, AlphaMode::Mask(_))
+    }
+}
+
 /// Decoded texture pixels (RGBA8). `srgb` says whether the bytes are sRGB-encoded
 /// (base colour, emissive) or linear data (metallic-roughness, normal, occlusion).
 #[derive(Clone, Debug, PartialEq)]
@@ -377,7 +384,7 @@ impl Scene {
         };
         SceneFeatures {
             has_transparent: uses(&|m| m.alpha_mode == AlphaMode::Blend),
-            has_alpha_mask: uses(&|m| matches!(m.alpha_mode, AlphaMode::Mask(_))),
+            has_alpha_mask: uses(&|m| m.alpha_mode.is_masked()),
             has_shadow_casters: self
                 .lights
                 .iter()

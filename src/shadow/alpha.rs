@@ -110,7 +110,7 @@ impl AlphaTable {
                 && scene
                     .materials
                     .get(m.material)
-                    .is_some_and(|s| matches!(s.alpha_mode, AlphaMode::Mask(_)))
+                    .is_some_and(|s| s.alpha_mode.is_masked())
         };
         let triangles: u64 = scene
             .meshes
@@ -125,7 +125,7 @@ impl AlphaTable {
             .materials
             .iter()
             .enumerate()
-            .filter(|(_, surface)| matches!(surface.alpha_mode, AlphaMode::Mask(_)))
+            .filter(|(_, surface)| surface.alpha_mode.is_masked())
             .map(|(index, surface)| MaskedMaterial {
                 index,
                 name: &surface.name,

@@ -21,7 +21,6 @@ use crate::graph::{Name, ScheduledPass};
 use crate::render::pipelines::PipelineKey;
 use crate::render::report::{PassReport, RasterReport};
 use crate::render::{RenderError, Renderer};
-use crate::scene::AlphaMode;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
@@ -158,7 +157,7 @@ pub(super) fn prepare_source(
                 bits[(t / 32) as usize] |= 1 << (t % 32);
             }
         };
-        if let AlphaMode::Mask(_) = material.alpha_mode {
+        if material.alpha_mode.is_masked() {
             mark(&mut alpha_tested);
             masked.push((m, end - first));
         }

@@ -210,7 +210,7 @@ impl Renderer {
         for mesh in meshes {
             let material_index = gpu.meshes[mesh].material;
             let m = &gpu.materials[material_index];
-            let masked = matches!(m.alpha_mode, AlphaMode::Mask(_));
+            let masked = m.alpha_mode.is_masked();
             let mut d: Vec<(&str, String)> = vec![];
             match mode {
                 DrawMode::DepthOnly => d.push(("DEPTH_ONLY", "1".into())),
