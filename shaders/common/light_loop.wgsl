@@ -10,11 +10,13 @@
 // in: directions spread over the disc spread half vectors over radius θ/2, whose slope
 // variance (θ/2)²/4 per axis adds to the lobe's α²/2, so α² grows by θ²/8 (measured
 // against the path-traced bounce in docs/indirect_light.md).
+// One material_eval call site either way: the loop's code grows by the widening only.
 fn reflect_incident(m: MaterialSample, inc: Incident) -> vec3<f32> {
+    var lobes = m;
     if (inc.spread > 0.0) {
-        return material_eval(material_widened(m, inc.spread * 0.125), inc.dir);
+        lobes = material_widened(m, inc.spread * 0.125);
     }
-    return material_eval(m, inc.dir);
+    return material_eval(lobes, inc.dir);
 }
 
 fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f32) -> vec3<f32> {
