@@ -315,12 +315,15 @@ impl<'a> OneBounce<'a> {
                 } else {
                     0
                 };
-            let side = (count as f32).sqrt().ceil() as u32;
+            // Stratified on the largest full side×side grid, jittered; the rays past it
+            // uniform (a partly filled grid would leave cells unsampled: biased).
+            let side = ((count as f64).sqrt() as u32).max(1);
             for k in 0..count {
-                // Stratified on a side×side grid, jittered.
-                let (i, j) = (k % side, k / side);
-                let u1 = (i as f32 + next(&mut rng)) / side as f32;
-                let u2 = ((j % side) as f32 + next(&mut rng)) / side as f32;
+                let (mut u1, mut u2) = (next(&mut rng), next(&mut rng));
+                if k < side * side {
+                    u1 = ((k % side) as f32 + u1) / side as f32;
+                    u2 = ((k / side) as f32 + u2) / side as f32;
+                }
                 let Some(l) = sampler.sample(which, v64, u1 as f64, u2 as f64) else {
                     continue;
                 };
