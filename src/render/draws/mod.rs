@@ -111,6 +111,14 @@ pub(super) struct MeshDraws {
 const SHADER: &str = "forward/forward.wgsl";
 
 /// The light loop's shadow defines (see `shaders/common/shadows.wgsl`).
+/// `NO_VPLS` where the scene has no indirect light, so no VPL: the light loops then leave
+/// out the glossy widening only VPLs take (shaders/common/light_loop.wgsl).
+pub(crate) fn vpl_defines(
+    features: &crate::scene::SceneFeatures,
+) -> Option<(&'static str, String)> {
+    (!features.has_indirect_lights).then(|| ("NO_VPLS", "1".into()))
+}
+
 pub(super) fn shadow_defines(shadows: Shadows) -> Vec<(&'static str, String)> {
     let offset = format!(
         "{:?}",
