@@ -170,6 +170,60 @@ fn a_scene_without_indirect_lights_runs_no_rsm_pass_and_renders_as_forward_plus(
     assert!(on.passes.iter().any(|p| p == "rsm") && on.passes.iter().any(|p| p == "vpl_spawn"));
 }
 
+/// The light loops leave the VPL code (the glossy lobes' widening by a VPL's disc) out of
+/// scenes without indirect lights (`NO_VPLS`: in a frame with no VPL it is a branch never
+/// taken that still cost the compute-first frame's shading time) and keep it where the
+/// scene has them, in every shading kind: compute, forward, deferred and transparent.
+#[test]
+fn light_loops_carry_the_vpl_code_only_for_scenes_with_indirect_lights() {
+    use lightgraph::scene::light_flags::INDIRECT;
+    let glass = lightgraph::scene::builtin::by_name("glass").expect("the glass scene");
+    let cases = [
+        (
+            "visibility_compute_raster.ron",
+            "visibility/visibility_shading.wgsl",
+            cornell(4),
+        ),
+        ("forward_plus.ron", "forward/forward.wgsl", cornell(4)),
+        (
+            "tiled_deferred.ron",
+            "deferred/deferred_shading.wgsl",
+            cornell(4),
+        ),
+        ("transparent.ron", "forward/forward.wgsl", glass),
+    ];
+    for (graph, shader, scene) in cases {
+        for indirect in [false, true] {
+            let mut s = scene.clone();
+            for l in &mut s.lights {
+                l.flags &= !INDIRECT;
+            }
+            if indirect {
+                s.lights[0].flags |= INDIRECT;
+            }
+            // The forward shader's shading draws (not its depth prepass's).
+            let built: Vec<String> = common::pipelines_built_from(shader, &graph_text(graph), &s)
+                .into_iter()
+                .filter(|k| !k.starts_with("forward/") || k.contains("SHADE=1"))
+                .collect();
+            assert!(!built.is_empty(), "{graph}: no {shader} shading pipeline");
+            // Both the opaque and the blended draws for transparent.ron.
+            let blended = built
+                .iter()
+                .filter(|k| k.contains("set=Transparent"))
+                .count();
+            assert!(graph != "transparent.ron" || blended > 0, "{built:?}");
+            for key in &built {
+                assert_eq!(
+                    key.contains("NO_VPLS"),
+                    !indirect,
+                    "{graph}, indirect {indirect}: {key}"
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn vpls_are_culled_like_any_light_the_culled_image_equals_every_light() {
     let (w, h) = (64, 48);

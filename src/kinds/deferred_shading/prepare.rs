@@ -138,6 +138,7 @@ pub(super) fn prepare(
         }
         d.extend(lists.define());
         d.extend(crate::render::draws::shadow_defines(shadows));
+        d.extend(crate::render::draws::vpl_defines(&cx.scene.features()));
         d.extend(super::VplLookup::defines(super::VplLookup::of(cx, sp)));
         let key = PipelineKey {
             shader: "deferred/deferred_shading.wgsl".into(),

@@ -31,6 +31,7 @@ pub(super) fn prepare(
         shadows,
         float_depth: false,
         vpl_visibility: super::VplLookup::of(cx, sp),
+        vpls: cx.scene.features().has_indirect_lights,
     };
     let draws = cx.renderer.mesh_draws(
         cx.gpu,

@@ -55,6 +55,7 @@ pub(super) fn prepare(
         shadows,
         float_depth,
         vpl_visibility: None,
+        vpls: cx.scene.features().has_indirect_lights,
     };
     let draws = cx.renderer.mesh_draws(
         cx.gpu,

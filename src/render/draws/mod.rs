@@ -42,6 +42,9 @@ pub(super) enum DrawMode {
         float_depth: bool,
         /// VPLs hidden from a pixel add nothing (`VPL_VISIBILITY`): the bits' layout.
         vpl_visibility: Option<super::passes::VplLookup>,
+        /// The scene has indirect lights, so the lights may hold VPLs; without them
+        /// `NO_VPLS` leaves their code out ([`vpl_defines`]).
+        vpls: bool,
     },
     /// A shadow atlas's views: depth only, the view from the instance index, both faces,
     /// biased.
@@ -255,10 +258,14 @@ impl Renderer {
                     shadows,
                     float_depth,
                     vpl_visibility,
+                    vpls,
                     ..
                 } => {
                     d.push(("SHADE", "1".into()));
                     d.extend(super::passes::VplLookup::defines(vpl_visibility));
+                    if !vpls {
+                        d.push(("NO_VPLS", "1".into()));
+                    }
                     d.extend(lists.define());
                     d.extend(shadow_defines(shadows));
                     if float_depth {
