@@ -266,3 +266,51 @@ fn a_wall_cut_out_everywhere_hides_no_vpl() {
         "{differ} pixels differ from the rooms without the wall"
     );
 }
+
+/// Where a block spans two surfaces (a box's edge and the floor beside it, a wall's
+/// corner), the block's point lies on one of them; the pixels on the other take the bits
+/// of a neighbouring block whose point lies on their own surface (`vpl_select` in
+/// shaders/indirect/vpl_lookup.wgsl). Against a ray per pixel (`block: 1`) the bounce
+/// through blocks then errs far less. The Cornell box at 256×192 with 4×4 blocks: about
+/// the geometry a block spans at 1920×1080 with default.ron's 8×8 (at 64×48 a block
+/// spans a box's whole face, and no neighbour is nearer its pixels than their own).
+#[test]
+fn pixels_take_the_bits_of_a_nearby_block_on_their_own_surface() {
+    let (w, h) = (256, 192);
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut s = scene::load(&root.join("scenes/cornell_indirect.ron"))
+        .unwrap()
+        .scene;
+    for c in s.vpl_controls.values_mut() {
+        c.n = 8;
+    }
+    let default = graph_text("default.ron");
+    let with_block = |b: u32| {
+        let t = default.replace(
+            "VplVisibility(block: 8,",
+            &format!("VplVisibility(block: {b},"),
+        );
+        assert_ne!(t, default);
+        t
+    };
+    let mut r = common::renderer();
+    let direct = render_text(
+        &mut r,
+        &graph_text("visibility_compute_raster.ron"),
+        &s,
+        w,
+        h,
+    )
+    .image;
+    let mut bounce = |text: &str| {
+        let image = render_text(&mut r, text, &s, w, h).image;
+        assert_eq!(image.len(), (w * h) as usize);
+        indirect_part(&image, &direct)
+    };
+    let exact = bounce(&with_block(1));
+    let blocked = bounce(&with_block(4));
+    let e = lightgraph::indirect::reference::relative_mse(&blocked, &exact);
+    eprintln!("4×4 blocks against a ray per pixel: relative MSE {e}");
+    // Measured on lavapipe: 0.0036; with every pixel taking its own block's bits 0.0171.
+    assert!(e < 0.006, "relative MSE {e}");
+}

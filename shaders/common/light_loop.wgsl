@@ -27,7 +27,7 @@ fn reflect_incident(m: MaterialSample, inc: Incident) -> vec3<f32> {
 fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f32) -> vec3<f32> {
     var color = material_emission(m) + frame.ambient.rgb * material_eval(m, p.normal);
 #if VPL_VISIBILITY
-    vpl_pixel = vec2<u32>(pixel);
+    vpl_select(vec2<u32>(pixel), p.position, p.normal);
 #endif
 #if SHADOWS
     // Casters are numbered before the material mask is applied, as job creation does.

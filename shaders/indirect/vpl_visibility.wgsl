@@ -7,6 +7,9 @@
 // unoccluded, or out of the point's range (it adds nothing near there; left lit). A VPL
 // behind the point's geometric normal is hidden (its light cannot reach that surface).
 // VPLs are the lights after the scene's: the last light's number tells how many there are.
+// After every block's bits, each block's point: its position and geometric normal, so a
+// shading pixel can take the bits of the nearby block whose point lies on its own surface
+// (indirect/vpl_lookup.wgsl); a block nothing covers gets no point (normal word 0).
 // Defines: VPL_BLOCK, VPL_WORDS, SHADOW_NORMAL_OFFSET, VISIBILITY_IDS.
 
 #include "common/types.wgsl"
@@ -56,11 +59,25 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
         }
     }
     let found = workgroupUniformLoad(&nearest);
+    let blocks = (frame.size + VPL_BLOCK - 1u) / VPL_BLOCK;
+    let block = group.y * blocks.x + group.x;
+    let point = blocks.x * blocks.y * VPL_WORDS + 4u * block;
     if (found == NO_PIXEL) {
-        return; // nothing covers the block: no pixel reads its bits
+        // Nothing covers the block: no pixel reads its bits, and its point is none.
+        if (lane == 0u) {
+            vpl_visibility[point + 3u] = 0u;
+        }
+        return;
     }
     let k = found & 0xffffu;
     let s = shadow_surface(corner + vec2<u32>(k % VPL_BLOCK, k / VPL_BLOCK));
+    if (lane == 0u) {
+        vpl_visibility[point] = bitcast<u32>(s.position.x);
+        vpl_visibility[point + 1u] = bitcast<u32>(s.position.y);
+        vpl_visibility[point + 2u] = bitcast<u32>(s.position.z);
+        // w = 1: a point (its byte 127, never 0).
+        vpl_visibility[point + 3u] = pack4x8snorm(vec4<f32>(s.ng, 1.0));
+    }
     let origin = shadow_origin(s.position, s.ng);
     let count = frame.light_count;
     var vpls = 0u;
@@ -85,8 +102,7 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
         }
     }
     workgroupBarrier();
-    let blocks_x = (frame.size.x + VPL_BLOCK - 1u) / VPL_BLOCK;
-    let base = (group.y * blocks_x + group.x) * VPL_WORDS;
+    let base = block * VPL_WORDS;
     // Only the words of VPLs that exist: no lookup reads past them.
     for (var w = lane; w < min((vpls + 31u) / 32u, VPL_WORDS); w += GROUP) {
         vpl_visibility[base + w] = atomicLoad(&bits[w]);

@@ -206,10 +206,10 @@ fn main(
 #if SHADOW_TRACE
     shadow_ng = surface_geometry(id.xy, surface_tri).ng;
 #endif
-#if VPL_VISIBILITY
-    vpl_pixel = id.xy;
-#endif
     let s = rebuild(id.xy, surface_tri);
+#if VPL_VISIBILITY
+    vpl_select(id.xy, s.p.position, s.p.normal);
+#endif
     let color = staged_lights(surface_unlit(s.p, s.m), shades, s.p, s.m, lane, group_list(tile));
     if (shades) {
         textureStore(hdr, id.xy, vec4<f32>(color, material_alpha(s.m)));
@@ -255,11 +255,12 @@ fn main(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group
 #if SHADOW_TRACE
     shadow_ng = surface_geometry(id.xy, tri).ng;
 #endif
-#if VPL_VISIBILITY
-    vpl_pixel = id.xy;
-#endif
     let s = rebuild(id.xy, tri);
 #if RANGE_FIRST
+    // (shade_surface selects the pixel's VPL block itself.)
+#if VPL_VISIBILITY
+    vpl_select(id.xy, s.p.position, s.p.normal);
+#endif
 #if UNIFORM_LIST
     let color = shade_list(s.p, s.m, group_list(tile));
 #else

@@ -49,7 +49,8 @@ pub enum BufferLayout {
         /// Who draws it, so its format: shading compares by hand in an R32Float atlas.
         raster: shadow_atlas::AtlasRaster,
     },
-    /// A `VplVisibility` pass's bits: `words` a block of `block`×`block` pixels.
+    /// A `VplVisibility` pass's bits, `words` a block of `block`×`block` pixels, then each
+    /// block's point (`shaders/indirect/vpl_visibility.wgsl`).
     VplVisibility {
         /// Pixels per side of a block.
         block: u32,
@@ -133,7 +134,10 @@ impl BufferLayout {
             BufferLayout::ShadowViews {
                 lights, max_views, ..
             } => shadow_atlas::view_table_bytes(*lights, *max_views),
-            BufferLayout::VplVisibility { words, blocks, .. } => 4 * u64::from(*words) * blocks,
+            // Each block's bits, then its point (position and packed normal: 16 bytes).
+            BufferLayout::VplVisibility { words, blocks, .. } => {
+                (4 * u64::from(*words) + 16) * blocks
+            }
             BufferLayout::LightSamples(l) => l.bytes(),
         }
     }
