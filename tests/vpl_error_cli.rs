@@ -1,10 +1,18 @@
 //! `lightgraph vpl-error --variant`: several VPL frames against one reference, one CSV
-//! row a variant and n, and a usage error for a variant without a label. On lavapipe, at
-//! a tiny size.
+//! row a variant and n, and a usage error for a variant without a label; `--no-noise`
+//! skips the reference's second estimate. On lavapipe, at a tiny size.
 
 use std::process::Command;
 
 fn vpl_error(out: &std::path::Path, variants: &[&str]) -> std::process::Output {
+    vpl_error_with(out, variants, &[])
+}
+
+fn vpl_error_with(
+    out: &std::path::Path,
+    variants: &[&str],
+    extra: &[&str],
+) -> std::process::Output {
     let root = env!("CARGO_MANIFEST_DIR");
     let mut args = vec![
         "vpl-error".to_string(),
@@ -27,6 +35,7 @@ fn vpl_error(out: &std::path::Path, variants: &[&str]) -> std::process::Output {
         args.push("--variant".into());
         args.push(v.to_string());
     }
+    args.extend(extra.iter().map(|a| a.to_string()));
     Command::new(env!("CARGO_BIN_EXE_lightgraph"))
         .current_dir(root)
         .args(&args)
@@ -78,4 +87,22 @@ fn variants_share_one_reference_and_fill_one_csv() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(stderr.contains("needs a label="), "{stderr}");
     let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn no_noise_skips_the_second_reference() {
+    let out = std::env::temp_dir().join(format!("lightgraph_vpl_noise_{}", std::process::id()));
+    for (extra, noise) in [
+        (&[][..], "its noise 0."),
+        (&["--no-noise"][..], "its noise not estimated"),
+    ] {
+        let o = vpl_error_with(&out, &[], extra);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{stderr}");
+        assert!(stderr.contains(noise), "{extra:?}: {stderr}");
+        let md = std::fs::read_to_string(out.join("results.md")).unwrap();
+        let table_says = noise.replace("its noise", "its own noise: relative MSE");
+        assert!(md.contains(&table_says), "{extra:?}: {md}");
+        let _ = std::fs::remove_dir_all(&out);
+    }
 }

@@ -142,6 +142,11 @@ pub struct VplErrorArgs {
     /// Bounce rays a pixel of the reference.
     #[arg(long, default_value_t = 256)]
     pub samples: u32,
+    /// Skip the reference's noise estimate (a second reference from other rays, as long
+    /// to trace as the first): its noise per pixel does not depend on the image size, so
+    /// a small image with the same samples measures it.
+    #[arg(long)]
+    pub no_noise: bool,
     /// Timed frames for each n, after as many warm-up frames and at least 1 s of them; medians are reported.
     #[arg(long, default_value_t = 10)]
     pub frames: u32,

@@ -179,9 +179,14 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
         let reference_s = t.elapsed().as_secs_f64();
         // Its own noise: half the relative MSE between it and an independent estimate
         // (the two differ by twice one's variance); a VPL image's relative MSE includes it.
-        let noise = relative_mse(&tracer.image_seeded(w, h, args.samples, 1), &reference) / 2.0;
+        let noise = if args.no_noise {
+            "not estimated".to_string()
+        } else {
+            let second = tracer.image_seeded(w, h, args.samples, 1);
+            format!("{:.4}", relative_mse(&second, &reference) / 2.0)
+        };
         eprintln!(
-            "{}: reference ({} samples) in {reference_s:.1} s, its noise {noise:.4} (relative MSE)",
+            "{}: reference ({} samples) in {reference_s:.1} s, its noise {noise} (relative MSE)",
             base.name, args.samples
         );
         let to_rgb = |v: &[glam::Vec3]| {
@@ -200,7 +205,7 @@ pub fn run(args: &VplErrorArgs) -> Result<()> {
         )?;
         let _ = writeln!(
             md,
-            "## {} ({} indirect lights; reference {reference_s:.1} s on the CPU; its own noise: relative MSE {noise:.4})\n\n| variant | n | VPLs | dropped | lists overflowed (timed graph) | rel. MSE | Σvpl/Σref | worst pixel: share of the squared error (VPL / reference luminance) | VPL passes (ms) | rsm | spawn | culling | shading | visibility |\n|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|",
+            "## {} ({} indirect lights; reference {reference_s:.1} s on the CPU; its own noise: relative MSE {noise})\n\n| variant | n | VPLs | dropped | lists overflowed (timed graph) | rel. MSE | Σvpl/Σref | worst pixel: share of the squared error (VPL / reference luminance) | VPL passes (ms) | rsm | spawn | culling | shading | visibility |\n|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|",
             base.name,
             indirect.len()
         );
