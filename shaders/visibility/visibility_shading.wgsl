@@ -257,8 +257,8 @@ fn main(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group
 #endif
     let s = rebuild(id.xy, tri);
 #if RANGE_FIRST
-    // (shade_surface selects the pixel's VPL block itself.)
 #if VPL_VISIBILITY
+    // These loops do not go through shade_surface, which selects the block itself.
     vpl_select(id.xy, s.p.position, s.p.normal);
 #endif
 #if UNIFORM_LIST
