@@ -8,8 +8,9 @@
 #             and the light linked list (their sweeps);
 #   stochastic (only when named) stochastic direct lighting's time against error with the
 #             spread over seeds, one sweep a scene (stochastic_seeds_*.ron);
-#   extras    the VPL bounce against its path-traced reference (vpl-error; the variants run
-#             puts with and without visibility and the cheaper VPLs on one plot) and hot-reload
+#   extras    the VPL bounce against its path-traced reference (vpl-error: Forward+ and the
+#             compute-first frame at 256 rays; default.ron with and without visibility, and
+#             the cheaper VPLs, each on one time-vs-error plot at 1,024 rays) and hot-reload
 #             latency (reload-bench).
 # Each sweep's CSV, Markdown and plots go to $OUT/r/<sweep>/ (or results/r/), packed into
 # results.tar.gz after every sweep, so a cut-off run still brings back what it finished.
@@ -50,19 +51,32 @@ if [[ $stages == *" extras "* ]]; then
         --error-graph benches/graphs/visibility_indirect_vpl_all_lights.ron \
         --direct graphs/visibility_compute_raster.ron --out "$out/vpl_error_visibility" > "$out/vpl_error_visibility.log" 2>&1
     echo "== vpl_error_visibility (rc $?)"; cat "$out/vpl_error_visibility/results.md" 2>/dev/null | head -20
-    # One time-vs-error plot: without and with visibility, and the cheaper VPLs
-    # (docs/indirect_light.md, "Cheaper VPLs"); one reference a scene for all of them.
-    vis="graph=graphs/visibility_indirect_vpl.ron;error_graph=benches/graphs/visibility_indirect_vpl_all_lights.ron;direct=graphs/visibility_compute_raster.ron"
-    timeout 600 $lg vpl-error --scene scenes/cornell_indirect.ron scenes/atrium_indirect.ron \
-        --width 1920 --height 1080 --samples 256 --frames 10 --n 4,8,16 \
-        --variant "label=no visibility;graph=benches/graphs/visibility_indirect_vpl_no_visibility.ron" \
-        --variant "label=visibility;$vis" \
-        --variant "label=visibility disc;$vis;spawn=falloff: Disc" \
-        --variant "label=visibility min_flux 1e-4;$vis;spawn=min_flux: 0.0001" \
-        --variant "label=visibility merge 2;$vis;spawn=merge: 2" \
-        --variant "label=default;$vis;spawn=min_flux: 0.0001, falloff: Disc" \
-        --out "$out/vpl_error_variants" > "$out/vpl_error_variants.log" 2>&1
-    echo "== vpl_error_variants (rc $?)"; cat "$out/vpl_error_variants/results.md" 2>/dev/null | head -40
+    # default.ron's bounce against the path-traced one at 1920x1080 with 1,024 reference
+    # rays: without visibility, as shipped (8x8 blocks) and with 16x16 blocks, on one
+    # time-vs-error plot (docs/indirect_light.md, "Measured cost (GPU)").
+    timeout 400 $lg vpl-error --scene scenes/cornell_indirect.ron scenes/atrium_indirect.ron \
+        --width 1920 --height 1080 --n 4,8,16 --samples 1024 --no-noise --frames 10 \
+        --direct graphs/visibility_compute_raster.ron \
+        --variant "label=no visibility;graph=benches/graphs/default_no_visibility.ron;error_graph=benches/graphs/default_all_lights_no_visibility.ron" \
+        --variant "label=8x8 blocks (default.ron);graph=graphs/default.ron;error_graph=benches/graphs/default_all_lights.ron" \
+        --variant "label=16x16 blocks;graph=benches/graphs/default_block16.ron;error_graph=benches/graphs/default_all_lights_block16.ron" \
+        --out "$out/vpl_error_1080p" > "$out/vpl_error_1080p.log" 2>&1
+    echo "== vpl_error_1080p (rc $?)"; sed -n '/^| variant/,/^$/p' "$out/vpl_error_1080p/results.md"
+    pack
+    # The cheaper VPLs on one time-vs-error plot against the same reference (docs/indirect_light.md,
+    # "Cheaper VPLs"): every VPL as spawned, the disc falloff, min_flux, merging, both
+    # of default.ron's.
+    vis="graph=graphs/visibility_indirect_vpl.ron;error_graph=benches/graphs/visibility_indirect_vpl_all_lights.ron"
+    timeout 560 $lg vpl-error --scene scenes/cornell_indirect.ron scenes/atrium_indirect.ron \
+        --width 1920 --height 1080 --n 4,8,16 --samples 1024 --no-noise --frames 10 \
+        --direct graphs/visibility_compute_raster.ron \
+        --variant "label=clamp;$vis" \
+        --variant "label=disc;$vis;spawn=falloff: Disc" \
+        --variant "label=min_flux 1e-4;$vis;spawn=min_flux: 0.0001" \
+        --variant "label=merge 2;$vis;spawn=merge: 2" \
+        --variant "label=disc and min_flux (default.ron);$vis;spawn=min_flux: 0.0001, falloff: Disc" \
+        --out "$out/vpl_cheaper_1080p" > "$out/vpl_cheaper_1080p.log" 2>&1
+    echo "== vpl_cheaper_1080p (rc $?)"; sed -n '/^| variant/,/^$/p' "$out/vpl_cheaper_1080p/results.md"
     timeout 150 $lg reload-bench --out "$out/reload_latency" --width 1920 --height 1080 \
         --lights 3072 --repeats 20 > "$out/reload_latency.log" 2>&1
     echo "== reload_latency (rc $?)"; cat "$out/reload_latency/reload_latency.md" 2>/dev/null | head -20
