@@ -22,6 +22,18 @@ fn without_visibility(text: &str) -> String {
     t
 }
 
+/// The Cornell box with its indirect point light, every view split into n×n VPLs.
+fn cornell(n: u32) -> Scene {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut s = scene::load(&root.join("scenes/cornell_indirect.ron"))
+        .unwrap()
+        .scene;
+    for c in s.vpl_controls.values_mut() {
+        c.n = n;
+    }
+    s
+}
+
 /// Two 4 × 3 × 4 m rooms side by side (x < 0 and x > 0), split by a full wall 0.1 m
 /// thick from floor to ceiling and side to side. One indirect spot light in the first
 /// room points at its floor, its cone clear of the wall, so no direct light reaches the
@@ -123,13 +135,7 @@ fn a_vpl_behind_a_full_wall_adds_nothing_to_the_other_room() {
 #[test]
 fn with_visibility_both_cornell_walls_still_bleed_onto_the_floor() {
     let (w, h) = (96, 72);
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut s = scene::load(&root.join("scenes/cornell_indirect.ron"))
-        .unwrap()
-        .scene;
-    for c in s.vpl_controls.values_mut() {
-        c.n = 8;
-    }
+    let s = cornell(8);
     let mut r = common::renderer();
     let with = render_text(&mut r, &graph_text("default.ron"), &s, w, h);
     let direct = render_text(
@@ -272,18 +278,11 @@ fn a_wall_cut_out_everywhere_hides_no_vpl() {
 /// of a neighbouring block whose point lies on their own surface (`vpl_select` in
 /// shaders/indirect/vpl_lookup.wgsl). Against a ray per pixel (`block: 1`) the bounce
 /// through blocks then errs far less. The Cornell box at 256×192 with 4×4 blocks: about
-/// the geometry a block spans at 1920×1080 with default.ron's 8×8 (at 64×48 a block
-/// spans a box's whole face, and no neighbour is nearer its pixels than their own).
+/// the geometry a block spans at 1920×1080 with default.ron's 8×8.
 #[test]
 fn pixels_take_the_bits_of_a_nearby_block_on_their_own_surface() {
     let (w, h) = (256, 192);
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut s = scene::load(&root.join("scenes/cornell_indirect.ron"))
-        .unwrap()
-        .scene;
-    for c in s.vpl_controls.values_mut() {
-        c.n = 8;
-    }
+    let s = cornell(8);
     let default = graph_text("default.ron");
     let with_block = |b: u32| {
         let t = default.replace(
