@@ -54,6 +54,8 @@ pub(super) fn prepare(
     let mut offered = cx.declared(sp)?;
     let lists = cx.shading_lists(sp, p.lights, &mut offered)?;
     let shadows = cx.shading_shadows(sp, &mut offered);
+    let has_indirect_lights = cx.scene.features().has_indirect_lights;
+    let vpl = super::VplLookup::of(cx, sp);
     // A multisampled G-buffer: every distinct sample shaded, the mean stored. Pixels whose
     // samples hold several materials sum over the materials' dispatches in `hdr`, which
     // each reads back (read-write storage; the MSAA formats already need the adapter's
@@ -138,8 +140,8 @@ pub(super) fn prepare(
         }
         d.extend(lists.define());
         d.extend(crate::render::draws::shadow_defines(shadows));
-        d.extend(crate::render::draws::vpl_defines(&cx.scene.features()));
-        d.extend(super::VplLookup::defines(super::VplLookup::of(cx, sp)));
+        d.extend(crate::render::draws::vpl_defines(has_indirect_lights));
+        d.extend(super::VplLookup::defines(vpl));
         let key = PipelineKey {
             shader: "deferred/deferred_shading.wgsl".into(),
             defines: defines(&d),

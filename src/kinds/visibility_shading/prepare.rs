@@ -62,7 +62,7 @@ pub(super) fn prepare(
     let shadows = cx.shading_shadows(sp, &mut offered);
     let vpl = super::VplLookup::of(cx, sp);
     let samples = sample_defines(cx, sp);
-    let vpl_features = cx.scene.features();
+    let has_indirect_lights = cx.scene.features().has_indirect_lights;
     let layout = tile_layout(cx, sp, lists);
     let side = p.workgroup_side();
     let light_loop = choose_light_loop(p.light_loop, layout, side);
@@ -149,7 +149,7 @@ pub(super) fn prepare(
         d.extend(lists.define());
         d.extend(loop_define(light_loop));
         d.extend(crate::render::draws::shadow_defines(shadows));
-        d.extend(crate::render::draws::vpl_defines(&vpl_features));
+        d.extend(crate::render::draws::vpl_defines(has_indirect_lights));
         d.extend(super::VplLookup::defines(vpl));
         d.extend(samples.iter().cloned());
         // The shader's `@workgroup_size(SHADING_GROUP, SHADING_GROUP, 1)`.

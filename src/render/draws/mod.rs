@@ -113,15 +113,13 @@ pub(super) struct MeshDraws {
 
 const SHADER: &str = "forward/forward.wgsl";
 
-/// The light loop's shadow defines (see `shaders/common/shadows.wgsl`).
 /// `NO_VPLS` where the scene has no indirect light, so no VPL: the light loops then leave
 /// out the glossy widening only VPLs take (shaders/common/light_loop.wgsl).
-pub(crate) fn vpl_defines(
-    features: &crate::scene::SceneFeatures,
-) -> Option<(&'static str, String)> {
-    (!features.has_indirect_lights).then(|| ("NO_VPLS", "1".into()))
+pub(crate) fn vpl_defines(has_indirect_lights: bool) -> Option<(&'static str, String)> {
+    (!has_indirect_lights).then(|| ("NO_VPLS", "1".into()))
 }
 
+/// The light loop's shadow defines (see `shaders/common/shadows.wgsl`).
 pub(super) fn shadow_defines(shadows: Shadows) -> Vec<(&'static str, String)> {
     let offset = format!(
         "{:?}",
@@ -263,9 +261,7 @@ impl Renderer {
                 } => {
                     d.push(("SHADE", "1".into()));
                     d.extend(super::passes::VplLookup::defines(vpl_visibility));
-                    if !vpls {
-                        d.push(("NO_VPLS", "1".into()));
-                    }
+                    d.extend(vpl_defines(vpls));
                     d.extend(lists.define());
                     d.extend(shadow_defines(shadows));
                     if float_depth {
