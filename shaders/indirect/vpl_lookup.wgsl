@@ -5,6 +5,8 @@
 //     var<storage, read> vpl_visibility: array<u32>;
 // The loop calls vpl_select with the shaded point before walking its lights.
 
+#include "indirect/vpl_layout.wgsl"
+
 var<private> vpl_block: u32;
 
 // A block's point: the surface its rays left from (indirect/vpl_visibility.wgsl).
@@ -15,8 +17,7 @@ struct VplPoint {
 };
 
 fn vpl_point(block: u32) -> VplPoint {
-    let blocks = (frame.size + VPL_BLOCK - 1u) / VPL_BLOCK;
-    let at = blocks.x * blocks.y * VPL_WORDS + 4u * block;
+    let at = vpl_point_word(block);
     let packed = vpl_visibility[at + 3u];
     let position = vec3<f32>(
         bitcast<f32>(vpl_visibility[at]),
@@ -47,7 +48,7 @@ fn vpl_point_fits(q: VplPoint, p: vec3<f32>, n: vec3<f32>, pixel_width: f32) -> 
 // fits leaves no tie between equally near neighbours for rounding to decide (the
 // compute-first and Forward+ paths rebuild the same point a rounding apart).
 fn vpl_select(pixel: vec2<u32>, p: vec3<f32>, n: vec3<f32>) {
-    let blocks = (frame.size + VPL_BLOCK - 1u) / VPL_BLOCK;
+    let blocks = vpl_blocks();
     let own = pixel / VPL_BLOCK;
     vpl_block = own.y * blocks.x + own.x;
     if (VPL_BLOCK == 1u) {

@@ -9,7 +9,7 @@
 // VPLs are the lights after the scene's: the last light's number tells how many there are.
 // After every block's bits, each block's point: its position and geometric normal, so a
 // shading pixel can take the bits of the nearby block whose point lies on its own surface
-// (indirect/vpl_lookup.wgsl); a block nothing covers gets no point (normal word 0).
+// (indirect/vpl_lookup.wgsl; the layout: indirect/vpl_layout.wgsl).
 // Defines: VPL_BLOCK, VPL_WORDS, SHADOW_NORMAL_OFFSET, VISIBILITY_IDS.
 
 #include "common/types.wgsl"
@@ -27,6 +27,7 @@
 #include "shadow/bvh.wgsl"
 #include "common/shadows.wgsl"
 #include "shadow/surface_source.wgsl"
+#include "indirect/vpl_layout.wgsl"
 
 const LIGHT_VPL: u32 = 4u;
 // How far off its surface a ray aims at a VPL, in units of its distance clamp: on the
@@ -59,9 +60,8 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
         }
     }
     let found = workgroupUniformLoad(&nearest);
-    let blocks = (frame.size + VPL_BLOCK - 1u) / VPL_BLOCK;
-    let block = group.y * blocks.x + group.x;
-    let point = blocks.x * blocks.y * VPL_WORDS + 4u * block;
+    let block = group.y * vpl_blocks().x + group.x;
+    let point = vpl_point_word(block);
     if (found == NO_PIXEL) {
         // Nothing covers the block: no pixel reads its bits, and its point is none.
         if (lane == 0u) {

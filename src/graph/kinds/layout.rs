@@ -50,7 +50,7 @@ pub enum BufferLayout {
         raster: shadow_atlas::AtlasRaster,
     },
     /// A `VplVisibility` pass's bits, `words` a block of `block`×`block` pixels, then each
-    /// block's point (`shaders/indirect/vpl_visibility.wgsl`).
+    /// block's point (`shaders/indirect/vpl_layout.wgsl`).
     VplVisibility {
         /// Pixels per side of a block.
         block: u32,
