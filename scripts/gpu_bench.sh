@@ -51,32 +51,36 @@ if [[ $stages == *" extras "* ]]; then
         --error-graph benches/graphs/visibility_indirect_vpl_all_lights.ron \
         --direct graphs/visibility_compute_raster.ron --out "$out/vpl_error_visibility" > "$out/vpl_error_visibility.log" 2>&1
     echo "== vpl_error_visibility (rc $?)"; cat "$out/vpl_error_visibility/results.md" 2>/dev/null | head -20
-    # default.ron's bounce against the path-traced one at 1920x1080 with 1,024 reference
-    # rays: without visibility, as shipped (8x8 blocks) and with 16x16 blocks, on one
-    # time-vs-error plot (docs/indirect_light.md, "Measured cost (GPU)").
-    timeout 400 $lg vpl-error --scene scenes/cornell_indirect.ron scenes/atrium_indirect.ron \
-        --width 1920 --height 1080 --n 4,8,16 --samples 1024 --no-noise --frames 10 \
-        --direct graphs/visibility_compute_raster.ron \
-        --variant "label=no visibility;graph=benches/graphs/default_no_visibility.ron;error_graph=benches/graphs/default_all_lights_no_visibility.ron" \
-        --variant "label=8x8 blocks (default.ron);graph=graphs/default.ron;error_graph=benches/graphs/default_all_lights.ron" \
-        --variant "label=16x16 blocks;graph=benches/graphs/default_block16.ron;error_graph=benches/graphs/default_all_lights_block16.ron" \
-        --out "$out/vpl_error_1080p" > "$out/vpl_error_1080p.log" 2>&1
-    echo "== vpl_error_1080p (rc $?)"; sed -n '/^| variant/,/^$/p' "$out/vpl_error_1080p/results.md"
-    pack
-    # The cheaper VPLs on one time-vs-error plot against the same reference (docs/indirect_light.md,
-    # "Cheaper VPLs"): every VPL as spawned, the disc falloff, min_flux, merging, both
-    # of default.ron's.
+    # vpl_error_1080p LABEL LIMIT_S VARIANT...: the bounce on the Cornell box and the atrium
+    # at 1920x1080 against the path-traced one with 1,024 reference rays a pixel (the
+    # reference is deterministic: every call traces the same), the variants (each a
+    # --variant text) on one time-vs-error plot.
+    vpl_error_1080p() {
+        local label=$1 limit=$2 v variants=()
+        shift 2
+        for v in "$@"; do variants+=(--variant "$v"); done
+        timeout "$limit" $lg vpl-error --scene scenes/cornell_indirect.ron scenes/atrium_indirect.ron \
+            --width 1920 --height 1080 --n 4,8,16 --samples 1024 --no-noise --frames 10 \
+            --direct graphs/visibility_compute_raster.ron "${variants[@]}" \
+            --out "$out/$label" > "$out/$label.log" 2>&1
+        echo "== $label (rc $?)"; sed -n '/^| variant/,/^$/p' "$out/$label/results.md"
+        pack
+    }
+    # default.ron without visibility, as shipped (8x8 blocks) and with 16x16 blocks
+    # (docs/indirect_light.md, "Measured cost (GPU)").
+    vpl_error_1080p vpl_error_1080p 400 \
+        "label=no visibility;graph=benches/graphs/default_no_visibility.ron;error_graph=benches/graphs/default_all_lights_no_visibility.ron" \
+        "label=8x8 blocks (default.ron);graph=graphs/default.ron;error_graph=benches/graphs/default_all_lights.ron" \
+        "label=16x16 blocks;graph=benches/graphs/default_block16.ron;error_graph=benches/graphs/default_all_lights_block16.ron"
+    # The cheaper VPLs (docs/indirect_light.md, "Cheaper VPLs"): every VPL as spawned, the
+    # disc falloff, min_flux, merging, both of default.ron's.
     vis="graph=graphs/visibility_indirect_vpl.ron;error_graph=benches/graphs/visibility_indirect_vpl_all_lights.ron"
-    timeout 560 $lg vpl-error --scene scenes/cornell_indirect.ron scenes/atrium_indirect.ron \
-        --width 1920 --height 1080 --n 4,8,16 --samples 1024 --no-noise --frames 10 \
-        --direct graphs/visibility_compute_raster.ron \
-        --variant "label=clamp;$vis" \
-        --variant "label=disc;$vis;spawn=falloff: Disc" \
-        --variant "label=min_flux 1e-4;$vis;spawn=min_flux: 0.0001" \
-        --variant "label=merge 2;$vis;spawn=merge: 2" \
-        --variant "label=disc and min_flux (default.ron);$vis;spawn=min_flux: 0.0001, falloff: Disc" \
-        --out "$out/vpl_cheaper_1080p" > "$out/vpl_cheaper_1080p.log" 2>&1
-    echo "== vpl_cheaper_1080p (rc $?)"; sed -n '/^| variant/,/^$/p' "$out/vpl_cheaper_1080p/results.md"
+    vpl_error_1080p vpl_cheaper_1080p 560 \
+        "label=clamp;$vis" \
+        "label=disc;$vis;spawn=falloff: Disc" \
+        "label=min_flux 1e-4;$vis;spawn=min_flux: 0.0001" \
+        "label=merge 2;$vis;spawn=merge: 2" \
+        "label=disc and min_flux (default.ron);$vis;spawn=min_flux: 0.0001, falloff: Disc"
     timeout 150 $lg reload-bench --out "$out/reload_latency" --width 1920 --height 1080 \
         --lights 3072 --repeats 20 > "$out/reload_latency.log" 2>&1
     echo "== reload_latency (rc $?)"; cat "$out/reload_latency/reload_latency.md" 2>/dev/null | head -20
