@@ -225,6 +225,63 @@ fn block_pixel(lane: u32) -> vec2<u32> {
     return vec2<u32>(lane % 8u + 8u * (block % across), (lane / 8u) % 4u + 4u * (block / across));
 }
 
+#if SUBGROUP_LIST
+// With SUBGROUP_LIST (GroupList on a device with subgroup operations): the workgroup's
+// one tile list walked a subgroup of lights at a time (shade_list_subgroup), which needs
+// every invocation of a subgroup in the walk. One-dimensional, as subgroup built-ins
+// require; block_pixel maps an invocation to its pixel either way.
+@compute @workgroup_size(SHADING_GROUP * SHADING_GROUP, 1, 1)
+fn main(
+    @builtin(local_invocation_index) lane: u32,
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(subgroup_invocation_id) sg_lane: u32,
+    @builtin(subgroup_size) sg_size: u32,
+) {
+    let tile = shading_tile(lane, group);
+    if (tile.x == NO_TILE) {
+        return;
+    }
+    let id = tile * SHADING_GROUP + block_pixel(lane);
+    let inside = all(id.xy < frame.size);
+    var tri = NO_TRIANGLE;
+    if (inside) {
+        tri = textureLoad(visibility, id.xy, 0).x;
+    }
+#if CLEARS
+    if (inside && tri == NO_TRIANGLE) {
+        textureStore(hdr, id.xy, vec4<f32>(0.0));
+    }
+#endif
+    let member = member_of(tri);
+    let shades = member != NO_MEMBER;
+    // A subgroup none of whose pixels is this group's leaves whole; in any other, every
+    // invocation rebuilds a surface (the group's first triangle where its pixel has
+    // none of the group's, as the staged loop does) and walks the list, adding the
+    // lights only where it shades.
+    if (subgroupAll(!shades)) {
+        return;
+    }
+    let shown = shading_members[select(MEMBERS_FIRST, member, shades)];
+    let surface_tri = select(shown.x, tri, shades);
+#if SHARED_CODE
+    material_constant_base = shown.z;
+#endif
+#if SHADOWS
+    shadow_pixel = id.y * frame.size.x + id.x;
+#endif
+#if SHADOW_TRACE
+    shadow_ng = surface_geometry(id.xy, surface_tri).ng;
+#endif
+    let s = rebuild(id.xy, surface_tri);
+#if VPL_VISIBILITY
+    vpl_select(id.xy, s.p.position, s.p.normal);
+#endif
+    let color = shade_list_subgroup(s.p, s.m, group_list(tile), sg_lane, sg_size);
+    if (shades) {
+        textureStore(hdr, id.xy, vec4<f32>(color, material_alpha(s.m)));
+    }
+}
+#else
 @compute @workgroup_size(SHADING_GROUP, SHADING_GROUP, 1)
 fn main(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group: vec3<u32>) {
     let tile = shading_tile(lane, group);
@@ -271,4 +328,5 @@ fn main(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group
 #endif
     textureStore(hdr, id.xy, vec4<f32>(color, material_alpha(s.m)));
 }
+#endif
 #endif

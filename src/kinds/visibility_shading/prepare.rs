@@ -123,6 +123,9 @@ pub(super) fn prepare(
     } else {
         None
     };
+    // GroupList walks its list a subgroup of lights at a time where the device has
+    // subgroup operations (shaders/visibility/staged_lights.wgsl's shade_list_subgroup).
+    let subgroups = cx.device().features().contains(wgpu::Features::SUBGROUP);
     let mut dispatches = Vec::new();
     for (slot, group) in shader_groups.iter().enumerate() {
         let m = &cx.gpu.materials[group[0]];
@@ -156,6 +159,9 @@ pub(super) fn prepare(
         d.push(("SHADING_GROUP", format!("{side}u")));
         if light_loop == LightLoop::GroupList {
             d.push(("UNIFORM_LIST", "1".into()));
+            if subgroups {
+                d.push(("SUBGROUP_LIST", "1".into()));
+            }
         }
         let key = PipelineKey {
             shader: "visibility/visibility_shading.wgsl".into(),

@@ -22,7 +22,7 @@ use crate::graph::error::GraphError;
 use crate::graph::model::{LightSource, SceneResource};
 use serde::{Deserialize, Serialize};
 
-/// `VisibilityShading(lights: Culled, light_loop: RangeFirst, workgroup: 16, materials: PerShader)`.
+/// `VisibilityShading(lights: Culled, light_loop: GroupList, workgroup: 16, materials: PerShader)`.
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
 #[serde(deny_unknown_fields)]
 pub struct VisibilityShading {
@@ -30,7 +30,7 @@ pub struct VisibilityShading {
     /// pass's lists (`Culled`).
     #[serde(default)]
     pub lights: LightSource,
-    /// How a pixel walks its lights (`RangeFirst` by default).
+    /// How a pixel walks its lights (`GroupList` by default).
     #[serde(default)]
     pub light_loop: LightLoop,
     /// Pixels per side of the shading workgroup: 8 or 16 (`Staged` takes 8). Its
@@ -93,16 +93,18 @@ impl VisibilityShading {
 pub enum LightLoop {
     /// Forward shading's loop (`common/light_loop.wgsl`), per pixel.
     Forward,
-    /// Per pixel, a light's range tested before its properties are read. The default: the
-    /// fastest of the three on an NVIDIA H200 (docs/visibility_buffer.md).
-    #[default]
+    /// Per pixel, a light's range tested before its properties are read.
     RangeFirst,
     /// A workgroup whose pixels all read one tile list (Frustum and DepthMask lists)
     /// stages it in workgroup memory, a batch at a time; other lists run `RangeFirst`.
     Staged,
     /// `RangeFirst` over the workgroup's one tile list, found from the workgroup id, so
     /// the compiler sees the walk as uniform (Frustum and DepthMask lists whose tile is a
-    /// multiple of the workgroup); other lists run `RangeFirst`.
+    /// multiple of the workgroup); other lists run `RangeFirst`. On a device with
+    /// subgroup operations each subgroup loads a light per invocation and passes them
+    /// round by shuffles. The default: the fastest on an NVIDIA H100
+    /// (docs/visibility_buffer.md).
+    #[default]
     GroupList,
 }
 
@@ -245,12 +247,16 @@ mod tests {
     }
 
     #[test]
-    fn light_loop_defaults_to_range_first_and_parses_each_kind() {
+    fn light_loop_defaults_to_group_list_and_parses_each_kind() {
         use super::{LightLoop, VisibilityShading};
         let parse = |t: &str| ron::from_str::<VisibilityShading>(t).unwrap();
-        assert_eq!(parse("(lights: Culled)").light_loop, LightLoop::RangeFirst);
+        assert_eq!(parse("(lights: Culled)").light_loop, LightLoop::GroupList);
         assert_eq!(
             VisibilityShading::default().light_loop,
+            LightLoop::GroupList
+        );
+        assert_eq!(
+            parse("(light_loop: RangeFirst)").light_loop,
             LightLoop::RangeFirst
         );
         assert_eq!(parse("(light_loop: Staged)").light_loop, LightLoop::Staged);
