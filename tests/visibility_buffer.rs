@@ -582,6 +582,34 @@ fn staged_light_loop_equals_the_per_pixel_loop_to_the_bit() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
+/// GroupList, the default light loop, walks each tile list a subgroup of lights at a
+/// time (SUBGROUP_LIST: an invocation loads a light, shuffles pass it round) on a device
+/// with subgroup operations, lavapipe among them, so the exactness test above checks that
+/// walk; RangeFirst, and lists that are not one per tile (HalfZ), keep the per-pixel walk.
+#[test]
+fn group_list_walks_by_subgroup_where_the_device_has_subgroups() {
+    let subgroups = renderer()
+        .ctx
+        .device
+        .features()
+        .contains(wgpu::Features::SUBGROUP);
+    println!("device has subgroup operations: {subgroups}");
+    let harada = masked_harada();
+    let plain = graph_text("visibility_buffer.ron");
+    let cases = [
+        ("default loop", plain.clone(), subgroups),
+        ("RangeFirst", with_loop(&plain, "RangeFirst"), false),
+        ("HalfZ", graph_text("visibility_buffer_half_z.ron"), false),
+    ];
+    for (name, text, expected) in cases {
+        let built = pipelines_built_from("visibility/visibility_shading.wgsl", &text, &harada);
+        assert!(!built.is_empty(), "{name}: no shading pipeline");
+        for key in &built {
+            assert_eq!(key.contains("SUBGROUP_LIST"), expected, "{name}: {key}");
+        }
+    }
+}
+
 /// The staged graphs (Frustum and DepthMask, tiles of 16 and 8, compact and fixed lists)
 /// and those on the range-first per-pixel walk (HalfZ, Clustered, linked lists, all
 /// lights) against forward brute force on the masked harada, within the Lambert bounds

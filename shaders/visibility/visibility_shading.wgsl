@@ -276,7 +276,7 @@ fn main(
 #if VPL_VISIBILITY
     vpl_select(id.xy, s.p.position, s.p.normal);
 #endif
-    let color = shade_list_subgroup(s.p, s.m, group_list(tile), sg_lane, sg_size);
+    let color = shade_list_subgroup(s.p, s.m, group_list(tile), shades, sg_lane, sg_size);
     if (shades) {
         textureStore(hdr, id.xy, vec4<f32>(color, material_alpha(s.m)));
     }
