@@ -3,7 +3,7 @@
 //! total is bounded by the graph.
 //!
 //! Where fixed lists of 256 overflow (harada's 3,072 lights at 64×36; 3,000 random lights
-//! at 96×64), every culling variant at both tile sizes must give:
+//! at 96×64), every culling variant at each tile size must give:
 //! - no list cut, no fill that disagrees with its count, every offset the sum of the
 //!   counts before it (checked on the CPU from the entries read back);
 //! - exactly the lists of fixed lists roomy enough not to overflow (same counts), and so
@@ -30,8 +30,8 @@ use lightgraph::render::{FrameResult, Renderer};
 use lightgraph::scene::Scene;
 use lightgraph::shader::ShaderLibrary;
 
-/// Every variant at both tile sizes.
-const ALL: [(u32, &str); 8] = [
+/// Every variant at 8 and 16 pixels, and the compute-first frame's Frustum at 32.
+const ALL: [(u32, &str); 9] = [
     (8, "Frustum"),
     (8, "HalfZ"),
     (8, "DepthMask"),
@@ -40,6 +40,7 @@ const ALL: [(u32, &str); 8] = [
     (16, "HalfZ"),
     (16, "DepthMask"),
     (16, "Clustered(slices: 16)"),
+    (32, "Frustum"),
 ];
 const TOLERANCE: f32 = 2e-6;
 /// Room for everything these scenes want (4 MiB of indices).

@@ -15,7 +15,7 @@ use lightgraph::render::FrameResult;
 use lightgraph::scene::{Light, LightShape, Scene};
 
 const VARIANTS: [&str; 4] = ["Frustum", "HalfZ", "DepthMask", "Clustered(slices: 16)"];
-const TILES: [u32; 2] = [8, 16];
+const TILES: [u32; 3] = [8, 16, 32];
 const W: u32 = 333;
 const H: u32 = 197;
 

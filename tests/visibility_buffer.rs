@@ -456,6 +456,11 @@ fn staging_graphs() -> Vec<(String, String)> {
             "fixed 512 Frustum",
             "LightCulling(tile: 16, variant: Frustum, capacity: 512)",
         ),
+        // Four 16×16 workgroups (GroupList's) share each list.
+        (
+            "tile 32 Frustum",
+            "LightCulling(tile: 32, variant: Frustum, lists: Compact(max_indices: 16777216))",
+        ),
     ] {
         graphs.push((
             name.to_string(),
@@ -585,7 +590,8 @@ fn staged_light_loop_equals_the_per_pixel_loop_to_the_bit() {
 /// GroupList, the default light loop, walks each tile list a subgroup of lights at a
 /// time (SUBGROUP_LIST: an invocation loads a light, shuffles pass it round) on a device
 /// with subgroup operations, lavapipe among them, so the exactness test above checks that
-/// walk; RangeFirst, and lists that are not one per tile (HalfZ), keep the per-pixel walk.
+/// walk; RangeFirst, and lists that are not one per tile (HalfZ), keep the per-pixel walk,
+/// as does GroupList on a device without subgroups, to the same image.
 #[test]
 fn group_list_walks_by_subgroup_where_the_device_has_subgroups() {
     let subgroups = renderer()
@@ -608,6 +614,25 @@ fn group_list_walks_by_subgroup_where_the_device_has_subgroups() {
             assert_eq!(key.contains("SUBGROUP_LIST"), expected, "{name}: {key}");
         }
     }
+    // A device without them walks per pixel: the same image to the bit.
+    let mut without =
+        lightgraph::render::Renderer::headless_with(&lightgraph::gpu::ContextOptions {
+            disabled_features: wgpu::Features::SUBGROUP,
+        })
+        .expect("a wgpu adapter (lavapipe on CI)");
+    let per_pixel = render_text(&mut without, &plain, &harada, W, H);
+    let by_subgroup = render_text(&mut renderer(), &plain, &harada, W, H);
+    assert_eq!(per_pixel.image.len(), (W * H) as usize);
+    let mut failures = Vec::new();
+    compare_bits(
+        "harada GroupList",
+        (
+            ("by subgroup", &by_subgroup.image[..]),
+            ("per pixel", &per_pixel.image[..]),
+        ),
+        &mut failures,
+    );
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
 /// The staged graphs (Frustum and DepthMask, tiles of 16 and 8, compact and fixed lists)

@@ -100,7 +100,11 @@ struct CompactParams {
 };
 #endif
 
-const THREADS: u32 = TILE * TILE;
+// The coarse stage's workgroup: TILE × TILE invocations up to 16 × 16 (the most every
+// device runs), each folding COARSE_FOLD × COARSE_FOLD pixels of its coarse tile.
+const COARSE_SIDE: u32 = min(TILE, 16u);
+const COARSE_FOLD: u32 = TILE / COARSE_SIDE * COARSE;
+const THREADS: u32 = COARSE_SIDE * COARSE_SIDE;
 // The tiles' pass (`main`) folds MAIN_STEP × MAIN_STEP pixels an invocation, so a tile
 // is a workgroup of MAIN_THREADS: more tiles fit an SM at once, and a tile's chain of
 // dependent steps (depth, range, candidates, hits, list) overlaps more of the others'.
@@ -646,14 +650,14 @@ fn light_touches_tile(
 }
 
 // The coarse stage: one workgroup per coarse tile of COARSE×COARSE tiles; each
-// invocation folds COARSE×COARSE pixels into its part of the depth range. No depth mask:
+// invocation folds COARSE_FOLD × COARSE_FOLD pixels into its part of the depth range. No depth mask:
 // every fine tile applies its own. Lights are taken a chunk of COARSE_CHUNK at a time:
 // every invocation tests one light a step and sets the hits' bits in workgroup memory,
 // with no barrier inside the chunk (per-batch ranks cost two barriers and a dozen
 // workgroup loads a batch, which bound this stage at high light counts); then each
 // invocation counts the bits of its own run of words, a prefix sum over the invocations
 // places the runs, and each writes its hits in ascending light order.
-@compute @workgroup_size(TILE, TILE, 1)
+@compute @workgroup_size(COARSE_SIDE, COARSE_SIDE, 1)
 fn coarse(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
@@ -665,7 +669,7 @@ fn coarse(
     }
     let span = TILE * COARSE;
     let origin = group.xy * span;
-    let range = workgroup_depth_range(local, TILE, block_depth_range(origin + lid.xy * COARSE, COARSE));
+    let range = workgroup_depth_range(local, COARSE_SIDE, block_depth_range(origin + lid.xy * COARSE_FOLD, COARSE_FOLD));
     let lo = bitcast<f32>(range.x);
     let hi = bitcast<f32>(range.y);
     let empty = range.y == 0u;

@@ -29,7 +29,7 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
 #[serde(deny_unknown_fields)]
 pub struct LightCulling {
-    /// Pixels per tile side: 8 or 16 (one workgroup of tile×tile invocations).
+    /// Pixels per tile side: 8, 16 or 32.
     pub tile: u32,
     /// How a tile is bounded in depth (`Frustum` by default).
     #[serde(default)]
@@ -291,9 +291,9 @@ pub(crate) fn check(p: &LightCulling, ctx: &KindCtx, errors: &mut Vec<GraphError
             ));
         }
     }
-    if !matches!(p.tile, 8 | 16) {
+    if !matches!(p.tile, 8 | 16 | 32) {
         errors.push(ctx.bad(format!(
-            "tile size {} is not supported (8 or 16: one workgroup of tile×tile invocations)",
+            "tile size {} is not supported (8, 16 or 32 pixels a side)",
             p.tile
         )));
     }
