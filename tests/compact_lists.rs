@@ -786,8 +786,8 @@ fn mutations_are_caught() {
     {
         let m = Mutated::new(
             &mut r,
-            "atomicStore(&light_lists[offset + slot], lights[j]);",
-            "atomicStore(&light_lists[offset + total + hits_in_batch(h) - 1u - rank_in_batch(h, j * MAIN_THREADS + local)], lights[j]);",
+            "atomicStore(&light_lists[offset + slot], i);",
+            "atomicStore(&light_lists[offset + total + hits_in_batch(h) - 1u - rank_in_batch(h, local)], i);",
         );
         let f = caught(
             "fill reversed",

@@ -111,12 +111,8 @@ const THREADS: u32 = COARSE_SIDE * COARSE_SIDE;
 const MAIN_STEP: u32 = 2u;
 const MAIN_SIDE: u32 = TILE / MAIN_STEP;
 const MAIN_THREADS: u32 = MAIN_SIDE * MAIN_SIDE;
-// Candidates a `main` invocation tests a batch: a batch of BATCH ends with two barriers,
-// which bounded the tiles' pass at high light counts.
-const CANDIDATES: u32 = 4u;
-const BATCH: u32 = MAIN_THREADS * CANDIDATES;
-// Words of a batch's hit bits: one bit a candidate.
-const MASK_WORDS: u32 = (BATCH + 31u) / 32u;
+// Words of a batch's hit bits: one bit a `main` invocation.
+const MASK_WORDS: u32 = (MAIN_THREADS + 31u) / 32u;
 const FAR_BITS: u32 = 0x7f7fffffu;
 
 #if SUBGROUPS
@@ -368,7 +364,7 @@ fn main(
         tile_mask = atomicLoad(&depth_mask);
     }
 
-    // 4. Candidates: the coarse tile's lights, or every light. In batches of BATCH;
+    // 4. Candidates: the coarse tile's lights, or every light. In batches of MAIN_THREADS;
     //    ranks within a batch from a bit mask keep the list in ascending light order.
     var count = frame.light_count;
     var from_coarse = false;
@@ -401,42 +397,29 @@ fn main(
     }
 #endif
     var h = 0u;
-    for (var base = first; base < count; base += BATCH) {
-        // Candidate slot s of the batch is invocation s % MAIN_THREADS's (s / MAIN_THREADS)-th.
-        var lights: array<u32, CANDIDATES>;
-        var mine = 0u;
-        for (var j = 0u; j < CANDIDATES; j++) {
-            let s = j * MAIN_THREADS + local;
-            let k = base + s;
-            var i = k;
-            var hit = false;
-            if (!empty && k < count) {
-                i = candidate(from_coarse, coarse_base, k);
-                hit = i >= below && light_touches_tile(i, light_sphere(i, false), bounds, lo, hi, tile_mask, tile_min, tile_max, 0.0);
-            }
-            lights[j] = i;
-            if (hit) {
-                mine |= 1u << j;
-                atomicOr(&hits[h][s / 32u], 1u << (s % 32u));
-            }
+    for (var base = first; base < count; base += MAIN_THREADS) {
+        let k = base + local;
+        var i = k;
+        var hit = false;
+        if (!empty && k < count) {
+            i = candidate(from_coarse, coarse_base, k);
+            hit = i >= below && light_touches_tile(i, light_sphere(i, false), bounds, lo, hi, tile_mask, tile_min, tile_max, 0.0);
+        }
+        if (hit) {
+            atomicOr(&hits[h][local / 32u], 1u << (local % 32u));
         }
         workgroupBarrier();
-        for (var j = 0u; j < CANDIDATES; j++) {
-            if ((mine & (1u << j)) == 0u) {
-                continue;
-            }
-            let slot = total + rank_in_batch(h, j * MAIN_THREADS + local);
+        let slot = total + rank_in_batch(h, local);
 #if COMPACT
-            if (slot < kept) {
-                atomicStore(&light_lists[offset + slot], lights[j]);
-            }
-#else
-            if (slot < CAPACITY) {
-                list[slot] = lights[j];
-            }
-#endif
+        if (hit && slot < kept) {
+            atomicStore(&light_lists[offset + slot], i);
         }
-        total += close_batch(h, local, base + BATCH < count);
+#else
+        if (hit && slot < CAPACITY) {
+            list[slot] = i;
+        }
+#endif
+        total += close_batch(h, local, base + MAIN_THREADS < count);
         h = 1u - h;
     }
 
@@ -539,15 +522,15 @@ fn tile_bounds(origin: vec2<u32>, span: u32, lo: f32, hi: f32, empty: bool) -> T
     return b;
 }
 
-// How many candidates before slot `s` of the batch hit (its place in the list); `h` is
-// the batch's set of hit bits.
-fn rank_in_batch(h: u32, s: u32) -> u32 {
+// How many lights before this invocation's in the batch hit (its place in the list);
+// `h` is the batch's set of hit bits.
+fn rank_in_batch(h: u32, local: u32) -> u32 {
     var rank = 0u;
-    let word = s / 32u;
+    let word = local / 32u;
     for (var w = 0u; w < word; w++) {
         rank += countOneBits(atomicLoad(&hits[h][w]));
     }
-    return rank + countOneBits(atomicLoad(&hits[h][word]) & ((1u << (s % 32u)) - 1u));
+    return rank + countOneBits(atomicLoad(&hits[h][word]) & ((1u << (local % 32u)) - 1u));
 }
 
 // Ends a batch of hit set `h`: its hit count. Clears the next batch's set (last read
