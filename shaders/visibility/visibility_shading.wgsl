@@ -154,6 +154,28 @@ fn rebuild(id: vec2<u32>, tri: u32) -> Surface {
     return Surface(p, m, pixel, view_z);
 }
 
+// The surface an invocation of a walk that every invocation joins (the staged and the
+// subgroup loops) takes: its pixel's where it shades (`shades`), else one rebuilt from
+// the group's first triangle, with the per-pixel state the light loop reads set.
+fn rebuild_for_every_invocation(id: vec2<u32>, tri: u32, member: u32, shades: bool) -> Surface {
+    let shown = shading_members[select(MEMBERS_FIRST, member, shades)];
+    let surface_tri = select(shown.x, tri, shades);
+#if SHARED_CODE
+    material_constant_base = shown.z;
+#endif
+#if SHADOWS
+    shadow_pixel = id.y * frame.size.x + id.x;
+#endif
+#if SHADOW_TRACE
+    shadow_ng = surface_geometry(id, surface_tri).ng;
+#endif
+    let s = rebuild(id, surface_tri);
+#if VPL_VISIBILITY
+    vpl_select(id, s.p.position, s.p.normal);
+#endif
+    return s;
+}
+
 #if STAGED_LIGHTS
 // Whether any pixel of the workgroup is this group's (zeroed at workgroup start).
 var<workgroup> group_shades: atomic<u32>;
@@ -195,21 +217,7 @@ fn main(
     // surface rebuilt in a branch and shaded after it came out one ulp off in a few
     // pixels on lavapipe (the compiler fuses the arithmetic differently). A warp with
     // any pixel of this group pays for the rebuild anyway.
-    let shown = shading_members[select(MEMBERS_FIRST, member, shades)];
-    let surface_tri = select(shown.x, tri, shades);
-#if SHARED_CODE
-    material_constant_base = shown.z;
-#endif
-#if SHADOWS
-    shadow_pixel = id.y * frame.size.x + id.x;
-#endif
-#if SHADOW_TRACE
-    shadow_ng = surface_geometry(id.xy, surface_tri).ng;
-#endif
-    let s = rebuild(id.xy, surface_tri);
-#if VPL_VISIBILITY
-    vpl_select(id.xy, s.p.position, s.p.normal);
-#endif
+    let s = rebuild_for_every_invocation(id.xy, tri, member, shades);
     let color = staged_lights(surface_unlit(s.p, s.m), shades, s.p, s.m, lane, group_list(tile));
     if (shades) {
         textureStore(hdr, id.xy, vec4<f32>(color, material_alpha(s.m)));
@@ -261,21 +269,7 @@ fn main(
     if (subgroupAll(!shades)) {
         return;
     }
-    let shown = shading_members[select(MEMBERS_FIRST, member, shades)];
-    let surface_tri = select(shown.x, tri, shades);
-#if SHARED_CODE
-    material_constant_base = shown.z;
-#endif
-#if SHADOWS
-    shadow_pixel = id.y * frame.size.x + id.x;
-#endif
-#if SHADOW_TRACE
-    shadow_ng = surface_geometry(id.xy, surface_tri).ng;
-#endif
-    let s = rebuild(id.xy, surface_tri);
-#if VPL_VISIBILITY
-    vpl_select(id.xy, s.p.position, s.p.normal);
-#endif
+    let s = rebuild_for_every_invocation(id.xy, tri, member, shades);
     let color = shade_list_subgroup(s.p, s.m, group_list(tile), shades, sg_lane, sg_size);
     if (shades) {
         textureStore(hdr, id.xy, vec4<f32>(color, material_alpha(s.m)));
