@@ -154,6 +154,22 @@ fn rebuild(id: vec2<u32>, tri: u32) -> Surface {
     return Surface(p, m, pixel, view_z);
 }
 
+// The triangle at pixel `id` (NO_TRIANGLE outside the frame, or where nothing was drawn:
+// black stored there by the dispatch that CLEARS), for a walk every invocation joins.
+fn triangle_at(id: vec2<u32>) -> u32 {
+    let inside = all(id < frame.size);
+    var tri = NO_TRIANGLE;
+    if (inside) {
+        tri = textureLoad(visibility, id, 0).x;
+    }
+#if CLEARS
+    if (inside && tri == NO_TRIANGLE) {
+        textureStore(hdr, id, vec4<f32>(0.0));
+    }
+#endif
+    return tri;
+}
+
 // The surface an invocation of a walk that every invocation joins (the staged and the
 // subgroup loops) takes: its pixel's where it shades (`shades`), else one rebuilt from
 // the group's first triangle, with the per-pixel state the light loop reads set.
@@ -194,16 +210,7 @@ fn main(
         return;
     }
     let id = tile * 8u + local.xy;
-    let inside = all(id.xy < frame.size);
-    var tri = NO_TRIANGLE;
-    if (inside) {
-        tri = textureLoad(visibility, id.xy, 0).x;
-    }
-#if CLEARS
-    if (inside && tri == NO_TRIANGLE) {
-        textureStore(hdr, id.xy, vec4<f32>(0.0));
-    }
-#endif
+    let tri = triangle_at(id);
     let member = member_of(tri);
     let shades = member != NO_MEMBER;
     if (shades) {
@@ -250,16 +257,7 @@ fn main(
         return;
     }
     let id = tile * SHADING_GROUP + block_pixel(lane);
-    let inside = all(id.xy < frame.size);
-    var tri = NO_TRIANGLE;
-    if (inside) {
-        tri = textureLoad(visibility, id.xy, 0).x;
-    }
-#if CLEARS
-    if (inside && tri == NO_TRIANGLE) {
-        textureStore(hdr, id.xy, vec4<f32>(0.0));
-    }
-#endif
+    let tri = triangle_at(id);
     let member = member_of(tri);
     let shades = member != NO_MEMBER;
     // A subgroup none of whose pixels is this group's leaves whole; in any other, every
