@@ -16,7 +16,8 @@
 // STAGED_LIGHTS (the workgroup's one tile list staged in workgroup memory, in
 // visibility/staged_lights.wgsl), RANGE_FIRST (the per-pixel cursor with the range test
 // before the light's properties; with UNIFORM_LIST the workgroup's one tile list, found
-// from the workgroup id, so the compiler sees the walk as uniform), or neither
+// from the workgroup id, so the compiler sees the walk as uniform, and with SUBGROUP_LIST
+// as well that list walked a subgroup of lights at a time), or neither
 // (common/light_loop.wgsl's shade_surface, as forward shading runs it). SHADOWS with
 // SHADOW_MASK: each shadow-casting light is looked up in a ray-cast mask
 // (shadow/shadow_ray_cast.wgsl), casters numbered as job creation numbers them; or with
