@@ -3,7 +3,8 @@
 # (STAGES, default all, in this order):
 #   frames    every frame kind on harada, AMD's atrium and the Cornell box glTF
 #             (frame_kinds_*.ron), Forward+'s tile tests (forward_plus_culling.ron), and
-#             visibility shading's material classification (material_classification.ron);
+#             visibility shading's material classification (material_classification.ron)
+#             and light walk (light_walk.ron);
 #   features  ray-cast shadows, the shadow atlas, transparency, MSAA, VPL indirect light, VPL visibility
 #             and the light linked list (their sweeps);
 #   stochastic (only when named) stochastic direct lighting's time against error with the
@@ -28,6 +29,7 @@ if [[ $stages == *" frames "* ]]; then
     run_sweep frame_kinds_cornell frame_kinds_cornell 120
     run_sweep forward_plus_culling forward_plus_culling 150
     run_sweep material_classification material_classification 200
+    run_sweep light_walk light_walk 200
 fi
 if [[ $stages == *" features "* ]]; then
     for s in raycast_shadows shadow_atlas transparency msaa indirect_vpl vpl_visibility vpl_cheaper light_linked_list; do
