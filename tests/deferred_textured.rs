@@ -45,13 +45,16 @@ const PAIRS: &[(&str, &str)] = &[
 
 /// FLIP mean of a deferred image against forward's. Measured on lavapipe at 160×96
 /// (2026-12-06): BoxTextured 3.6e-5, the textured scene 1.25e-4 (1.26e-4 packed), no
-/// pixel over 1.1e-3 relative; forward samples with textureSample, deferred with
-/// textureSampleGrad at the stored uv and derivatives, and the tangent comes back from
+/// pixel over 1.1e-3 relative; its floor through a second uv set at 2.7 times the
+/// frequency 2.24e-4 (2.33e-4 packed; through the first set instead 7.1e-2). Forward
+/// samples with textureSample, deferred with textureSampleGrad at the stored uv and
+/// derivatives, and the tangent comes back from
 /// an angle, so filter weights (8-bit on lavapipe) and normal-mapped shading move in
 /// their last steps. For comparison, ignoring the uv (every texel at uv 0) scores
-/// FLIP 0.1-0.3. The bound is about 2.4× the worst.
+/// FLIP 0.1-0.3. The bound is about 1.3× the worst (the second uv set, packed).
 const FLIP_BOUND: f64 = 3e-4;
-/// At 4× MSAA: BoxTextured 2.96e-4, the textured scene 5.24e-4. Higher: edge pixels
+/// At 4× MSAA: BoxTextured 2.96e-4, the textured scene 5.24e-4, the second uv set
+/// 9.83e-4. Higher: edge pixels
 /// average samples whose uv derivatives lavapipe's implicit sampling takes across the
 /// quad at centroid-moved positions, while the G-buffer stores dpdx of the centroid uv.
 const FLIP_BOUND_MSAA: f64 = 1.2e-3;
@@ -66,7 +69,49 @@ fn scenes() -> Vec<(String, Scene)> {
     vec![
         ("BoxTextured".into(), box_textured),
         ("textured_scene".into(), textured_scene()),
+        ("second_uv_set".into(), second_uv_set_scene()),
     ]
+}
+
+/// The textured scene with its floor's checker sampled through TEXCOORD_1: a second uv
+/// set on the floor, scaled, rotated and offset from the first, so a G-buffer that
+/// carried only the first would show the checker at another size and angle.
+fn second_uv_set_scene() -> Scene {
+    let mut s = textured_scene();
+    s.name = "second_uv_set".into();
+    s.materials[0].sampling.base_color.tex_coord = 1;
+    let mut floors = 0;
+    for mesh in s.meshes.iter_mut().filter(|m| m.material == 0) {
+        mesh.uvs1 = mesh
+            .uvs
+            .iter()
+            .map(|uv| glam::Vec2::new(0.6 * uv.x - 0.8 * uv.y + 0.3, 0.8 * uv.x + 0.6 * uv.y) * 2.7)
+            .collect();
+        floors += 1;
+    }
+    assert!(
+        floors > 0,
+        "the textured scene has no floor mesh of material 0"
+    );
+    s
+}
+
+/// The floor's second uv set is what the second-uv-set scene's image shows: sampled
+/// through TEXCOORD_0 instead (what deferred shading did before the G-buffer carried the
+/// second set), forward shading's image differs far beyond the deferred bound.
+#[test]
+fn the_second_uv_set_changes_the_image() {
+    let mut r = renderer();
+    let uv1 = second_uv_set_scene();
+    let mut uv0 = uv1.clone();
+    uv0.materials[0].sampling.base_color.tex_coord = 0;
+    let a = render_file(&mut r, "forward_plus.ron", &uv1, W, H);
+    let b = render_file(&mut r, "forward_plus.ron", &uv0, W, H);
+    assert_eq!(a.image.len(), (W * H) as usize);
+    let m = compare(&a.image, &b.image, W, H, &CompareOptions::default()).unwrap();
+    let flip = m.flip_mean.unwrap();
+    println!("TEXCOORD_1 against TEXCOORD_0: FLIP mean {flip:.3e}");
+    assert!(flip > 100.0 * FLIP_BOUND, "{m}");
 }
 
 #[test]
@@ -122,10 +167,15 @@ fn every_deferred_graph_matches_forward_on_textured_scenes() {
 fn a_textured_material_needs_the_surface_targets() {
     let text: String = std::fs::read_to_string(graph_path("tiled_deferred.ron"))
         .unwrap()
-        .replace(", \"g_surface\", \"g_uv_grad\"", "")
+        .replace(
+            ", \"g_surface\", \"g_uv_grad\", \"g_uv1\", \"g_uv1_grad\"",
+            "",
+        )
         .lines()
         .filter(|l| {
-            !l.contains("Texture(name: \"g_surface\"") && !l.contains("Texture(name: \"g_uv_grad\"")
+            !["g_surface", "g_uv_grad", "g_uv1", "g_uv1_grad"]
+                .iter()
+                .any(|t| l.contains(&format!("Texture(name: \"{t}\"")))
         })
         .map(|l| format!("{l}\n"))
         .collect();
@@ -173,29 +223,40 @@ fn anisotropic_materials_turn_about_the_stored_tangent() {
 /// of the scene reads the uv or the tangent: the pair is two more Rgba32Float targets, and
 /// on GH100's few graphics SMs it doubled harada's G-buffer pass (1.93 → 3.81 ms at
 /// 1080p). A textured scene fills it; a plain one leaves it as created (zero) and still
-/// renders as forward does.
+/// renders as forward does. The second uv set's pair (`g_uv1`, `g_uv1_grad`) likewise, only
+/// for a material that samples with TEXCOORD_1.
 #[test]
 fn the_surface_pair_is_written_only_for_materials_that_read_it() {
     let mut r = renderer();
-    let written = |r: &mut lightgraph::render::Renderer, s: &Scene| {
+    let written = |r: &mut lightgraph::render::Renderer, s: &Scene, target: &str| {
         let text = std::fs::read_to_string(graph_path("tiled_deferred.ron")).unwrap();
         let frame = prepare_text(r, &text, s, W, H, false).unwrap();
         frame.execute(r).unwrap();
-        let surface = frame.read_texture(r, "g_surface").unwrap();
-        assert_eq!(surface.len(), (W * H) as usize, "g_surface's size");
-        surface
+        let texels = frame.read_texture(r, target).unwrap();
+        assert_eq!(texels.len(), (W * H) as usize, "{target}'s size");
+        texels
             .iter()
             .filter(|t| t.iter().any(|&c| c != 0.0))
             .count()
     };
-    let textured = written(&mut r, &textured_scene());
+    let textured = written(&mut r, &textured_scene(), "g_surface");
     assert!(
         textured > (W * H / 4) as usize,
         "a textured scene fills g_surface ({textured} texels written)"
     );
+    assert_eq!(
+        written(&mut r, &textured_scene(), "g_uv1"),
+        0,
+        "a scene without TEXCOORD_1 textures leaves g_uv1 unwritten"
+    );
+    let uv1 = written(&mut r, &second_uv_set_scene(), "g_uv1_grad");
+    assert!(
+        uv1 > (W * H / 8) as usize,
+        "the floor's TEXCOORD_1 checker fills g_uv1_grad ({uv1} texels written)"
+    );
     let plain = random_scene(64, 5);
     assert_eq!(
-        written(&mut r, &plain),
+        written(&mut r, &plain, "g_surface"),
         0,
         "a plain scene leaves g_surface unwritten"
     );

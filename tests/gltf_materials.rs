@@ -716,7 +716,8 @@ fn unlit_ignores_the_lights_that_light_the_same_material_lit() {
 /// TEXCOORD_1 as the Sample Viewer reads it: a texture whose textureInfo names set 1, or
 /// whose KHR_texture_transform's texCoord does (with an offset there too), samples the
 /// second uv set, checked against the CPU sampler at second_uv(pixel_uv) in forward
-/// shading, the hardware visibility buffer and the compute-first default frame.
+/// shading, the hardware visibility buffer, the compute-first default frame and tiled
+/// deferred (its G-buffer's g_uv1 and g_uv1_grad, in both layouts).
 #[test]
 fn texcoord_1_is_sampled_where_a_texture_names_it() {
     let sampler = format!("{{\"magFilter\":{GL_NEAREST},\"minFilter\":{GL_NEAREST}}}");
@@ -772,7 +773,13 @@ fn texcoord_1_is_sampled_where_a_texture_names_it() {
             let uv = second_uv(pixel_uv(x, y));
             sample(&img, [uv[0] + shift[0], uv[1] + shift[1]], &desc)
         };
-        for graph in ["forward_plus.ron", "visibility_buffer.ron", "default.ron"] {
+        for graph in [
+            "forward_plus.ron",
+            "visibility_buffer.ron",
+            "default.ron",
+            "tiled_deferred.ron",
+            "tiled_deferred_packed.ron",
+        ] {
             let out = render_file(&mut r, graph, &loaded.scene, W, H);
             let (d, x, y) = worst_abs(&out.image, expected);
             println!("{name}, {graph}: worst {d:.2e} at ({x}, {y})");

@@ -45,6 +45,15 @@ fn same_surface(p: vec2<u32>, a: u32, b: u32) -> bool {
     let sb = bitcast<vec4<u32>>(textureLoad(g_surface, p, b));
     let da = bitcast<vec4<u32>>(textureLoad(g_uv_grad, p, a));
     let db = bitcast<vec4<u32>>(textureLoad(g_uv_grad, p, b));
+#if G_UV1
+    let ua = bitcast<vec4<u32>>(textureLoad(g_uv1, p, a));
+    let ub = bitcast<vec4<u32>>(textureLoad(g_uv1, p, b));
+    let ea = bitcast<vec4<u32>>(textureLoad(g_uv1_grad, p, a));
+    let eb = bitcast<vec4<u32>>(textureLoad(g_uv1_grad, p, b));
+    if (any(ua != ub) || any(ea != eb)) {
+        return false;
+    }
+#endif
     return all(pa == pb) && all(na == nb) && all(sa == sb) && all(da == db);
 #else
     return all(pa == pb) && all(na == nb);

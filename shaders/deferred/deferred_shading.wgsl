@@ -7,7 +7,8 @@
 // the position is rebuilt on the pixel's view ray.
 // With G_SURFACE the G-buffer also holds the material's surface (deferred/g_surface.wgsl:
 // uv and tangent) and the uv's screen derivatives, which textured materials
-// (MATERIAL_TEXTURED, code generated with explicit derivatives) sample with.
+// (MATERIAL_TEXTURED, code generated with explicit derivatives) sample with; with G_UV1
+// as well the second uv set and its derivatives (g_uv1, g_uv1_grad), for TEXCOORD_1.
 // Defines: GROUP_INDEX (the group: `material_groups` gives each material's group and
 // first constant; SHARED_CODE where the group's code reads its constants from
 // `material_constants`) or, with G_SAMPLES, MATERIAL_INDEX; LIGHT_LISTS (tile lists) or
@@ -36,6 +37,10 @@
 @group(0) @binding(12) var g_surface: texture_multisampled_2d<f32>;
 @group(0) @binding(13) var g_uv_grad: texture_multisampled_2d<f32>;
 #endif
+#if G_UV1
+@group(0) @binding(16) var g_uv1: texture_multisampled_2d<f32>;
+@group(0) @binding(17) var g_uv1_grad: texture_multisampled_2d<f32>;
+#endif
 #else
 @group(0) @binding(5) var g_position: texture_2d<f32>;
 #if G_PACKED
@@ -47,6 +52,10 @@
 #if G_SURFACE
 @group(0) @binding(12) var g_surface: texture_2d<f32>;
 @group(0) @binding(13) var g_uv_grad: texture_2d<f32>;
+#endif
+#if G_UV1
+@group(0) @binding(16) var g_uv1: texture_2d<f32>;
+@group(0) @binding(17) var g_uv1_grad: texture_2d<f32>;
 #endif
 #endif
 
@@ -88,15 +97,26 @@ fn load_surface(q: ptr<function, ShadingPoint>, p: vec2<u32>, s: u32) {
     // Its rgb to 8 bits, alpha 1 (deferred/g_surface.wgsl).
     (*q).color = surface_color(t);
     (*q).uv = t.xy;
-    // Only TEXCOORD_0 is kept: a TEXCOORD_1 texture samples it (the pass warns).
+#if G_UV1
+    (*q).uv1 = textureLoad(g_uv1, p, s).xy;
+#else
+    // Without the second uv set's targets a TEXCOORD_1 texture samples TEXCOORD_0 (the
+    // pass warns).
     (*q).uv1 = t.xy;
+#endif
     (*q).tangent = surface_tangent((*q).normal, t);
 #if MATERIAL_TEXTURED
     let d = textureLoad(g_uv_grad, p, s);
     material_uv_ddx = d.xy;
     material_uv_ddy = d.zw;
+#if G_UV1
+    let d1 = textureLoad(g_uv1_grad, p, s);
+    material_uv1_ddx = d1.xy;
+    material_uv1_ddy = d1.zw;
+#else
     material_uv1_ddx = d.xy;
     material_uv1_ddy = d.zw;
+#endif
 #endif
 #else
     (*q).color = vec4<f32>(1.0);

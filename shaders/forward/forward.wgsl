@@ -172,7 +172,8 @@ fn shading_point(in: VertexOut, front: bool) -> ShadingPoint {
 // Deferred shading's G-buffer: world position with the material index in w (-1 where
 // nothing was drawn), and the shading normal (already facing the viewer). With
 // GBUFFER_SURFACE two more targets, last: the surface the material samples
-// (deferred/g_surface.wgsl) and the uv's screen derivatives.
+// (deferred/g_surface.wgsl) and the uv's screen derivatives; GBUFFER_UV1 (with it) adds
+// the second uv set and its derivatives, for materials that sample with TEXCOORD_1.
 #if GBUFFER_SURFACE
 #include "deferred/g_surface.wgsl"
 #endif
@@ -184,6 +185,10 @@ struct GBufferOut {
 #if GBUFFER_SURFACE
     @location(1) surface: vec4<f32>,
     @location(2) uv_grad: vec4<f32>,
+#if GBUFFER_UV1
+    @location(3) uv1: vec4<f32>,
+    @location(4) uv1_grad: vec4<f32>,
+#endif
 #endif
 };
 #else
@@ -197,11 +202,19 @@ struct GBufferOut {
 #if GBUFFER_SURFACE
     @location(3) surface: vec4<f32>,
     @location(4) uv_grad: vec4<f32>,
+#if GBUFFER_UV1
+    @location(5) uv1: vec4<f32>,
+    @location(6) uv1_grad: vec4<f32>,
+#endif
 #endif
 #else
 #if GBUFFER_SURFACE
     @location(2) surface: vec4<f32>,
     @location(3) uv_grad: vec4<f32>,
+#if GBUFFER_UV1
+    @location(4) uv1: vec4<f32>,
+    @location(5) uv1_grad: vec4<f32>,
+#endif
 #endif
 #endif
 };
@@ -223,6 +236,9 @@ fn fs_gbuffer(in: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
     // The derivatives forward shading's textureSample takes implicitly, across the 2×2
     // quad as the rasterizer takes them (uniform control flow: before any discard).
     let uv_grad = vec4<f32>(dpdxCoarse(in.uv), dpdyCoarse(in.uv));
+#endif
+#if GBUFFER_UV1
+    let uv1_grad = vec4<f32>(dpdxCoarse(in.uv1), dpdyCoarse(in.uv1));
 #endif
     let p = shading_point(in, front);
 #if ALPHA_MASK
@@ -255,6 +271,10 @@ fn fs_gbuffer(in: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
 #endif
 #if GBUFFER_SURFACE
     out.uv_grad = uv_grad;
+#endif
+#if GBUFFER_UV1
+    out.uv1 = vec4<f32>(p.uv1, 0.0, 0.0);
+    out.uv1_grad = uv1_grad;
 #endif
     return out;
 }

@@ -226,11 +226,13 @@ mod tests {
                 ("g_normal", 16 * px * 4, 16 * px * 3),
                 ("g_position", 16 * px * 4, 16 * px * 3),
                 ("g_surface", 16 * px * 4, 16 * px * 3),
+                ("g_uv1", 16 * px * 4, 16 * px * 3),
+                ("g_uv1_grad", 16 * px * 4, 16 * px * 3),
                 ("g_uv_grad", 16 * px * 4, 16 * px * 3),
             ]
         );
         let t = by_technique(&compiled("tiled_deferred_msaa_8x.ron", false));
         assert_eq!(t[0].technique, "MSAA 8×");
-        assert_eq!(t[0].added(), (4 + 4 * 16) * px * 7);
+        assert_eq!(t[0].added(), (4 + 6 * 16) * px * 7);
     }
 }

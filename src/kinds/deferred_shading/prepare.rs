@@ -9,7 +9,7 @@
 
 use super::{defines, pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::deferred_shading::HDR;
-use crate::graph::kinds::g_buffer::{G_NORMAL, G_SURFACE};
+use crate::graph::kinds::g_buffer::{G_NORMAL, G_SURFACE, G_UV1};
 use crate::graph::Name;
 use crate::graph::{DeferredShading, ScheduledPass};
 use crate::render::pipelines::PipelineKey;
@@ -41,6 +41,15 @@ pub(super) fn writes_surface(cx: &PrepareCtx, sp: &ScheduledPass) -> bool {
             .materials
             .iter()
             .any(|m| m.reads_uv_or_tangent || m.reads_vertex_color)
+}
+
+/// Whether the second uv set's pair (`g_uv1`, `g_uv1_grad`) is written and read: where the
+/// graph gives it beside the surface pair and a material of the scene samples a texture
+/// with TEXCOORD_1.
+pub(super) fn writes_uv1(cx: &PrepareCtx, sp: &ScheduledPass) -> bool {
+    writes_surface(cx, sp)
+        && sp.roles.slot(G_UV1).is_some()
+        && cx.gpu.materials.iter().any(|m| m.reads_uv1)
 }
 
 pub(super) fn prepare(
@@ -93,11 +102,12 @@ pub(super) fn prepare(
             format!("material '{}' reads textures, the tangent or the vertex colour: its G-buffer needs the surface targets '{G_SURFACE}' and 'g_uv_grad' (uv, tangent, vertex colour and uv derivatives), which this pass does not read", m.name),
         ));
     }
-    // No G-buffer target holds a second uv set: materials that read one are shaded
-    // without it here, said rather than left to be noticed in the image.
-    if let Some(m) = cx.gpu.materials.iter().find(|m| m.reads_uv1) {
+    // A graph without the second uv set's targets shades materials that read one
+    // without it, said rather than left to be noticed in the image.
+    let uv1 = writes_uv1(cx, sp);
+    if let Some(m) = cx.gpu.materials.iter().find(|m| m.reads_uv1 && !uv1) {
         log::warn!(
-            "pass '{}': material '{}' samples a texture with TEXCOORD_1, which the G-buffer does not carry: it samples TEXCOORD_0 there",
+            "pass '{}': material '{}' samples a texture with TEXCOORD_1, which this G-buffer does not carry (it names no '{G_UV1}' and 'g_uv1_grad'): it samples TEXCOORD_0 there",
             sp.name,
             m.name
         );
@@ -134,6 +144,9 @@ pub(super) fn prepare(
         }
         if surface {
             d.push(("G_SURFACE", "1".into()));
+        }
+        if uv1 {
+            d.push(("G_UV1", "1".into()));
         }
         if textured {
             d.push(("MATERIAL_TEXTURED", "1".into()));

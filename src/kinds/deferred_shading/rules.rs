@@ -1,7 +1,7 @@
 //! `DeferredShading`: lighting in a compute shader from the G-buffer (tiled deferred
 //! with `lights: Culled`), one dispatch per material. Runs `shaders/deferred/deferred_shading.wgsl`.
 
-use super::g_buffer::{G_NORMAL, G_POSITION, G_SURFACE, G_UV_GRAD};
+use super::g_buffer::{G_NORMAL, G_POSITION, G_SURFACE, G_UV1, G_UV1_GRAD, G_UV_GRAD};
 use super::shadow_ray_jobs::SHADOW_MASK;
 use super::{check_light_source, Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
@@ -49,6 +49,9 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     // Textured and anisotropic materials: the surface the material samples.
     super::g_buffer::G_SURFACE_READ,
     super::g_buffer::G_UV_GRAD_READ,
+    // Materials that sample with TEXCOORD_1: the second uv set.
+    super::g_buffer::G_UV1_READ,
+    super::g_buffer::G_UV1_GRAD_READ,
     super::VPL_VISIBILITY_READ,
 ];
 
@@ -73,7 +76,7 @@ fn check_msaa(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         return;
     };
     let ps = ctx.samples(position);
-    for normal in [G_NORMAL, G_SURFACE, G_UV_GRAD]
+    for normal in [G_NORMAL, G_SURFACE, G_UV_GRAD, G_UV1, G_UV1_GRAD]
         .iter()
         .filter_map(|s| ctx.slot(s))
     {

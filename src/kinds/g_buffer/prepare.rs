@@ -6,7 +6,7 @@
 
 use super::{PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::g_buffer::{
-    self as kind, G_GEOMETRIC, G_NORMAL, G_POSITION, G_SURFACE, G_UV_GRAD,
+    self as kind, G_GEOMETRIC, G_NORMAL, G_POSITION, G_SURFACE, G_UV1, G_UV1_GRAD, G_UV_GRAD,
 };
 use crate::graph::Name;
 use crate::graph::{slot, ScheduledPass};
@@ -34,19 +34,26 @@ pub(super) fn prepare(cx: &mut PrepareCtx, sp: &ScheduledPass) -> Result<GBuffer
     let offered = cx.declared(sp)?;
     let geometric = sp.roles.slot(G_GEOMETRIC).is_some();
     let surface = super::deferred_shading::writes_surface(cx, sp);
+    let uv1 = super::deferred_shading::writes_uv1(cx, sp);
     let mode = DrawMode::GBuffer {
         writes_depth,
         packed,
         normals: sp.roles.slot(G_NORMAL).is_some(),
         geometric,
         surface,
+        uv1,
     };
-    // The surface pair is left unwritten where no material reads it: on GH100 the two
+    // The surface pairs are left unwritten where no material reads them: on GH100 the two
     // Rgba32Float targets cost the G-buffer pass 1.9 ms at 1080p on harada.
     let written = |slot: &str| {
-        sp.roles.slot(slot).is_some() && (surface || (slot != G_SURFACE && slot != G_UV_GRAD))
+        sp.roles.slot(slot).is_some()
+            && match slot {
+                G_SURFACE | G_UV_GRAD => surface,
+                G_UV1 | G_UV1_GRAD => uv1,
+                _ => true,
+            }
     };
-    let count = 1 + [G_NORMAL, G_GEOMETRIC, G_SURFACE, G_UV_GRAD]
+    let count = 1 + OPTIONAL_TARGETS
         .into_iter()
         .filter(|s| written(s))
         .count() as u32;
@@ -62,7 +69,7 @@ pub(super) fn prepare(cx: &mut PrepareCtx, sp: &ScheduledPass) -> Result<GBuffer
         &offered,
     )?;
     let mut targets = vec![cx.view(&sp.name, sp.required(G_POSITION))?];
-    for slot in [G_NORMAL, G_GEOMETRIC, G_SURFACE, G_UV_GRAD] {
+    for slot in OPTIONAL_TARGETS {
         if let Some(name) = sp.roles.slot(slot).filter(|_| written(slot)) {
             targets.push(cx.view(&sp.name, name)?);
         }
@@ -76,6 +83,9 @@ pub(super) fn prepare(cx: &mut PrepareCtx, sp: &ScheduledPass) -> Result<GBuffer
     })
 }
 
+/// The colour targets after the positions, in the fragment shader's order.
+const OPTIONAL_TARGETS: [&str; 6] = [G_NORMAL, G_GEOMETRIC, G_SURFACE, G_UV_GRAD, G_UV1, G_UV1_GRAD];
+
 /// Why `targets` Rgba32Float colour targets (16 bytes a sample each) exceed the device's
 /// colour attachment limits, if they do (wgpu would say so in its own words).
 fn attachment_problem(targets: u32, limits: &wgpu::Limits) -> Option<String> {
@@ -85,7 +95,7 @@ fn attachment_problem(targets: u32, limits: &wgpu::Limits) -> Option<String> {
         limits.max_color_attachment_bytes_per_sample,
     );
     (targets > max_targets || bytes > max_bytes).then(|| {
-        format!("its {targets} Rgba32Float targets take {bytes} bytes a sample; the device allows {max_targets} colour targets and {max_bytes} bytes a sample (leave out g_geometric or the surface pair g_surface, g_uv_grad)")
+        format!("its {targets} Rgba32Float targets take {bytes} bytes a sample; the device allows {max_targets} colour targets and {max_bytes} bytes a sample (leave out g_geometric, or the surface pairs g_surface, g_uv_grad and g_uv1, g_uv1_grad)")
     })
 }
 

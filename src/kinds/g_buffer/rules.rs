@@ -1,7 +1,9 @@
 //! `GBuffer`: the scene's geometry into one packed Rgba32Float texture (view depth,
 //! octahedral normal, material) or two (world position with the material in w, shading
 //! normal), plus optionally the surface the material samples (`g_surface`: uv, tangent;
-//! `g_uv_grad`: the uv's screen derivatives) for textured and anisotropic materials.
+//! `g_uv_grad`: the uv's screen derivatives) for textured and anisotropic materials, and
+//! the second uv set and its derivatives (`g_uv1`, `g_uv1_grad`) for materials that
+//! sample with glTF `TEXCOORD_1`.
 //! After a depth prepass it only tests depth. Runs `shaders/forward/forward.wgsl` with
 //! `GBUFFER`.
 
@@ -16,6 +18,10 @@ pub(crate) const G_GEOMETRIC: &str = "g_geometric";
 pub(crate) const G_SURFACE: &str = "g_surface";
 /// The uv's screen derivatives (d/dx, d/dy), the mip footprint textures are sampled with.
 pub(crate) const G_UV_GRAD: &str = "g_uv_grad";
+/// The second uv set (glTF `TEXCOORD_1`) in x, y, for materials that sample with it.
+pub(crate) const G_UV1: &str = "g_uv1";
+/// The second uv set's screen derivatives (d/dx, d/dy).
+pub(crate) const G_UV1_GRAD: &str = "g_uv1_grad";
 
 pub(crate) const SLOTS: &[SlotSpec] = &[
     super::GEOMETRY_READ,
@@ -61,10 +67,26 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
         Usage::Attachment,
     )
     .optional(),
+    SlotSpec::new(G_UV1, SlotType::ColorTexture, Access::Write, Usage::Attachment).optional(),
+    SlotSpec::new(
+        G_UV1_GRAD,
+        SlotType::ColorTexture,
+        Access::Write,
+        Usage::Attachment,
+    )
+    .optional(),
 ];
 
 pub(crate) fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
-    let targets = [G_POSITION, G_NORMAL, G_GEOMETRIC, G_SURFACE, G_UV_GRAD];
+    let targets = [
+        G_POSITION,
+        G_NORMAL,
+        G_GEOMETRIC,
+        G_SURFACE,
+        G_UV_GRAD,
+        G_UV1,
+        G_UV1_GRAD,
+    ];
     for s in targets {
         if let Some(name) = ctx.slot(s) {
             if !ctx.is_rgba32f(name) {
@@ -94,12 +116,24 @@ pub(crate) fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
 }
 
 /// `g_surface` and `g_uv_grad` come together: textures are sampled at the stored uv
-/// with the stored derivatives.
+/// with the stored derivatives. So do `g_uv1` and `g_uv1_grad`, the second uv set's,
+/// and only beside the first pair.
 pub(crate) fn check_surface_pair(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     match (ctx.slot(G_SURFACE), ctx.slot(G_UV_GRAD)) {
         (Some(one), None) | (None, Some(one)) => errors.push(ctx.mismatch(
             one,
             format!("the G-buffer's surface is two textures, {G_SURFACE} (uv, tangent) and {G_UV_GRAD} (uv derivatives): give both or neither"),
+        )),
+        _ => {}
+    }
+    match (ctx.slot(G_UV1), ctx.slot(G_UV1_GRAD)) {
+        (Some(one), None) | (None, Some(one)) => errors.push(ctx.mismatch(
+            one,
+            format!("the second uv set is two textures, {G_UV1} (uv) and {G_UV1_GRAD} (its derivatives): give both or neither"),
+        )),
+        (Some(one), Some(_)) if ctx.slot(G_SURFACE).is_none() => errors.push(ctx.mismatch(
+            one,
+            format!("the second uv set ({G_UV1}, {G_UV1_GRAD}) goes with the surface ({G_SURFACE}, {G_UV_GRAD}), which this pass does not name"),
         )),
         _ => {}
     }
@@ -142,6 +176,15 @@ pub(crate) const G_SURFACE_READ: SlotSpec = SlotSpec::new(
 .optional();
 pub(crate) const G_UV_GRAD_READ: SlotSpec = SlotSpec::new(
     G_UV_GRAD,
+    SlotType::ColorTexture,
+    Access::Read,
+    Usage::Sampled,
+)
+.optional();
+pub(crate) const G_UV1_READ: SlotSpec =
+    SlotSpec::new(G_UV1, SlotType::ColorTexture, Access::Read, Usage::Sampled).optional();
+pub(crate) const G_UV1_GRAD_READ: SlotSpec = SlotSpec::new(
+    G_UV1_GRAD,
     SlotType::ColorTexture,
     Access::Read,
     Usage::Sampled,
@@ -217,6 +260,20 @@ mod tests {
         );
         assert!(
             e.contains("resource 'geo': G-buffer texture has 1 sample(s) but depth 'depth4' has 4"),
+            "{e}"
+        );
+        // The second uv set: a pair too, and only beside the surface pair.
+        let e = errors(
+            &pass(r#""depth", "pos", "g_surface=geo", "g_uv_grad=hdr", "g_uv1=nrm""#),
+            "pos",
+        );
+        assert!(
+            e.contains("resource 'nrm': the second uv set is two textures"),
+            "{e}"
+        );
+        let e = errors(&pass(r#""depth", "pos", "g_uv1=geo", "g_uv1_grad=hdr""#), "pos");
+        assert!(
+            e.contains("resource 'geo': the second uv set (g_uv1, g_uv1_grad) goes with the surface"),
             "{e}"
         );
     }

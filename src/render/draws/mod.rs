@@ -29,8 +29,10 @@ pub(super) enum DrawMode {
         normals: bool,
         /// Unpacked: a target of geometric normals next (ray-cast shadows).
         geometric: bool,
-        /// Two targets last: the surface the material samples and the uv derivatives.
+        /// Two targets next: the surface the material samples and the uv derivatives.
         surface: bool,
+        /// Two targets last: the second uv set and its derivatives.
+        uv1: bool,
     },
     Shade {
         lists: super::passes::ShadeLists,
@@ -234,6 +236,7 @@ impl Renderer {
                     normals,
                     geometric,
                     surface,
+                    uv1,
                     ..
                 } => {
                     d.push(("GBUFFER", "1".into()));
@@ -249,6 +252,9 @@ impl Renderer {
                     }
                     if surface {
                         d.push(("GBUFFER_SURFACE", "1".into()));
+                    }
+                    if uv1 {
+                        d.push(("GBUFFER_UV1", "1".into()));
                     }
                 }
                 DrawMode::Shade {
@@ -424,10 +430,14 @@ fn build_pipeline(
             normals,
             geometric,
             surface,
+            uv1,
             ..
         } => (
             "fs_gbuffer",
-            1 + usize::from(normals) + usize::from(geometric) + 2 * usize::from(surface),
+            1 + usize::from(normals)
+                + usize::from(geometric)
+                + 2 * usize::from(surface)
+                + 2 * usize::from(uv1),
         ),
         DrawMode::Shade { .. } => ("fs_main", 1),
         DrawMode::AtlasDepth { .. } => ("fs_depth", 0),
