@@ -604,7 +604,7 @@ fn internal_buffers_are_checked_against_the_device() {
     let mut failures = Vec::new();
     for (graph, at) in [
         ("forward_plus.ron", "forward_plus.ron:25:19"),
-        ("tiled_deferred.ron", "tiled_deferred.ron:22:19"),
+        ("tiled_deferred.ron", "tiled_deferred.ron:24:19"),
     ] {
         let mut args = os(
             &["render", "--width", "4100", "--height", "4100", "--graph"],
