@@ -53,10 +53,7 @@ pub(super) fn prepare(cx: &mut PrepareCtx, sp: &ScheduledPass) -> Result<GBuffer
                 _ => true,
             }
     };
-    let count = 1 + OPTIONAL_TARGETS
-        .into_iter()
-        .filter(|s| written(s))
-        .count() as u32;
+    let count = 1 + OPTIONAL_TARGETS.into_iter().filter(|s| written(s)).count() as u32;
     if let Some(problem) = attachment_problem(count, &cx.device().limits()) {
         return Err(super::pass_error(&sp.name, problem));
     }
@@ -84,7 +81,14 @@ pub(super) fn prepare(cx: &mut PrepareCtx, sp: &ScheduledPass) -> Result<GBuffer
 }
 
 /// The colour targets after the positions, in the fragment shader's order.
-const OPTIONAL_TARGETS: [&str; 6] = [G_NORMAL, G_GEOMETRIC, G_SURFACE, G_UV_GRAD, G_UV1, G_UV1_GRAD];
+const OPTIONAL_TARGETS: [&str; 6] = [
+    G_NORMAL,
+    G_GEOMETRIC,
+    G_SURFACE,
+    G_UV_GRAD,
+    G_UV1,
+    G_UV1_GRAD,
+];
 
 /// Why `targets` Rgba32Float colour targets (16 bytes a sample each) exceed the device's
 /// colour attachment limits, if they do (wgpu would say so in its own words).

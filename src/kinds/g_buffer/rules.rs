@@ -67,7 +67,13 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
         Usage::Attachment,
     )
     .optional(),
-    SlotSpec::new(G_UV1, SlotType::ColorTexture, Access::Write, Usage::Attachment).optional(),
+    SlotSpec::new(
+        G_UV1,
+        SlotType::ColorTexture,
+        Access::Write,
+        Usage::Attachment,
+    )
+    .optional(),
     SlotSpec::new(
         G_UV1_GRAD,
         SlotType::ColorTexture,
@@ -271,9 +277,14 @@ mod tests {
             e.contains("resource 'nrm': the second uv set is two textures"),
             "{e}"
         );
-        let e = errors(&pass(r#""depth", "pos", "g_uv1=geo", "g_uv1_grad=hdr""#), "pos");
+        let e = errors(
+            &pass(r#""depth", "pos", "g_uv1=geo", "g_uv1_grad=hdr""#),
+            "pos",
+        );
         assert!(
-            e.contains("resource 'geo': the second uv set (g_uv1, g_uv1_grad) goes with the surface"),
+            e.contains(
+                "resource 'geo': the second uv set (g_uv1, g_uv1_grad) goes with the surface"
+            ),
             "{e}"
         );
     }
