@@ -1,7 +1,7 @@
 //! `DeferredShading`: lighting in a compute shader from the G-buffer (tiled deferred
 //! with `lights: Culled`), one dispatch per material. Runs `shaders/deferred/deferred_shading.wgsl`.
 
-use super::g_buffer::{G_NORMAL, G_POSITION, G_SURFACE, G_UV1, G_UV1_GRAD, G_UV_GRAD};
+use super::g_buffer::{G_NORMAL, G_POSITION};
 use super::shadow_ray_jobs::SHADOW_MASK;
 use super::{check_light_source, Access, Contents, KindCtx, KindRules, SlotSpec, SlotType, Usage};
 use crate::graph::error::GraphError;
@@ -76,7 +76,8 @@ fn check_msaa(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
         return;
     };
     let ps = ctx.samples(position);
-    for normal in [G_NORMAL, G_SURFACE, G_UV_GRAD, G_UV1, G_UV1_GRAD]
+    // Every G-buffer texture it names (g_geometric is not among its slots).
+    for normal in super::g_buffer::TARGETS[1..]
         .iter()
         .filter_map(|s| ctx.slot(s))
     {

@@ -53,7 +53,9 @@ pub(super) fn prepare(cx: &mut PrepareCtx, sp: &ScheduledPass) -> Result<GBuffer
                 _ => true,
             }
     };
-    let count = 1 + OPTIONAL_TARGETS.into_iter().filter(|s| written(s)).count() as u32;
+    // The positions, then the optional targets in the shader's order.
+    let optional = &kind::TARGETS[1..];
+    let count = 1 + optional.iter().filter(|s| written(s)).count() as u32;
     if let Some(problem) = attachment_problem(count, &cx.device().limits()) {
         return Err(super::pass_error(&sp.name, problem));
     }
@@ -66,7 +68,7 @@ pub(super) fn prepare(cx: &mut PrepareCtx, sp: &ScheduledPass) -> Result<GBuffer
         &offered,
     )?;
     let mut targets = vec![cx.view(&sp.name, sp.required(G_POSITION))?];
-    for slot in OPTIONAL_TARGETS {
+    for &slot in optional {
         if let Some(name) = sp.roles.slot(slot).filter(|_| written(slot)) {
             targets.push(cx.view(&sp.name, name)?);
         }
@@ -79,16 +81,6 @@ pub(super) fn prepare(cx: &mut PrepareCtx, sp: &ScheduledPass) -> Result<GBuffer
         draws,
     })
 }
-
-/// The colour targets after the positions, in the fragment shader's order.
-const OPTIONAL_TARGETS: [&str; 6] = [
-    G_NORMAL,
-    G_GEOMETRIC,
-    G_SURFACE,
-    G_UV_GRAD,
-    G_UV1,
-    G_UV1_GRAD,
-];
 
 /// Why `targets` Rgba32Float colour targets (16 bytes a sample each) exceed the device's
 /// colour attachment limits, if they do (wgpu would say so in its own words).

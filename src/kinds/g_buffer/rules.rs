@@ -83,17 +83,20 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
     .optional(),
 ];
 
+/// Every colour target of a G-buffer, in the fragment shader's order: the positions (or
+/// the packed texture) first, then the optional ones.
+pub(crate) const TARGETS: [&str; 7] = [
+    G_POSITION,
+    G_NORMAL,
+    G_GEOMETRIC,
+    G_SURFACE,
+    G_UV_GRAD,
+    G_UV1,
+    G_UV1_GRAD,
+];
+
 pub(crate) fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
-    let targets = [
-        G_POSITION,
-        G_NORMAL,
-        G_GEOMETRIC,
-        G_SURFACE,
-        G_UV_GRAD,
-        G_UV1,
-        G_UV1_GRAD,
-    ];
-    for s in targets {
+    for s in TARGETS {
         if let Some(name) = ctx.slot(s) {
             if !ctx.is_rgba32f(name) {
                 errors.push(ctx.mismatch(name, "G-buffer textures are Rgba32Float"));
@@ -107,7 +110,7 @@ pub(crate) fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
     // MSAA: every target and the depth at one sample count (a render pass's attachments
     // must agree), and only the two-texture layout (see check_msaa_layout).
     let ds = ctx.samples(depth);
-    for name in targets.iter().filter_map(|s| ctx.slot(s)) {
+    for name in TARGETS.iter().filter_map(|s| ctx.slot(s)) {
         let ts = ctx.samples(name);
         if ts != ds {
             errors.push(ctx.mismatch(
