@@ -419,6 +419,119 @@ fn masked_materials_match_the_prepass_alpha_test() {
     }
 }
 
+/// The triangle ids of material `m`'s meshes: the merged triangles are sorted by
+/// material, so one material's form one range.
+fn material_triangles(s: &Scene, m: usize) -> std::ops::Range<u32> {
+    let count = |keep: &dyn Fn(usize) -> bool| -> u32 {
+        s.meshes
+            .iter()
+            .filter(|mesh| s.materials[mesh.material].alpha_mode != AlphaMode::Blend)
+            .filter(|mesh| keep(mesh.material))
+            .map(|mesh| mesh.indices.len() as u32 / 3)
+            .sum()
+    };
+    let first = count(&|k| k < m);
+    first..first + count(&|k| k == m)
+}
+
+/// Masked materials that differ only in their constants and cutoffs share one run of
+/// the rasterizer (one pipeline, their constants read from a buffer): each must still
+/// test its own alpha against its own cutoff. Two groups: the striped texture at 70%
+/// alpha with cutoffs 0.5 (stripes kept) and 0.75 (cut out whole), and three untextured
+/// panels (alpha 0.2 at cutoff 0.5, 0.6 at 0.75, 0.6 at 0.5: cut, cut, kept; an opaque
+/// material's triangles between the first two). Coverage as
+/// the prepass's alpha test, which draws each material with its own code.
+#[test]
+fn masked_materials_sharing_code_keep_their_own_alpha_and_cutoff() {
+    if !has_atomics() {
+        return;
+    }
+    let mut s = textured_scene();
+    let striped = s.materials.len() - 1;
+    s.materials[striped].base_color.w = 0.7;
+    let mut striped_high = s.materials[striped].clone();
+    striped_high.name = "striped_high".into();
+    striped_high.alpha_mode = AlphaMode::Mask(0.75);
+    s.materials.push(striped_high);
+    let striped_high = s.materials.len() - 1;
+    let back = s
+        .meshes
+        .iter()
+        .position(|m| m.name == "panel_back")
+        .unwrap();
+    s.meshes[back].material = striped_high;
+    let mut panels = Vec::new();
+    for (i, (alpha, cutoff)) in [(0.2, 0.5), (0.6, 0.75), (0.6, 0.5)]
+        .into_iter()
+        .enumerate()
+    {
+        let mut m = lightgraph::scene::SurfaceMaterial {
+            name: format!("flat_{i}"),
+            alpha_mode: AlphaMode::Mask(cutoff),
+            ..Default::default()
+        };
+        m.base_color.w = alpha;
+        s.materials.push(m);
+        panels.push(s.materials.len() - 1);
+        s.meshes.push(quad(
+            &format!("flat_panel_{i}"),
+            Vec3::new(-3.0 + 3.0 * i as f32, -0.5, -5.0),
+            Vec3::X * 1.2,
+            Vec3::Y * 0.8,
+            s.materials.len() - 1,
+        ));
+        if i == 0 {
+            // An opaque material between members: the run's triangles are not one range.
+            s.materials.push(Default::default());
+            s.meshes.push(quad(
+                "opaque_between",
+                Vec3::new(0.0, -2.0, -7.0),
+                Vec3::X * 2.0,
+                Vec3::Y * 0.5,
+                s.materials.len() - 1,
+            ));
+        }
+    }
+    let (w, h) = (333, 197);
+    let (px, report) = rasterize_limited(&s, w, h, "");
+    let d = diff(&s, &px);
+    eprintln!("shared masked runs: {d:?}, {report:?}");
+    assert_eq!(report.serial(), 0);
+    assert_matches("shared masked runs", &d);
+    let mut solid = s.clone();
+    for m in solid.materials.iter_mut() {
+        if m.alpha_mode.is_masked() {
+            m.alpha_mode = AlphaMode::Opaque;
+        }
+    }
+    let opaque = rasterize(&solid, w, h);
+    let shown = |px: &[Pixel], m: usize| {
+        let ids = material_triangles(&s, m);
+        px.iter().filter(|p| ids.contains(&p.id)).count()
+    };
+    let kept: Vec<_> = [striped, striped_high]
+        .into_iter()
+        .chain(panels.iter().copied())
+        .map(|m| (shown(&px, m), shown(&opaque, m)))
+        .collect();
+    eprintln!("kept of solid: {kept:?}");
+    let [front, back, faint, high, half] = kept[..] else {
+        unreachable!()
+    };
+    assert!(
+        front.0 > 500 && front.0 < front.1 - 500,
+        "stripes kept at 0.5: {front:?}"
+    );
+    assert_eq!(back.0, 0, "cut out at 0.75: {back:?}");
+    assert_eq!(faint.0, 0, "alpha 0.2 cut at 0.5: {faint:?}");
+    assert!(
+        half.1 > 100 && half.0 == half.1,
+        "alpha 0.6 kept at 0.5: {half:?}"
+    );
+    assert_eq!(high.0, 0, "alpha 0.6 cut at 0.75: {high:?}");
+    assert!(back.1 > 1000 && faint.1 > 100 && high.1 > 100, "{kept:?}");
+}
+
 /// A triangle covering the whole viewport behind a field of small triangles (some under
 /// a pixel, some single-sided and facing away, many across tile and block borders): the
 /// rasterizer (setup's direct paths, tiles, bin, raster) against the hardware prepass,

@@ -35,12 +35,13 @@
 // RESOLVE: the full-screen draw writing the id and frag_depth.
 //
 // Alpha-masked materials: setup, bin and raster run once for the opaque triangles (those
-// marked in `alpha_tested` skipped), then once per masked material (ALPHA_TEST, with
-// MATERIAL_INDEX and its material code): its triangles only, each covered pixel nearer
-// than what the buffer holds rebuilt (visibility/surface.wgsl, as visibility shading
-// rebuilds it) and kept only where the material's alpha reaches its cutoff, as the depth
-// prepass discards. A masked run starts from a lists-only clear (LISTS_ONLY), keeping the
-// buffer. Each run counts into its own `counters`.
+// marked in `alpha_tested` skipped), then once per group of masked materials that share
+// their code (ALPHA_TEST, with the group's `masked_members` and its material code, the
+// constants read from material_constants where SHARED_CODE): its triangles only, each
+// covered pixel nearer than what the buffer holds rebuilt (visibility/surface.wgsl, as
+// visibility shading rebuilds it) and kept only where its material's alpha reaches that
+// material's cutoff, as the depth prepass discards. A masked run starts from a lists-only
+// clear (LISTS_ONLY), keeping the buffer. Each run counts into its own `counters`.
 
 #include "common/types.wgsl"
 #include "common/triangle_setup.wgsl"
@@ -78,9 +79,8 @@
 @group(0) @binding(3) var<storage, read> triangles: array<u32>;
 @group(0) @binding(4) var<storage, read> single_sided: array<u32>;
 #if ALPHA_TEST
-@group(0) @binding(13) var<storage, read> material_triangles: array<vec2<u32>>;
 #else
-// Bit t set: triangle t is alpha-tested, drawn by its material's own run.
+// Bit t set: triangle t is alpha-tested, drawn by its material group's own run.
 @group(0) @binding(13) var<storage, read> alpha_tested: array<u32>;
 #endif
 #else
@@ -89,6 +89,12 @@
 @group(0) @binding(2) var<storage, read> vertices: array<f32>;
 @group(0) @binding(3) var<storage, read> triangles: array<u32>;
 #endif
+#endif
+#if ALPHA_TEST
+// The run's MEMBERS_COUNT materials, ascending: (first triangle, its setup thread, first
+// constant in material_constants, alpha cutoff's bits). Setup's threads take the
+// members' triangles one after another, MEMBERS_THREADS in all.
+@group(0) @binding(13) var<storage, read> masked_members: array<vec4<u32>>;
 #endif
 #if SETUP
 @group(0) @binding(6) var<storage, read_write> tiles: array<vec2<u32>>;
@@ -224,11 +230,31 @@ struct Tri {
 #include "visibility/surface.wgsl"
 #include <material>
 
+// The last member whose component `c` (0: first triangle, 1: first setup thread) is not
+// over `at`: the member holding that triangle or thread (both ascend with the members).
+fn masked_member(c: u32, at: u32) -> vec4<u32> {
+    var lo = 0u;
+    var hi = MEMBERS_COUNT;
+    while (hi - lo > 1u) {
+        let mid = (lo + hi) / 2u;
+        if (masked_members[mid][c] <= at) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return masked_members[lo];
+}
+
 // Whether triangle `tri`'s material keeps pixel (px, py): its alpha there reaches the
-// cutoff (forward.wgsl's prepass discards below it).
+// material's cutoff (forward.wgsl's prepass discards below it).
 fn alpha_keeps(tri: u32, px: i32, py: i32) -> bool {
+    let member = masked_member(0u, tri);
+#if SHARED_CODE
+    material_constant_base = member.z;
+#endif
     let p = surface_point(vec2<u32>(u32(px), u32(py)), tri);
-    return material_alpha(material_setup(p)) >= MATERIAL_ALPHA_CUTOFF;
+    return material_alpha(material_setup(p)) >= bitcast<f32>(member.w);
 }
 #endif
 

@@ -358,9 +358,10 @@ fn setup(
 ) {
     // No early return: every thread reaches the reservations' barriers.
 #if ALPHA_TEST
-    let range = material_triangles[MATERIAL_INDEX];
-    let id = range.x + flat_index(wg, groups, local, GROUP);
-    let drawn = id < range.y;
+    let thread = flat_index(wg, groups, local, GROUP);
+    let member = masked_member(1u, thread);
+    let id = member.x + (thread - member.y);
+    let drawn = thread < MEMBERS_THREADS;
 #else
     let id = flat_index(wg, groups, local, GROUP);
     let drawn = id < raster_params.x && (alpha_tested[id / 32u] & (1u << (id % 32u))) == 0u;

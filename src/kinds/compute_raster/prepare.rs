@@ -7,8 +7,9 @@
 //! may cover; `raster` (indirect), a thread per pixel of a block. A resolve then writes the buffer into the
 //! depth texture and the R32Uint visibility texture (a draw or a dispatch, by the depth's
 //! format: `resolve.rs`). Alpha-masked materials: setup, bin and raster
-//! run again per masked material, with its material code testing alpha per pixel; the
-//! first run draws the opaque triangles.
+//! run again per group of masked materials that share their code (as visibility
+//! shading groups them), with that code testing alpha per pixel; the first run draws the
+//! opaque triangles.
 //! See `shaders/visibility/compute_raster.wgsl`.
 
 use super::compute_raster_lists::{
@@ -18,9 +19,11 @@ use super::compute_raster_resolve::Resolve;
 use super::{defines, grid, pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::gpu::readback::read_buffer;
 use crate::graph::{Name, ScheduledPass};
+use crate::render::materials::{group_label, shared_code_groups, GroupConstants, MaterialProgram};
 use crate::render::pipelines::PipelineKey;
 use crate::render::report::{PassReport, RasterReport};
 use crate::render::{RenderError, Renderer};
+use crate::scene::AlphaMode;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
@@ -58,7 +61,7 @@ pub const FEATURES: wgpu::Features =
 pub(super) struct ComputeRasterPass {
     name: Name,
     /// The opaque triangles' run (its clear also clears the per-pixel buffer), then one
-    /// per alpha-masked material.
+    /// per group of alpha-masked materials sharing their code.
     runs: Vec<RasterRun>,
     /// Indirect arguments of `bin` and `raster`, written by the dispatch before each.
     tile_args: wgpu::Buffer,
@@ -140,7 +143,7 @@ pub(super) fn prepare_source(
     let words = (geometry.triangle_count.div_ceil(32)).max(1) as usize;
     let mut single_sided = vec![0u32; words];
     let mut alpha_tested = vec![0u32; words];
-    // (material, triangles) of each masked material's run.
+    // The masked materials that have triangles, ascending.
     let mut masked = Vec::new();
     let ranges = if opaque {
         &geometry.material_ranges[..]
@@ -159,7 +162,7 @@ pub(super) fn prepare_source(
         };
         if material.alpha_mode.is_masked() {
             mark(&mut alpha_tested);
-            masked.push((m, end - first));
+            masked.push(m);
         }
         if !material.double_sided {
             mark(&mut single_sided);
@@ -306,9 +309,15 @@ pub(super) fn prepare_source(
         ("TILE_BLOCKS", format!("{TILE_BLOCKS}u")),
         ("TILES_PER_GROUP", format!("{TILES_PER_GROUP}u")),
     ];
+    // Masked materials that differ only in constants (and read the same images) share one
+    // run, their constants read from `material_constants` (as visibility shading groups).
+    let materials = &cx.gpu.materials;
+    let groups = shared_code_groups(materials, &masked);
+    let constants = GroupConstants::new(materials, &groups);
+    constants.offer(&device, &mut offered);
     let mut runs = Vec::new();
-    // `None`: the opaque run over every triangle; else (material, its triangle count).
-    for run in std::iter::once(None).chain(masked.into_iter().map(Some)) {
+    // `None`: the opaque run over every triangle; else a group of masked materials.
+    for run in std::iter::once(None).chain(groups.iter().map(Some)) {
         let counters = storage(
             "compute raster counters",
             4 * COUNTERS as u64,
@@ -318,21 +327,37 @@ pub(super) fn prepare_source(
         offered.buffer("counters", &counters);
         let mut material_defines = Vec::new();
         let mut material = None;
-        if let Some((index, _)) = run {
-            let m = &cx.gpu.materials[index];
+        let mut setup_triangles = geometry.triangle_count;
+        if let Some(group) = run {
+            let members = MaskedMembers::new(materials, group, ranges, &constants);
+            setup_triangles = members.triangles;
+            offered.buffer(
+                "masked_members",
+                &init(
+                    "masked materials' triangles",
+                    bytemuck::cast_slice(&members.table),
+                    wgpu::BufferUsages::STORAGE,
+                ),
+            );
+            let m = &materials[group[0]];
+            let shared = group.len() > 1;
             material_defines.push(("ALPHA_TEST", "1".to_string()));
-            material_defines.push(("MATERIAL_INDEX", index.to_string()));
+            material_defines.push(("MEMBERS_COUNT", format!("{}u", group.len())));
+            material_defines.push(("MEMBERS_THREADS", format!("{}u", members.triangles)));
+            if shared {
+                material_defines.push(("SHARED_CODE", "1".to_string()));
+            }
             if m.textures.is_some() {
                 material_defines.push(("MATERIAL_TEXTURED", "1".to_string()));
             }
             material = Some((
-                m.wgsl_for_compute().to_string(),
+                m.group_code(shared).to_string(),
                 m.textures.clone(),
-                &m.name,
+                group_label(&sp.name, materials, group),
             ));
         }
         let label = match &material {
-            Some((_, _, name)) => format!("{} (alpha test of material '{name}')", sp.name),
+            Some((_, _, group)) => format!("{group}'s alpha test"),
             None => sp.name.to_string(),
         };
         let mut pipeline = |stage: &str, entry: &str, extra: &[(&str, String)]| {
@@ -370,10 +395,10 @@ pub(super) fn prepare_source(
                 pipeline("RASTER", "raster", &material_defines)?,
             ),
         };
-        let (clear_items, setup_items) = match run {
-            None => (pixels.min(u32::MAX as u64) as u32, geometry.triangle_count),
+        let clear_items = match run {
+            None => pixels.min(u32::MAX as u64) as u32,
             // The counters and arguments only.
-            Some((_, triangles)) => (COUNTERS as u32, triangles),
+            Some(_) => COUNTERS as u32,
         };
         runs.push(RasterRun {
             clear,
@@ -382,7 +407,7 @@ pub(super) fn prepare_source(
             raster,
             grids: [
                 grid(clear_items, CLEAR_GROUP, max_groups),
-                grid(setup_items, GROUP, max_groups),
+                grid(setup_triangles, GROUP, max_groups),
             ],
             counters,
         });
@@ -402,6 +427,37 @@ pub(super) fn prepare_source(
         capacity,
         resolve,
     })
+}
+
+/// A masked run's materials as its shader finds them (`masked_members`): per material, its
+/// first triangle, the first setup thread that draws it (its triangles follow the earlier
+/// members'), its first constant in `material_constants` and its alpha cutoff's bits.
+struct MaskedMembers {
+    table: Vec<[u32; 4]>,
+    /// The members' triangles together: the setup dispatch's threads.
+    triangles: u32,
+}
+
+impl MaskedMembers {
+    fn new(
+        materials: &[MaterialProgram],
+        group: &[usize],
+        ranges: &[[u32; 2]],
+        constants: &GroupConstants,
+    ) -> Self {
+        let mut table = Vec::with_capacity(group.len());
+        let mut triangles = 0;
+        for &m in group {
+            let [first, end] = ranges[m];
+            let cutoff = match materials[m].alpha_mode {
+                AlphaMode::Mask(c) => c,
+                _ => 0.0,
+            };
+            table.push([first, triangles, constants.first[m], cutoff.to_bits()]);
+            triangles += end - first;
+        }
+        Self { table, triangles }
+    }
 }
 
 impl ComputeRasterPass {
