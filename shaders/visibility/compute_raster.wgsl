@@ -42,6 +42,8 @@
 // visibility shading rebuilds it) and kept only where its material's alpha reaches that
 // material's cutoff, as the depth prepass discards. A masked run starts from a lists-only
 // clear (LISTS_ONLY), keeping the buffer. Each run counts into its own `counters`.
+// FOLDED (with ALPHA_TEST): the opaque run draws the first group's triangles too, its
+// setup flagging them (RECORD_ALPHA) for the alpha test, so that group costs no run.
 
 #include "common/types.wgsl"
 #include "common/triangle_setup.wgsl"
@@ -78,10 +80,15 @@
 @group(0) @binding(2) var<storage, read> vertices: array<f32>;
 @group(0) @binding(3) var<storage, read> triangles: array<u32>;
 @group(0) @binding(4) var<storage, read> single_sided: array<u32>;
+// Bit t set: triangle t is alpha-tested, drawn by its material group's own run (or, with
+// FOLDED, flagged by this one).
+#if FOLDED
+@group(0) @binding(14) var<storage, read> alpha_tested: array<u32>;
+#else
 #if ALPHA_TEST
 #else
-// Bit t set: triangle t is alpha-tested, drawn by its material group's own run.
-@group(0) @binding(13) var<storage, read> alpha_tested: array<u32>;
+@group(0) @binding(14) var<storage, read> alpha_tested: array<u32>;
+#endif
 #endif
 #else
 #if ALPHA_TEST
@@ -130,6 +137,8 @@ const BLOCK_TRIANGLES: u32 = 7u;
 // Record flags: bits 0-2, edge k is not a top or left edge (bias -1); RECORD_LINEAR, the
 // snapped coordinates are small enough for the edge functions to be exactly linear.
 const RECORD_LINEAR: u32 = 8u;
+// RECORD_ALPHA: the folded group's triangle, alpha-tested (FOLDED).
+const RECORD_ALPHA: u32 = 16u;
 // Snapped coordinates up to this (2^29 fixed point, 2^21 pixels) keep every difference
 // the edge functions take within i32 (pixel centres are under 2^22 for viewports up to
 // 16,384 pixels), so an edge function is exactly the linear function of the pixel.
@@ -224,6 +233,8 @@ struct Tri {
     box: vec4<i32>,
     id: u32,
     flags: u32,
+    // Its entry in masked_members (ALPHA_TEST): whose material tests its alpha.
+    member: u32,
 };
 
 #if ALPHA_TEST
@@ -232,7 +243,8 @@ struct Tri {
 
 // The last member whose component `c` (0: first triangle, 1: first setup thread) is not
 // over `at`: the member holding that triangle or thread (both ascend with the members).
-fn masked_member(c: u32, at: u32) -> vec4<u32> {
+// Setup finds it once a triangle (the records carry it), not every pixel.
+fn masked_member(c: u32, at: u32) -> u32 {
     var lo = 0u;
     var hi = MEMBERS_COUNT;
     while (hi - lo > 1u) {
@@ -243,17 +255,17 @@ fn masked_member(c: u32, at: u32) -> vec4<u32> {
             hi = mid;
         }
     }
-    return masked_members[lo];
+    return lo;
 }
 
-// Whether triangle `tri`'s material keeps pixel (px, py): its alpha there reaches the
-// material's cutoff (forward.wgsl's prepass discards below it).
-fn alpha_keeps(tri: u32, px: i32, py: i32) -> bool {
-    let member = masked_member(0u, tri);
+// Whether `t`'s material keeps pixel (px, py): its alpha there reaches the material's
+// cutoff (forward.wgsl's prepass discards below it).
+fn alpha_keeps(t: Tri, px: i32, py: i32) -> bool {
+    let member = masked_members[t.member];
 #if SHARED_CODE
     material_constant_base = member.z;
 #endif
-    let p = surface_point(vec2<u32>(u32(px), u32(py)), tri);
+    let p = surface_point(vec2<u32>(u32(px), u32(py)), t.id);
     return material_alpha(material_setup(p)) >= bitcast<f32>(member.w);
 }
 #endif
@@ -272,9 +284,14 @@ fn cover(t: Tri, px: i32, py: i32) {
     let key = (u64(bitcast<u32>(max(z, 0.0))) << 32u) | u64(~t.id);
     let at = u32(py) * raster_params.z + u32(px);
 #if ALPHA_TEST
+#if FOLDED
+    let tested = (t.flags & RECORD_ALPHA) != 0u;
+#else
+    let tested = true;
+#endif
     // The material only where it could win: behind what the buffer holds, the min
     // would keep that anyway.
-    if (atomicLoad(&vis[at]) <= key || !alpha_keeps(t.id, px, py)) {
+    if (tested && (atomicLoad(&vis[at]) <= key || !alpha_keeps(t, px, py))) {
         return;
     }
 #endif
@@ -337,6 +354,7 @@ fn load_record(r: u32) -> Tri {
     t.dz = vec2<f32>(bitcast<f32>(w2.w), bitcast<f32>(w3.x));
     t.id = w3.y;
     t.flags = w3.z;
+    t.member = w3.w;
     t.bias = -vec3<i32>(vec3<u32>(t.flags, t.flags >> 1u, t.flags >> 2u) & vec3<u32>(1u));
     return t;
 }

@@ -37,7 +37,7 @@ fn store_record(r: u32, t: Tri) {
     records[i] = bitcast<vec4<u32>>(vec4<i32>(t.a, t.b));
     records[i + 1u] = vec4<u32>(bitcast<vec2<u32>>(t.c), pack_point(t.box.xy), pack_point(t.box.zw));
     records[i + 2u] = vec4<u32>(bitcast<vec3<u32>>(t.sa), bitcast<u32>(t.dz.x));
-    records[i + 3u] = vec4<u32>(bitcast<u32>(t.dz.y), t.id, t.flags, 0u);
+    records[i + 3u] = vec4<u32>(bitcast<u32>(t.dz.y), t.id, t.flags, t.member);
 }
 
 fn clip_position(v: u32) -> vec4<f32> {
@@ -357,14 +357,24 @@ fn setup(
     @builtin(local_invocation_index) local: u32,
 ) {
     // No early return: every thread reaches the reservations' barriers.
+#if FOLDED
+    let id = flat_index(wg, groups, local, GROUP);
+    let drawn = id < raster_params.x;
+    let alpha = drawn && (alpha_tested[id / 32u] & (1u << (id % 32u))) != 0u;
+    var member = 0u;
+    if (alpha) {
+        member = masked_member(0u, id);
+    }
+#else
 #if ALPHA_TEST
     let thread = flat_index(wg, groups, local, GROUP);
     let member = masked_member(1u, thread);
-    let id = member.x + (thread - member.y);
+    let id = masked_members[member].x + (thread - masked_members[member].y);
     let drawn = thread < MEMBERS_THREADS;
 #else
     let id = flat_index(wg, groups, local, GROUP);
     let drawn = id < raster_params.x && (alpha_tested[id / 32u] & (1u << (id % 32u))) == 0u;
+#endif
 #endif
     var a = vec4<f32>(0.0);
     var b = vec4<f32>(0.0);
@@ -404,6 +414,12 @@ fn setup(
             } else {
                 fan = prepare_fan(a, b, c, id, cull_back);
             }
+#if ALPHA_TEST
+            fan.t.member = member;
+#endif
+#if FOLDED
+            fan.t.flags |= select(0u, RECORD_ALPHA, alpha);
+#endif
         }
         draw_fan(fan, local);
     }

@@ -9,7 +9,7 @@
 //! format: `resolve.rs`). Alpha-masked materials: setup, bin and raster
 //! run again per group of masked materials that share their code (as visibility
 //! shading groups them), with that code testing alpha per pixel; the first run draws the
-//! opaque triangles.
+//! opaque triangles, and the only group's too where there is one (flagged for the test).
 //! See `shaders/visibility/compute_raster.wgsl`.
 
 use super::compute_raster_lists::{
@@ -315,9 +315,17 @@ pub(super) fn prepare_source(
     let groups = shared_code_groups(materials, &masked);
     let constants = GroupConstants::new(materials, &groups);
     constants.offer(&device, &mut offered);
+    // (opaque, masked group) per run: the opaque run over every triangle, then a run per
+    // group; one group alone is folded into the opaque run (its triangles flagged for
+    // the alpha test there), which saves its four dispatches.
+    let plan: Vec<(bool, Option<&Vec<usize>>)> = match &groups[..] {
+        [group] => vec![(true, Some(group))],
+        _ => std::iter::once((true, None))
+            .chain(groups.iter().map(|g| (false, Some(g))))
+            .collect(),
+    };
     let mut runs = Vec::new();
-    // `None`: the opaque run over every triangle; else a group of masked materials.
-    for run in std::iter::once(None).chain(groups.iter().map(Some)) {
+    for (opaque_run, run) in plan {
         let counters = storage(
             "compute raster counters",
             4 * COUNTERS as u64,
@@ -330,7 +338,11 @@ pub(super) fn prepare_source(
         let mut setup_triangles = geometry.triangle_count;
         if let Some(group) = run {
             let members = MaskedMembers::new(materials, group, ranges, &constants);
-            setup_triangles = members.triangles;
+            if opaque_run {
+                material_defines.push(("FOLDED", "1".to_string()));
+            } else {
+                setup_triangles = members.triangles;
+            }
             offered.buffer(
                 "masked_members",
                 &init(
@@ -357,6 +369,7 @@ pub(super) fn prepare_source(
             ));
         }
         let label = match &material {
+            Some((_, _, group)) if opaque_run => format!("{group}, alpha-tested"),
             Some((_, _, group)) => format!("{group}'s alpha test"),
             None => sp.name.to_string(),
         };
@@ -381,25 +394,21 @@ pub(super) fn prepare_source(
                 textures,
             })
         };
-        let (clear, setup, bin, raster) = match run {
-            None => (
+        let (clear, clear_items) = if opaque_run {
+            (
                 pipeline("CLEAR", "clear", &[])?,
-                pipeline("SETUP", "setup", &[])?,
-                pipeline("BIN", "bin", &[])?,
-                pipeline("RASTER", "raster", &[])?,
-            ),
-            Some(_) => (
+                pixels.min(u32::MAX as u64) as u32,
+            )
+        } else {
+            // The counters and arguments only, keeping the buffer.
+            (
                 pipeline("CLEAR", "clear", &[("LISTS_ONLY", "1".into())])?,
-                pipeline("SETUP", "setup", &material_defines)?,
-                pipeline("BIN", "bin", &material_defines)?,
-                pipeline("RASTER", "raster", &material_defines)?,
-            ),
+                COUNTERS as u32,
+            )
         };
-        let clear_items = match run {
-            None => pixels.min(u32::MAX as u64) as u32,
-            // The counters and arguments only.
-            Some(_) => COUNTERS as u32,
-        };
+        let setup = pipeline("SETUP", "setup", &material_defines)?;
+        let bin = pipeline("BIN", "bin", &material_defines)?;
+        let raster = pipeline("RASTER", "raster", &material_defines)?;
         runs.push(RasterRun {
             clear,
             setup,
