@@ -43,6 +43,13 @@ fn shade_surface(p: ShadingPoint, m: MaterialSample, pixel: vec2<f32>, view_z: f
 #else
     for (var c = light_first(pixel, view_z); light_valid(c); c = light_next(c, view_z)) {
         let i = light_index(c);
+        // Out of range adds nothing (and numbers no caster): rejected before the light's
+        // properties are read (the gallery's glass at 65,536 lights, H100: transparent
+        // shading 0.644 -> 0.575 ms).
+        let reach = light_geometry[i].position - p.position;
+        if (dot(reach, reach) > reject_beyond(light_geometry[i].range)) {
+            continue;
+        }
         let props = light_properties[i];
 #if VPL_VISIBILITY
         // A VPL hidden from this pixel's block (VplVisibility) adds nothing; VPLs cast no

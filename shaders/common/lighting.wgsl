@@ -9,6 +9,15 @@ fn range_window(dist_sq: f32, range: f32) -> f32 {
     return clamp(1.0 - r * r, 0.0, 1.0);
 }
 
+// A squared distance past which range_window is surely zero: dist_sq over
+// fl(range²)·1.001 rounded down is over range² by 1e-3 at least, so the quotient r in
+// range_window, within 2.5 ulp (Vulkan's OpFDiv), is over 1, r² rounds to 1 or more, and
+// 1 − r² clamps to 0, fused or not. A NaN or infinite range rejects nothing here; the
+// exact test after it decides.
+fn reject_beyond(range: f32) -> f32 {
+    return range * range * 1.001;
+}
+
 fn spot_factor(g: LightGeometry, p: LightProperties, to_light_dir: vec3<f32>) -> f32 {
     if (g.cos_outer <= -1.0) {
         return 1.0;

@@ -63,15 +63,6 @@ fn add_reached(color: vec3<f32>, i: u32, g: LightGeometry, props: LightPropertie
     return color;
 }
 
-// A squared distance past which range_window is surely zero: dist_sq over
-// fl(range²)·1.001 rounded down is over range² by 1e-3 at least, so the quotient r in
-// range_window, within 2.5 ulp (Vulkan's OpFDiv), is over 1, r² rounds to 1 or more, and
-// 1 − r² clamps to 0, fused or not. A NaN or infinite range rejects nothing here; the
-// exact test after it decides.
-fn reject_beyond(range: f32) -> f32 {
-    return range * range * 1.001;
-}
-
 #if RANGE_FIRST
 // Light i (its position and range in q) added to `color` when its range window is
 // positive: first reject_beyond's bound (no division), then the exact window.
