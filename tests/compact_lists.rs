@@ -756,24 +756,28 @@ fn mutations_are_caught() {
             exactness_failures(m.r, &dense, (96, 64), &SOME),
         );
     }
-    // The block loop's total forgets the blocks of earlier rounds.
+    // The total (header word 0) is the first invocation's share of the blocks only.
     {
         let m = Mutated::new(
             &mut r,
-            "carry = add_sat(carry, placed.y);",
-            "carry = placed.y;",
+            "atomicStore(&light_lists[0], wanted);",
+            "atomicStore(&light_lists[0], every);",
         );
-        caught("block carry dropped", many_lists_failures(m.r, 0));
+        caught("blocks' total dropped", many_lists_failures(m.r, 0));
     }
-    // The block scan leaves out earlier rounds' total from its offsets.
+    // A block's offset leaves out the blocks before it.
     {
-        let m = Mutated::new(
-            &mut r,
-            "atomicStore(&list_block_sums[2u * b], add_sat(carry, placed.x));",
-            "atomicStore(&list_block_sums[2u * b], placed.x);",
-        );
+        let m = Mutated::new(&mut r, "earlier = add_sat(earlier, v);", "earlier = 0u;");
         caught(
-            "block offsets without the carry",
+            "block offsets without the earlier blocks",
+            many_lists_failures(m.r, 0),
+        );
+    }
+    // A block's offset leaves out the block just before it.
+    {
+        let m = Mutated::new(&mut r, "if (b < group.x) {", "if (b + 1u < group.x) {");
+        caught(
+            "block offsets without the block before",
             many_lists_failures(m.r, 0),
         );
     }

@@ -21,9 +21,9 @@
 // `compact.phase` 0 counts each list (entry count, depth range, block sums) and writes
 // its first `compact.scratch` indices to the list's scratch slot; 1 fills the lists
 // longer than their slot (the other workgroups return at once). Between them
-// `scan_blocks` (one workgroup) and `scan_lists` (a workgroup per SCAN_BLOCK lists) point
-// each list that fits its slot there, and prefix-sum the longer lists' counts into
-// offsets in the pool after the slots. A list runs past the index array's end
+// `scan_lists` (a workgroup per SCAN_BLOCK lists) points each list that fits its slot
+// there, and prefix-sums the longer lists' counts into offsets in the pool after the
+// slots. A list runs past the index array's end
 // (`list_params.pool_indices`, the graph's max_indices) only when the long lists
 // together want more than the pool: its count is cut to what fits, and the cut is counted.
 // Every light's view-space bounds are found once a frame (`bounds`, the first dispatch):
@@ -84,8 +84,7 @@ fn bounds_capacity() -> u32 {
 
 #if COMPACT
 // Per scan block of SCAN_BLOCK lists: the sum of the counts of its lists longer than
-// their scratch slot (then, after `scan_blocks`, the block's first offset in the pool)
-// and whether the sum wrapped past u32.
+// their scratch slot and whether the sum wrapped past u32.
 @group(0) @binding(7) var<storage, read_write> list_block_sums: array<atomic<u32>>;
 @group(0) @binding(8) var<uniform> compact: CompactParams;
 
@@ -775,34 +774,21 @@ fn list_count() -> u32 {
     return list_params.tiles_x * list_params.tiles_y * list_params.lists_per_tile;
 }
 
-// One workgroup: block sums → each block's first offset in the pool; header word 0 → the
-// indices the lists longer than their scratch slot want (all lists' without scratch).
-@compute @workgroup_size(SCAN_THREADS, 1, 1)
-fn scan_blocks(@builtin(local_invocation_index) local: u32) {
-    let blocks = (list_count() + SCAN_BLOCK - 1u) / SCAN_BLOCK;
-    var carry = 0u;
-    for (var base = 0u; base < blocks; base += SCAN_THREADS) {
-        let b = base + local;
-        var v = 0u;
-        if (b < blocks) {
-            v = atomicLoad(&list_block_sums[2u * b]);
-            if (atomicLoad(&list_block_sums[2u * b + 1u]) != 0u) {
-                v = 0xffffffffu;
-            }
-        }
-        let placed = exclusive_scan(local, v, SCAN_THREADS);
-        if (b < blocks) {
-            atomicStore(&list_block_sums[2u * b], add_sat(carry, placed.x));
-        }
-        carry = add_sat(carry, placed.y);
+// Block b's sum of the counts of its lists longer than their slot, saturated where it
+// wrapped.
+fn block_sum(b: u32) -> u32 {
+    if (atomicLoad(&list_block_sums[2u * b + 1u]) != 0u) {
+        return 0xffffffffu;
     }
-    if (local == 0u) {
-        atomicStore(&light_lists[0], carry);
-    }
+    return atomicLoad(&list_block_sums[2u * b]);
 }
 
 // A workgroup per block of SCAN_BLOCK lists, SCAN_PER_THREAD consecutive lists an
-// invocation: each list's offset and the count it keeps under the bound. A list that
+// invocation: each list's offset and the count it keeps under the bound. Each workgroup
+// sums the blocks before its own itself (a few at most: 8 at 1920×1080 with 16-pixel
+// tiles, 128 with 16 clusters), so no dispatch scans the blocks first (saturating sums
+// are associative: the same offsets in any order); the first writes header word 0, the
+// indices the lists longer than their scratch slot want (all lists' without scratch). A list that
 // fits its scratch slot (1..=scratch lights) stays there, whole; the others lie in the
 // pool after every slot, back to back in list order (empty ones too, holding nothing,
 // so that without scratch every offset is the sum of the counts before it).
@@ -828,9 +814,24 @@ fn scan_lists(
         }
     }
     let before = exclusive_scan(local, sum, SCAN_THREADS).x;
+    let blocks = (lists + SCAN_BLOCK - 1u) / SCAN_BLOCK;
+    var earlier = 0u;
+    var every = 0u;
+    for (var b = local; b < blocks; b += SCAN_THREADS) {
+        let v = block_sum(b);
+        every = add_sat(every, v);
+        if (b < group.x) {
+            earlier = add_sat(earlier, v);
+        }
+    }
+    let block_start = exclusive_scan(local, earlier, SCAN_THREADS).y;
+    let wanted = exclusive_scan(local, every, SCAN_THREADS).y;
+    if (group.x == 0u && local == 0u) {
+        atomicStore(&light_lists[0], wanted);
+    }
     // At most half the index array (`ListLayout::scratch_per_list`): no overflow.
     let pool_start = scratch * lists;
-    var offset = add_sat(atomicLoad(&list_block_sums[2u * group.x]), before);
+    var offset = add_sat(block_start, before);
     let pool = list_params.pool_indices;
     for (var j = 0u; j < SCAN_PER_THREAD; j++) {
         let l = first + j;

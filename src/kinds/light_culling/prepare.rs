@@ -40,16 +40,15 @@ pub(super) struct LightCullingPass {
     report_copy: wgpu::Buffer,
     layout: ListLayout,
     /// Diagnosis: the one dispatch the pass's timestamps bracket (`LIGHTGRAPH_TIME_DISPATCH`:
-    /// 0 bounds, 1 coarse, then count, scan_blocks, scan_lists, fill; counted without the
+    /// 0 bounds, 1 coarse, then count, scan_lists, fill; counted without the
     /// coarse stage when there is none).
     timed_dispatch: Option<usize>,
 }
 
 /// What compact lists add: the fill's bind group (the same pipeline as the count, with
-/// `compact.phase` 1), the two scan pipelines and the block sums they share.
+/// `compact.phase` 1), the scan pipeline and the block sums it reads.
 struct Compact {
     fill: wgpu::BindGroup,
-    scan_blocks: Arc<wgpu::ComputePipeline>,
     scan_lists: Arc<wgpu::ComputePipeline>,
     block_sums: wgpu::Buffer,
     blocks: u32,
@@ -194,13 +193,10 @@ pub(super) fn prepare(
         // The same pipeline (a cache hit) bound with the fill phase.
         offered.buffer("compact", &phase(1));
         let (_, fill) = cx.compute_pipeline(&sp.name, key(""), "main", &offered)?;
-        let (scan_blocks, _) =
-            cx.compute_pipeline(&sp.name, key("scan_blocks"), "scan_blocks", &offered)?;
         let (scan_lists, _) =
             cx.compute_pipeline(&sp.name, key("scan_lists"), "scan_lists", &offered)?;
         Some(Compact {
             fill,
-            scan_blocks,
             scan_lists,
             block_sums,
             blocks,
@@ -257,7 +253,7 @@ impl PreparedPass for LightCullingPass {
         if let Some(c) = &self.compact {
             encoder.clear_buffer(&c.block_sums, 0, None);
         }
-        // Bounds, coarse, count, then (compact) scan, scan, fill. Each dispatch sees the
+        // Bounds, coarse, count, then (compact) scan, fill. Each dispatch sees the
         // previous one's writes: wgpu puts a barrier between dispatches that use a buffer
         // read-write. The fill's workgroups of lists that fit their scratch slot return
         // at once. (An indirect fill of only the longer lists was measured on the H200:
@@ -271,7 +267,6 @@ impl PreparedPass for LightCullingPass {
         }
         steps.push((&self.pipeline, &self.bind, [x, y, z]));
         if let Some(c) = &self.compact {
-            steps.push((&c.scan_blocks, &self.bind, [1, 1, 1]));
             steps.push((&c.scan_lists, &self.bind, [c.blocks, 1, 1]));
             steps.push((&self.pipeline, &c.fill, [x, y, z]));
         }
