@@ -5,7 +5,6 @@
 
 use super::model::{Color, ColorExpr, Lobe, Scalar, ScalarExpr};
 use super::{Material, MaterialError};
-use crate::scene::AlphaMode;
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
@@ -232,10 +231,7 @@ pub(crate) fn generate_with_constants(m: &Material, opts: &WgslOptions) -> (Stri
         o.push('\n');
     }
     let _ = writeln!(o, "const MATERIAL_TYPE_BIT: u32 = {}u;", desc.type_bit);
-    let cutoff = match desc.alpha_mode {
-        AlphaMode::Mask(c) => c,
-        _ => 0.0,
-    };
+    let cutoff = desc.alpha_mode.cutoff();
     // Shared code leaves out what only the rasterizing passes read (the alpha test's
     // cutoff, the faces drawn): visibility shading, which takes it, reads neither, so
     // materials that differ only in them share their code.

@@ -49,6 +49,14 @@ impl AlphaMode {
     pub fn is_masked(self) -> bool {
         matches!(self, AlphaMode::Mask(_))
     }
+
+    /// The alpha a masked fragment must reach to be kept; 0 (everything kept) otherwise.
+    pub fn cutoff(self) -> f32 {
+        match self {
+            AlphaMode::Mask(c) => c,
+            _ => 0.0,
+        }
+    }
 }
 
 /// Decoded texture pixels (RGBA8). `srgb` says whether the bytes are sRGB-encoded

@@ -17,7 +17,7 @@
 
 use crate::material::model::{Filter, Scalar, ScalarExpr, Wrap};
 use crate::material::{Material, TextureSlot};
-use crate::scene::{AlphaMode, Mesh, Scene};
+use crate::scene::{Mesh, Scene};
 use glam::{Vec2, Vec4};
 
 /// Words of the header.
@@ -358,10 +358,7 @@ fn compile(
     texels: &mut Vec<u32>,
 ) -> Result<Vec<u32>, String> {
     let desc = material.desc();
-    let cutoff = match desc.alpha_mode {
-        AlphaMode::Mask(c) => c,
-        _ => 0.0,
-    };
+    let cutoff = desc.alpha_mode.cutoff();
     let mut ops: Vec<[u32; OP_WORDS]> = Vec::new();
     let mut copy = |slot: &TextureSlot| texture_index(slot, side, textures, texels);
     let depth = emit(&desc.alpha, material.texture_slots(), &mut copy, &mut ops)?;

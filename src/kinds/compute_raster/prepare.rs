@@ -23,7 +23,6 @@ use crate::render::materials::{group_label, shared_code_groups, GroupConstants, 
 use crate::render::pipelines::PipelineKey;
 use crate::render::report::{PassReport, RasterReport};
 use crate::render::{RenderError, Renderer};
-use crate::scene::AlphaMode;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
@@ -458,10 +457,7 @@ impl MaskedMembers {
         let mut triangles = 0;
         for &m in group {
             let [first, end] = ranges[m];
-            let cutoff = match materials[m].alpha_mode {
-                AlphaMode::Mask(c) => c,
-                _ => 0.0,
-            };
+            let cutoff = materials[m].alpha_mode.cutoff();
             table.push([first, triangles, constants.first[m], cutoff.to_bits()]);
             triangles += end - first;
         }
