@@ -176,6 +176,40 @@ fn without_the_atomics_the_transparent_depth_is_drawn_and_copied() {
     );
 }
 
+/// Without the atomics, ComputeRaster with the transparent depth in its writes
+/// (`graphs/default.ron`) draws the blended meshes too: the depth the raster units give
+/// them (TransparentDepth into Depth32Float, the same draws), bit for bit.
+#[test]
+fn without_the_atomics_the_opaque_pass_still_writes_the_transparent_depth() {
+    let mut r = masked_renderer();
+    let scene = lightgraph::scene::builtin::by_name("glass").expect("the glass scene");
+    let (_, want) = render_reading(
+        &mut r,
+        common::compute_raster::TRANSPARENT_COMPARE,
+        &scene,
+        &["transparent_hw"],
+    )
+    .unwrap();
+    let (frame, got) = render_reading(
+        &mut r,
+        &graph_text("default.ron"),
+        &scene,
+        &["transparent_depth"],
+    )
+    .unwrap();
+    let covered = want[0].iter().filter(|&&d| f32::from_bits(d) < 1.0).count();
+    assert!(
+        covered > 5_000,
+        "{covered} blended pixels: nothing compared"
+    );
+    assert!(got[0] == want[0], "the transparent depth's bits differ");
+    assert!(
+        frame.fallbacks.iter().any(|f| f.pass == "compute_raster"),
+        "{:?}",
+        frame.fallbacks
+    );
+}
+
 /// With the atomics the compute rasterizer runs and nothing is reported.
 #[test]
 fn with_the_atomics_nothing_falls_back() {

@@ -96,3 +96,111 @@ fn compute_transparent_depth_matches_the_raster_units() {
         500,
     );
 }
+
+/// ComputeRaster with the transparent depth in its writes, as `graphs/default.ron` has it
+/// (`FOLDED_PASSES`), or beside a TransparentDepth pass of its own (`ALONE_PASSES`); the
+/// culling pass reads both depths, which keeps them apart in memory to the end.
+fn glass_graph(passes: &str) -> String {
+    format!(
+        r#"Graph(
+    name: "glass_in_the_opaque_run",
+    resources: [
+        Texture(name: "depth", format: R32Float),
+        Texture(name: "visibility", format: R32Uint),
+        Texture(name: "glass", format: R32Float),
+        Texture(name: "hdr", format: Rgba32Float),
+        Buffer(name: "lists"),
+        Import(name: "geometry", from: Geometry),
+        Import(name: "vertices", from: Vertices),
+        Import(name: "triangles", from: Triangles),
+        Import(name: "material_triangles", from: MaterialTriangles),
+        Import(name: "light_geometry", from: LightGeometry),
+        Import(name: "light_properties", from: LightProperties),
+    ],
+    passes: [
+        {passes}
+        Pass(name: "cull", kind: LightCulling(tile: 16), reads: ["depth", "transparent_depth=glass", "light_geometry"], writes: ["lists"]),
+        Pass(name: "shade", kind: VisibilityShading(lights: AllLights), reads: ["visibility", "vertices", "triangles", "material_triangles", "light_geometry", "light_properties"], writes: ["hdr"]),
+    ],
+    output: "hdr",
+    side_effects: ["cull"],
+)"#
+    )
+}
+
+const FOLDED_PASSES: &str = r#"Pass(name: "cr", kind: ComputeRaster, reads: ["vertices", "triangles", "material_triangles"], writes: ["depth", "visibility", "transparent_depth=glass"]),"#;
+const ALONE_PASSES: &str = r#"Pass(name: "cr", kind: ComputeRaster, reads: ["vertices", "triangles", "material_triangles"], writes: ["depth", "visibility"]),
+        Pass(name: "td", kind: TransparentDepth, reads: ["geometry"], writes: ["depth=glass"]),"#;
+
+/// The bits of the depth, the ids and the transparent depth through `passes`, and the
+/// rasterizer's report (the folded pass's), under the rasterizer's test `limits` ("" for
+/// none).
+fn depth_ids_glass(
+    scene: &Scene,
+    passes: &str,
+    limits: &str,
+) -> ([Vec<u32>; 3], lightgraph::render::RasterReport) {
+    let mut r = renderer();
+    let _limits = common::compute_raster::Limits::set(limits);
+    let prepared = prepare_text(&mut r, &glass_graph(passes), scene, W, H, false).expect("prepare");
+    let result = prepared.render(&r).expect("render");
+    assert!(result.fallbacks.is_empty(), "{:?}", result.fallbacks);
+    let bits = ["depth", "visibility", "glass"].map(|name| {
+        let b = prepared.read_texture_bits(&r, name).expect("readback");
+        assert_eq!(b.len(), (W * H) as usize, "{name}: one value a pixel");
+        b
+    });
+    let report = result
+        .rasters
+        .iter()
+        .find(|r| r.pass == "cr")
+        .expect("the rasterizer's report")
+        .clone();
+    (bits, report)
+}
+
+fn differing(a: &[u32], b: &[u32]) -> usize {
+    a.iter().zip(b).filter(|(x, y)| x != y).count()
+}
+
+/// The opaque run that also draws the blended triangles (their depth alone, both faces)
+/// writes TransparentDepth's own run's transparent depth to the bit and leaves the opaque
+/// depth and ids as a run without them writes them; also through the list-full paths
+/// (setup, bin and raster covering pixels serially). On the glass scene and on
+/// AlphaBlendModeTest (whose masked materials ride in the same run, flagged).
+#[test]
+fn glass_in_the_opaque_run_equals_its_own_run() {
+    if !has_atomics() {
+        return;
+    }
+    let glass = builtin::by_name("glass").expect("the built-in glass scene");
+    for (what, scene, min_glass) in [
+        ("glass", glass, 5_000),
+        (
+            "AlphaBlendModeTest",
+            khronos_model("AlphaBlendModeTest"),
+            500,
+        ),
+    ] {
+        let (alone, _) = depth_ids_glass(&scene, ALONE_PASSES, "");
+        let covered = alone[2]
+            .iter()
+            .filter(|&&b| f32::from_bits(b) < 1.0)
+            .count();
+        assert!(covered >= min_glass, "{what}: {covered} glass pixels");
+        for limits in ["", "records=0", "blocks=40"] {
+            let (folded, report) = depth_ids_glass(&scene, FOLDED_PASSES, limits);
+            eprintln!("{what}, limits '{limits}': {covered} glass pixels, {report:?}");
+            let serial_work = report.serial_triangles + report.serial_tiles + report.serial_blocks;
+            assert_eq!(
+                serial_work > 0,
+                !limits.is_empty(),
+                "{what}, '{limits}': {report:?}"
+            );
+            for (k, name) in [(0, "depth"), (1, "ids"), (2, "glass depth")] {
+                let d = differing(&folded[k], &alone[k]);
+                assert_eq!(d, 0, "{what}, '{limits}': {name} differs at {d} pixels");
+            }
+        }
+    }
+}

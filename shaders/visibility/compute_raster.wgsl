@@ -44,6 +44,10 @@
 // clear (LISTS_ONLY), keeping the buffer. Each run counts into its own `counters`.
 // FOLDED (with ALPHA_TEST): the opaque run draws the first group's triangles too, its
 // setup flagging them (RECORD_ALPHA) for the alpha test, so that group costs no run.
+// GLASS: the opaque run also draws the blended triangles (glass_triangles, after the
+// opaque ones in setup's threads, both faces), flagged RECORD_GLASS: their pixels keep
+// the nearest depth alone (a 32-bit atomic min in glass_depth), which the resolve writes
+// into the transparent depth, as TransparentDepth's own run would. One run instead of two.
 
 #include "common/types.wgsl"
 #include "common/triangle_setup.wgsl"
@@ -61,7 +65,14 @@
 @group(0) @binding(8) var<storage, read_write> counters: array<u32, 8>;
 @group(0) @binding(9) var<storage, read_write> tile_args: array<u32, 4>;
 @group(0) @binding(10) var<storage, read_write> block_args: array<u32, 4>;
+#if GLASS
+@group(0) @binding(15) var<storage, read_write> glass_depth: array<u32>;
+#endif
 #else
+#if GLASS
+// The blended triangles' nearest depth bits per pixel (all ones where none).
+@group(0) @binding(15) var<storage, read_write> glass_depth: array<atomic<u32>>;
+#endif
 @group(0) @binding(7) var<storage, read_write> vis: array<atomic<u64>>;
 // Four vec4<u32> per record (see `store_record`).
 #if SETUP
@@ -80,6 +91,12 @@
 @group(0) @binding(2) var<storage, read> vertices: array<f32>;
 @group(0) @binding(3) var<storage, read> triangles: array<u32>;
 @group(0) @binding(4) var<storage, read> single_sided: array<u32>;
+#if GLASS
+// The blended meshes' own merge (vertices as `vertices`), and its triangle count in x.
+@group(0) @binding(16) var<storage, read> glass_vertices: array<f32>;
+@group(0) @binding(17) var<storage, read> glass_triangles: array<u32>;
+@group(0) @binding(18) var<uniform> glass_params: vec4<u32>;
+#endif
 // Bit t set: triangle t is alpha-tested, drawn by its material group's own run (or, with
 // FOLDED, flagged by this one).
 #if FOLDED
@@ -139,6 +156,8 @@ const BLOCK_TRIANGLES: u32 = 7u;
 const RECORD_LINEAR: u32 = 8u;
 // RECORD_ALPHA: the folded group's triangle, alpha-tested (FOLDED).
 const RECORD_ALPHA: u32 = 16u;
+// RECORD_GLASS: a blended triangle, into glass_depth (GLASS).
+const RECORD_GLASS: u32 = 32u;
 // Snapped coordinates up to this (2^29 fixed point, 2^21 pixels) keep every difference
 // the edge functions take within i32 (pixel centres are under 2^22 for viewports up to
 // 16,384 pixels), so an edge function is exactly the linear function of the pixel.
@@ -212,6 +231,9 @@ fn clear(
 #else
     if (i < raster_params.z * raster_params.w) {
         vis[i] = vec2<u32>(0xffffffffu, 0xffffffffu);
+#if GLASS
+        glass_depth[i] = 0xffffffffu;
+#endif
     }
 #endif
 }
@@ -281,8 +303,14 @@ fn cover(t: Tri, px: i32, py: i32) {
     if (!(z <= 1.0)) {
         return;
     }
-    let key = (u64(bitcast<u32>(max(z, 0.0))) << 32u) | u64(~t.id);
     let at = u32(py) * raster_params.z + u32(px);
+#if GLASS
+    if ((t.flags & RECORD_GLASS) != 0u) {
+        atomicMin(&glass_depth[at], bitcast<u32>(max(z, 0.0)));
+        return;
+    }
+#endif
+    let key = (u64(bitcast<u32>(max(z, 0.0))) << 32u) | u64(~t.id);
 #if ALPHA_TEST
 #if FOLDED
     let tested = (t.flags & RECORD_ALPHA) != 0u;

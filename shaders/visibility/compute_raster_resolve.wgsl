@@ -4,7 +4,8 @@
 // where nothing was drawn, as the full-screen draw resolve writes a Depth32Float depth.
 // A frame resolved here runs no vertex or fragment work. One invocation a pixel, in 8×8
 // tiles (storage textures are tiled in memory). DEPTH_ONLY: the depth alone (the blended
-// triangles' transparent depth, whose ids nothing reads).
+// triangles' transparent depth, whose ids nothing reads). GLASS: also the blended
+// triangles' depth the same run kept (glass_depth) into the transparent depth.
 
 #include "common/types.wgsl"
 
@@ -15,6 +16,10 @@
 #if DEPTH_ONLY
 #else
 @group(0) @binding(3) var visibility: texture_storage_2d<r32uint, write>;
+#endif
+#if GLASS
+@group(0) @binding(4) var<storage, read> glass_depth: array<u32>;
+@group(0) @binding(5) var transparent_depth: texture_storage_2d<r32float, write>;
 #endif
 
 const NO_TRIANGLE: u32 = 0xffffffffu;
@@ -33,6 +38,10 @@ fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
         triangle = ~v.x;
     }
     textureStore(depth, id.xy, vec4<f32>(z, 0.0, 0.0, 0.0));
+#if GLASS
+    let g = glass_depth[id.y * frame.size.x + id.x];
+    textureStore(transparent_depth, id.xy, vec4<f32>(select(bitcast<f32>(g), 1.0, g == EMPTY), 0.0, 0.0, 0.0));
+#endif
 #if DEPTH_ONLY
 #else
     textureStore(visibility, id.xy, vec4<u32>(triangle, 0u, 0u, 0u));

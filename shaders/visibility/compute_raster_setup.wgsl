@@ -46,6 +46,14 @@ fn clip_position(v: u32) -> vec4<f32> {
     return frame.view_proj * vec4<f32>(p, 1.0);
 }
 
+#if GLASS
+fn glass_clip_position(v: u32) -> vec4<f32> {
+    let b = VERTEX_FLOATS * v;
+    let p = vec3<f32>(glass_vertices[b], glass_vertices[b + 1u], glass_vertices[b + 2u]);
+    return frame.view_proj * vec4<f32>(p, 1.0);
+}
+#endif
+
 // Framebuffer position (x right, y down, pixels) and depth, as the viewport transform.
 fn to_screen(c: vec4<f32>) -> vec3<f32> {
     let ndc = c.xyz * (1.0 / c.w);
@@ -383,12 +391,26 @@ fn setup(
     var fans = 0u;
     var clipped = false;
     var poly: Polygon;
+#if GLASS
+    // Threads past the opaque triangles take the blended ones, both faces.
+    let glass = id >= raster_params.x && id - raster_params.x < glass_params.x;
+    if (glass) {
+        let t = 3u * (id - raster_params.x);
+        a = glass_clip_position(glass_triangles[t]);
+        b = glass_clip_position(glass_triangles[t + 1u]);
+        c = glass_clip_position(glass_triangles[t + 2u]);
+    }
+    if (drawn || glass) {
+#else
     if (drawn) {
-        let t = 3u * id;
-        a = clip_position(triangles[t]);
-        b = clip_position(triangles[t + 1u]);
-        c = clip_position(triangles[t + 2u]);
-        cull_back = (single_sided[id / 32u] & (1u << (id % 32u))) != 0u;
+#endif
+        if (drawn) {
+            let t = 3u * id;
+            a = clip_position(triangles[t]);
+            b = clip_position(triangles[t + 1u]);
+            c = clip_position(triangles[t + 2u]);
+            cull_back = (single_sided[id / 32u] & (1u << (id % 32u))) != 0u;
+        }
         if (!needs_clipping(a, b, c)) {
             fans = 1u;
         } else if (!outside_one_plane(a, b, c)) {
@@ -419,6 +441,9 @@ fn setup(
 #endif
 #if FOLDED
             fan.t.flags |= select(0u, RECORD_ALPHA, alpha);
+#endif
+#if GLASS
+            fan.t.flags |= select(0u, RECORD_GLASS, glass);
 #endif
         }
         draw_fan(fan, local);

@@ -88,7 +88,7 @@ pub const TEST_LIMITS: &str = "LIGHTGRAPH_COMPUTE_RASTER_TEST_LIMITS";
 /// Sets the test hook while alive.
 pub struct Limits;
 impl Limits {
-    fn set(limits: &str) -> Self {
+    pub fn set(limits: &str) -> Self {
         std::env::set_var(TEST_LIMITS, limits);
         Limits
     }

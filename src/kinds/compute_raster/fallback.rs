@@ -6,13 +6,17 @@
 //! memory plan) and copied into it by one compute dispatch
 //! (`shaders/visibility/compute_raster_depth_copy.wgsl`, bit-exact).
 //! Alpha-masked materials are alpha-tested by those draws as the compute path tests them.
+//! With the transparent depth in its writes, the blended meshes are drawn too, as
+//! `TransparentDepth`'s own fallback draws them (into an internal Depth32Float, copied).
 
 use super::compute_raster::{self, FEATURES};
+use super::depth_prepass::{prepare_meshes_into, DepthPrepass};
 use super::visibility_buffer::{draw_ids, IdTargets, VisibilityBuffer};
 use super::{defines, pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::compute_raster::VISIBILITY;
 use crate::graph::{slot, Name, ScheduledPass};
 use crate::render::bind::Bound;
+use crate::render::draws::MeshSet;
 use crate::render::pipelines::PipelineKey;
 use crate::render::report::{FallbackReport, PassReport};
 use crate::render::{RenderError, Renderer};
@@ -46,6 +50,9 @@ struct HardwareRaster {
     draws: VisibilityBuffer,
     /// An R32Float depth: the copy from the drawn Depth32Float.
     copy: Option<DepthCopy>,
+    /// The transparent depth, where the pass writes it: the blended meshes' draws into
+    /// an internal Depth32Float and the copy from it.
+    glass: Option<(DepthPrepass, DepthCopy)>,
     report: FallbackReport,
 }
 
@@ -87,10 +94,21 @@ impl HardwareRaster {
             writes_depth: true,
             ids,
         };
+        let glass = match sp.roles.slot(slot::TRANSPARENT_DEPTH) {
+            Some(glass) => {
+                let size = (cx.size.width, cx.size.height);
+                let target = cx.view(&sp.name, glass)?;
+                let (drawn, copy) = depth_copy(cx, sp, size, target)?;
+                let draws = prepare_meshes_into(cx, sp, MeshSet::Transparent, drawn, true)?;
+                Some((draws, copy))
+            }
+            None => None,
+        };
         Ok(Self {
             name: sp.name.clone(),
             draws: draw_ids(cx, sp, target)?,
             copy,
+            glass,
             report,
         })
     }
@@ -165,6 +183,11 @@ pub(super) fn record_depth_copy(
 
 impl PreparedPass for HardwareRaster {
     fn record(&self, encoder: &mut wgpu::CommandEncoder, ts: Timestamps<'_>) {
+        // The blended meshes' depth first, untimed: the pair brackets the ids' draws.
+        if let Some((draws, copy)) = &self.glass {
+            draws.record_with(encoder, None);
+            record_depth_copy(encoder, &self.name, copy, Timestamps(None));
+        }
         let Some(copy) = &self.copy else {
             self.draws.record_with(encoder, ts.render());
             return;

@@ -18,7 +18,7 @@ use super::compute_raster_lists::{
 use super::compute_raster_resolve::Resolve;
 use super::{defines, grid, pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::gpu::readback::read_buffer;
-use crate::graph::{Name, ScheduledPass};
+use crate::graph::{slot, Name, ScheduledPass};
 use crate::render::materials::{group_label, shared_code_groups, GroupConstants, MaterialProgram};
 use crate::render::pipelines::PipelineKey;
 use crate::render::report::{PassReport, RasterReport};
@@ -137,6 +137,19 @@ pub(super) fn prepare_source(
         RasterSource::Blended => cx.gpu.transparent_geometry(&device, cx.scene),
     }
     .map_err(|m| pass_error(&sp.name, m))?;
+    // The blended triangles, drawn in the opaque run where the pass writes their depth
+    // too (none where the scene has none: the transparent depth is then left unwritten,
+    // as a TransparentDepth pass under `when: Some(Transparent)` would be skipped).
+    let glass = match sp.roles.slot(slot::TRANSPARENT_DEPTH) {
+        Some(_) if opaque => Some(
+            cx.gpu
+                .transparent_geometry(&device, cx.scene)
+                .map_err(|m| pass_error(&sp.name, m))?,
+        )
+        .filter(|g| g.triangle_count > 0),
+        _ => None,
+    };
+    let glass_triangles = glass.map_or(0, |g| g.triangle_count);
     // Bit t set: triangle t is culled when it faces away (its material is single-sided);
     // in `alpha_tested`, its masked material's run draws it. Blended triangles: neither.
     let words = (geometry.triangle_count.div_ceil(32)).max(1) as usize;
@@ -182,13 +195,11 @@ pub(super) fn prepare_source(
             ),
         ));
     }
-    if geometry.triangle_count > MAX_TRIANGLES {
+    let all_triangles = geometry.triangle_count as u64 + glass_triangles as u64;
+    if all_triangles > MAX_TRIANGLES as u64 {
         return Err(pass_error(
             &sp.name,
-            format!(
-                "{} triangles are over the {MAX_TRIANGLES} it counts",
-                geometry.triangle_count
-            ),
+            format!("{all_triangles} triangles are over the {MAX_TRIANGLES} it counts"),
         ));
     }
     // Pixel coordinates are packed in 16 bits in the lists' entries.
@@ -200,7 +211,7 @@ pub(super) fn prepare_source(
     }
     let test_limits = TestLimits::from_env().map_err(|m| pass_error(&sp.name, m))?;
     let (capacity, max_groups) = test_limits.apply(
-        list_capacity(geometry.triangle_count, width, height, max_binding),
+        list_capacity(all_triangles as u32, width, height, max_binding),
         limits.max_compute_workgroups_per_dimension.max(1),
     );
     let storage = |label: &str, size: u64, extra: wgpu::BufferUsages| {
@@ -290,6 +301,22 @@ pub(super) fn prepare_source(
     offered.buffer("tiles", &tiles);
     offered.buffer("blocks", &blocks);
     offered.buffer("alpha_tested", &alpha_tested);
+    if let Some(g) = glass {
+        offered.buffer("glass_vertices", &g.vertices);
+        offered.buffer("glass_triangles", &g.triangles);
+        offered.buffer(
+            "glass_params",
+            &init(
+                "compute raster glass params",
+                bytemuck::cast_slice(&[g.triangle_count, 0, 0, 0]),
+                wgpu::BufferUsages::UNIFORM,
+            ),
+        );
+        offered.buffer(
+            "glass_depth",
+            &storage("compute raster glass depth", 4 * pixels, none),
+        );
+    }
     offered.buffer("tile_args", &tile_args);
     offered.buffer("block_args", &block_args);
     let key = |d: &[(&str, String)], state: &str, material: Option<&str>| PipelineKey {
@@ -335,6 +362,13 @@ pub(super) fn prepare_source(
         let mut material_defines = Vec::new();
         let mut material = None;
         let mut setup_triangles = geometry.triangle_count;
+        // The glass rides in the opaque run (the first).
+        let glass_defines = if opaque_run && glass.is_some() {
+            setup_triangles += glass_triangles;
+            vec![("GLASS", "1".to_string())]
+        } else {
+            Vec::new()
+        };
         if let Some(group) = run {
             let members = MaskedMembers::new(materials, group, ranges, &constants);
             if opaque_run {
@@ -393,9 +427,10 @@ pub(super) fn prepare_source(
                 textures,
             })
         };
+        material_defines.extend(glass_defines.iter().cloned());
         let (clear, clear_items) = if opaque_run {
             (
-                pipeline("CLEAR", "clear", &[])?,
+                pipeline("CLEAR", "clear", &glass_defines)?,
                 pixels.min(u32::MAX as u64) as u32,
             )
         } else {
@@ -426,6 +461,7 @@ pub(super) fn prepare_source(
         key(&[("RESOLVE", "1".into())], "resolve", None),
         &offered,
         opaque,
+        glass.is_some(),
     )?;
     Ok(ComputeRasterPass {
         name: sp.name.clone(),

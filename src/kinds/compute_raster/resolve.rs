@@ -41,24 +41,28 @@ impl Resolve {
     /// The resolve the pass's depth format asks for; `draw_key` is the rasterizer
     /// shader's full-screen resolve (`RESOLVE`). `offered` holds the pass's slots, the
     /// frame uniform and the `vis` buffer. Without `ids` (the blended triangles' depth)
-    /// only the depth is written, and it must be R32Float.
+    /// only the depth is written, and it must be R32Float. With `glass` (an R32Float
+    /// depth only) the `glass_depth` buffer goes into `transparent_depth` too.
     pub fn prepare(
         cx: &mut PrepareCtx,
         sp: &ScheduledPass,
         draw_key: PipelineKey,
         offered: &BindingSet,
         ids: bool,
+        glass: bool,
     ) -> Result<Self, RenderError> {
         let depth = sp.required(slot::DEPTH);
         if cx.float_depth(depth) {
-            let depth_only: &[(&str, String)] = if ids {
-                &[]
-            } else {
-                &[("DEPTH_ONLY", "1".to_string())]
-            };
+            let mut options = Vec::new();
+            if !ids {
+                options.push(("DEPTH_ONLY", "1".to_string()));
+            }
+            if glass {
+                options.push(("GLASS", "1".to_string()));
+            }
             let key = PipelineKey {
                 shader: COMPUTE_SHADER.into(),
-                defines: defines(depth_only),
+                defines: defines(&options),
                 virtual_code: BTreeMap::new(),
                 state: "resolve".into(),
             };
@@ -72,6 +76,12 @@ impl Resolve {
                     1,
                 ],
             });
+        }
+        if glass {
+            return Err(pass_error(
+                &sp.name,
+                format!("the compute rasterizer writes the blended triangles' depth beside an R32Float depth only, and '{depth}' is a depth format"),
+            ));
         }
         if !ids {
             return Err(pass_error(

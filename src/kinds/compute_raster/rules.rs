@@ -52,6 +52,16 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
         Access::Write,
         Usage::AttachmentOrStorage,
     ),
+    // Optional: the blended triangles' nearest depth (what `TransparentDepth` writes),
+    // rasterized in the same dispatches as the opaque ones, so a frame with glass runs
+    // no rasterizer pass of its own for it.
+    SlotSpec::new(
+        slot::TRANSPARENT_DEPTH,
+        SlotType::DepthValues,
+        Access::Write,
+        Usage::AttachmentOrStorage,
+    )
+    .optional(),
 ];
 
 pub(crate) fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
@@ -69,6 +79,17 @@ pub(crate) fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
             errors.push(ctx.mismatch(
                 depth,
                 "ComputeRaster writes 32-bit float depth per pixel: a single-sample Depth32Float texture (resolved by a draw) or R32Float (resolved in compute)",
+            ));
+        }
+    }
+    if let Some(glass) = ctx.slot(slot::TRANSPARENT_DEPTH) {
+        let float_depth = ctx
+            .slot(slot::DEPTH)
+            .is_some_and(|d| format(d) == Some((TextureFormat::R32Float, 1)));
+        if format(glass) != Some((TextureFormat::R32Float, 1)) || !float_depth {
+            errors.push(ctx.mismatch(
+                glass,
+                "ComputeRaster writes the blended triangles' depth in its compute resolve: a single-sample R32Float texture, beside an R32Float depth",
             ));
         }
     }
@@ -180,6 +201,33 @@ mod tests {
             e.contains(
                 "an R32Float depth is read by LightCulling, LightLinkedList and TransparentShading"
             ),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn writes_the_blended_triangles_depth_beside_an_r32float_depth_only() {
+        let glass = FLOAT_FRAME.replace(
+            r#"writes: ["fdepth", "visibility"]"#,
+            r#"writes: ["fdepth", "visibility", "transparent_depth=tdepth_f"]"#,
+        );
+        validate(&glass, "hdr").unwrap();
+        let e = errors(
+            &glass.replace("transparent_depth=tdepth_f", "transparent_depth=depth"),
+            "hdr",
+        );
+        assert!(
+            e.contains("pass 'cr', resource 'depth': ComputeRaster writes the blended triangles' depth in its compute resolve: a single-sample R32Float texture, beside an R32Float depth"),
+            "{e}"
+        );
+        let e = errors(
+            &format!(
+                r#"Pass(name: "cr", kind: ComputeRaster, {READS}, writes: ["depth", "visibility", "transparent_depth=tdepth_f"]), {SHADE}"#
+            ),
+            "hdr",
+        );
+        assert!(
+            e.contains("resource 'tdepth_f': ComputeRaster writes the blended triangles' depth"),
             "{e}"
         );
     }
