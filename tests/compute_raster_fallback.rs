@@ -178,7 +178,8 @@ fn without_the_atomics_the_transparent_depth_is_drawn_and_copied() {
 
 /// Without the atomics, ComputeRaster with the transparent depth in its writes
 /// (`graphs/default.ron`) draws the blended meshes too: the depth the raster units give
-/// them (TransparentDepth into Depth32Float, the same draws), bit for bit.
+/// them (TransparentDepth into Depth32Float, the same draws), bit for bit; their farthest
+/// depth is the far plane (not drawn).
 #[test]
 fn without_the_atomics_the_opaque_pass_still_writes_the_transparent_depth() {
     let mut r = masked_renderer();
@@ -194,7 +195,7 @@ fn without_the_atomics_the_opaque_pass_still_writes_the_transparent_depth() {
         &mut r,
         &graph_text("default.ron"),
         &scene,
-        &["transparent_depth"],
+        &["transparent_depth", "transparent_far"],
     )
     .unwrap();
     let covered = want[0].iter().filter(|&&d| f32::from_bits(d) < 1.0).count();
@@ -203,6 +204,12 @@ fn without_the_atomics_the_opaque_pass_still_writes_the_transparent_depth() {
         "{covered} blended pixels: nothing compared"
     );
     assert!(got[0] == want[0], "the transparent depth's bits differ");
+    // No farthest depth drawn: the far plane everywhere, so culling bounds the glass's
+    // ranges by the opaque depth alone.
+    assert!(
+        got[1].iter().all(|&b| b == 1f32.to_bits()),
+        "the farthest transparent depth is not the far plane everywhere"
+    );
     assert!(
         frame.fallbacks.iter().any(|f| f.pass == "compute_raster"),
         "{:?}",

@@ -191,6 +191,52 @@ fn glass_over_the_compute_first_frame_equals_brute_force() {
     );
 }
 
+/// The glass's lists in graphs/default.ron end at the farthest glass (`transparent_far`,
+/// which its rasterizer keeps beside the nearest) where the opaque surface lies farther:
+/// fewer lights listed than with ranges that run on to the opaque surface, and the same
+/// image to the bit (every light that reaches a glass surface is still listed, in the
+/// same order, and a culled light adds exactly nothing). On the glass scene and on
+/// AlphaBlendModeTest's textured panels.
+#[test]
+fn the_farthest_glass_shortens_the_glass_lists_and_changes_no_pixel() {
+    let with_far = graph_file("default.ron");
+    let reads = r#"reads: ["depth", "transparent_depth", "transparent_far", "light_geometry"]"#;
+    assert!(with_far.contains(reads));
+    let without_far = with_far.replace(
+        reads,
+        r#"reads: ["depth", "transparent_depth", "light_geometry"]"#,
+    );
+    let listed = |f: &lightgraph::render::FrameResult| -> u64 {
+        let c = f
+            .culling
+            .iter()
+            .find(|c| c.pass == "transparent_culling")
+            .expect("a report of the transparent culling pass");
+        c.counts.iter().map(|&n| n as u64).sum()
+    };
+    // The model with 64 random lights through its bounds (it brings none of its own).
+    let mut model = khronos_model("AlphaBlendModeTest");
+    let (lo, hi) = model.bounds().expect("the model's bounds");
+    let size = (hi - lo).length();
+    let mut rng = Rng(11);
+    model.lights = (0..64)
+        .map(|_| random_light(&mut rng, lo, hi, 0.1 * size, 0.4 * size))
+        .collect();
+    let mut r = renderer();
+    for (what, scene) in [("glass", glass()), ("AlphaBlendModeTest", model)] {
+        let near_only = render_text_with(&mut r, &without_far, &scene, W, H, false);
+        let bounded = render_text_with(&mut r, &with_far, &scene, W, H, false);
+        let (short, long) = (listed(&bounded), listed(&near_only));
+        eprintln!(
+            "{what}: glass lists hold {short} lights bounded by the farthest glass, {long} without"
+        );
+        assert!(short > 0, "{what}: no glass lists");
+        assert!(short < long, "{what}: {short} against {long}");
+        assert_eq!(bounded.image.len(), (W * H) as usize);
+        assert_eq!(differing(&bounded.image, &near_only.image), 0, "{what}");
+    }
+}
+
 /// Glass over tiled deferred (graphs/tiled_deferred_transparent.ron) is glass over
 /// Forward+ (transparent.ron): the same depth prepass, transparent depth, transparent
 /// lists and `TransparentShading` pass, blended over an opaque layer that deferred and

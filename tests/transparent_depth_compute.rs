@@ -100,7 +100,7 @@ fn compute_transparent_depth_matches_the_raster_units() {
 /// ComputeRaster with the transparent depth in its writes, as `graphs/default.ron` has it
 /// (`FOLDED_PASSES`), or beside a TransparentDepth pass of its own (`ALONE_PASSES`); the
 /// culling pass reads both depths, which keeps them apart in memory to the end.
-fn glass_graph(passes: &str) -> String {
+fn glass_graph(passes: &str, culling_reads: &str) -> String {
     format!(
         r#"Graph(
     name: "glass_in_the_opaque_run",
@@ -108,6 +108,7 @@ fn glass_graph(passes: &str) -> String {
         Texture(name: "depth", format: R32Float),
         Texture(name: "visibility", format: R32Uint),
         Texture(name: "glass", format: R32Float),
+        Texture(name: "glass_far", format: R32Float),
         Texture(name: "hdr", format: Rgba32Float),
         Buffer(name: "lists"),
         Import(name: "geometry", from: Geometry),
@@ -119,7 +120,7 @@ fn glass_graph(passes: &str) -> String {
     ],
     passes: [
         {passes}
-        Pass(name: "cull", kind: LightCulling(tile: 16), reads: ["depth", "transparent_depth=glass", "light_geometry"], writes: ["lists"]),
+        Pass(name: "cull", kind: LightCulling(tile: 16), reads: [{culling_reads}], writes: ["lists"]),
         Pass(name: "shade", kind: VisibilityShading(lights: AllLights), reads: ["visibility", "vertices", "triangles", "material_triangles", "light_geometry", "light_properties"], writes: ["hdr"]),
     ],
     output: "hdr",
@@ -128,28 +129,44 @@ fn glass_graph(passes: &str) -> String {
     )
 }
 
-const FOLDED_PASSES: &str = r#"Pass(name: "cr", kind: ComputeRaster, reads: ["vertices", "triangles", "material_triangles"], writes: ["depth", "visibility", "transparent_depth=glass"]),"#;
+const FOLDED_PASSES: &str = r#"Pass(name: "cr", kind: ComputeRaster, reads: ["vertices", "triangles", "material_triangles"], writes: ["depth", "visibility", "transparent_depth=glass", "transparent_far=glass_far"]),"#;
+const FOLDED_READS: &str =
+    r#""depth", "transparent_depth=glass", "transparent_far=glass_far", "light_geometry""#;
+const ALONE_READS: &str = r#""depth", "transparent_depth=glass", "light_geometry""#;
 const ALONE_PASSES: &str = r#"Pass(name: "cr", kind: ComputeRaster, reads: ["vertices", "triangles", "material_triangles"], writes: ["depth", "visibility"]),
         Pass(name: "td", kind: TransparentDepth, reads: ["geometry"], writes: ["depth=glass"]),"#;
 
-/// The bits of the depth, the ids and the transparent depth through `passes`, and the
-/// rasterizer's report (the folded pass's), under the rasterizer's test `limits` ("" for
-/// none).
+/// The bits of the depth, the ids, the transparent depth and (folded) the farthest
+/// transparent depth through `passes`, and the rasterizer's report (the folded pass's),
+/// under the rasterizer's test `limits` ("" for none).
 fn depth_ids_glass(
     scene: &Scene,
-    passes: &str,
+    folded: bool,
     limits: &str,
-) -> ([Vec<u32>; 3], lightgraph::render::RasterReport) {
+) -> (Vec<Vec<u32>>, lightgraph::render::RasterReport) {
     let mut r = renderer();
     let _limits = common::compute_raster::Limits::set(limits);
-    let prepared = prepare_text(&mut r, &glass_graph(passes), scene, W, H, false).expect("prepare");
+    let (passes, reads, names): (_, _, &[&str]) = if folded {
+        (
+            FOLDED_PASSES,
+            FOLDED_READS,
+            &["depth", "visibility", "glass", "glass_far"],
+        )
+    } else {
+        (ALONE_PASSES, ALONE_READS, &["depth", "visibility", "glass"])
+    };
+    let prepared =
+        prepare_text(&mut r, &glass_graph(passes, reads), scene, W, H, false).expect("prepare");
     let result = prepared.render(&r).expect("render");
     assert!(result.fallbacks.is_empty(), "{:?}", result.fallbacks);
-    let bits = ["depth", "visibility", "glass"].map(|name| {
-        let b = prepared.read_texture_bits(&r, name).expect("readback");
-        assert_eq!(b.len(), (W * H) as usize, "{name}: one value a pixel");
-        b
-    });
+    let bits = names
+        .iter()
+        .map(|name| {
+            let b = prepared.read_texture_bits(&r, name).expect("readback");
+            assert_eq!(b.len(), (W * H) as usize, "{name}: one value a pixel");
+            b
+        })
+        .collect();
     let report = result
         .rasters
         .iter()
@@ -166,7 +183,8 @@ fn differing(a: &[u32], b: &[u32]) -> usize {
 /// The opaque run that also draws the blended triangles (their depth alone, both faces)
 /// writes TransparentDepth's own run's transparent depth to the bit and leaves the opaque
 /// depth and ids as a run without them writes them; also through the list-full paths
-/// (setup, bin and raster covering pixels serially). On the glass scene and on
+/// (setup, bin and raster covering pixels serially); its farthest glass depth lies at or
+/// behind the nearest, and is the same through those paths. On the glass scene and on
 /// AlphaBlendModeTest (whose masked materials ride in the same run, flagged).
 #[test]
 fn glass_in_the_opaque_run_equals_its_own_run() {
@@ -174,22 +192,41 @@ fn glass_in_the_opaque_run_equals_its_own_run() {
         return;
     }
     let glass = builtin::by_name("glass").expect("the built-in glass scene");
-    for (what, scene, min_glass) in [
-        ("glass", glass, 5_000),
+    // Glass pixels at least, and of those with glass behind glass (the glass scene's
+    // quads overlap; the model's panels stand apart).
+    for (what, scene, min_glass, min_behind) in [
+        ("glass", glass, 5_000, 1_000),
         (
             "AlphaBlendModeTest",
             khronos_model("AlphaBlendModeTest"),
             500,
+            0,
         ),
     ] {
-        let (alone, _) = depth_ids_glass(&scene, ALONE_PASSES, "");
+        let (alone, _) = depth_ids_glass(&scene, false, "");
+        let (unlimited, _) = depth_ids_glass(&scene, true, "");
+        // The farthest glass depth: at or behind the nearest wherever there is glass,
+        // behind it where layers overlap (or a surface is seen from both sides), 1.0
+        // (as the nearest) elsewhere.
+        let (mut behind, mut wrong) = (0, 0);
+        for (&near, &far) in unlimited[2].iter().zip(&unlimited[3]) {
+            let (near, far) = (f32::from_bits(near), f32::from_bits(far));
+            wrong += (far < near || (near >= 1.0 && far != 1.0)) as usize;
+            behind += (near < 1.0 && far > near) as usize;
+        }
+        eprintln!("{what}: the farthest glass lies behind the nearest at {behind} pixels");
+        assert_eq!(wrong, 0, "{what}: farthest glass depths out of order");
+        assert!(
+            behind >= min_behind,
+            "{what}: {behind} pixels with glass behind glass"
+        );
         let covered = alone[2]
             .iter()
             .filter(|&&b| f32::from_bits(b) < 1.0)
             .count();
         assert!(covered >= min_glass, "{what}: {covered} glass pixels");
         for limits in ["", "records=0", "blocks=40"] {
-            let (folded, report) = depth_ids_glass(&scene, FOLDED_PASSES, limits);
+            let (folded, report) = depth_ids_glass(&scene, true, limits);
             eprintln!("{what}, limits '{limits}': {covered} glass pixels, {report:?}");
             let serial_work = report.serial_triangles + report.serial_tiles + report.serial_blocks;
             assert_eq!(
@@ -201,6 +238,11 @@ fn glass_in_the_opaque_run_equals_its_own_run() {
                 let d = differing(&folded[k], &alone[k]);
                 assert_eq!(d, 0, "{what}, '{limits}': {name} differs at {d} pixels");
             }
+            let d = differing(&folded[3], &unlimited[3]);
+            assert_eq!(
+                d, 0,
+                "{what}, '{limits}': farthest glass differs at {d} pixels"
+            );
         }
     }
 }

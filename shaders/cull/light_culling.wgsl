@@ -67,6 +67,10 @@
 #endif
 #endif
 #endif
+#if TRANSPARENT_FAR
+// The farthest transparent depth (R32Float): the range's far end where nearer than d.
+@group(0) @binding(10) var transparent_far: texture_2d<f32>;
+#endif
 // What the tile tests need of the lights, in view space (`bounds` writes it, the tests
 // read it), four arrays of `capacity` = arrayLength / 4 vec4s:
 //   [i]               the bounding sphere of light i's volume (its range sphere, or for a
@@ -171,7 +175,13 @@ fn sample_range(pixel: vec2<u32>, s: u32) -> vec2<f32> {
     if (t >= 1.0 || t > d) {
         return none;
     }
+#if TRANSPARENT_FAR
+    // Every transparent surface here lies within [t, far]; those behind d are hidden.
+    let far = max(textureLoad(transparent_far, pixel, 0).x, t);
+    return vec2<f32>(view_depth(t), view_depth(min(far, d)));
+#else
     return vec2<f32>(view_depth(t), view_depth(d));
+#endif
 #else
     if (d >= 1.0) {
         return none;

@@ -48,6 +48,9 @@
 // opaque ones in setup's threads, both faces), flagged RECORD_GLASS: their pixels keep
 // the nearest depth alone (a 32-bit atomic min in glass_depth), which the resolve writes
 // into the transparent depth, as TransparentDepth's own run would. One run instead of two.
+// GLASS_FAR (with GLASS): their farthest depth too (a 32-bit atomic max in the word after
+// each pixel's nearest in glass_depth, so no binding more), the far end of the
+// transparent culling range.
 
 #include "common/types.wgsl"
 #include "common/triangle_setup.wgsl"
@@ -72,6 +75,13 @@
 #if GLASS
 // The blended triangles' nearest depth bits per pixel (all ones where none).
 @group(0) @binding(15) var<storage, read_write> glass_depth: array<atomic<u32>>;
+#endif
+// Words per pixel in glass_depth: the nearest, and with GLASS_FAR the farthest (zero
+// where none).
+#if GLASS_FAR
+const GLASS_WORDS: u32 = 2u;
+#else
+const GLASS_WORDS: u32 = 1u;
 #endif
 @group(0) @binding(7) var<storage, read_write> vis: array<atomic<u64>>;
 // Four vec4<u32> per record (see `store_record`).
@@ -232,7 +242,12 @@ fn clear(
     if (i < raster_params.z * raster_params.w) {
         vis[i] = vec2<u32>(0xffffffffu, 0xffffffffu);
 #if GLASS
+#if GLASS_FAR
+        glass_depth[2u * i] = 0xffffffffu;
+        glass_depth[2u * i + 1u] = 0u;
+#else
         glass_depth[i] = 0xffffffffu;
+#endif
 #endif
     }
 #endif
@@ -306,7 +321,10 @@ fn cover(t: Tri, px: i32, py: i32) {
     let at = u32(py) * raster_params.z + u32(px);
 #if GLASS
     if ((t.flags & RECORD_GLASS) != 0u) {
-        atomicMin(&glass_depth[at], bitcast<u32>(max(z, 0.0)));
+        atomicMin(&glass_depth[GLASS_WORDS * at], bitcast<u32>(max(z, 0.0)));
+#if GLASS_FAR
+        atomicMax(&glass_depth[GLASS_WORDS * at + 1u], bitcast<u32>(max(z, 0.0)));
+#endif
         return;
     }
 #endif

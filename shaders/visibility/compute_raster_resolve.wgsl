@@ -5,7 +5,9 @@
 // A frame resolved here runs no vertex or fragment work. One invocation a pixel, in 8×8
 // tiles (storage textures are tiled in memory). DEPTH_ONLY: the depth alone (the blended
 // triangles' transparent depth, whose ids nothing reads). GLASS: also the blended
-// triangles' depth the same run kept (glass_depth) into the transparent depth.
+// triangles' depth the same run kept (glass_depth) into the transparent depth;
+// GLASS_FAR, their farthest (the word after each nearest) into transparent_far (1.0
+// where none, as the nearest).
 
 #include "common/types.wgsl"
 
@@ -20,6 +22,12 @@
 #if GLASS
 @group(0) @binding(4) var<storage, read> glass_depth: array<u32>;
 @group(0) @binding(5) var transparent_depth: texture_storage_2d<r32float, write>;
+#endif
+#if GLASS_FAR
+@group(0) @binding(6) var transparent_far: texture_storage_2d<r32float, write>;
+const GLASS_WORDS: u32 = 2u;
+#else
+const GLASS_WORDS: u32 = 1u;
 #endif
 
 const NO_TRIANGLE: u32 = 0xffffffffu;
@@ -39,8 +47,13 @@ fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     textureStore(depth, id.xy, vec4<f32>(z, 0.0, 0.0, 0.0));
 #if GLASS
-    let g = glass_depth[id.y * frame.size.x + id.x];
+    let at = GLASS_WORDS * (id.y * frame.size.x + id.x);
+    let g = glass_depth[at];
     textureStore(transparent_depth, id.xy, vec4<f32>(select(bitcast<f32>(g), 1.0, g == EMPTY), 0.0, 0.0, 0.0));
+#endif
+#if GLASS_FAR
+    let f = glass_depth[at + 1u];
+    textureStore(transparent_far, id.xy, vec4<f32>(select(bitcast<f32>(f), 1.0, g == EMPTY), 0.0, 0.0, 0.0));
 #endif
 #if DEPTH_ONLY
 #else

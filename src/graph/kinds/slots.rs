@@ -18,6 +18,9 @@ pub mod slot {
     pub const LIGHT_LISTS: &str = "light_lists";
     /// The nearest transparent depth a culling pass bounds its tiles with.
     pub(crate) const TRANSPARENT_DEPTH: &str = "transparent_depth";
+    /// The farthest transparent depth (R32Float): where given, the far end of a
+    /// transparent culling range instead of the opaque depth, when nearer.
+    pub(crate) const TRANSPARENT_FAR: &str = "transparent_far";
 }
 
 /// What a slot takes.

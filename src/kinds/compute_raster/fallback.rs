@@ -8,6 +8,9 @@
 //! Alpha-masked materials are alpha-tested by those draws as the compute path tests them.
 //! With the transparent depth in its writes, the blended meshes are drawn too, as
 //! `TransparentDepth`'s own fallback draws them (into an internal Depth32Float, copied).
+//! Their farthest depth, where it writes that too, is the far plane everywhere (a cleared
+//! internal depth, copied): transparent culling then bounds its ranges by the opaque
+//! depth alone, as without it (exact, the lists only longer).
 
 use super::compute_raster::{self, FEATURES};
 use super::depth_prepass::{prepare_meshes_into, DepthPrepass};
@@ -16,7 +19,7 @@ use super::{defines, pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::graph::kinds::compute_raster::VISIBILITY;
 use crate::graph::{slot, Name, ScheduledPass};
 use crate::render::bind::Bound;
-use crate::render::draws::MeshSet;
+use crate::render::draws::{depth_attachment, MeshSet};
 use crate::render::pipelines::PipelineKey;
 use crate::render::report::{FallbackReport, PassReport};
 use crate::render::{RenderError, Renderer};
@@ -53,6 +56,8 @@ struct HardwareRaster {
     /// The transparent depth, where the pass writes it: the blended meshes' draws into
     /// an internal Depth32Float and the copy from it.
     glass: Option<(DepthPrepass, DepthCopy)>,
+    /// Their farthest depth: an internal depth cleared to the far plane, and its copy.
+    far: Option<(wgpu::TextureView, DepthCopy)>,
     report: FallbackReport,
 }
 
@@ -104,11 +109,20 @@ impl HardwareRaster {
             }
             None => None,
         };
+        let far = match sp.roles.slot(slot::TRANSPARENT_FAR) {
+            Some(far) => {
+                let size = (cx.size.width, cx.size.height);
+                let target = cx.view(&sp.name, far)?;
+                Some(depth_copy(cx, sp, size, target)?)
+            }
+            None => None,
+        };
         Ok(Self {
             name: sp.name.clone(),
             draws: draw_ids(cx, sp, target)?,
             copy,
             glass,
+            far,
             report,
         })
     }
@@ -186,6 +200,17 @@ impl PreparedPass for HardwareRaster {
         // The blended meshes' depth first, untimed: the pair brackets the ids' draws.
         if let Some((draws, copy)) = &self.glass {
             draws.record_with(encoder, None);
+            record_depth_copy(encoder, &self.name, copy, Timestamps(None));
+        }
+        if let Some((cleared, copy)) = &self.far {
+            drop(encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some(&self.name),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(depth_attachment(cleared, true)),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            }));
             record_depth_copy(encoder, &self.name, copy, Timestamps(None));
         }
         let Some(copy) = &self.copy else {

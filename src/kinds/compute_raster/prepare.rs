@@ -15,7 +15,7 @@
 use super::compute_raster_lists::{
     list_capacity, ListCapacity, TestLimits, ENTRY_BYTES, RECORD_BYTES,
 };
-use super::compute_raster_resolve::Resolve;
+use super::compute_raster_resolve::{Glass, Resolve};
 use super::{defines, grid, pass_error, PrepareCtx, PreparedPass, Timestamps};
 use crate::gpu::readback::read_buffer;
 use crate::graph::{slot, Name, ScheduledPass};
@@ -150,6 +150,8 @@ pub(super) fn prepare_source(
         _ => None,
     };
     let glass_triangles = glass.map_or(0, |g| g.triangle_count);
+    // Their farthest depth too, where the pass writes it.
+    let far = glass.is_some() && sp.roles.slot(slot::TRANSPARENT_FAR).is_some();
     // Bit t set: triangle t is culled when it faces away (its material is single-sided);
     // in `alpha_tested`, its masked material's run draws it. Blended triangles: neither.
     let words = (geometry.triangle_count.div_ceil(32)).max(1) as usize;
@@ -312,9 +314,11 @@ pub(super) fn prepare_source(
                 wgpu::BufferUsages::UNIFORM,
             ),
         );
+        // Per pixel the nearest depth's bits, and the farthest's after it where kept.
+        let words = 1 + far as u64;
         offered.buffer(
             "glass_depth",
-            &storage("compute raster glass depth", 4 * pixels, none),
+            &storage("compute raster glass depths", 4 * words * pixels, none),
         );
     }
     offered.buffer("tile_args", &tile_args);
@@ -363,12 +367,14 @@ pub(super) fn prepare_source(
         let mut material = None;
         let mut setup_triangles = geometry.triangle_count;
         // The glass rides in the opaque run (the first).
-        let glass_defines = if opaque_run && glass.is_some() {
+        let mut glass_defines = Vec::new();
+        if opaque_run && glass.is_some() {
             setup_triangles += glass_triangles;
-            vec![("GLASS", "1".to_string())]
-        } else {
-            Vec::new()
-        };
+            glass_defines.push(("GLASS", "1".to_string()));
+            if far {
+                glass_defines.push(("GLASS_FAR", "1".to_string()));
+            }
+        }
         if let Some(group) = run {
             let members = MaskedMembers::new(materials, group, ranges, &constants);
             if opaque_run {
@@ -461,7 +467,11 @@ pub(super) fn prepare_source(
         key(&[("RESOLVE", "1".into())], "resolve", None),
         &offered,
         opaque,
-        glass.is_some(),
+        match (glass.is_some(), far) {
+            (false, _) => Glass::None,
+            (true, false) => Glass::Nearest,
+            (true, true) => Glass::NearestAndFarthest,
+        },
     )?;
     Ok(ComputeRasterPass {
         name: sp.name.clone(),

@@ -21,6 +21,17 @@ const COMPUTE_SHADER: &str = "visibility/compute_raster_resolve.wgsl";
 /// The compute resolve's workgroup side (8×8 pixels).
 const TILE: u32 = 8;
 
+/// What the compute resolve writes of the blended triangles the run drew with the opaque
+/// ones.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Glass {
+    None,
+    /// `glass_depth` into `transparent_depth`.
+    Nearest,
+    /// And `glass_far` into `transparent_far`.
+    NearestAndFarthest,
+}
+
 pub(super) enum Resolve {
     /// Depth32Float: a full-screen triangle into the depth and id attachments.
     Draw {
@@ -42,14 +53,14 @@ impl Resolve {
     /// shader's full-screen resolve (`RESOLVE`). `offered` holds the pass's slots, the
     /// frame uniform and the `vis` buffer. Without `ids` (the blended triangles' depth)
     /// only the depth is written, and it must be R32Float. With `glass` (an R32Float
-    /// depth only) the `glass_depth` buffer goes into `transparent_depth` too.
+    /// depth only) the blended triangles' buffers go into their textures too.
     pub fn prepare(
         cx: &mut PrepareCtx,
         sp: &ScheduledPass,
         draw_key: PipelineKey,
         offered: &BindingSet,
         ids: bool,
-        glass: bool,
+        glass: Glass,
     ) -> Result<Self, RenderError> {
         let depth = sp.required(slot::DEPTH);
         if cx.float_depth(depth) {
@@ -57,8 +68,11 @@ impl Resolve {
             if !ids {
                 options.push(("DEPTH_ONLY", "1".to_string()));
             }
-            if glass {
+            if glass != Glass::None {
                 options.push(("GLASS", "1".to_string()));
+            }
+            if glass == Glass::NearestAndFarthest {
+                options.push(("GLASS_FAR", "1".to_string()));
             }
             let key = PipelineKey {
                 shader: COMPUTE_SHADER.into(),
@@ -77,7 +91,7 @@ impl Resolve {
                 ],
             });
         }
-        if glass {
+        if glass != Glass::None {
             return Err(pass_error(
                 &sp.name,
                 format!("the compute rasterizer writes the blended triangles' depth beside an R32Float depth only, and '{depth}' is a depth format"),

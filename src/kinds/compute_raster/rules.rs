@@ -62,6 +62,15 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
         Usage::AttachmentOrStorage,
     )
     .optional(),
+    // Optional, beside the transparent depth: the blended triangles' farthest depth, the
+    // far end of the transparent culling range where nearer than the opaque surface.
+    SlotSpec::new(
+        slot::TRANSPARENT_FAR,
+        SlotType::DepthValues,
+        Access::Write,
+        Usage::AttachmentOrStorage,
+    )
+    .optional(),
 ];
 
 pub(crate) fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
@@ -90,6 +99,16 @@ pub(crate) fn check(ctx: &KindCtx, errors: &mut Vec<GraphError>) {
             errors.push(ctx.mismatch(
                 glass,
                 "ComputeRaster writes the blended triangles' depth in its compute resolve: a single-sample R32Float texture, beside an R32Float depth",
+            ));
+        }
+    }
+    if let Some(far) = ctx.slot(slot::TRANSPARENT_FAR) {
+        if format(far) != Some((TextureFormat::R32Float, 1))
+            || ctx.slot(slot::TRANSPARENT_DEPTH).is_none()
+        {
+            errors.push(ctx.mismatch(
+                far,
+                "ComputeRaster writes the blended triangles' farthest depth beside their nearest: a single-sample R32Float texture, with a transparent depth in its writes",
             ));
         }
     }
@@ -228,6 +247,28 @@ mod tests {
         );
         assert!(
             e.contains("resource 'tdepth_f': ComputeRaster writes the blended triangles' depth"),
+            "{e}"
+        );
+        // The farthest beside the nearest only, R32Float.
+        let far = glass.replace(
+            "\"transparent_depth=tdepth_f\"]",
+            "\"transparent_depth=tdepth_f\", \"transparent_far=fdepth2\"]",
+        );
+        assert_ne!(far, glass);
+        let far = far.replace(
+            "Pass(name: \"c\"",
+            "Pass(name: \"c2\", kind: LightCulling(tile: 16), reads: [\"fdepth\", \"transparent_depth=tdepth_f\", \"transparent_far=fdepth2\", \"lg\"], writes: [\"lists2\"]), Pass(name: \"c\"",
+        );
+        validate(&far, "hdr").unwrap();
+        let e = errors(&far.replace("\"transparent_depth=tdepth_f\", ", ""), "hdr");
+        assert!(
+            e.contains("resource 'fdepth2': ComputeRaster writes the blended triangles' farthest depth beside their nearest"),
+            "{e}"
+        );
+        assert!(
+            e.contains(
+                "resource 'fdepth2': the farthest transparent depth bounds the nearest one's range"
+            ),
             "{e}"
         );
     }

@@ -134,6 +134,9 @@ pub(super) fn prepare(
         if cx.float_depth(t) {
             d.push(("FLOAT_TRANSPARENT", "1".into()));
         }
+        if sp.roles.slot(slot::TRANSPARENT_FAR).is_some() {
+            d.push(("TRANSPARENT_FAR", "1".into()));
+        }
     }
     let blocks = layout.scan_blocks();
     if let ListStorage::Fixed { capacity } = layout.storage {

@@ -270,6 +270,15 @@ pub(crate) const SLOTS: &[SlotSpec] = &[
         Usage::Sampled,
     )
     .optional(),
+    // The farthest transparent depth: a transparent tile's range ends there where that
+    // is nearer than the opaque surface (ComputeRaster writes it beside the nearest).
+    SlotSpec::new(
+        slot::TRANSPARENT_FAR,
+        SlotType::DepthValues,
+        Access::Read,
+        Usage::Sampled,
+    )
+    .optional(),
 ];
 
 pub(crate) fn check(p: &LightCulling, ctx: &KindCtx, errors: &mut Vec<GraphError>) {
@@ -279,6 +288,16 @@ pub(crate) fn check(p: &LightCulling, ctx: &KindCtx, errors: &mut Vec<GraphError
             errors.push(ctx.mismatch(
                 t,
                 format!("an R32Float transparent depth is single-sample (compute stores one depth a pixel); it has {} samples: use a multisampled Depth32Float for MSAA", ctx.samples(t)),
+            ));
+        }
+    }
+    if let Some(far) = ctx.slot(slot::TRANSPARENT_FAR) {
+        let single_float =
+            |r: Option<&str>| r.is_some_and(|r| ctx.is_float_depth(r) && ctx.samples(r) == 1);
+        if !single_float(Some(far)) || !single_float(ctx.slot(slot::TRANSPARENT_DEPTH)) {
+            errors.push(ctx.mismatch(
+                far,
+                "the farthest transparent depth bounds the nearest one's range: a single-sample R32Float texture beside a single-sample R32Float transparent depth",
             ));
         }
     }
