@@ -177,7 +177,7 @@ fn without_the_atomics_the_transparent_depth_is_drawn_and_copied() {
 }
 
 /// Without the atomics, ComputeRaster with the transparent depth in its writes
-/// (`graphs/default.ron`) draws the blended meshes too: the depth the raster units give
+/// (`graphs/default.ron`, here with the farthest glass too) draws the blended meshes too: the depth the raster units give
 /// them (TransparentDepth into Depth32Float, the same draws), bit for bit; their farthest
 /// depth is the far plane (not drawn).
 #[test]
@@ -193,7 +193,7 @@ fn without_the_atomics_the_opaque_pass_still_writes_the_transparent_depth() {
     .unwrap();
     let (frame, got) = render_reading(
         &mut r,
-        &graph_text("default.ron"),
+        &common::glass::default_with_farthest_glass(),
         &scene,
         &["transparent_depth", "transparent_far"],
     )

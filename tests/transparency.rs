@@ -191,21 +191,16 @@ fn glass_over_the_compute_first_frame_equals_brute_force() {
     );
 }
 
-/// The glass's lists in graphs/default.ron end at the farthest glass (`transparent_far`,
-/// which its rasterizer keeps beside the nearest) where the opaque surface lies farther:
-/// fewer lights listed than with ranges that run on to the opaque surface, and the same
-/// image to the bit (every light that reaches a glass surface is still listed, in the
-/// same order, and a culled light adds exactly nothing). On the glass scene and on
-/// AlphaBlendModeTest's textured panels.
+/// With the glass's lists ending at the farthest glass (`transparent_far`, which the
+/// compute rasterizer keeps beside the nearest) where the opaque surface lies farther:
+/// fewer lights listed than graphs/default.ron's ranges, which run on to the opaque
+/// surface, and the same image to the bit (every light that reaches a glass surface is
+/// still listed, in the same order, and a culled light adds exactly nothing). On the
+/// glass scene and on AlphaBlendModeTest's textured panels.
 #[test]
 fn the_farthest_glass_shortens_the_glass_lists_and_changes_no_pixel() {
-    let with_far = graph_file("default.ron");
-    let reads = r#"reads: ["depth", "transparent_depth", "transparent_far", "light_geometry"]"#;
-    assert!(with_far.contains(reads));
-    let without_far = with_far.replace(
-        reads,
-        r#"reads: ["depth", "transparent_depth", "light_geometry"]"#,
-    );
+    let with_far = common::glass::default_with_farthest_glass();
+    let without_far = graph_file("default.ron");
     let listed = |f: &lightgraph::render::FrameResult| -> u64 {
         let c = f
             .culling

@@ -71,3 +71,28 @@ pub fn check_glass_layers(graph: &str, width: u32, tol: f32, l: &GlassLayers) ->
     );
     (opaque_err, peak)
 }
+
+/// graphs/default.ron with the glass's culling ranges ending at the farthest glass: its
+/// rasterizer also writes `transparent_far`, which the transparent culling reads.
+pub fn default_with_farthest_glass() -> String {
+    let text = std::fs::read_to_string(super::graph_path("default.ron")).unwrap();
+    let edits = [
+        (
+            r#"        Texture(name: "transparent_depth", format: R32Float, size: Output),"#,
+            r#"        Texture(name: "transparent_depth", format: R32Float, size: Output),
+        Texture(name: "transparent_far", format: R32Float, size: Output),"#,
+        ),
+        (
+            r#"writes: ["depth", "visibility", "transparent_depth"]"#,
+            r#"writes: ["depth", "visibility", "transparent_depth", "transparent_far"]"#,
+        ),
+        (
+            r#"reads: ["depth", "transparent_depth", "light_geometry"]"#,
+            r#"reads: ["depth", "transparent_depth", "transparent_far", "light_geometry"]"#,
+        ),
+    ];
+    edits.iter().fold(text, |t, (from, to)| {
+        assert_eq!(t.matches(from).count(), 1, "default.ron: {from}");
+        t.replace(from, to)
+    })
+}
