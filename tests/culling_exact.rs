@@ -414,3 +414,63 @@ fn the_subgroup_depth_range_gives_the_same_lists() {
         }
     }
 }
+
+/// The wide stage (`wide: 2`: wide tiles of 2×2 coarse tiles, culled against their side
+/// planes first) only narrows the coarse stage's candidates: every list and the image
+/// are the same to the bit as without it, for every variant and tile size. Also where a
+/// wide tile holds more lights than its list (`wide: 16`, one wide tile over the frame
+/// with 20,000 lights in view, over its 16,384): its coarse tiles then test every light.
+#[test]
+fn the_wide_stage_changes_no_list() {
+    let crowded = {
+        let mut s = random_scene(0, 41);
+        let mut rng = Rng(9);
+        s.lights = (0..20_000)
+            .map(|_| {
+                random_light(
+                    &mut rng,
+                    Vec3::new(-12.0, 0.0, -30.0),
+                    Vec3::new(12.0, 8.0, -4.0),
+                    0.1,
+                    0.6,
+                )
+            })
+            .collect();
+        s
+    };
+    let mut r = renderer();
+    for (scene, tiles, variants, wide) in [
+        (pillar_scene(600), &TILES[..], &VARIANTS[..], 2),
+        (crowded, &[16][..], &["Frustum"][..], 16),
+    ] {
+        for &tile in tiles {
+            for variant in variants {
+                let capacity = if variant.starts_with("Clustered") {
+                    256
+                } else {
+                    1024
+                };
+                let text = |wide: u32| {
+                    graph_with_culling(
+                        "forward_plus.ron",
+                        &format!("LightCulling(tile: {tile}, variant: {variant}, capacity: {capacity}, wide: {wide})"),
+                    )
+                };
+                let with = render_text_with(&mut r, &text(wide), &scene, W, H, false);
+                let without = render_text_with(&mut r, &text(0), &scene, W, H, false);
+                let what = format!("{} tile {tile} {variant}", scene.name);
+                assert_eq!(with.culling[0].overflowed_lists, 0, "{what}");
+                assert!(
+                    with.culling[0].counts.iter().any(|&n| n > 0),
+                    "{what}: empty lists"
+                );
+                let (a, b) = (&with.culling[0].counts, &without.culling[0].counts);
+                assert_eq!(a.len(), b.len(), "{what}");
+                let differ = a.iter().zip(b).filter(|(x, y)| x != y).count();
+                assert_eq!(differ, 0, "{what}: {differ} lists differ");
+                assert_eq!(with.image.len(), (W * H) as usize);
+                assert!(with.image == without.image, "{what}: images differ");
+            }
+        }
+    }
+}

@@ -56,6 +56,17 @@
 // Per coarse tile: its light count, then up to COARSE_CAPACITY light indices ascending.
 // A count over the capacity sends its tiles back to testing every light.
 @group(0) @binding(5) var<storage, read_write> coarse_lists: array<u32>;
+#if WIDE_STAGE
+// Per wide tile (WIDE × WIDE coarse tiles): its light count, then up to WIDE_CAPACITY
+// light indices ascending, the candidates of its coarse tiles (WIDE_PASS writes them).
+// A count over the capacity sends its coarse tiles back to testing every light.
+@group(0) @binding(11) var<storage, read_write> wide_lists: array<u32>;
+const WIDE_STRIDE: u32 = WIDE_CAPACITY + 1u;
+var<workgroup> wide_count: u32;
+// A coarse workgroup's wide list (its first word) and whether it holds the candidates.
+var<private> wide_base: u32;
+var<private> from_wide: bool;
+#endif
 #if TRANSPARENT
 #if MSAA
 @group(0) @binding(6) var transparent_depth: texture_depth_multisampled_2d;
@@ -672,10 +683,27 @@ fn coarse(
     @builtin(local_invocation_index) local: u32,
     @builtin(local_invocation_id) lid: vec3<u32>,
 ) {
-    // Ordered before the first chunk's bits by the depth range's barriers.
+    // Ordered before the first chunk's bits by the depth range's barriers (the wide
+    // pass's by the barrier below).
     for (var k = 0u; k < COARSE_WORDS_PER_THREAD; k++) {
         atomicStore(&coarse_hits[local * COARSE_WORDS_PER_THREAD + k], 0u);
     }
+    let coarse_x = (list_params.tiles_x + COARSE - 1u) / COARSE;
+#if WIDE_PASS
+    // A wide tile: its whole frustum between the depths 0 and 1 (no depth read; every
+    // range a tile or coarse tile takes lies within it), every light a candidate.
+    let span = TILE * COARSE * WIDE;
+    let origin = group.xy * span;
+    let lo = view_depth(0.0);
+    let hi = view_depth(1.0);
+    let empty = false;
+    let bounds = tile_bounds(origin, span, lo, hi, false);
+    let wide_x = (coarse_x + WIDE - 1u) / WIDE;
+    let base_word = (group.y * wide_x + group.x) * WIDE_STRIDE;
+    let capacity = WIDE_CAPACITY;
+    let count = frame.light_count;
+    workgroupBarrier();
+#else
     let span = TILE * COARSE;
     let origin = group.xy * span;
     let range = workgroup_depth_range(local, COARSE_SIDE, block_depth_range(origin + lid.xy * COARSE_FOLD, COARSE_FOLD));
@@ -683,24 +711,40 @@ fn coarse(
     let hi = bitcast<f32>(range.y);
     let empty = range.y == 0u;
     let bounds = tile_bounds(origin, span, lo, hi, empty);
-    let coarse_x = (list_params.tiles_x + COARSE - 1u) / COARSE;
     let base_word = (group.y * coarse_x + group.x) * COARSE_STRIDE;
-
+    let capacity = COARSE_CAPACITY;
+#if WIDE_STAGE
+    // The candidates: the wide tile's lights where they fit its list.
+    let wide_x = (coarse_x + WIDE - 1u) / WIDE;
+    wide_base = ((group.y / WIDE) * wide_x + group.x / WIDE) * WIDE_STRIDE;
+    if (local == 0u) {
+        wide_count = wide_lists[wide_base];
+    }
+    let listed = workgroupUniformLoad(&wide_count);
+    from_wide = listed <= WIDE_CAPACITY;
+    let count = select(frame.light_count, listed, from_wide);
+#else
     let count = frame.light_count;
+#endif
+#endif
+
     var total = 0u;
     // Each step's sphere is loaded a step ahead (COARSE_CHUNK is a multiple of THREADS,
-    // so the next step is the same invocation's next light across chunks too).
-    var next_sphere = light_sphere(local, true);
+    // so the next step is the same invocation's next candidate across chunks too).
+    var next_light = coarse_candidate(local, count);
+    var next_sphere = stage_sphere(next_light);
     for (var chunk = 0u; chunk < count; chunk += COARSE_CHUNK) {
         let end = min(count, chunk + COARSE_CHUNK);
         if (!empty) {
             for (var i = chunk + local; i < end; i += THREADS) {
+                let light = next_light;
                 let sphere = next_sphere;
                 if (i + THREADS < count) {
-                    next_sphere = light_sphere(i + THREADS, true);
+                    next_light = coarse_candidate(i + THREADS, count);
+                    next_sphere = stage_sphere(next_light);
                 }
                 // An all-ones mask: the depth-mask test passes here.
-                if (light_touches_tile(i, sphere, bounds, lo, hi, 0xffffffffu, lo, hi, COARSE_REACH)) {
+                if (light_touches_tile(light, sphere, bounds, lo, hi, 0xffffffffu, lo, hi, STAGE_REACH)) {
                     let bit = i - chunk;
                     atomicOr(&coarse_hits[bit / 32u], 1u << (bit % 32u));
                 }
@@ -718,10 +762,10 @@ fn coarse(
             // Only this invocation reads or clears its words until the next barrier.
             var bits = atomicLoad(&coarse_hits[first_word + k]);
             atomicStore(&coarse_hits[first_word + k], 0u);
-            let first_light = chunk + (first_word + k) * 32u;
+            let first = chunk + (first_word + k) * 32u;
             while (bits != 0u) {
-                if (slot < COARSE_CAPACITY) {
-                    coarse_lists[base_word + 1u + slot] = first_light + firstTrailingBit(bits);
+                if (slot < capacity) {
+                    store_candidate(base_word + 1u + slot, coarse_candidate(first + firstTrailingBit(bits), count));
                 }
                 slot += 1u;
                 bits &= bits - 1u;
@@ -733,8 +777,54 @@ fn coarse(
         workgroupBarrier();
     }
     if (local == 0u) {
-        coarse_lists[base_word] = total;
+        store_candidate(base_word, total);
     }
+}
+
+// Candidate k of the coarse stage (k < count): entry k of its wide tile's list (WIDE, where
+// the list fits), else light k. Bits and list slots go by k, so lists stay ascending.
+// Past `count` it returns k (a prefetch that is never used).
+fn coarse_candidate(k: u32, count: u32) -> u32 {
+#if WIDE_STAGE
+#if WIDE_PASS
+#else
+    if (from_wide && k < count) {
+        return wide_lists[wide_base + 1u + k];
+    }
+#endif
+#endif
+    return k;
+}
+
+// Where the stage writes: the wide lists (WIDE_PASS) or the coarse lists.
+fn store_candidate(word: u32, value: u32) {
+#if WIDE_PASS
+    wide_lists[word] = value;
+#else
+    coarse_lists[word] = value;
+#endif
+}
+
+// The cone test's widening of the stage's tile: twice the coarse stage's for the wide
+// pass (as its spheres, below).
+#if WIDE_PASS
+const STAGE_REACH: f32 = 2.0 * COARSE_REACH;
+#else
+const STAGE_REACH: f32 = COARSE_REACH;
+#endif
+
+// The stage's sphere of light i: the coarse one, and for the wide pass widened again by
+// COARSE_REACH of its distance, since a wide tile's planes round differently from its
+// coarse tiles' as those do from their tiles' (so every light a coarse tile keeps, its
+// wide tile keeps).
+fn stage_sphere(i: u32) -> vec4<f32> {
+    let s = light_sphere(i, true);
+#if WIDE_PASS
+    let r = abs(s.w) + COARSE_REACH * length(s.xyz);
+    return vec4<f32>(s.xyz, select(r, -r, s.w < 0.0));
+#else
+    return s;
+#endif
 }
 
 // Exclusive prefix sum of `v` over the workgroup's `n` invocations (n ≤ SCAN_MAX, a

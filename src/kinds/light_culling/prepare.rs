@@ -18,6 +18,9 @@ use std::sync::Arc;
 /// Most lights a coarse culling tile lists; a tile with more sends its fine tiles back
 /// to testing every light.
 const COARSE_CAPACITY: u64 = 8192;
+/// Most lights a wide tile lists; a wide tile with more sends its coarse tiles back to
+/// testing every light.
+const WIDE_CAPACITY: u64 = 16384;
 /// `light_bounds` in `light_culling.wgsl`: four vec4s a light.
 const LIGHT_BOUNDS_BYTES: u64 = 64;
 /// The bounds dispatch's workgroup size (`bounds` in the shader).
@@ -27,7 +30,8 @@ pub(super) struct LightCullingPass {
     name: Name,
     /// Every light's view-space bounds, first: (pipeline, workgroups).
     bounds: (Arc<wgpu::ComputePipeline>, [u32; 3]),
-    /// The coarse stage, run first in the same pass.
+    /// The wide and coarse stages, run first in the same pass.
+    wide: Option<(Arc<wgpu::ComputePipeline>, [u32; 3])>,
     coarse: Option<(Arc<wgpu::ComputePipeline>, [u32; 3])>,
     pipeline: Arc<wgpu::ComputePipeline>,
     bind: wgpu::BindGroup,
@@ -40,8 +44,7 @@ pub(super) struct LightCullingPass {
     report_copy: wgpu::Buffer,
     layout: ListLayout,
     /// Diagnosis: the one dispatch the pass's timestamps bracket (`LIGHTGRAPH_TIME_DISPATCH`:
-    /// 0 bounds, 1 coarse, then count, scan_lists, fill; counted without the
-    /// coarse stage when there is none).
+    /// 0 bounds, then wide, coarse, count, scan_lists, fill, each counted where it runs).
     timed_dispatch: Option<usize>,
 }
 
@@ -91,6 +94,27 @@ pub(super) fn prepare(
         &crate::gpu::structs::GpuListParams::new(&layout).buffer(&device),
     );
     offered.buffer("coarse_lists", &coarse_lists);
+    // The wide stage: a count and up to WIDE_CAPACITY indices per wide tile.
+    let wide = if coarse > 1 { p.wide.max(1) } else { 1 };
+    let wide_groups = [
+        coarse_groups[0].div_ceil(wide),
+        coarse_groups[1].div_ceil(wide),
+        1,
+    ];
+    if wide > 1 {
+        let words = wide_groups[0] as u64 * wide_groups[1] as u64 * (WIDE_CAPACITY + 1);
+        let wide_lists = create_internal_buffer(
+            &device,
+            &sp.name,
+            &wgpu::BufferDescriptor {
+                label: Some("wide light lists"),
+                size: words * 4,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            },
+        )?;
+        offered.buffer("wide_lists", &wide_lists);
+    }
     // Every light's view-space bounds, written by the pass's first dispatch: room for
     // every light the bound light buffer holds (passes before this one, VplSpawn, may
     // add lights to the scene's).
@@ -114,11 +138,16 @@ pub(super) fn prepare(
         ("VARIANT", format!("{}u", p.variant.code())),
         ("COARSE", format!("{coarse}u")),
         ("COARSE_CAPACITY", format!("{COARSE_CAPACITY}u")),
+        ("WIDE", format!("{wide}u")),
+        ("WIDE_CAPACITY", format!("{WIDE_CAPACITY}u")),
         // Every sample of a multisampled depth bounds the tile.
         ("SAMPLES", format!("{}u", sp.samples)),
     ];
     if sp.samples > 1 {
         d.push(("MSAA", "1".into()));
+    }
+    if wide > 1 {
+        d.push(("WIDE_STAGE", "1".into()));
     }
     // The tile's depth range by subgroup reductions (one barrier instead of two).
     if device.features().contains(wgpu::Features::SUBGROUP) {
@@ -222,6 +251,21 @@ pub(super) fn prepare(
     } else {
         None
     };
+    // The wide stage: the coarse stage's code over wide tiles (WIDE_PASS).
+    let wide = if wide > 1 {
+        let mut wide_defines = d.clone();
+        wide_defines.push(("WIDE_PASS", "1".into()));
+        let key = PipelineKey {
+            shader: "cull/light_culling.wgsl".into(),
+            defines: defines(&wide_defines),
+            virtual_code: BTreeMap::new(),
+            state: "wide".to_string(),
+        };
+        let (pipeline, _) = cx.compute_pipeline(&sp.name, key, "coarse", &offered)?;
+        Some((pipeline, wide_groups))
+    } else {
+        None
+    };
     let report_copy = create_internal_buffer(
         &device,
         &sp.name,
@@ -234,6 +278,7 @@ pub(super) fn prepare(
     )?;
     Ok(LightCullingPass {
         bounds,
+        wide,
         timed_dispatch: std::env::var("LIGHTGRAPH_TIME_DISPATCH")
             .ok()
             .and_then(|v| v.parse().ok()),
@@ -265,8 +310,8 @@ impl PreparedPass for LightCullingPass {
         let [x, y, z] = self.groups;
         let mut steps: Vec<(&wgpu::ComputePipeline, &wgpu::BindGroup, [u32; 3])> =
             vec![(&self.bounds.0, &self.bind, self.bounds.1)];
-        if let Some((coarse, groups)) = &self.coarse {
-            steps.push((coarse, &self.bind, *groups));
+        for (stage, groups) in [&self.wide, &self.coarse].into_iter().flatten() {
+            steps.push((stage, &self.bind, *groups));
         }
         steps.push((&self.pipeline, &self.bind, [x, y, z]));
         if let Some(c) = &self.compact {

@@ -51,6 +51,15 @@ pub struct LightCulling {
     /// their coarse tile's lights instead of every light. 0 or 1 turns it off.
     #[serde(default = "default_coarse")]
     pub coarse: u32,
+    /// Coarse tiles per side of a wide tile culled before them against its side planes
+    /// alone (no depth): coarse tiles then test only their wide tile's lights. 0 or 1
+    /// turns it off (the default); it needs the coarse stage.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub wide: u32,
+}
+
+fn is_zero(v: &u32) -> bool {
+    *v == 0
 }
 
 /// How a culling pass stores its lists.
@@ -345,6 +354,17 @@ pub(crate) fn check(p: &LightCulling, ctx: &KindCtx, errors: &mut Vec<GraphError
             p.coarse
         )));
     }
+    if p.wide > 16 {
+        errors.push(ctx.bad(format!(
+            "wide {} must be in 0..=16 coarse tiles per side (0 or 1: no wide stage)",
+            p.wide
+        )));
+    } else if p.wide > 1 && p.coarse <= 1 {
+        errors.push(ctx.bad(format!(
+            "wide {} groups coarse tiles, and coarse {} turns the coarse stage off",
+            p.wide, p.coarse
+        )));
+    }
     if let CullVariant::Clustered { slices } = p.variant {
         if slices == 0 || slices > 64 {
             errors.push(ctx.bad(format!("clustered slices {slices} must be in 1..=64")));
@@ -390,6 +410,21 @@ mod tests {
         ] {
             assert!(e.contains(want), "{want}: {e}");
         }
+        let wide = |params: &str| {
+            errors(
+                &format!(
+                    r#"{PREPASS} Pass(name: "c", kind: LightCulling(tile: 16, {params}), reads: ["depth", "lg"], writes: ["lists"])"#
+                ),
+                "hdr",
+            )
+        };
+        let e = wide("wide: 17");
+        assert!(e.contains("wide 17 must be in 0..=16"), "{e}");
+        let e = wide("wide: 4, coarse: 0");
+        assert!(
+            e.contains("wide 4 groups coarse tiles, and coarse 0 turns the coarse stage off"),
+            "{e}"
+        );
     }
 
     #[test]
