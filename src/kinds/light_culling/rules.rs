@@ -410,33 +410,27 @@ mod tests {
         ] {
             assert!(e.contains(want), "{want}: {e}");
         }
-        let wide = |params: &str| {
-            errors(
-                &format!(
-                    r#"{PREPASS} Pass(name: "c", kind: LightCulling(tile: 16, {params}), reads: ["depth", "lg"], writes: ["lists"])"#
-                ),
-                "hdr",
-            )
-        };
-        let e = wide("wide: 17");
+        let e = cull("LightCulling(tile: 16, wide: 17)");
         assert!(e.contains("wide 17 must be in 0..=16"), "{e}");
-        let e = wide("wide: 4, coarse: 0");
+        let e = cull("LightCulling(tile: 16, wide: 4, coarse: 0)");
         assert!(
             e.contains("wide 4 groups coarse tiles, and coarse 0 turns the coarse stage off"),
             "{e}"
         );
     }
 
+    /// The errors of a depth prepass and a culling pass of `kind`.
+    fn cull(kind: &str) -> String {
+        errors(
+            &format!(
+                r#"{PREPASS} Pass(name: "c", kind: {kind}, reads: ["depth", "lg"], writes: ["lists"])"#
+            ),
+            "hdr",
+        )
+    }
+
     #[test]
     fn compact_lists_take_a_bound_and_no_capacity() {
-        let cull = |kind: &str| {
-            errors(
-                &format!(
-                    r#"{PREPASS} Pass(name: "c", kind: {kind}, reads: ["depth", "lg"], writes: ["lists"])"#
-                ),
-                "hdr",
-            )
-        };
         let e = cull("LightCulling(tile: 16, lists: Compact(max_indices: 64), capacity: 256)");
         assert!(e.contains("capacity 256 is for lists: Fixed"), "{e}");
         let e = cull("LightCulling(tile: 16, lists: Compact(max_indices: 0))");
