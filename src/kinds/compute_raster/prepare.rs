@@ -10,6 +10,8 @@
 //! run again per group of masked materials that share their code (as visibility
 //! shading groups them), with that code testing alpha per pixel; the first run draws the
 //! opaque triangles, and the only group's too where there is one (flagged for the test).
+//! With a transparent depth in its writes the first run also draws the blended triangles
+//! (flagged: their nearest depth alone, and their farthest where it writes that too).
 //! See `shaders/visibility/compute_raster.wgsl`.
 
 use super::compute_raster_lists::{

@@ -3,7 +3,9 @@
 //! depth texture and an R32Uint visibility texture (triangle ids, `NO_TRIANGLE` where
 //! nothing covers). The depth is Depth32Float (resolved by a full-screen draw, for later
 //! passes that test against it) or R32Float (resolved in compute: a frame without vertex
-//! or fragment work, read by LightCulling, LightLinkedList and TransparentShading). Runs
+//! or fragment work, read by LightCulling, LightLinkedList and TransparentShading).
+//! Optionally the blended triangles' nearest (and farthest) depth too, drawn in the same
+//! dispatches (what `TransparentDepth` writes, without its pass). Runs
 //! `shaders/visibility/compute_raster.wgsl` and `compute_raster_resolve.wgsl`.
 
 use super::{slot, Access, KindCtx, KindRules, SlotSpec, SlotType, Usage};
