@@ -25,6 +25,7 @@ fn masked_renderer() -> MutexGuard<'static, Renderer> {
     R.get_or_init(|| {
         let options = ContextOptions {
             disabled_features: MASKED,
+            ..Default::default()
         };
         Mutex::new(Renderer::headless_with(&options).expect("a wgpu adapter (lavapipe on CI)"))
     })
@@ -304,6 +305,7 @@ fn render_says_when_it_falls_back() {
 fn without_primitive_index_too_it_is_refused_naming_both() {
     let options = ContextOptions {
         disabled_features: MASKED | wgpu::Features::PRIMITIVE_INDEX,
+        ..Default::default()
     };
     let mut r = Renderer::headless_with(&options).expect("a wgpu adapter (lavapipe on CI)");
     let e = render_reading(
@@ -319,4 +321,37 @@ fn without_primitive_index_too_it_is_refused_naming_both() {
         e.contains("lacks SHADER_INT64_ATOMIC_MIN_MAX for the compute rasterizer, and PRIMITIVE_INDEX for its hardware fallback"),
         "{e}"
     );
+}
+
+/// On a device that lets a shader stage bind only 8 storage buffers (WebGPU's default,
+/// which smaller GPUs give), a pipeline that binds more is refused at prepare with the
+/// pass, the shader, its switches and both counts, not wgpu's layout validation text;
+/// a graph whose shaders fit renders.
+#[test]
+fn a_shader_over_the_storage_buffer_limit_is_refused_by_name() {
+    let options = ContextOptions {
+        storage_buffers_per_stage: Some(8),
+        ..Default::default()
+    };
+    let mut r = Renderer::headless_with(&options).expect("a wgpu adapter (lavapipe on CI)");
+    assert_eq!(
+        r.ctx.device.limits().max_storage_buffers_per_shader_stage,
+        8
+    );
+    let scene = lightgraph::scene::builtin::by_name("glass").expect("the glass scene");
+    let error = render_reading(&mut r, &graph_text("default.ron"), &scene, &[])
+        .err()
+        .expect("the compute rasterizer binds more than 8 storage buffers");
+    eprintln!("{error}");
+    assert!(
+        error.contains("compute_raster")
+            && error.contains("visibility/compute_raster.wgsl: binds ")
+            && error.contains("storage buffers in one stage (")
+            && error.contains("over the 8 this device allows"),
+        "{error}"
+    );
+    assert!(!error.contains("Validation Error"), "{error}");
+    let (frame, _) = render_reading(&mut r, &graph_text("forward_plus.ron"), &scene, &[])
+        .expect("Forward+ fits 8 storage buffers a stage");
+    assert_eq!(frame.image.len(), 333 * 197);
 }

@@ -392,6 +392,7 @@ fn the_subgroup_depth_range_gives_the_same_lists() {
     let mut without =
         lightgraph::render::Renderer::headless_with(&lightgraph::gpu::ContextOptions {
             disabled_features: wgpu::Features::SUBGROUP,
+            ..Default::default()
         })
         .expect("a wgpu adapter (lavapipe on CI)");
     let mut scene = pillar_scene(500);

@@ -618,6 +618,7 @@ fn group_list_walks_by_subgroup_where_the_device_has_subgroups() {
     let mut without =
         lightgraph::render::Renderer::headless_with(&lightgraph::gpu::ContextOptions {
             disabled_features: wgpu::Features::SUBGROUP,
+            ..Default::default()
         })
         .expect("a wgpu adapter (lavapipe on CI)");
     let per_pixel = render_text(&mut without, &plain, &harada, W, H);

@@ -207,6 +207,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
                 .map_err(|e| anyhow::anyhow!("--disable-features: {e}"))?,
             None => wgpu::Features::empty(),
         },
+        ..Default::default()
     };
     let mut renderer = Renderer::headless_with(&options)?;
     let checked = assets::check_graph(&graph_path, &renderer.shaders)?;

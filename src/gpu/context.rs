@@ -33,6 +33,10 @@ pub struct ContextOptions {
     /// what an adapter without them gives: tests of the fallbacks on lavapipe, and
     /// `render --disable-features`.
     pub disabled_features: wgpu::Features,
+    /// Storage buffers a shader stage may bind, where lower than what lightgraph asks
+    /// (the adapter's, at most 16): the device a smaller GPU gives (WebGPU's default is
+    /// 8), for the tests of the message a pipeline over it gets.
+    pub storage_buffers_per_stage: Option<u32>,
 }
 
 impl ContextOptions {
@@ -178,7 +182,11 @@ impl GpuContext {
         let disabled_features = adapter.features() & wanted & options.disabled_features;
         let features = (adapter.features() & wanted) - disabled_features;
         let has_timestamps = features.contains(TIMESTAMPS);
-        let limits = Self::wanted_limits(&adapter);
+        let mut limits = Self::wanted_limits(&adapter);
+        if let Some(n) = options.storage_buffers_per_stage {
+            limits.max_storage_buffers_per_shader_stage =
+                limits.max_storage_buffers_per_shader_stage.min(n);
+        }
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("lightgraph"),

@@ -470,6 +470,7 @@ impl PipelineCache {
         self.build_wall += compose;
         let (composed, naga_module) = composed?;
         let bindings: Arc<[ReflectedBinding]> = reflect_bindings(&naga_module).into();
+        check_storage_buffers(&key, &bindings, device)?;
         if only.is_some_and(|n| nth_miss < n) {
             // A miss before the one this fork builds: a stand-in lets the pass go on.
             return match self.stand_in(&key) {
@@ -630,4 +631,36 @@ impl PipelineCache {
         self.stale.extend(dropped);
         n
     }
+}
+
+/// Every binding of a pass's layout is visible to its stage, so a module's storage
+/// buffers all count against the device's per-stage limit: refused here with the
+/// shader, its options and the counts, not by wgpu's layout validation.
+fn check_storage_buffers(
+    key: &PipelineKey,
+    bindings: &[ReflectedBinding],
+    device: &wgpu::Device,
+) -> Result<(), ShaderError> {
+    let storage = bindings
+        .iter()
+        .filter(|b| matches!(b.kind, crate::shader::BindingKind::Storage { .. }))
+        .count() as u32;
+    let limit = device.limits().max_storage_buffers_per_shader_stage;
+    if storage <= limit {
+        return Ok(());
+    }
+    // The switches among its defines (the sizes say little here).
+    let options: Vec<&str> = key
+        .defines
+        .iter()
+        .filter(|(_, value)| value.as_str() == "1")
+        .map(|(name, _)| name.as_str())
+        .collect();
+    Err(ShaderError::OverLimit {
+        file: key.shader.clone().into(),
+        message: format!(
+            "binds {storage} storage buffers in one stage ({}), over the {limit} this device allows",
+            options.join(", ")
+        ),
+    })
 }

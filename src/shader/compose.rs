@@ -42,6 +42,14 @@ pub enum ShaderError {
         /// The offending source line, shown under the message.
         source_line: String,
     },
+    /// The composed shader binds more of a resource than the device allows.
+    #[error("{file}: {message}")]
+    OverLimit {
+        /// The shader file.
+        file: PathBuf,
+        /// What it binds, with which options, and the device's limit.
+        message: String,
+    },
 }
 
 /// Where shader files are found; `#include "x.wgsl"` resolves against `root`, and with
