@@ -8,10 +8,14 @@
 // light in every tile is what bounds culling at high light counts (memory traffic).
 // The coarse test is the same conservative test on a larger frustum and depth range,
 // so the tiles' lists are exactly those without it.
+// WIDE_STAGE (wide > 1): before it, the same code (WIDE_PASS) culls every light against
+// wide tiles of WIDE×WIDE coarse tiles by their side planes alone (no depth read), and
+// each coarse tile then tests only its wide tile's lights: the same coarse lists.
 // MSAA: the depth is multisampled and every one of its SAMPLES samples bounds the tile.
 // FLOAT_DEPTH: the depth is single-sample R32Float (a compute resolve's; the same values
 // a depth texture holds), read as texture_2d<f32>. Not with MSAA. FLOAT_TRANSPARENT: the
-// same for the transparent depth (TransparentDepth rasterized in compute).
+// same for the transparent depth (rasterized in compute). TRANSPARENT_FAR: the farthest
+// transparent depth (R32Float) ends a transparent range where nearer than the opaque.
 // TRANSPARENT: lists for transparent surfaces (AMD's TiledLighting11 sample). A sample where a transparent
 // surface lies in front of the opaque one contributes the range from the nearest
 // transparent depth to the opaque depth (the far plane over the background): every
@@ -34,8 +38,9 @@
 // SUBGROUPS (the device has wgpu's SUBGROUP): the tile's depth range by subgroup
 // reductions, one barrier instead of two (naga 30 takes subgroup built-ins without an
 // `enable subgroups;`, and refuses that directive).
-// Defines: TILE (8 or 16), CAPACITY, VARIANT (see types.wgsl), COARSE, COARSE_CAPACITY,
-// SAMPLES, MSAA, FLOAT_DEPTH, TRANSPARENT, COMPACT, SCAN_BLOCK.
+// Defines: TILE (8, 16 or 32), CAPACITY, VARIANT (see types.wgsl), COARSE, COARSE_CAPACITY,
+// WIDE, WIDE_CAPACITY, WIDE_STAGE, WIDE_PASS, SAMPLES, MSAA, FLOAT_DEPTH, TRANSPARENT,
+// TRANSPARENT_FAR, COMPACT, SCAN_BLOCK.
 
 #include "common/types.wgsl"
 #include "common/view_space.wgsl"
@@ -781,8 +786,8 @@ fn coarse(
     }
 }
 
-// Candidate k of the coarse stage (k < count): entry k of its wide tile's list (WIDE, where
-// the list fits), else light k. Bits and list slots go by k, so lists stay ascending.
+// Candidate k of the coarse stage (k < count): entry k of its wide tile's list
+// (WIDE_STAGE, where the list fits), else light k. Bits and list slots go by k, so lists stay ascending.
 // Past `count` it returns k (a prefetch that is never used).
 fn coarse_candidate(k: u32, count: u32) -> u32 {
 #if WIDE_STAGE
