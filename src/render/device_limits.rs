@@ -6,6 +6,8 @@
 use super::RenderError;
 use crate::graph::plan::PhysicalDesc;
 use crate::graph::CompiledGraph;
+use crate::render::pipelines::PipelineKey;
+use crate::shader::{BindingKind, ReflectedBinding, ShaderError};
 
 /// Every planned texture and buffer against the device's size limits.
 pub fn check_plan(graph: &CompiledGraph, limits: &wgpu::Limits) -> Result<(), RenderError> {
@@ -186,4 +188,36 @@ pub fn check_light_loop(
         }),
         _ => Ok(()),
     }
+}
+
+/// Every binding of a pass's layout is visible to its stage, so a module's storage
+/// buffers all count against the device's per-stage limit: refused here with the
+/// shader, its options and the counts, not by wgpu's layout validation.
+pub(super) fn check_storage_buffers(
+    key: &PipelineKey,
+    bindings: &[ReflectedBinding],
+    device: &wgpu::Device,
+) -> Result<(), ShaderError> {
+    let storage = bindings
+        .iter()
+        .filter(|b| matches!(b.kind, BindingKind::Storage { .. }))
+        .count() as u32;
+    let limit = device.limits().max_storage_buffers_per_shader_stage;
+    if storage <= limit {
+        return Ok(());
+    }
+    // The switches among its defines (the sizes say little here).
+    let options: Vec<&str> = key
+        .defines
+        .iter()
+        .filter(|(_, value)| value.as_str() == "1")
+        .map(|(name, _)| name.as_str())
+        .collect();
+    Err(ShaderError::OverLimit {
+        file: key.shader.clone().into(),
+        message: format!(
+            "binds {storage} storage buffers in one stage ({}), over the {limit} this device allows",
+            options.join(", ")
+        ),
+    })
 }

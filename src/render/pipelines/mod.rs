@@ -6,10 +6,15 @@
 use crate::gpu::pipeline_cache::DiskPipelineCache;
 use crate::shader::{reflect_bindings, Composed, ReflectedBinding, ShaderError, ShaderLibrary};
 use std::cell::RefCell;
-use std::collections::{BTreeMap, HashMap};
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
+
+mod key;
+mod stats;
+pub use key::PipelineKey;
+pub use stats::{CacheCounters, PipelineBuild};
 
 thread_local! {
     /// The driver cache of the pipeline a build function on this thread is building.
@@ -30,89 +35,6 @@ fn with_driver_cache<R>(cache: Option<wgpu::PipelineCache>, f: impl FnOnce() -> 
     let result = f();
     DRIVER_CACHE.with(|c| c.replace(previous));
     result
-}
-
-/// What a pipeline is built from; equal keys share one pipeline in the [`PipelineCache`].
-#[derive(Clone, Debug, PartialEq, Eq, Hash)]
-pub struct PipelineKey {
-    /// The WGSL file, relative to the shader root.
-    pub shader: String,
-    /// `#define`s the shader was composed with (name to value).
-    pub defines: BTreeMap<String, String>,
-    /// Generated code's text (materials), part of the key so an edit rebuilds.
-    pub virtual_code: BTreeMap<String, String>,
-    /// Target formats, sample count, entry points...
-    pub state: String,
-}
-
-impl PipelineKey {
-    /// A short human description: shader, defines, and the material the generated code
-    /// comes from (its first line names it), e.g.
-    /// ``forward/forward.wgsl [LIGHT_LISTS=1] material `box` ``.
-    pub fn describe(&self) -> String {
-        let mut out = self.shader.clone();
-        if !self.defines.is_empty() {
-            let d: Vec<String> = self
-                .defines
-                .iter()
-                .map(|(k, v)| format!("{k}={v}"))
-                .collect();
-            out.push_str(&format!(" [{}]", d.join(" ")));
-        }
-        for (name, code) in &self.virtual_code {
-            let first = code.lines().next().unwrap_or("");
-            match first.split('`').nth(1) {
-                Some(material) => out.push_str(&format!(" {name} `{material}`")),
-                None => out.push_str(&format!(" <{name}>")),
-            }
-        }
-        if !self.state.is_empty() {
-            out.push_str(&format!(" ({})", self.state));
-        }
-        out
-    }
-
-    /// The shader and the material its generated code comes from, without defines and
-    /// state: ``forward/forward.wgsl `car_paint` ``.
-    /// Without a material, the state (a compute pipeline's entry point) tells a shader's
-    /// pipelines apart.
-    pub fn short(&self) -> String {
-        let mut out = self.shader.clone();
-        let mut material = false;
-        for code in self.virtual_code.values() {
-            if let Some(name) = code.lines().next().unwrap_or("").split('`').nth(1) {
-                out.push_str(&format!(" `{name}`"));
-                material = true;
-            }
-        }
-        if !material && !self.state.is_empty() {
-            out.push_str(&format!(" ({})", self.state));
-        }
-        out
-    }
-}
-
-/// One pipeline built: which pass asked for it and where its time went.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PipelineBuild {
-    /// The pass being prepared when it was asked for (see [`PipelineCache::set_pass`]).
-    pub pass: String,
-    /// [`PipelineKey::short`]: shader and material.
-    pub pipeline: String,
-    /// Composing the shader source and validating it with naga.
-    pub compose: Duration,
-    /// `create_shader_module` (naga's WGSL front end and SPIR-V back end in wgpu).
-    pub module: Duration,
-    /// The pass's build function: layouts and `create_render/compute_pipeline` (the
-    /// driver's compile, unless it defers it to first use).
-    pub create: Duration,
-}
-
-impl PipelineBuild {
-    /// `pass: shader `material``, the name the benchmark shows.
-    pub fn name(&self) -> String {
-        format!("{}: {}", self.pass, self.pipeline)
-    }
 }
 
 /// A built render or compute pipeline, shared between the passes that use it.
@@ -143,44 +65,6 @@ impl Pipeline {
                 cache: driver_cache().as_ref(),
             },
         )))
-    }
-}
-
-/// Running totals of a [`PipelineCache`]; subtract two snapshots to see what happened
-/// in between.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct CacheCounters {
-    /// Requests answered from the cache.
-    pub hits: usize,
-    /// Requests that were not in the cache (built, or failed to compose or validate).
-    pub misses: usize,
-    /// Pipelines built.
-    pub builds: usize,
-    /// Time spent composing shader sources and validating them with naga.
-    pub compose: Duration,
-    /// Time spent creating shader modules and pipelines (`module` + `create`).
-    pub build: Duration,
-    /// Of `build`: creating shader modules.
-    pub module: Duration,
-    /// Of `build`: the build functions (`create_render/compute_pipeline`).
-    pub create: Duration,
-    /// Of `builds`: those built ahead on other threads ([`PipelineCache::fork`]).
-    pub prebuilt: usize,
-}
-
-impl std::ops::Sub for CacheCounters {
-    type Output = CacheCounters;
-    fn sub(self, earlier: CacheCounters) -> CacheCounters {
-        CacheCounters {
-            hits: self.hits - earlier.hits,
-            misses: self.misses - earlier.misses,
-            builds: self.builds - earlier.builds,
-            compose: self.compose.saturating_sub(earlier.compose),
-            build: self.build.saturating_sub(earlier.build),
-            module: self.module.saturating_sub(earlier.module),
-            create: self.create.saturating_sub(earlier.create),
-            prebuilt: self.prebuilt - earlier.prebuilt,
-        }
     }
 }
 
@@ -470,7 +354,7 @@ impl PipelineCache {
         self.build_wall += compose;
         let (composed, naga_module) = composed?;
         let bindings: Arc<[ReflectedBinding]> = reflect_bindings(&naga_module).into();
-        check_storage_buffers(&key, &bindings, device)?;
+        super::device_limits::check_storage_buffers(&key, &bindings, device)?;
         if only.is_some_and(|n| nth_miss < n) {
             // A miss before the one this fork builds: a stand-in lets the pass go on.
             return match self.stand_in(&key) {
@@ -631,36 +515,4 @@ impl PipelineCache {
         self.stale.extend(dropped);
         n
     }
-}
-
-/// Every binding of a pass's layout is visible to its stage, so a module's storage
-/// buffers all count against the device's per-stage limit: refused here with the
-/// shader, its options and the counts, not by wgpu's layout validation.
-fn check_storage_buffers(
-    key: &PipelineKey,
-    bindings: &[ReflectedBinding],
-    device: &wgpu::Device,
-) -> Result<(), ShaderError> {
-    let storage = bindings
-        .iter()
-        .filter(|b| matches!(b.kind, crate::shader::BindingKind::Storage { .. }))
-        .count() as u32;
-    let limit = device.limits().max_storage_buffers_per_shader_stage;
-    if storage <= limit {
-        return Ok(());
-    }
-    // The switches among its defines (the sizes say little here).
-    let options: Vec<&str> = key
-        .defines
-        .iter()
-        .filter(|(_, value)| value.as_str() == "1")
-        .map(|(name, _)| name.as_str())
-        .collect();
-    Err(ShaderError::OverLimit {
-        file: key.shader.clone().into(),
-        message: format!(
-            "binds {storage} storage buffers in one stage ({}), over the {limit} this device allows",
-            options.join(", ")
-        ),
-    })
 }
