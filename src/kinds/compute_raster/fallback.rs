@@ -86,9 +86,7 @@ impl HardwareRaster {
         // A depth format is drawn into directly; an R32Float depth is drawn into an
         // internal Depth32Float, then copied.
         let (drawn, copy) = if cx.float_depth(depth) {
-            let size = (cx.size.width, cx.size.height);
-            let target = cx.view(&sp.name, depth)?;
-            let (drawn, copy) = depth_copy(cx, sp, size, target)?;
+            let (drawn, copy) = depth_copy(cx, sp, depth)?;
             (drawn, Some(copy))
         } else {
             (cx.view(&sp.name, depth)?, None)
@@ -101,20 +99,14 @@ impl HardwareRaster {
         };
         let glass = match sp.roles.slot(slot::TRANSPARENT_DEPTH) {
             Some(glass) => {
-                let size = (cx.size.width, cx.size.height);
-                let target = cx.view(&sp.name, glass)?;
-                let (drawn, copy) = depth_copy(cx, sp, size, target)?;
+                let (drawn, copy) = depth_copy(cx, sp, glass)?;
                 let draws = prepare_meshes_into(cx, sp, MeshSet::Transparent, drawn, true)?;
                 Some((draws, copy))
             }
             None => None,
         };
         let far = match sp.roles.slot(slot::TRANSPARENT_FAR) {
-            Some(far) => {
-                let size = (cx.size.width, cx.size.height);
-                let target = cx.view(&sp.name, far)?;
-                Some(depth_copy(cx, sp, size, target)?)
-            }
+            Some(far) => Some(depth_copy(cx, sp, far)?),
             None => None,
         };
         Ok(Self {
@@ -128,15 +120,16 @@ impl HardwareRaster {
     }
 }
 
-/// The internal Depth32Float (`width` × `height`) that draws write for an R32Float
-/// `depth` of that size, and the dispatch copying it there (bit-exact: a depth load gives
-/// the stored f32). Also the reflective shadow maps' fallback for alpha-masked casters.
+/// The internal Depth32Float of the frame's size that draws write for the pass's R32Float
+/// texture `resource`, and the dispatch copying it there (bit-exact: a depth load gives
+/// the stored f32).
 pub(super) fn depth_copy(
     cx: &mut PrepareCtx,
     sp: &ScheduledPass,
-    (width, height): (u32, u32),
-    depth: wgpu::TextureView,
+    resource: &str,
 ) -> Result<(wgpu::TextureView, DepthCopy), RenderError> {
+    let (width, height) = (cx.size.width, cx.size.height);
+    let depth = cx.view(&sp.name, resource)?;
     let device = cx.device();
     let drawn = device
         .create_texture(&wgpu::TextureDescriptor {

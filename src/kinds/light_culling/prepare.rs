@@ -214,12 +214,13 @@ pub(super) fn prepare(
         offered.buffer("list_block_sums", b);
         offered.buffer("compact", &phase(0));
     }
-    let key = |state: &str| PipelineKey {
+    let key_with = |d: &[(&str, String)], state: &str| PipelineKey {
         shader: "cull/light_culling.wgsl".into(),
-        defines: defines(&d),
+        defines: defines(d),
         virtual_code: BTreeMap::new(),
         state: state.to_string(),
     };
+    let key = |state: &str| key_with(&d, state);
     let (pipeline, bind) = cx.compute_pipeline(&sp.name, key(""), "main", &offered)?;
     let compact = if let Some(block_sums) = block_sums {
         // The same pipeline (a cache hit) bound with the fill phase.
@@ -255,12 +256,7 @@ pub(super) fn prepare(
     let wide = if wide > 1 {
         let mut wide_defines = d.clone();
         wide_defines.push(("WIDE_PASS", "1".into()));
-        let key = PipelineKey {
-            shader: "cull/light_culling.wgsl".into(),
-            defines: defines(&wide_defines),
-            virtual_code: BTreeMap::new(),
-            state: "wide".to_string(),
-        };
+        let key = key_with(&wide_defines, "wide");
         let (pipeline, _) = cx.compute_pipeline(&sp.name, key, "coarse", &offered)?;
         Some((pipeline, wide_groups))
     } else {
@@ -301,7 +297,7 @@ impl PreparedPass for LightCullingPass {
         if let Some(c) = &self.compact {
             encoder.clear_buffer(&c.block_sums, 0, None);
         }
-        // Bounds, coarse, count, then (compact) scan, fill. Each dispatch sees the
+        // Bounds, wide, coarse, count, then (compact) scan, fill. Each dispatch sees the
         // previous one's writes: wgpu puts a barrier between dispatches that use a buffer
         // read-write. The fill's workgroups of lists that fit their scratch slot return
         // at once. (An indirect fill of only the longer lists was measured on the H200:

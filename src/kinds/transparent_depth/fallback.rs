@@ -29,9 +29,7 @@ impl DrawnAndCopied {
         missing: wgpu::Features,
     ) -> Result<Self, RenderError> {
         let report = FallbackReport::new(&sp.name, &cx.renderer.ctx, missing, INSTEAD);
-        let size = (cx.size.width, cx.size.height);
-        let target = cx.view(&sp.name, sp.required(slot::DEPTH))?;
-        let (drawn, copy) = depth_copy(cx, sp, size, target)?;
+        let (drawn, copy) = depth_copy(cx, sp, sp.required(slot::DEPTH))?;
         Ok(Self {
             name: sp.name.clone(),
             draws: prepare_meshes_into(cx, sp, MeshSet::Transparent, drawn, true)?,
