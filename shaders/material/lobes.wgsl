@@ -309,6 +309,15 @@ fn lg_through(
     coupling: u32,
     d: LgDirs,
 ) -> vec3<f32> {
+    let path = 1.0 / lg_cos_inside(d.nl, ior) + 1.0 / lg_cos_inside(d.nv, ior);
+    return lg_through_clear(ior, weight, transmission, coupling, d) * exp(-sigma_d * path);
+}
+
+// lg_through of a layer that absorbs nothing (σ d = 0): its Beer-Lambert factor is
+// exp(−0 · path) = 1 for every path (path is finite: each cosine is at least LG_COS_MIN),
+// so the refracted cosines, their reciprocals and the three exponentials are left out.
+// Every glTF material's specular layer is one: this is most of the lights' shading.
+fn lg_through_clear(ior: f32, weight: f32, transmission: f32, coupling: u32, d: LgDirs) -> f32 {
     var pass_ = transmission;
     if (ior > 1.0) {
         let f0 = lg_ior_f0(ior);
@@ -318,8 +327,7 @@ fn lg_through(
             pass_ *= lg_one_minus_wf(f0, weight, d.nl) * lg_one_minus_wf(f0, weight, d.nv);
         }
     }
-    let path = 1.0 / lg_cos_inside(d.nl, ior) + 1.0 / lg_cos_inside(d.nv, ior);
-    return pass_ * exp(-sigma_d * path);
+    return pass_;
 }
 
 // Tangent frame: the tangent made orthogonal to n, or a branchless basis from n alone (Duff

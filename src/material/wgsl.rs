@@ -437,17 +437,29 @@ pub(crate) fn generate_with_constants(m: &Material, opts: &WgslOptions) -> (Stri
         } else {
             let a = layer.absorption;
             let th = layer.thickness;
-            let _ = writeln!(
-                o,
-                "    acc = s{i} + lg_through({}, {}, {}, vec3<f32>({}, {}, {}), {}u, d) * acc;",
+            let sigma_d = [a.0 * th, a.1 * th, a.2 * th];
+            let common = format!(
+                "{}, {}, {}",
                 g.eval_num(layer.ior.unwrap_or(1.0)),
                 g.eval_num(layer.weight),
                 g.eval_num(layer.transmission),
-                g.eval_num(a.0 * th),
-                g.eval_num(a.1 * th),
-                g.eval_num(a.2 * th),
-                layer.coupling as u32
             );
+            let coupling = layer.coupling as u32;
+            if sigma_d.iter().all(|&x| x == 0.0) {
+                // No absorption: its factor is 1 for every path (lobes.wgsl).
+                let _ = writeln!(
+                    o,
+                    "    acc = s{i} + lg_through_clear({common}, {coupling}u, d) * acc;"
+                );
+            } else {
+                let _ = writeln!(
+                    o,
+                    "    acc = s{i} + lg_through({common}, vec3<f32>({}, {}, {}), {coupling}u, d) * acc;",
+                    g.eval_num(sigma_d[0]),
+                    g.eval_num(sigma_d[1]),
+                    g.eval_num(sigma_d[2]),
+                );
+            }
         }
     }
     o.push_str("    return acc * min(cos_l, 1.0);\n}\n\n");
