@@ -631,6 +631,40 @@ fn internal_buffers_are_checked_against_the_device() {
     assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
 }
 
+/// The default graph's ray-cast shadow jobs (16 a pixel: 315 MB at 1920×1080) on a device
+/// whose storage buffers are smaller (lavapipe's 128 MiB): refused naming the graph line,
+/// the pass and the resource, with the jobs_per_pixel that fits (checked where the
+/// device's limit is under the buffer).
+#[test]
+fn the_job_buffer_error_says_what_fits() {
+    const JOB_BYTES: u64 = 315_187_232;
+    let limit = lightgraph::render::Renderer::headless()
+        .unwrap()
+        .ctx
+        .device
+        .limits()
+        .max_storage_buffer_binding_size;
+    let tmp = tempfile::tempdir().unwrap();
+    let mut args = os(
+        &["render", "--width", "1920", "--height", "1080", "--scene"],
+        &root().join("scenes/chairs.ron"),
+    );
+    args.push(OsString::from("--out"));
+    args.push(tmp.path().join("x.png").into());
+    if JOB_BYTES <= limit {
+        return;
+    }
+    let o = lightgraph(&args);
+    let want = format!(
+        "default.ron:107:22: pass 'shadow_ray_jobs': resource 'shadow_jobs': buffer of {JOB_BYTES} bytes is over the device's limit of {limit} bytes for a storage buffer: ShadowRayJobs' jobs_per_pixel "
+    );
+    assert!(
+        o.code == Some(1) && o.output.contains(&want) && o.output.contains("or less fits"),
+        "want {want:?}, got:\n{}",
+        o.output
+    );
+}
+
 /// The light-loop check reads the context's driver limits, not the adapter's name: with a
 /// limit of 8 set on this adapter, whatever it is, brute force over 9 lights is refused
 /// naming the pass, and over 8 it prepares (with the light statistics, whose exact count

@@ -28,7 +28,11 @@ pub fn check_plan(graph: &CompiledGraph, limits: &wgpu::Limits) -> Result<(), Re
                     .max_buffer_size
                     .min(limits.max_storage_buffer_binding_size);
                 (bytes > max).then(|| {
-                    format!("buffer of {bytes} bytes is over the device's limit of {max} bytes for a storage buffer")
+                    let hint = r.layout.and_then(|l| l.fit_hint(max));
+                    format!(
+                        "buffer of {bytes} bytes is over the device's limit of {max} bytes for a storage buffer{}",
+                        hint.map_or_else(String::new, |h| format!(": {h}"))
+                    )
                 })
             }
         };

@@ -141,4 +141,20 @@ impl BufferLayout {
             BufferLayout::LightSamples(l) => l.bytes(),
         }
     }
+    /// What would bring the buffer under `max` bytes, where a pass parameter sizes it:
+    /// said with the error that refuses it.
+    pub fn fit_hint(&self, max: u64) -> Option<String> {
+        match *self {
+            BufferLayout::ShadowJobs { pixels, .. } => Some(
+                match shadow_ray_jobs::jobs_per_pixel_within(pixels, max) {
+                    Some(x) => format!("ShadowRayJobs' jobs_per_pixel {x} or less fits (jobs past the buffer are lit unshadowed and counted)"),
+                    None => format!(
+                        "the pixels' surfaces alone take {} bytes: render a smaller frame",
+                        shadow_ray_jobs::job_buffer_bytes(0, pixels)
+                    ),
+                },
+            ),
+            _ => None,
+        }
+    }
 }

@@ -56,8 +56,30 @@ pub(crate) const MASK_WORDS: u64 = 4;
 impl ShadowRayJobs {
     /// Jobs the buffer holds at `width`×`height`.
     pub fn capacity(&self, width: u32, height: u32) -> u64 {
-        ((width as f64 * height as f64 * self.jobs_per_pixel as f64).ceil() as u64).max(1)
+        capacity_for(width as u64 * height as u64, self.jobs_per_pixel)
     }
+}
+
+/// Jobs a buffer of `jobs_per_pixel` holds for `pixels` pixels.
+fn capacity_for(pixels: u64, jobs_per_pixel: f32) -> u64 {
+    ((pixels as f64 * jobs_per_pixel as f64).ceil() as u64).max(1)
+}
+
+/// The largest `jobs_per_pixel`, in hundredths, whose job buffer for `pixels` pixels
+/// takes at most `max` bytes; `None` where even the smallest does not fit.
+pub(crate) fn jobs_per_pixel_within(pixels: u64, max: u64) -> Option<f32> {
+    let fixed = job_buffer_bytes(0, pixels);
+    let jobs = max.saturating_sub(fixed) / (4 * JOB_WORDS);
+    let mut hundredths = (jobs as f64 / pixels.max(1) as f64 * 100.0).floor() as u64;
+    // At most a step down: f32 rounding of the value said can add a job.
+    while hundredths > 0 {
+        let x = hundredths as f32 / 100.0;
+        if job_buffer_bytes(capacity_for(pixels, x), pixels) <= max {
+            return Some(x);
+        }
+        hundredths -= 1;
+    }
+    None
 }
 
 /// Bytes of a job buffer holding `capacity` jobs and the surfaces of `pixels` pixels.
@@ -324,7 +346,37 @@ impl KindRules for ShadowRayJobs {
 
 #[cfg(test)]
 mod tests {
+    use super::{job_buffer_bytes, jobs_per_pixel_within, ShadowRayJobs};
     use crate::graph::kinds::test_support::errors;
+
+    /// The jobs_per_pixel said to fit does, and a hundredth more does not: lavapipe's
+    /// 128 MiB at 1920×1080 (the default graph's 16 take 315 MB), a bound met exactly,
+    /// frames too small for a hundredth to add a job, and one whose surfaces alone do not
+    /// fit.
+    #[test]
+    fn the_jobs_per_pixel_said_to_fit_fits() {
+        let bytes = |w: u32, h: u32, x: f32| {
+            let jobs = ShadowRayJobs { jobs_per_pixel: x };
+            job_buffer_bytes(jobs.capacity(w, h), w as u64 * h as u64)
+        };
+        assert_eq!(bytes(1920, 1080, 16.0), 315_187_232);
+        let lavapipe = 128 << 20;
+        assert_eq!(jobs_per_pixel_within(1920 * 1080, lavapipe), Some(5.09));
+        let exact = bytes(640, 360, 2.5);
+        for (w, h, max) in [
+            (1920, 1080, lavapipe),
+            (640, 360, exact),
+            (640, 360, exact - 1),
+            (7, 3, 1000),
+            (1, 1, 100),
+        ] {
+            let x = jobs_per_pixel_within(w as u64 * h as u64, max).unwrap();
+            assert!(bytes(w, h, x) <= max, "{w}x{h} {max}: {x}");
+            assert!(bytes(w, h, x + 0.01) > max, "{w}x{h} {max}: {x} is not the largest");
+        }
+        assert_eq!(jobs_per_pixel_within(640 * 360, exact), Some(2.5));
+        assert_eq!(jobs_per_pixel_within(1920 * 1080, 40 << 20), None);
+    }
 
     #[test]
     fn checks_capacity_and_inputs() {
