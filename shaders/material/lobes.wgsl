@@ -316,7 +316,7 @@ fn lg_through(
 // lg_through of a layer that absorbs nothing (σ d = 0): its Beer-Lambert factor is
 // exp(−0 · path) = 1 for every path (path is finite: each cosine is at least LG_COS_MIN),
 // so the refracted cosines, their reciprocals and the three exponentials are left out.
-// Every glTF material's specular layer is one: this is most of the lights' shading.
+// Every glTF material's specular layer is one.
 fn lg_through_clear(ior: f32, weight: f32, transmission: f32, coupling: u32, d: LgDirs) -> f32 {
     var pass_ = transmission;
     if (ior > 1.0) {

@@ -4,6 +4,7 @@
 pub mod bench;
 pub mod live;
 pub mod render;
+mod render_report;
 pub mod vpl_error;
 pub mod vpl_variants;
 
