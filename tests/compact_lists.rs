@@ -692,8 +692,16 @@ fn the_compact_lists_sweep_runs_at_a_tiny_size() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// A copy of the culling shader with `from` replaced by `to` (which must occur once),
-/// used through the renderer's shader library until the guard is dropped.
+/// The culling shader and the files it includes for its stages.
+const CULLING_FILES: [&str; 4] = [
+    "cull/light_culling.wgsl",
+    "cull/tile_depth.wgsl",
+    "cull/coarse_stage.wgsl",
+    "cull/list_scan.wgsl",
+];
+
+/// A copy of the culling shader's files with `from` replaced by `to` (which must occur
+/// once in them), used through the renderer's shader library until the guard is dropped.
 struct Mutated<'a> {
     r: &'a mut Renderer,
     _dir: tempfile::TempDir,
@@ -702,9 +710,15 @@ struct Mutated<'a> {
 
 impl<'a> Mutated<'a> {
     fn new(r: &'a mut Renderer, from: &str, to: &str) -> Self {
-        let file = "cull/light_culling.wgsl";
-        let text = ShaderLibrary::builtin().read_source(file).unwrap();
-        assert_eq!(text.matches(from).count(), 1, "mutation site: {from}");
+        let library = ShaderLibrary::builtin();
+        let texts = CULLING_FILES.map(|f| library.read_source(f).unwrap());
+        let sites: usize = texts.iter().map(|t| t.matches(from).count()).sum();
+        assert_eq!(sites, 1, "mutation site: {from}");
+        let (file, text) = CULLING_FILES
+            .iter()
+            .zip(&texts)
+            .find(|(_, t)| t.contains(from))
+            .unwrap();
         let dir = tempfile::tempdir().unwrap();
         std::fs::create_dir_all(dir.path().join("cull")).unwrap();
         std::fs::write(dir.path().join(file), text.replace(from, to)).unwrap();
