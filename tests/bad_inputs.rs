@@ -586,6 +586,16 @@ fn light_loops_are_checked_against_the_adapter() {
     assert!(failures.is_empty(), "\n{}", failures.join("\n\n"));
 }
 
+/// The largest storage buffer binding this machine's default device allows.
+fn storage_binding_limit() -> u64 {
+    lightgraph::render::Renderer::headless()
+        .unwrap()
+        .ctx
+        .device
+        .limits()
+        .max_storage_buffer_binding_size
+}
+
 /// A pass's own buffers (not planned by the graph) are checked against the device before
 /// they are created: at 4100×4100 the culling's coarse lists of Forward+ and tiled deferred
 /// are 138,461,700 bytes, over a 128 MiB storage binding (wgpu's raw
@@ -594,12 +604,7 @@ fn light_loops_are_checked_against_the_adapter() {
 #[test]
 fn internal_buffers_are_checked_against_the_device() {
     const COARSE_BYTES: u64 = 138_461_700;
-    let limit = lightgraph::render::Renderer::headless()
-        .unwrap()
-        .ctx
-        .device
-        .limits()
-        .max_storage_buffer_binding_size;
+    let limit = storage_binding_limit();
     let tmp = tempfile::tempdir().unwrap();
     let mut failures = Vec::new();
     for (graph, at) in [
@@ -638,12 +643,10 @@ fn internal_buffers_are_checked_against_the_device() {
 #[test]
 fn the_job_buffer_error_says_what_fits() {
     const JOB_BYTES: u64 = 315_187_232;
-    let limit = lightgraph::render::Renderer::headless()
-        .unwrap()
-        .ctx
-        .device
-        .limits()
-        .max_storage_buffer_binding_size;
+    let limit = storage_binding_limit();
+    if JOB_BYTES <= limit {
+        return;
+    }
     let tmp = tempfile::tempdir().unwrap();
     let mut args = os(
         &["render", "--width", "1920", "--height", "1080", "--scene"],
@@ -651,9 +654,6 @@ fn the_job_buffer_error_says_what_fits() {
     );
     args.push(OsString::from("--out"));
     args.push(tmp.path().join("x.png").into());
-    if JOB_BYTES <= limit {
-        return;
-    }
     let o = lightgraph(&args);
     let want = format!(
         "default.ron:107:22: pass 'shadow_ray_jobs': resource 'shadow_jobs': buffer of {JOB_BYTES} bytes is over the device's limit of {limit} bytes for a storage buffer: ShadowRayJobs' jobs_per_pixel "
